@@ -1,0 +1,66 @@
+"""Command-line interface: ``python -m app {derive,simulate,table1,bench,serve,bldc} …``.
+
+Each sub-command lives in its own module exposing ``add_arguments(parser)`` and
+``run(args) -> int``. Bad input exits with code 2 and one clear line on stderr, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: sub-command → (module, help)
+COMMANDS: dict[str, tuple[str, str]] = {
+    "derive": ("app.cli_derive", "derive α_max, observer gains, profile, comparator gains, energies"),
+    "simulate": ("app.cli_simulate", "simulate the FDSMC and the conventional controller"),
+    "table1": ("app.cli_table1", "Table-1 sweep of the friction saving over manoeuvre times"),
+    "bench": ("app.bench", "print speed figures of the simulation engine"),
+    "serve": ("app.serve", "start the commissioning web UI"),
+    "bldc": ("app.cli_bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, exit 2
+        sys.stderr.write(f"error: {message}\n")
+        raise SystemExit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every available sub-command."""
+    parser = _Parser(prog="python -m app", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for name, (module, help_text) in COMMANDS.items():
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name != module:
+                raise
+            continue
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        mod.add_arguments(p)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None) -> None:
+    """The PRESET positional and repeatable ``--set section.field=value`` options."""
+    if default is None:
+        p.add_argument("preset", metavar="PRESET", help="preset name (presets/NAME.yaml) or YAML path")
+    else:
+        p.add_argument("preset", metavar="PRESET", nargs="?", default=default, help="preset name or YAML path")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.FIELD=VALUE",
+                   help="override a preset value, e.g. --set manoeuvre.T_m=1.4 or motor.L_d_mH=5.4")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; returns the process exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args._run(args) or 0)
+    except ValueError as exc:  # ParameterError, PresetError: bad input
+        sys.stderr.write(f"error: {exc}\n")
+        return 2
+    except KeyboardInterrupt:
+        return 130

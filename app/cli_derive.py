@@ -1,0 +1,32 @@
+"""``python -m app derive PRESET [--set …] [--json]``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from app.cli import add_preset_arguments
+from app.derived_view import derived_json, derived_rows, format_table
+from app.presets import load_preset
+from control.derivations import derive
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``derive``."""
+    add_preset_arguments(p)
+    p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the derived values (table or JSON) and warnings."""
+    params = load_preset(args.preset, args.overrides)
+    d = derive(params)
+    if args.json:
+        print(json.dumps(derived_json(d), indent=2, ensure_ascii=False))
+        return 0
+    print(f"Preset: {params.name}  ({params.source})\n")
+    print(format_table(derived_rows(d)))
+    print("\nWarnings:" if d.warnings else "\nNo warnings.")
+    for w in d.warnings:
+        print(f"  ! {w}")
+    return 0

@@ -1,0 +1,271 @@
+"""Preset loader and writer: the only module that reads or writes YAML.
+
+A preset is a YAML mapping with ``schema: 1``, ``name``, ``source``, an optional ``mode``
+(``position``, the default, or another registered mode) and one mapping per section of the
+mode's parameter dataclass. Loading is safe (``yaml.safe_load``, no aliases, size-limited),
+rejects unknown keys with a "did you mean" hint, missing keys and wrong types, and converts
+unit-suffixed keys (``L_d_mH``, ``omega_b_rpm``, ``Ke_Vrms_krpm`` …) through :mod:`app.units`.
+Saving writes SI field names only, so load → save → load gives equal objects.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import types
+import typing
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from app import units
+from control.params import DriveParams, ParameterError
+
+SCHEMA = 1
+PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
+MAX_BYTES = 256 * 1024
+DEFAULT_PRESET = "paper_12kw_pmsm"
+_TOP_KEYS = ("schema", "name", "source", "mode")
+
+#: Parameter dataclass per preset mode. Other modes register themselves here.
+MODES: dict[str, type] = {"position": DriveParams}
+
+
+class PresetError(ValueError):
+    """A preset file or override that cannot be loaded; the message says what and where."""
+
+
+def _hint(key: str, allowed: list[str]) -> str:
+    close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.5)
+    return f" — did you mean '{close[0]}'?" if close else f" (allowed: {', '.join(allowed)})"
+
+
+def _describe(tp: Any) -> str:
+    if tp is float:
+        return "a number"
+    if tp is int:
+        return "an integer"
+    if tp is str:
+        return "a text"
+    if isinstance(tp, types.UnionType):
+        return " or ".join(_describe(a) for a in typing.get_args(tp))
+    return "a list of mappings"
+
+
+def _coerce(name: str, value: Any, tp: Any) -> Any:
+    """Check ``value`` against the annotation ``tp``; parse nested dataclasses."""
+    number = isinstance(value, int | float) and not isinstance(value, bool)
+    if tp is float and number:
+        return float(value)
+    if tp is int and number:
+        return value
+    if tp is str and isinstance(value, str):
+        return value
+    if isinstance(tp, types.UnionType):
+        for arg in typing.get_args(tp):
+            try:
+                return _coerce(name, value, arg)
+            except PresetError:
+                continue
+    if typing.get_origin(tp) is tuple and isinstance(value, list):
+        item = typing.get_args(tp)[0]
+        return tuple(_parse_section(item, v, f"{name}[{i}]") for i, v in enumerate(value))
+    raise PresetError(f"{name} = {value!r} has the wrong type: expected {_describe(tp)}")
+
+
+def _parse_section(cls: type, raw: Any, section: str) -> Any:
+    """Build dataclass ``cls`` from mapping ``raw``; ``section`` names it in messages."""
+    if not isinstance(raw, dict):
+        raise PresetError(f"{section} must be a mapping of field: value, got {raw!r}")
+    hints = typing.get_type_hints(cls)
+    names = [f.name for f in dataclasses.fields(cls)]
+    aliases = units.ALIASES.get(section, {})
+    extra = [units.KE_KEY] if section == "motor" else []
+    allowed = names + list(aliases) + extra
+    values: dict[str, Any] = {}
+    for key, value in raw.items():
+        key = str(key)
+        if key in names:
+            target = key
+            values[key] = _coerce(f"{section}.{key}", value, hints[key])
+        elif key in aliases:
+            target = aliases[key].field
+            number = _coerce(f"{section}.{key}", value, float)
+            values[target] = aliases[key].convert(number)
+        elif key in extra:
+            target = "psi_pm"
+            ke = _coerce(f"{section}.{key}", value, float)
+            p = raw.get("p")
+            if not isinstance(p, int) or isinstance(p, bool) or p < 1:
+                raise PresetError(f"{section}.{key} needs a valid {section}.p (pole pairs) beside it")
+            values[target] = units.ke_vrms_krpm_to_psi_pm(ke, p)
+        else:
+            raise PresetError(f"unknown key {section}.{key}{_hint(key, allowed)}")
+        if sum(1 for k in raw if _field_of(str(k), aliases, extra) == target) > 1:
+            raise PresetError(f"{section}.{target} is given more than once (SI and unit-suffixed forms)")
+    missing = [
+        f.name for f in dataclasses.fields(cls)
+        if f.name not in values and f.default is dataclasses.MISSING
+        and f.default_factory is dataclasses.MISSING
+    ]
+    if missing:
+        raise PresetError(f"missing key(s) in {section}: {', '.join(missing)}")
+    return cls(**values)
+
+
+def _field_of(key: str, aliases: dict[str, units.Alias], extra: list[str]) -> str:
+    if key in aliases:
+        return aliases[key].field
+    return "psi_pm" if key in extra else key
+
+
+def parse_preset(raw: Any) -> Any:
+    """Validate a preset mapping and return its parameter object (e.g. :class:`DriveParams`).
+
+    Raises
+    ------
+    PresetError, ParameterError
+        With a message naming the field, the value and the allowed range or type.
+    """
+    if not isinstance(raw, dict):
+        raise PresetError("a preset must be a YAML mapping with schema, name, source and sections")
+    if raw.get("schema") != SCHEMA:
+        raise PresetError(f"schema = {raw.get('schema')!r} is not supported: allowed schema: {SCHEMA}")
+    mode = raw.get("mode", "position")
+    if mode not in MODES:
+        raise PresetError(f"mode = {mode!r} is not known{_hint(str(mode), list(MODES))}")
+    cls = MODES[mode]
+    sections = [f.name for f in dataclasses.fields(cls) if f.name not in ("name", "source")]
+    allowed = list(_TOP_KEYS) + list(sections)
+    for key in raw:
+        if key not in allowed:
+            raise PresetError(f"unknown top-level key {key!r}{_hint(str(key), allowed)}")
+    hints = typing.get_type_hints(cls)
+    kwargs: dict[str, Any] = {}
+    for name in sections:
+        if name not in raw:
+            raise PresetError(f"missing section {name!r} (allowed sections: {', '.join(sections)})")
+        kwargs[name] = _parse_section(hints[name], raw[name], name)
+    for key in ("name", "source"):
+        if key not in raw:
+            raise PresetError(f"missing key {key!r}: every preset names itself and its source")
+        kwargs[key] = _coerce(key, raw[key], str)
+    return cls(**kwargs)
+
+
+def _check_no_aliases(text: str) -> None:
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, yaml.AliasEvent):
+            raise PresetError("YAML anchors/aliases (*name) are not allowed in presets")
+
+
+def loads_raw(text: str, origin: str = "<text>") -> Any:
+    """Parse YAML text safely (size-limited, no aliases) into plain Python data."""
+    if len(text.encode("utf-8", "replace")) > MAX_BYTES:
+        raise PresetError(f"{origin} is too large: allowed ≤ {MAX_BYTES // 1024} KiB")
+    try:
+        _check_no_aliases(text)
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise PresetError(f"{origin} is not valid YAML{where}: {problem}") from None
+    except RecursionError:
+        raise PresetError(f"{origin} is nested too deeply") from None
+
+
+def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
+    """Apply ``section.field=value`` overrides (values parsed as YAML scalars) to a raw preset."""
+    if not isinstance(raw, dict):
+        raise PresetError("overrides need a preset mapping to apply to")
+    for item in overrides:
+        key, sep, text = item.partition("=")
+        section, dot, name = key.strip().partition(".")
+        if not sep or not dot or not name:
+            raise PresetError(f"--set {item!r} is malformed: allowed form section.field=value")
+        if not isinstance(raw.get(section), dict):
+            raise PresetError(f"--set {item!r}: unknown section {section!r}{_hint(section, [k for k, v in raw.items() if isinstance(v, dict)])}")
+        value = loads_raw(text, f"--set {key}") if text.strip() else None
+        if value is None:
+            raise PresetError(f"--set {item!r} has no value")
+        raw[section][name] = value
+    return raw
+
+
+def resolve(name_or_path: str) -> Path:
+    """Preset name (file stem in ``presets/``) or path → path; a clear error if absent."""
+    path = Path(name_or_path)
+    if path.suffix in (".yaml", ".yml") and path.exists():
+        return path
+    candidate = PRESET_DIR / f"{name_or_path}.yaml"
+    if candidate.exists():
+        return candidate
+    raise PresetError(f"preset {name_or_path!r} not found{_hint(str(name_or_path), list_presets())}")
+
+
+def list_presets() -> list[str]:
+    """Names of the shipped presets."""
+    return sorted(p.stem for p in PRESET_DIR.glob("*.yaml"))
+
+
+def load_raw(name_or_path: str) -> Any:
+    """Read a preset file (by name or path) into raw data, without validating sections."""
+    path = resolve(name_or_path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise PresetError(f"cannot read preset {str(path)!r}: {exc}") from None
+    return loads_raw(text, path.name)
+
+
+def load_preset(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()) -> Any:
+    """Load, override and validate a preset; returns its parameter object."""
+    return parse_preset(apply_overrides(load_raw(name_or_path), overrides))
+
+
+def loads_preset(text: str, origin: str = "<upload>") -> Any:
+    """Validate preset YAML text (e.g. an upload) and return its parameter object."""
+    return parse_preset(loads_raw(text, origin))
+
+
+def _plain(value: Any) -> Any:
+    if dataclasses.is_dataclass(value):
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, tuple | list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def to_raw(params: Any) -> dict[str, Any]:
+    """Parameter object → preset mapping (schema, name, source, mode, sections)."""
+    mode = next(m for m, cls in MODES.items() if isinstance(params, cls))
+    body = _plain(params)
+    raw: dict[str, Any] = {"schema": SCHEMA, "name": body.pop("name"), "source": body.pop("source")}
+    if mode != "position":
+        raw["mode"] = mode
+    raw.update(body)
+    return raw
+
+
+def dumps(data: Any) -> str:
+    """Any plain data → YAML text (block style, key order kept)."""
+    return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=False)
+
+
+def dumps_preset(params: Any) -> str:
+    """Parameter object → preset YAML text in SI field names."""
+    return dumps(to_raw(params))
+
+
+def save_preset(params: Any, path: str | Path) -> None:
+    """Write a parameter object as a preset file."""
+    Path(path).write_text(dumps_preset(params), encoding="utf-8")
+
+
+__all__ = [
+    "DEFAULT_PRESET", "MODES", "ParameterError", "PresetError", "apply_overrides", "dumps",
+    "dumps_preset", "list_presets", "load_preset", "loads_preset", "parse_preset", "save_preset",
+    "to_raw",
+]

@@ -1,0 +1,104 @@
+"""Unit conversion at the edge: nameplate units → SI. The only place non-SI units are converted.
+
+A preset or ``--set`` key may carry a unit suffix instead of the SI field name, e.g.
+``omega_b_rpm: 1432``, ``L_d_mH: 5.4``, ``P_r_kW: 12``, or ``Ke_Vrms_krpm`` instead of ``psi_pm``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+
+def rpm_to_rad_s(n_rpm: float) -> float:
+    """Speed [rpm] → [rad/s]: n·2π/60."""
+    return n_rpm * 2.0 * math.pi / 60.0
+
+
+def rad_s_to_rpm(omega: float) -> float:
+    """Speed [rad/s] → [rpm]."""
+    return omega * 60.0 / (2.0 * math.pi)
+
+
+def mH_to_H(L_mH: float) -> float:
+    """Inductance [mH] → [H]."""
+    return L_mH * 1e-3
+
+
+def kW_to_W(P_kW: float) -> float:
+    """Power [kW] → [W]."""
+    return P_kW * 1e3
+
+
+def ms_to_s(t_ms: float) -> float:
+    """Time [ms] → [s]."""
+    return t_ms * 1e-3
+
+
+def kHz_to_Hz(f_kHz: float) -> float:
+    """Frequency [kHz] → [Hz]."""
+    return f_kHz * 1e3
+
+
+def deg_to_rad(x_deg: float) -> float:
+    """Angle [deg] → [rad]."""
+    return math.radians(x_deg)
+
+
+def rev_to_rad(x_rev: float) -> float:
+    """Angle [rev] → [rad]."""
+    return x_rev * 2.0 * math.pi
+
+
+def ke_vrms_krpm_to_psi_pm(Ke_Vrms_krpm: float, p: int) -> float:
+    """Back-EMF constant Ke [V_rms line-to-line per 1000 rpm] → Ψ_PM [Wb] (amplitude-invariant dq).
+
+    The phase back-EMF peak at mechanical speed ω is p·ω·Ψ_PM, and the line-to-line RMS value is
+    √3/√2 times the phase peak, so Ke/1000 rpm = √(3/2)·p·Ψ_PM·(2π·1000/60), i.e.
+    Ψ_PM = Ke·√(2/3) / (p·2π·1000/60).
+
+    Parameters
+    ----------
+    Ke_Vrms_krpm : float  Back-EMF constant [V_rms(LL)/krpm].
+    p : int               Pole pairs [-].
+
+    Returns
+    -------
+    float
+        Ψ_PM [Wb].
+    """
+    return Ke_Vrms_krpm * math.sqrt(2.0 / 3.0) / (p * rpm_to_rad_s(1000.0))
+
+
+@dataclass(frozen=True)
+class Alias:
+    """A unit-suffixed input key that maps onto an SI field."""
+
+    field: str
+    convert: Callable[[float], float]
+    unit: str
+
+
+#: Unit-suffixed keys accepted per section, mapping to the SI field and its converter.
+ALIASES: dict[str, dict[str, Alias]] = {
+    "motor": {
+        "omega_b_rpm": Alias("omega_b", rpm_to_rad_s, "rpm"),
+        "P_r_kW": Alias("P_r", kW_to_W, "kW"),
+        "L_d_mH": Alias("L_d", mH_to_H, "mH"),
+        "L_q_mH": Alias("L_q", mH_to_H, "mH"),
+    },
+    "controller": {
+        "T_si_ms": Alias("T_si", ms_to_s, "ms"),
+        "T_salpha_ms": Alias("T_salpha", ms_to_s, "ms"),
+        "T_so_ms": Alias("T_so", ms_to_s, "ms"),
+        "f_s_kHz": Alias("f_s", kHz_to_Hz, "kHz"),
+    },
+    "manoeuvre": {
+        "theta_dem_deg": Alias("theta_dem", deg_to_rad, "deg"),
+        "theta_dem_rev": Alias("theta_dem", rev_to_rad, "rev"),
+    },
+}
+
+#: Keys needing more than one field to convert (Ke needs the pole pairs).
+KE_KEY = "Ke_Vrms_krpm"

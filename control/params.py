@@ -1,0 +1,282 @@
+"""Parameter model of the FDSMC position drive: frozen dataclasses in SI units.
+
+Every field carries its unit in the docstring. Construction rejects impossible values with a
+:class:`ParameterError` whose message names the field, the value and the allowed range.
+
+References
+----------
+[1] S. J. Dodds, G. Sooriyakumar, R. Perryman, "A Robust Forced Dynamic Sliding Mode Minimum
+    Energy Position Controller for Permanent Magnet Synchronous Motor Drives" (the FDSMC paper).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any
+
+ALPHA_MAX_RULES = ("paper", "torque_limit")
+
+
+class ParameterError(ValueError):
+    """An input value outside its allowed range; the message names field, value and range."""
+
+
+def check_range(
+    name: str,
+    value: Any,
+    low: float | None = None,
+    high: float | None = None,
+    *,
+    low_open: bool = True,
+    unit: str = "",
+) -> float:
+    """Return ``value`` as float or raise :class:`ParameterError` naming the allowed range.
+
+    Parameters
+    ----------
+    name : str
+        Dotted field name shown to the user, e.g. ``"motor.L_d"``.
+    value : Any
+        The value to check.
+    low, high : float or None
+        Bounds (``None`` = unbounded). ``low`` is exclusive when ``low_open`` else inclusive;
+        ``high`` is inclusive.
+    unit : str
+        Unit shown in the message.
+
+    Returns
+    -------
+    float
+        The checked value.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ParameterError(f"{name} = {value!r} is not a number{_range_text(low, high, low_open, unit)}")
+    x = float(value)
+    bad = not math.isfinite(x)
+    bad = bad or (low is not None and (x <= low if low_open else x < low))
+    bad = bad or (high is not None and x > high)
+    if bad:
+        raise ParameterError(f"{name} = {value!r} {unit}".rstrip() + f" is out of range{_range_text(low, high, low_open, unit)}")
+    return x
+
+
+def _range_text(low: float | None, high: float | None, low_open: bool, unit: str) -> str:
+    u = f" {unit}" if unit else ""
+    if low is not None and high is not None:
+        op = "<" if low_open else "≤"
+        return f": allowed {low:g} {op} value ≤ {high:g}{u}"
+    if low is not None:
+        return f": allowed {'>' if low_open else '≥'} {low:g}{u}"
+    if high is not None:
+        return f": allowed ≤ {high:g}{u}"
+    return ": allowed any finite number"
+
+
+def _check_fields(obj: Any, section: str, spec: dict[str, tuple[float | None, float | None, bool, str]]) -> None:
+    for f in fields(obj):
+        if f.name in spec:
+            low, high, low_open, unit = spec[f.name]
+            check_range(f"{section}.{f.name}", getattr(obj, f.name), low, high, low_open=low_open, unit=unit)
+
+
+_POS = (0.0, None, True)
+
+
+@dataclass(frozen=True)
+class Motor:
+    """PMSM nameplate and model data, eqs. (1)–(5) and section 5 of [1].
+
+    Attributes
+    ----------
+    V_0 : float
+        Rated voltage, line-to-line RMS [V].
+    P_r : float
+        Rated power [W].
+    omega_b : float
+        Base speed [rad/s] (mechanical).
+    Gamma_max : float
+        Maximum electromagnetic torque [N·m].
+    psi_pm : float
+        Permanent-magnet flux linkage Ψ_PM [Wb] (amplitude-invariant dq, eq. (5)).
+    L_d, L_q : float
+        Direct / quadrature-axis inductance [H].
+    R_s : float
+        Stator resistance per phase [Ω].
+    p : int
+        Pole pairs [-].
+    J_r : float
+        Rotor moment of inertia [kg·m²].
+    """
+
+    V_0: float
+    P_r: float
+    omega_b: float
+    Gamma_max: float
+    psi_pm: float
+    L_d: float
+    L_q: float
+    R_s: float
+    p: int
+    J_r: float
+
+    def __post_init__(self) -> None:
+        spec = {
+            "V_0": (*_POS, "V"), "P_r": (*_POS, "W"), "omega_b": (*_POS, "rad/s"),
+            "Gamma_max": (*_POS, "N·m"), "psi_pm": (*_POS, "Wb"), "L_d": (*_POS, "H"),
+            "L_q": (*_POS, "H"), "R_s": (*_POS, "Ω"), "J_r": (*_POS, "kg·m²"),
+        }
+        _check_fields(self, "motor", spec)
+        if isinstance(self.p, bool) or not isinstance(self.p, int | float) or not (
+            math.isfinite(self.p) and float(self.p).is_integer() and 1 <= self.p <= 100
+        ):
+            raise ParameterError(f"motor.p = {self.p!r} is out of range: allowed an integer 1 … 100 pole pairs")
+        object.__setattr__(self, "p", int(self.p))
+
+
+@dataclass(frozen=True)
+class LoadStep:
+    """A step of the external load torque: from time ``t`` [s] on, Γ_Le = ``Gamma_Le`` [N·m]."""
+
+    t: float
+    Gamma_Le: float
+
+    def __post_init__(self) -> None:
+        check_range("load.steps.t", self.t, 0.0, None, low_open=False, unit="s")
+        check_range("load.steps.Gamma_Le", self.Gamma_Le, -1e6, 1e6, unit="N·m")
+
+
+@dataclass(frozen=True)
+class Load:
+    """Mechanical load referred to the rotor, eqs. (4b) and (6) of [1].
+
+    Attributes
+    ----------
+    J_L : float
+        Load inertia referred to the rotor [kg·m²] (≥ 0; unknown to the controller).
+    F_v : float
+        Viscous friction coefficient [N·m·s/rad].
+    Gamma_Le : float
+        External load torque at t = 0 [N·m].
+    steps : tuple of LoadStep
+        Later steps of the external load torque (time-ordered) [s, N·m].
+    Gamma_Le_ramp : float
+        Ramp rate added to the external load torque from t = 0 [N·m/s].
+    """
+
+    J_L: float
+    F_v: float
+    Gamma_Le: float = 0.0
+    steps: tuple[LoadStep, ...] = ()
+    Gamma_Le_ramp: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_fields(self, "load", {
+            "J_L": (0.0, None, False, "kg·m²"), "F_v": (0.0, None, False, "N·m·s/rad"),
+            "Gamma_Le": (-1e6, 1e6, True, "N·m"), "Gamma_Le_ramp": (-1e6, 1e6, True, "N·m/s"),
+        })
+        steps = tuple(s if isinstance(s, LoadStep) else LoadStep(**s) for s in self.steps)
+        times = [s.t for s in steps]
+        if times != sorted(times):
+            raise ParameterError(f"load.steps times = {times} must be in increasing order")
+        object.__setattr__(self, "steps", steps)
+
+
+@dataclass(frozen=True)
+class Controller:
+    """FDC inner loops, observer and sliding-mode outer loop settings of [1].
+
+    Attributes
+    ----------
+    T_si : float
+        Direct-axis current settling time (5 %), eq. (8) [s].
+    T_salpha : float
+        Acceleration-loop settling time (5 %), eq. (13) [s].
+    T_so : float
+        Observer settling time (5 %), eq. (17) [s].
+    K : float
+        Boundary-layer gain, eq. (45) [s/rad].
+    T_c : float or "T_a"
+        Sliding-mode time constant of the sloped boundary segment, eq. (41) [s]; ``"T_a"``
+        applies eq. (59), T_c = T_a.
+    alpha_max_rule : str
+        ``"paper"`` (α_max = H·P_r/V_0, section 5) or ``"torque_limit"``
+        (α_max = (Γ_max − |Γ_Le|)/(J_r + J_L)).
+    f_s : float or "continuous"
+        Controller sample rate [Hz], or ``"continuous"`` to evaluate the controller continuously.
+    delay_samples : int
+        Computation delay of the digital controller [samples] (0 or 1).
+    """
+
+    T_si: float
+    T_salpha: float
+    T_so: float
+    K: float
+    T_c: float | str = "T_a"
+    alpha_max_rule: str = "paper"
+    f_s: float | str = 20000.0
+    delay_samples: int = 0
+
+    def __post_init__(self) -> None:
+        _check_fields(self, "controller", {
+            "T_si": (0.0, 10.0, True, "s"), "T_salpha": (0.0, 10.0, True, "s"),
+            "T_so": (0.0, 10.0, True, "s"), "K": (0.0, 1e9, True, "s/rad"),
+        })
+        if self.T_c != "T_a":
+            if isinstance(self.T_c, str):
+                raise ParameterError(f"controller.T_c = {self.T_c!r} is not allowed: a time > 0 s or 'T_a'")
+            check_range("controller.T_c", self.T_c, 0.0, 100.0, unit="s")
+        if self.alpha_max_rule not in ALPHA_MAX_RULES:
+            raise ParameterError(
+                f"controller.alpha_max_rule = {self.alpha_max_rule!r} is not allowed: one of {', '.join(ALPHA_MAX_RULES)}"
+            )
+        if self.f_s != "continuous":
+            if isinstance(self.f_s, str):
+                raise ParameterError(f"controller.f_s = {self.f_s!r} is not allowed: a rate in Hz or 'continuous'")
+            check_range("controller.f_s", self.f_s, 100.0, 1e7, low_open=False, unit="Hz")
+        if self.delay_samples not in (0, 1) or isinstance(self.delay_samples, bool):
+            raise ParameterError(f"controller.delay_samples = {self.delay_samples!r} is out of range: allowed 0 or 1")
+
+    @property
+    def is_continuous(self) -> bool:
+        """True when the controller is evaluated continuously (no sampling)."""
+        return self.f_s == "continuous"
+
+
+@dataclass(frozen=True)
+class Manoeuvre:
+    """Rest-to-rest manoeuvre from θ_r = 0.
+
+    Attributes
+    ----------
+    theta_dem : float
+        Demanded rotor angle [rad].
+    T_m : float
+        Demanded manoeuvre time [s].
+    """
+
+    theta_dem: float
+    T_m: float
+
+    def __post_init__(self) -> None:
+        check_range("manoeuvre.theta_dem", self.theta_dem, -1e6, 1e6, unit="rad")
+        if self.theta_dem == 0.0:
+            raise ParameterError("manoeuvre.theta_dem = 0 rad is out of range: a non-zero angle is needed")
+        check_range("manoeuvre.T_m", self.T_m, 0.0, 1e4, unit="s")
+
+
+@dataclass(frozen=True)
+class DriveParams:
+    """Everything one FDSMC commissioning case needs: motor, load, controller, manoeuvre."""
+
+    motor: Motor
+    load: Load
+    controller: Controller
+    manoeuvre: Manoeuvre
+    name: str = "custom"
+    source: str = "user input"
+
+    @property
+    def J_total(self) -> float:
+        """Total inertia J_r + J_L turned by the motor, eq. (4b) [kg·m²]."""
+        return self.motor.J_r + self.load.J_L
