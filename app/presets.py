@@ -80,8 +80,8 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
         raise PresetError(f"{section} must be a mapping of field: value, got {raw!r}")
     hints = typing.get_type_hints(cls)
     names = [f.name for f in dataclasses.fields(cls)]
-    aliases = units.ALIASES.get(section, {})
-    extra = [units.KE_KEY] if section == "motor" else []
+    aliases = {k: a for k, a in units.ALIASES.get(section, {}).items() if a.field in names}
+    extra = [units.KE_KEY] if "psi_pm" in names else []
     allowed = names + list(aliases) + extra
     values: dict[str, Any] = {}
     for key, value in raw.items():
