@@ -186,10 +186,15 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
         if not sep or not dot or not name:
             raise PresetError(f"--set {item!r} is malformed: allowed form section.field=value")
         if not isinstance(raw.get(section), dict):
-            raise PresetError(f"--set {item!r}: unknown section {section!r}{_hint(section, [k for k, v in raw.items() if isinstance(v, dict)])}")
+            known = [k for k, v in raw.items() if isinstance(v, dict)]
+            raise PresetError(f"--set {item!r}: unknown section {section!r}{_hint(section, known)}")
         value = loads_raw(text, f"--set {key}") if text.strip() else None
         if value is None:
             raise PresetError(f"--set {item!r} has no value")
+        aliases = units.ALIASES.get(section, {})
+        target = _field_of(name, aliases, [units.KE_KEY])
+        for other in [k for k in raw[section] if _field_of(str(k), aliases, [units.KE_KEY]) == target]:
+            del raw[section][other]  # an override replaces the value in any unit form
         raw[section][name] = value
     return raw
 

@@ -57,7 +57,8 @@ def check_range(
     bad = bad or (low is not None and (x <= low if low_open else x < low))
     bad = bad or (high is not None and x > high)
     if bad:
-        raise ParameterError(f"{name} = {value!r} {unit}".rstrip() + f" is out of range{_range_text(low, high, low_open, unit)}")
+        shown = f"{name} = {value!r} {unit}".rstrip()
+        raise ParameterError(f"{shown} is out of range{_range_text(low, high, low_open, unit)}")
     return x
 
 
@@ -228,7 +229,8 @@ class Controller:
             check_range("controller.T_c", self.T_c, 0.0, 100.0, unit="s")
         if self.alpha_max_rule not in ALPHA_MAX_RULES:
             raise ParameterError(
-                f"controller.alpha_max_rule = {self.alpha_max_rule!r} is not allowed: one of {', '.join(ALPHA_MAX_RULES)}"
+                f"controller.alpha_max_rule = {self.alpha_max_rule!r} is not allowed: "
+                f"one of {', '.join(ALPHA_MAX_RULES)}"
             )
         if self.f_s != "continuous":
             if isinstance(self.f_s, str):

@@ -1,0 +1,14 @@
+"""Shared fixtures."""
+
+from __future__ import annotations
+
+import pytest
+
+from app.presets import load_preset
+from control.params import DriveParams
+
+
+@pytest.fixture(scope="session")
+def paper_params() -> DriveParams:
+    """The paper's section-5 preset (FDSMC paper, section 5)."""
+    return load_preset("paper_12kw_pmsm")
