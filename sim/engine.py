@@ -1,0 +1,405 @@
+"""Closed-loop simulation engine: one run, an FDSMC-vs-conventional comparison, the Table-1 sweep.
+
+The model (plant, FDC inner loops, observer, outer loop, energies) is integrated by the
+compiled kernel :func:`sim.kernel.run_kernel`; this module packs the parameters, chooses the
+time grid, and turns the raw arrays into frozen results with the metrics of issue 3.
+
+Rest-to-rest manoeuvre from θ_r = 0 to θ_dem, simulated over [0, (1 + TAIL_FRACTION)·T_m].
+Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) in [1]); the
+``_total`` ones are over the whole simulated horizon.
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.derivations import Derived, derive
+from control.model import torque_constant
+from control.params import DriveParams, ParameterError
+from sim import kernel as kn
+from sim.metrics import detect_chatter, response_metrics
+
+CONTROLLERS = ("fdsmc", "conventional")
+#: Simulated horizon beyond T_m, as a fraction of T_m [-].
+TAIL_FRACTION = 0.3
+#: RK4 step of continuous mode [s]; friction energies converged to < 0.05 % (see tests).
+CONTINUOUS_STEP_S = 5e-6
+#: Most trace points kept per run (energies and peaks use every step).
+MAX_POINTS = 20000
+#: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
+PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
+
+
+@dataclass(frozen=True)
+class Trace:
+    """Time series of one run on a common grid (SI units; energies cumulative from t = 0).
+
+    Attributes
+    ----------
+    t [s]; theta_r [rad]; omega_r [rad/s]; i_d, i_q [A]; u_d, u_q [V] (applied);
+    alpha [rad/s²] true rotor acceleration dω_r/dt; alpha_dem [rad/s²] outer-loop demand;
+    alpha_hat [rad/s²] eq. (7) with Γ̂_L; Gamma_L [N·m] true total load torque, eq. (4a)/(6);
+    Gamma_L_hat [N·m] observer's L̂0; theta_hat [rad]; omega_hat [rad/s]; S [rad/s] switching
+    function (0 for the conventional law); E_friction, E_copper, E_electrical, E_motoring,
+    E_load [J].
+    """
+
+    t: np.ndarray
+    theta_r: np.ndarray
+    omega_r: np.ndarray
+    i_d: np.ndarray
+    i_q: np.ndarray
+    u_d: np.ndarray
+    u_q: np.ndarray
+    alpha: np.ndarray
+    alpha_dem: np.ndarray
+    Gamma_L: np.ndarray
+    Gamma_L_hat: np.ndarray
+    theta_hat: np.ndarray
+    omega_hat: np.ndarray
+    S: np.ndarray
+    E_friction: np.ndarray
+    E_copper: np.ndarray
+    E_electrical: np.ndarray
+    alpha_hat: np.ndarray
+    E_motoring: np.ndarray
+    E_load: np.ndarray
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """One controller's run: trace and the metrics of ``simulate --json`` (plus ``reason``)."""
+
+    controller: str
+    trace: Trace
+    metrics: dict[str, float | bool | str | None]
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """FDSMC and conventional runs of one case and the savings [%] (None if not both stable).
+
+    ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
+    ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
+    """
+
+    derived: Derived
+    fdsmc: RunResult | None
+    conventional: RunResult | None
+    saving_friction_pct: float | None
+    saving_electrical_pct: float | None
+
+
+@dataclass(frozen=True)
+class Table1Row:
+    """One column of Table 1 in [1]: friction [J] over [0, T_m] and savings [%]."""
+
+    T_m: float
+    friction_fdsmc_J: float
+    friction_conventional_J: float
+    saving_pct: float
+    saving_eq52_pct: float
+    bound_pct: float
+    paper_pct: float | None
+
+
+@dataclass(frozen=True)
+class _Grid:
+    continuous: bool
+    h: float
+    n_steps: int
+    n_sub: int
+    decim: int
+    n_out: int
+
+
+def _grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: int) -> _Grid:
+    t_end = (1.0 + TAIL_FRACTION) * params.manoeuvre.T_m
+    ctrl = params.controller
+    if ctrl.is_continuous:
+        n_steps, h, sub = int(math.ceil(t_end / h_continuous)), h_continuous, 1
+    else:
+        T_s = 1.0 / float(ctrl.f_s)
+        n_steps, h, sub = int(math.ceil(t_end / T_s)), T_s / n_sub, n_sub
+    decim = max(1, int(math.ceil(n_steps / max_points)))
+    return _Grid(ctrl.is_continuous, h, n_steps, sub, decim, n_steps // decim + 1)
+
+
+def pack_parameters(params: DriveParams, d: Derived, controller: str) -> np.ndarray:
+    """The kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.kernel`)."""
+    c, m, ld, ctrl = d.coefficients, params.motor, params.load, params.controller
+    prm = np.zeros(kn.N_PRM)
+    for name, idx in zip("ABCDEFGHKM", (kn.P_A, kn.P_B, kn.P_C, kn.P_D, kn.P_E, kn.P_F, kn.P_G,
+                                         kn.P_H, kn.P_K, kn.P_M), strict=True):
+        prm[idx] = getattr(c, name)
+    prm[[kn.P_RS, kn.P_LD, kn.P_LQ, kn.P_PSI, kn.P_P, kn.P_JR]] = (
+        m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, m.J_r)
+    prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (params.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
+    prm[kn.P_CTRL] = CONTROLLERS.index(controller)
+    pr, o = d.profile, d.observer
+    prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
+        params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
+    prm[[kn.P_G1, kn.P_G2]] = (d.conventional.g1, d.conventional.g2)
+    prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
+    prm[[kn.P_UMAX, kn.P_IMAX]] = (getattr(ctrl, "u_max", 0.0), getattr(ctrl, "i_max", 0.0))
+    prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
+    w_scale = max(m.omega_b, pr.omega_p, abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
+    i_scale = max(m.Gamma_max, d.alpha.torque_needed) / torque_constant(m)
+    prm[[kn.P_WLIM, kn.P_ILIM]] = (20.0 * w_scale, 100.0 * i_scale)
+    return prm
+
+
+def _observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    od = d.observer_discrete
+    if od is None:
+        return np.zeros((4, 4)), np.zeros(4), np.zeros(4)
+    return np.ascontiguousarray(od.Phi), np.ascontiguousarray(od.Gamma), np.ascontiguousarray(od.L)
+
+
+def _load_steps(params: DriveParams) -> tuple[np.ndarray, np.ndarray]:
+    steps = params.load.steps
+    return (np.array([s.t for s in steps], dtype=float),
+            np.array([s.Gamma_Le for s in steps], dtype=float))
+
+
+def _check_controller(controller: str) -> None:
+    if controller not in CONTROLLERS:
+        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(CONTROLLERS)}")
+
+
+def _check_feasible(d: Derived) -> None:
+    pr, T_m = d.profile, d.params.manoeuvre.T_m
+    if not pr.feasible:
+        raise ParameterError(
+            f"manoeuvre.T_m = {T_m:g} s is infeasible: allowed ≥ T_m,min = {pr.T_m_min:.4g} s "
+            f"for Δθ = {pr.delta_theta:g} rad at α_max = {d.alpha.alpha_max:.5g} rad/s²")
+
+
+def simulate(
+    params: DriveParams,
+    controller: str = "fdsmc",
+    derived: Derived | None = None,
+    *,
+    n_sub: int = 1,
+    h_continuous: float = CONTINUOUS_STEP_S,
+    max_points: int = MAX_POINTS,
+) -> RunResult:
+    """Simulate one rest-to-rest manoeuvre with the FDC inner loops and the chosen outer loop.
+
+    Parameters
+    ----------
+    params : DriveParams
+        The commissioning case.
+    controller : str
+        ``"fdsmc"`` (eqs. 41–46 in [1]) or ``"conventional"`` (eq. 62 sign-corrected).
+    derived : Derived or None
+        ``derive(params)`` if already computed.
+    n_sub : int
+        RK4 substeps per sample in digital mode [-].
+    h_continuous : float
+        RK4 step in continuous mode [s].
+    max_points : int
+        Most trace points kept [-].
+
+    Returns
+    -------
+    RunResult
+        Never raises for an unstable run: ``metrics["stable"]`` is False with a ``reason``.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown controller or an infeasible manoeuvre (T_m < T_m,min).
+    """
+    _check_controller(controller)
+    d = derive(params) if derived is None else derived
+    _check_feasible(d)
+    g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
+    prm = pack_parameters(params, d, controller)
+    step_t, step_v = _load_steps(params)
+    Phi, Gam, Lo = _observer_arrays(d)
+    out = np.zeros((g.n_out, kn.N_CH))
+    info = np.zeros(kn.N_INFO)
+    kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
+                  params.controller.delay_samples, g.decim, out, info)
+    trace = _trace(out[: int(info[kn.I_NOUT])])
+    return RunResult(controller, trace, _metrics(params, d, controller, trace, info))
+
+
+def _trace(rows: np.ndarray) -> Trace:
+    finite = np.all(np.isfinite(rows), axis=1)
+    if not np.all(finite):
+        rows = rows[: int(np.argmin(finite))]
+    cols = {name: np.ascontiguousarray(rows[:, i]) for i, name in enumerate(kn.CHANNELS)}
+    return Trace(**cols)
+
+
+def _energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
+    snap, end = info[kn.I_SNAP: kn.I_SNAP + kn.N_X], info[kn.I_END: kn.I_END + kn.N_X]
+    m = params.motor
+
+    def kinetic(x: np.ndarray) -> float:
+        return float(0.5 * params.J_total * x[kn.X_W] ** 2)
+
+    def magnetic(x: np.ndarray) -> float:
+        return float(0.75 * (m.L_d * x[kn.X_ID] ** 2 + m.L_q * x[kn.X_IQ] ** 2))
+
+    out: dict[str, float] = {}
+    for suffix, x in (("", snap), ("_total", end)):
+        out[f"friction{suffix}_J"] = float(x[kn.X_EF])
+        out[f"copper{suffix}_J"] = float(x[kn.X_ECU])
+        out[f"electrical_in{suffix}_J"] = float(x[kn.X_EEL])
+        out[f"motoring{suffix}_J"] = float(x[kn.X_EMOT])
+        out[f"regenerated{suffix}_J"] = float(x[kn.X_EMOT] - x[kn.X_EEL])
+        out[f"load_work{suffix}_J"] = float(x[kn.X_ELOAD])
+    out["kinetic_at_Tm_J"] = float(kinetic(snap))
+    out["kinetic_end_J"] = kinetic(end)
+    out["magnetic_end_J"] = magnetic(end)
+    stored = out["kinetic_end_J"] + out["magnetic_end_J"]
+    losses = out["copper_total_J"] + out["friction_total_J"] + out["load_work_total_J"]
+    residual = out["electrical_in_total_J"] - losses - stored
+    out["energy_balance_residual_J"] = float(residual)
+    ref = max(abs(out["electrical_in_total_J"]), out["motoring_total_J"], 1e-12)
+    out["energy_balance_residual_pct"] = float(100.0 * abs(residual) / ref)
+    return out
+
+
+def _chatter_window(params: DriveParams, d: Derived, controller: str) -> tuple[float, float]:
+    T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
+    if controller == "conventional":
+        return 0.2 * T_m, T_m
+    cruise = T_m - 4.0 * T_a
+    return T_a + 0.2 * cruise, T_a + 0.8 * cruise
+
+
+def _metrics(
+    params: DriveParams, d: Derived, controller: str, tr: Trace, info: np.ndarray
+) -> dict[str, float | bool | str | None]:
+    failed = bool(info[kn.I_FAILED])
+    met: dict[str, float | bool | str | None] = {}
+    energies = _energy_metrics(params, info)
+    theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
+    resp = response_metrics(tr.t, tr.theta_r, params.manoeuvre.theta_dem, theta_Tm)
+    cv = detect_chatter(tr.t, tr.alpha_dem, tr.omega_r, _chatter_window(params, d, controller),
+                        d.alpha.alpha_max)
+    met.update(energies)
+    met.update(resp)
+    met.update({
+        "omega_peak_rad_s": float(info[kn.I_PW]),
+        "i_q_peak_A": float(info[kn.I_PIQ]),
+        "i_d_peak_A": float(info[kn.I_PID]),
+        "u_peak_V": float(info[kn.I_PU]),
+        "torque_peak_Nm": float(info[kn.I_PTQ]),
+        "saturated_s": float(info[kn.I_TSAT]),
+        "chatter": bool(cv.chatter),
+        "chatter_alpha_ptp_rad_s2": cv.ptp,
+        "chatter_frequency_Hz": cv.frequency_Hz,
+        "cruise_omega_ptp_rad_s": cv.omega_ptp,
+        "stable": not failed,
+        "reason": None,
+    })
+    if failed:
+        for k, v in met.items():
+            if isinstance(v, float) and k != "saturated_s":
+                met[k] = None
+        met["chatter"] = False
+        met["reason"] = (
+            f"diverged at t = {info[kn.I_TFAIL]:.4g} s (a state left its bound or became "
+            "non-finite); see the sample-rate check")
+    return met
+
+
+def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:
+    if a is None or b is None or not (a.metrics["stable"] and b.metrics["stable"]):
+        return None
+    va, vb = a.metrics[key], b.metrics[key]
+    if not isinstance(va, float) or not isinstance(vb, float) or vb == 0.0:
+        return None
+    return 100.0 * (1.0 - va / vb)
+
+
+def compare(
+    params: DriveParams, controllers: tuple[str, ...] = CONTROLLERS, **options: float
+) -> Comparison:
+    """Simulate both controllers on the same case (thread-safe; the kernel releases the GIL).
+
+    Parameters
+    ----------
+    params : DriveParams
+    controllers : tuple of str
+        Any of ``"fdsmc"``, ``"conventional"``.
+    **options
+        Passed to :func:`simulate` (``n_sub``, ``h_continuous``, ``max_points``).
+
+    Returns
+    -------
+    Comparison
+        Savings are None unless both runs exist and are stable.
+    """
+    for c in controllers:
+        _check_controller(c)
+    d = derive(params)
+    _check_feasible(d)
+    runs: dict[str, RunResult] = {}
+    if len(controllers) > 1:
+        with ThreadPoolExecutor(max_workers=len(controllers)) as pool:
+            futures = {c: pool.submit(simulate, params, c, d, **options) for c in controllers}
+            runs = {c: f.result() for c, f in futures.items()}
+    else:
+        runs = {c: simulate(params, c, d, **options) for c in controllers}
+    f, c = runs.get("fdsmc"), runs.get("conventional")
+    return Comparison(d, f, c, _saving(f, c, "friction_J"), _saving(f, c, "electrical_in_total_J"))
+
+
+def table1_sweep(
+    params: DriveParams,
+    T_m_values: Sequence[float],
+    progress: Callable[[int, int], None] | None = None,
+    **options: float,
+) -> list[Table1Row]:
+    """Friction energies and savings over manoeuvre times, as Table 1 of [1].
+
+    Parameters
+    ----------
+    params : DriveParams
+        The case; its T_m is replaced by each value.
+    T_m_values : sequence of float
+        Manoeuvre times [s].
+    progress : callable or None
+        Called as ``progress(done, total)`` after each point.
+
+    Returns
+    -------
+    list of Table1Row
+
+    Raises
+    ------
+    ParameterError
+        For an infeasible T_m, or when a run is unstable (naming T_m and the reason), so that
+        no row is ever computed from a diverged run.
+    """
+    rows: list[Table1Row] = []
+    for i, T_m in enumerate(T_m_values):
+        p = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=float(T_m)))
+        cmp = compare(p, **options)
+        assert cmp.fdsmc is not None and cmp.conventional is not None
+        for run in (cmp.fdsmc, cmp.conventional):
+            if not run.metrics["stable"]:
+                raise ParameterError(
+                    f"manoeuvre.T_m = {T_m:g} s: {run.controller} run unstable — {run.metrics['reason']}")
+        wf, wc = float(cmp.fdsmc.metrics["friction_J"]), float(cmp.conventional.metrics["friction_J"])  # type: ignore[arg-type]
+        e = cmp.derived.energy
+        rows.append(Table1Row(float(T_m), wf, wc, 100.0 * (1.0 - wf / wc),
+                              float(e.saving_pct) if e.saving_pct is not None else math.nan,
+                              e.bound_pct, PAPER_TABLE1.get(round(float(T_m), 3))))
+        if progress is not None:
+            progress(i + 1, len(T_m_values))
+    return rows
