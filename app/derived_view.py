@@ -58,7 +58,26 @@ def derived_rows(d: Derived) -> list[Row]:
             Row("Discrete observer gain", f"L{i + 1}", float(v), u, "Ackermann")
             for i, (v, u) in enumerate(zip(od.L, ("-", "1/s", "N·m/rad", "N·m/(rad·s)"), strict=True))
         ]
+    rows += _loop_rows(d)
     return [r for r in rows if r.value is not None]
+
+
+def _loop_rows(d: Derived) -> list[Row]:
+    """Recommended K and sample-rate verdict of :mod:`control.loop_analysis`."""
+    rows: list[Row] = []
+    if d.gain is not None:
+        g = d.gain
+        rows += [
+            Row(f"K stability limit, linearised loop ({g.mode})", "K_limit", g.K_limit, "s/rad", "loop analysis"),
+            Row(f"Recommended K (gain margin {g.margin:g})", "K_rec", g.K_recommended, "s/rad", "loop analysis"),
+        ]
+    if d.sample_rate is not None and d.sample_rate.f_s is not None:
+        s = d.sample_rate
+        rows += [
+            Row("Spectral radius, sampled inner loops", "ρ", s.spectral_radius, "-", "loop analysis"),
+            Row("Slowest stable sample rate", "f_s,min", s.f_s_min, "Hz", "loop analysis"),
+        ]
+    return rows
 
 
 def derived_json(d: Derived) -> dict[str, Any]:
@@ -88,6 +107,10 @@ def derived_json(d: Derived) -> dict[str, Any]:
         },
         "warnings": list(d.warnings),
     }
+    if d.gain is not None:
+        out["loop"] = {k: getattr(d.gain, k) for k in d.gain.__dataclass_fields__}
+    if d.sample_rate is not None:
+        out["sample_rate"] = {k: getattr(d.sample_rate, k) for k in d.sample_rate.__dataclass_fields__}
     if d.observer_discrete is not None:
         od = d.observer_discrete
         out["observer_discrete"] = {

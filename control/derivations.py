@@ -8,10 +8,17 @@ UI and the CLI need, plus human-readable warnings.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from control.conventional import ConventionalGains, conventional_gains, friction_energy_conventional
 from control.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
+from control.loop_analysis import (
+    GainRecommendation,
+    SampleRateCheck,
+    loop_warnings,
+    recommend_K,
+    sample_rate_check,
+)
 from control.model import ModelCoefficients, model_coefficients
 from control.observer import DiscreteObserver, ObserverGains, discrete_observer, observer_gains
 from control.params import DriveParams
@@ -52,6 +59,8 @@ class Derived:
     energy: EnergyPrediction
     feasibility: Feasibility
     warnings: tuple[str, ...]
+    gain: GainRecommendation | None = None
+    sample_rate: SampleRateCheck | None = None
 
 
 def predicted_energy(params: DriveParams, profile: VelocityProfile) -> EnergyPrediction:
@@ -85,7 +94,7 @@ def derive(params: DriveParams) -> Derived:
     obs_d = None if ctrl.is_continuous else discrete_observer(obs, coeff.M, float(ctrl.f_s))
     prof = velocity_profile(params.manoeuvre.theta_dem, alpha.alpha_max, params.manoeuvre.T_m, ctrl.T_c)
     feas = feasibility(params, alpha, prof.omega_p)
-    return Derived(
+    d = Derived(
         params=params,
         coefficients=coeff,
         alpha=alpha,
@@ -97,6 +106,9 @@ def derive(params: DriveParams) -> Derived:
         feasibility=feas,
         warnings=_warnings(params, alpha, prof, feas),
     )
+    # Recommended K and sample-rate verdict of the linearised loop (control.loop_analysis).
+    gain, rate = recommend_K(d), sample_rate_check(d)
+    return replace(d, gain=gain, sample_rate=rate, warnings=d.warnings + loop_warnings(gain, rate))
 
 
 def _warnings(
