@@ -234,6 +234,32 @@ def simulate(
     return RunResult(controller, trace, _metrics(params, d, controller, trace, info))
 
 
+def run_steps(
+    params: DriveParams, controller: str, n_steps: int, *, n_sub: int = 1,
+    h_continuous: float = CONTINUOUS_STEP_S, derived: Derived | None = None,
+) -> np.ndarray:
+    """Run the kernel for ``n_steps`` samples (digital) or RK4 steps (continuous) from rest.
+
+    Returns
+    -------
+    numpy.ndarray
+        Final kernel state [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, E_mot, E_load, θ̂, ω̂, L̂0, L̂1]
+        (indices ``X_*`` of :mod:`sim.kernel`; SI units).
+    """
+    _check_controller(controller)
+    d = derive(params) if derived is None else derived
+    prm = pack_parameters(params, d, controller)
+    step_t, step_v = _load_steps(params)
+    Phi, Gam, Lo = _observer_arrays(d)
+    cont = params.controller.is_continuous
+    h = h_continuous if cont else 1.0 / float(params.controller.f_s) / n_sub
+    out = np.zeros((1, kn.N_CH))
+    info = np.zeros(kn.N_INFO)
+    kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
+                  params.controller.delay_samples, int(n_steps) + 1, out, info)
+    return info[kn.I_END: kn.I_END + kn.N_X].copy()
+
+
 def _trace(rows: np.ndarray) -> Trace:
     finite = np.all(np.isfinite(rows), axis=1)
     if not np.all(finite):
@@ -311,10 +337,18 @@ def _metrics(
             if isinstance(v, float) and k != "saturated_s":
                 met[k] = None
         met["chatter"] = False
-        met["reason"] = (
-            f"diverged at t = {info[kn.I_TFAIL]:.4g} s (a state left its bound or became "
-            "non-finite); see the sample-rate check")
+        met["reason"] = _unstable_reason(d, float(info[kn.I_TFAIL]))
     return met
+
+
+def _unstable_reason(d: Derived, t_fail: float) -> str:
+    text = f"diverged at t = {t_fail:.4g} s (a state became non-finite or left its bound)"
+    s = d.sample_rate
+    if s is not None and not s.stable:
+        need = f"≥ {s.f_s_min:.4g} Hz" if s.f_s_min is not None else "a faster controller"
+        text += (f": f_s = {s.f_s:g} Hz is too slow for T_so/T_sα (sampled inner loops + observer "
+                 f"have spectral radius {s.spectral_radius:.4f} ≥ 1; needs {need})")
+    return text
 
 
 def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:
