@@ -43,7 +43,7 @@ I_END = I_SNAP + N_X  # then N_X values of the final state
 N_INFO = I_END + N_X
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) -> float:
     """External load torque Γ_Le(t) [N·m]: last step value (or Γ_Le0) plus the ramp."""
     g = prm[P_GLE0]
@@ -53,7 +53,7 @@ def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) 
     return g + prm[P_GRAMP] * t
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def outer_law(theta_hat: float, omega_hat: float, prm: np.ndarray) -> tuple[float, float]:
     """Demanded acceleration [rad/s²] and switching function S [rad/s] (eqs. 44–46 or 62)."""
     if prm[P_CTRL] == 1.0:
@@ -67,7 +67,7 @@ def outer_law(theta_hat: float, omega_hat: float, prm: np.ndarray) -> tuple[floa
     return -prm[P_AMAX] * x, S
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0: float,
                  L1: float, prm: np.ndarray) -> tuple[float, float, float]:
     """u_d of eq. (9), u_q of eq. (14) [V] and α of eq. (7) [rad/s²]."""
@@ -82,7 +82,7 @@ def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0:
     return u_d, u_q, alpha
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
                   prm: np.ndarray) -> tuple[float, float, bool]:
     """Optional inverter limits: current limit on i_q, then |u_dq| ≤ u_max. Returns flag."""
@@ -103,7 +103,7 @@ def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: flo
     return u_d, u_q, sat
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def control_output(x: np.ndarray, prm: np.ndarray) -> tuple[float, float, float, float, float, bool]:
     """u_d, u_q [V], α_dem, α [rad/s²], S [rad/s], saturated, from measured i and estimates."""
     alpha_dem, S = outer_law(x[X_THH], x[X_WH], prm)
@@ -112,7 +112,7 @@ def control_output(x: np.ndarray, prm: np.ndarray) -> tuple[float, float, float,
     return u_d, u_q, alpha_dem, alpha, S, sat
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def plant_rhs(t: float, x: np.ndarray, u_d: float, u_q: float, prm: np.ndarray,
               step_t: np.ndarray, step_v: np.ndarray, dx: np.ndarray) -> float:
     """Plant + energy derivatives into ``dx`` (eqs. 1–3, 4b, 5); returns Γ_em [N·m]."""
@@ -133,7 +133,7 @@ def plant_rhs(t: float, x: np.ndarray, u_d: float, u_q: float, prm: np.ndarray,
     return T_em
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def full_rhs(t: float, x: np.ndarray, u_d: float, u_q: float, continuous: bool,
              prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, dx: np.ndarray) -> None:
     """Derivatives of all states; in continuous mode the controller and observer are inside."""
@@ -147,48 +147,44 @@ def full_rhs(t: float, x: np.ndarray, u_d: float, u_q: float, continuous: bool,
         dx[X_WH] = a_em - prm[P_M] * x[X_L0] + prm[P_K2] * e_o
         dx[X_L0] = x[X_L1] + prm[P_K3] * e_o
         dx[X_L1] = prm[P_K4] * e_o
-    else:
-        dx[X_THH] = 0.0
-        dx[X_WH] = 0.0
-        dx[X_L0] = 0.0
-        dx[X_L1] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def rk4_step(t: float, h: float, x: np.ndarray, u_d: float, u_q: float, continuous: bool,
              prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, wk: np.ndarray) -> None:
-    """One classical Runge–Kutta step of size h [s], in place; ``wk`` is a 5×N_X workspace."""
+    """One classical Runge–Kutta step of size h [s], in place; ``wk`` is a 5×N_X workspace.
+
+    In digital mode only the plant and energy states are integrated (the observer is discrete).
+    """
+    n = N_X if continuous else X_THH
     k1, k2, k3, k4, xs = wk[0], wk[1], wk[2], wk[3], wk[4]
+    xs[n:] = x[n:]
     full_rhs(t, x, u_d, u_q, continuous, prm, step_t, step_v, k1)
-    for i in range(N_X):
+    for i in range(n):
         xs[i] = x[i] + 0.5 * h * k1[i]
     full_rhs(t + 0.5 * h, xs, u_d, u_q, continuous, prm, step_t, step_v, k2)
-    for i in range(N_X):
+    for i in range(n):
         xs[i] = x[i] + 0.5 * h * k2[i]
     full_rhs(t + 0.5 * h, xs, u_d, u_q, continuous, prm, step_t, step_v, k3)
-    for i in range(N_X):
+    for i in range(n):
         xs[i] = x[i] + h * k3[i]
     full_rhs(t + h, xs, u_d, u_q, continuous, prm, step_t, step_v, k4)
-    for i in range(N_X):
+    for i in range(n):
         x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def observer_update(x: np.ndarray, a_em: float, Phi: np.ndarray, Gam: np.ndarray,
                     Lo: np.ndarray) -> None:
     """Discrete observer x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·(θ_r[k] − θ̂_r[k]), in place."""
     e_o = x[X_TH] - x[X_THH]
-    old = np.empty(4)
+    o0, o1, o2, o3 = x[X_THH], x[X_WH], x[X_L0], x[X_L1]
     for i in range(4):
-        old[i] = x[X_THH + i]
-    for i in range(4):
-        acc = Gam[i] * a_em + Lo[i] * e_o
-        for j in range(4):
-            acc += Phi[i, j] * old[j]
-        x[X_THH + i] = acc
+        x[X_THH + i] = (Gam[i] * a_em + Lo[i] * e_o + Phi[i, 0] * o0 + Phi[i, 1] * o1
+                        + Phi[i, 2] * o2 + Phi[i, 3] * o3)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def record(out: np.ndarray, n: int, t: float, x: np.ndarray, u_d: float, u_q: float,
            alpha_dem: float, alpha_hat: float, S: float, prm: np.ndarray, step_t: np.ndarray,
            step_v: np.ndarray, dx: np.ndarray) -> None:
@@ -203,7 +199,7 @@ def record(out: np.ndarray, n: int, t: float, x: np.ndarray, u_d: float, u_q: fl
     row[18], row[19] = x[X_EMOT], x[X_ELOAD]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def track_peaks(info: np.ndarray, x: np.ndarray, u_d: float, u_q: float, prm: np.ndarray) -> None:
     """Update the peak |ω_r|, |i_q|, |u_dq|, |Γ_em|, |i_d| kept in ``info``."""
     info[I_PW] = max(info[I_PW], abs(x[X_W]))
@@ -214,7 +210,7 @@ def track_peaks(info: np.ndarray, x: np.ndarray, u_d: float, u_q: float, prm: np
     info[I_PID] = max(info[I_PID], abs(x[X_ID]))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def diverged(x: np.ndarray, prm: np.ndarray) -> bool:
     """True when a state is not finite or beyond the divergence limits."""
     for i in range(N_X):
@@ -224,7 +220,7 @@ def diverged(x: np.ndarray, prm: np.ndarray) -> bool:
             or abs(x[X_ID]) > prm[P_ILIM] or abs(x[X_WH]) > 10.0 * prm[P_WLIM])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def snapshot(info: np.ndarray, x_prev: np.ndarray, x: np.ndarray, t0: float, t1: float,
              T_m: float) -> None:
     """Store the state linearly interpolated at T_m when t0 < T_m ≤ t1."""
@@ -235,7 +231,7 @@ def snapshot(info: np.ndarray, x_prev: np.ndarray, x: np.ndarray, t0: float, t1:
         info[I_TM_HIT] = 1.0
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy", fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray,
                Gam: np.ndarray, Lo: np.ndarray, continuous: bool, h: float, n_steps: int,
                n_sub: int, delay: int, decim: int, out: np.ndarray, info: np.ndarray) -> None:
