@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import re
 import types
 import typing
 from pathlib import Path
@@ -20,6 +21,7 @@ from typing import Any
 import yaml
 
 from app import units
+from control.bldc_params import BldcParams
 from control.params import DriveParams, ParameterError
 
 SCHEMA = 1
@@ -30,6 +32,7 @@ _TOP_KEYS = ("schema", "name", "source", "mode")
 
 #: Parameter dataclass per preset mode. Other modes register themselves here.
 MODES: dict[str, type] = {"position": DriveParams}
+MODES["bldc"] = BldcParams
 
 
 class PresetError(ValueError):
@@ -70,6 +73,8 @@ def _coerce(name: str, value: Any, tp: Any) -> Any:
                 continue
     if typing.get_origin(tp) is tuple and isinstance(value, list):
         item = typing.get_args(tp)[0]
+        if item is float:  # a list of numbers, e.g. a sampled back-EMF period
+            return tuple(_coerce(f"{name}[{i}]", v, float) for i, v in enumerate(value))
         return tuple(_parse_section(item, v, f"{name}[{i}]") for i, v in enumerate(value))
     raise PresetError(f"{name} = {value!r} has the wrong type: expected {_describe(tp)}")
 
@@ -80,7 +85,8 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
         raise PresetError(f"{section} must be a mapping of field: value, got {raw!r}")
     hints = typing.get_type_hints(cls)
     names = [f.name for f in dataclasses.fields(cls)]
-    aliases = {k: a for k, a in units.ALIASES.get(section, {}).items() if a.field in names}
+    table = units.ALIASES.get(re.sub(r"\[\d+\]", "", section), {})  # scenario.cases[0] → scenario.cases
+    aliases = {k: a for k, a in table.items() if a.field in names}
     extra = [units.KE_KEY] if "psi_pm" in names else []
     allowed = names + list(aliases) + extra
     values: dict[str, Any] = {}

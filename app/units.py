@@ -94,6 +94,16 @@ ALIASES: dict[str, dict[str, Alias]] = {
         "T_so_ms": Alias("T_so", ms_to_s, "ms"),
         "f_s_kHz": Alias("f_s", kHz_to_Hz, "kHz"),
     },
+    # BLDC speed-control mode (control/bldc_params.py); nested lists use the dotted path
+    "machine": {"L_s_minus_M_s_mH": Alias("L_s_minus_M_s", mH_to_H, "mH")},
+    "inverter": {"f_s_kHz": Alias("f_s", kHz_to_Hz, "kHz")},
+    "gains": {"eps_lambda_rpm": Alias("eps_lambda", rpm_to_rad_s, "rpm")},
+    "scenario.cases": {
+        "omega_0_rpm": Alias("omega_0", rpm_to_rad_s, "rpm"),
+        "omega_ref_rpm": Alias("omega_ref", rpm_to_rad_s, "rpm"),
+        "band_recovery_rpm": Alias("band_recovery", rpm_to_rad_s, "rpm"),
+        "t_window_ms": Alias("t_window", ms_to_s, "ms"),
+    },
     "manoeuvre": {
         "theta_dem_deg": Alias("theta_dem", deg_to_rad, "deg"),
         "theta_dem_rev": Alias("theta_dem", rev_to_rad, "rev"),
