@@ -1,0 +1,126 @@
+"""Pure Plotly figures of the energy comparison and the Table-1 sweep.
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import plotly.graph_objects as go
+
+from app.figures import COLOURS, LABELS, decimate_index, f32, runs
+
+#: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
+ENERGIES = (
+    ("E_friction", "friction_total_J", "friction", "solid"),
+    ("E_copper", "copper_total_J", "copper", "dot"),
+    ("E_electrical", "electrical_in_total_J", "electrical input", "dash"),
+)
+
+
+def make_energy_figure(comparison: Any) -> go.Figure:
+    """Cumulative friction, copper and electrical input energy [J] vs time for both controllers.
+
+    Parameters
+    ----------
+    comparison : sim.engine.Comparison
+
+    Returns
+    -------
+    plotly.graph_objects.Figure
+    """
+    fig = go.Figure()
+    for key, run in runs(comparison):
+        tr = run.trace
+        i = decimate_index(len(tr.t))
+        for attr, _, label, dash in ENERGIES:
+            fig.add_scatter(x=f32(tr.t[i]), y=f32(getattr(tr, attr)[i]), mode="lines",
+                            name=f"{LABELS[key]} {label}", legendgroup=key,
+                            line={"color": COLOURS[key], "dash": dash, "width": 2})
+    fig.update_layout(meta={"id": "energy_time"}, template="plotly_white",
+                      title={"text": "Energy vs time", "x": 0.01},
+                      xaxis_title="t [s]", yaxis_title="energy [J]",
+                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
+                      legend={"orientation": "h", "y": -0.18})
+    return fig
+
+
+def energy_total(run: Any, attr: str, metric: str) -> float:
+    """Total of one energy kind over the horizon [J]: the metric if given, else the trace's end."""
+    value = run.metrics.get(metric)
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return float(value)
+    return float(getattr(run.trace, attr)[-1])
+
+
+def _pct(value: float | None) -> str:
+    return "–" if value is None else f"{value:.1f} %"
+
+
+def make_energy_bars_figure(comparison: Any) -> go.Figure:
+    """Bar chart of the energy totals [J] per controller, titled with the savings [%].
+
+    Parameters
+    ----------
+    comparison : sim.engine.Comparison
+        ``saving_friction_pct`` and ``saving_electrical_pct`` [%] may be None.
+
+    Returns
+    -------
+    plotly.graph_objects.Figure
+    """
+    fig = go.Figure()
+    kinds = [label for _, _, label, _ in ENERGIES]
+    for key, run in runs(comparison):
+        totals = [energy_total(run, attr, metric) for attr, metric, _, _ in ENERGIES]
+        fig.add_bar(x=kinds, y=totals, name=LABELS[key], marker_color=COLOURS[key],
+                    text=[f"{v:.4g} J" for v in totals], textposition="outside")
+    title = (f"Totals — FDSMC saves {_pct(comparison.saving_friction_pct)} friction, "
+             f"{_pct(comparison.saving_electrical_pct)} electrical input")
+    fig.update_layout(meta={"id": "energy_bars"}, template="plotly_white", barmode="group",
+                      title={"text": title, "x": 0.01}, yaxis_title="energy [J]",
+                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
+                      legend={"orientation": "h", "y": -0.15})
+    return fig
+
+
+def make_table1_figure(rows: Sequence[Any], paper: Mapping[float, float] | None = None) -> go.Figure:
+    """Friction saving [%] vs manoeuvre time T_m [s]: simulation, eq. (52), bound (53), paper's Table 1.
+
+    Parameters
+    ----------
+    rows : sequence of sim.engine.Table1Row
+        ``T_m`` [s], ``saving_pct``, ``saving_eq52_pct``, ``bound_pct``, ``paper_pct`` [%] (None allowed).
+    paper : mapping T_m [s] → saving [%], optional
+        The paper's Table 1 values; drawn in full when given.
+
+    Returns
+    -------
+    plotly.graph_objects.Figure
+    """
+    fig = go.Figure()
+    t_m = [r.T_m for r in rows]
+    series = (
+        ("saving_pct", "simulated (FDSMC vs conventional)", COLOURS["fdsmc"], "lines+markers"),
+        ("saving_eq52_pct", "predicted, eqs. (52), (61)", "#2b8a3e", "lines"),
+        ("bound_pct", "bound 1 − 4/5.6, eq. (53)", "#555555", "lines"),
+    )
+    for attr, name, colour, mode in series:
+        fig.add_scatter(x=t_m, y=[getattr(r, attr) for r in rows], mode=mode, name=name,
+                        line={"color": colour, "dash": "dash" if attr == "bound_pct" else "solid"})
+    if paper:
+        xs = sorted(paper)
+        fig.add_scatter(x=xs, y=[paper[x] for x in xs], mode="markers", name="paper, Table 1",
+                        marker={"symbol": "x", "size": 11, "color": "#c92a2a"})
+    fig.update_layout(meta={"id": "table1"}, template="plotly_white",
+                      title={"text": "Friction saving vs manoeuvre time (Table 1)", "x": 0.01},
+                      xaxis_title="T_m [s]", yaxis_title="saving [%]",
+                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
+                      legend={"orientation": "h", "y": -0.2})
+    return fig
+
+
+__all__ = ["ENERGIES", "energy_total", "make_energy_bars_figure", "make_energy_figure",
+           "make_table1_figure"]

@@ -1,0 +1,270 @@
+"""The commissioning web UI: one :class:`Session` per browser tab, all state on ``client.gui``.
+
+``server.gui`` is shared by every client, so nothing per-user lives there: each connection gets
+its own inputs, results, worker thread and replay. Simulations run on the session's worker (never
+on the GUI event loop); a second Simulate while one runs is refused.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import threading
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import viser
+
+from app.presets import list_presets, load_preset
+from app.ui_files import FilesPanel
+from app.ui_inputs import InputError, InputsPanel
+from app.ui_results import ResultsPanel
+from app.ui_scene import RotorScene
+from app.ui_text import derived_markdown, recommended_K, run_warnings, warnings_html
+from app.ui_worker import Worker
+from control.derivations import derive
+from control.params import DriveParams, ParameterError
+from sim.engine import PAPER_TABLE1, Comparison, compare, table1_sweep
+
+#: Widths of the control panel (left) and the results panel (right) [px].
+CONTROL_WIDTH, RESULTS_WIDTH = 430, 780
+
+
+def comparison_or_derived(params: DriveParams) -> Comparison:
+    """Simulate both controllers; for an infeasible case, the derivations alone (no runs)."""
+    try:
+        return compare(params)
+    except ParameterError:
+        return Comparison(derive(params), None, None, None, None)
+
+
+@dataclass
+class AppConfig:
+    """Server-wide settings; ``initial`` is simulated once and shared read-only by new sessions."""
+
+    params: DriveParams
+    origin: str
+    scene_3d: bool = True
+    _initial: Comparison | None = None
+    _lock: threading.Lock = field(default_factory=threading.Lock)
+    sessions: dict[int, Session] = field(default_factory=dict)
+
+    def initial(self) -> Comparison:
+        """The comparison of the start-up preset (computed on first use)."""
+        with self._lock:
+            if self._initial is None:
+                self._initial = comparison_or_derived(self.params)
+            return self._initial
+
+
+class Session:
+    """Everything one browser tab sees and does."""
+
+    def __init__(self, client: viser.ClientHandle, config: AppConfig) -> None:
+        self.client, self.gui = client, client.gui
+        self.params, self.origin = config.params, config.origin
+        self.comparison = config.initial()
+        self.error: str | None = None
+        self.runs = 0
+        self.worker = Worker(self._set_busy, self._job_failed, name=f"ui-client-{client.client_id}")
+        scene = RotorScene(client.scene) if config.scene_3d else None
+        self._layout(scene)
+        self.results.show(self.comparison, autoplay=False)
+        self._show_text()
+
+    # ---- layout -------------------------------------------------------------------------------
+    def _layout(self, scene: RotorScene | None) -> None:
+        gui = self.gui
+        gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
+        gui.main_panel.dock_left()
+        gui.main_panel.set_width(CONTROL_WIDTH)
+        tabs = gui.add_tab_group()
+        with tabs.add_tab("Position drive (FDSMC)"):
+            self._controls()
+        _add_bldc_tab(self.client, tabs, self.submit)
+        self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep)
+        self.results.panel.dock_right()
+        self.results.panel.set_width(RESULTS_WIDTH)
+
+    def _controls(self) -> None:
+        gui = self.gui
+        names = list_presets()
+        self.preset = gui.add_dropdown("Preset", names, initial_value=self.origin if self.origin in names
+                                       else names[0])
+        self.preset.on_update(self._preset_chosen)
+        self.files = FilesPanel(self.client, self._export_state, self._imported)
+        self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
+        self.simulate_button.on_click(lambda _: self.simulate())
+        self.status = gui.add_markdown("Ready.")
+        self.warnings = gui.add_html("")
+        self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
+        self.use_k.on_click(lambda _: self._use_recommended_k())
+        with gui.add_form(None) as form:
+            self.inputs = InputsPanel(gui, self.params)
+        form.on_submit(lambda _: self.simulate())
+        with gui.add_folder("Derived values", expand_by_default=True):
+            self.derived = gui.add_markdown("")
+
+    # ---- actions ------------------------------------------------------------------------------
+    def simulate(self) -> bool:
+        """Commit the inputs and simulate both controllers on the worker; False if not started."""
+        try:
+            params = self.inputs.collect()
+        except InputError as exc:
+            self._reject(str(exc))
+            return False
+        return self.submit(lambda: self._run(params))
+
+    def submit(self, fn: Callable[[], None]) -> bool:
+        """Run ``fn`` on this client's worker (one job at a time); False (with a note) if busy."""
+        if self.worker.submit(fn) is None:
+            self.client.add_notification("Busy", "A run is still in progress — wait for it to finish.",
+                                         color="yellow", auto_close_seconds=4.0)
+            return False
+        return True
+
+    def _run(self, params: DriveParams) -> None:
+        self.status.content = "Simulating…"
+        comparison = comparison_or_derived(params)  # ParameterError from derive → _job_failed
+        self.params, self.comparison, self.error = params, comparison, None
+        self.runs += 1
+        if comparison.fdsmc is not None:
+            self.results.show(comparison)
+        else:
+            self.results.replay.load(comparison, autoplay=False)
+        self._show_text()
+
+    def sweep(self, T_m_values: list[float]) -> None:
+        """Run the Table-1 sweep over ``T_m_values`` [s] on the worker with a progress bar."""
+        params = self.params
+
+        def job() -> None:
+            self.results.set_progress(0, len(T_m_values))
+            rows = table1_sweep(params, T_m_values, progress=self.results.set_progress)
+            self.results.show_table1(rows, PAPER_TABLE1)
+
+        self.submit(job)
+
+    def _preset_chosen(self, event: viser.GuiEvent) -> None:
+        if event.client is None:
+            return
+        try:
+            params = load_preset(self.preset.value)
+        except ValueError as exc:
+            self._reject(str(exc))
+            return
+        self._imported(params, self.preset.value)
+
+    def _imported(self, params: DriveParams, origin: str) -> None:
+        self.origin = origin
+        self.inputs.populate(params)
+        self.params = params
+        self.simulate()
+
+    def _use_recommended_k(self) -> None:
+        k_rec = recommended_K(self.comparison.derived)
+        if k_rec is not None:
+            self.inputs.set_value("controller.K", k_rec)
+            self.simulate()
+
+    # ---- feedback -----------------------------------------------------------------------------
+    def _show_text(self) -> None:
+        d = self.comparison.derived
+        self.derived.content = derived_markdown(d)
+        items = list(d.warnings) + run_warnings(self.comparison)
+        if self.comparison.fdsmc is None:
+            items.append("Not simulated: the manoeuvre is infeasible (see above).")
+        self.warnings.content = warnings_html(items, self.error)
+        chatter = any(r is not None and r.metrics.get("chatter")
+                      for r in (self.comparison.fdsmc, self.comparison.conventional))
+        k_rec = recommended_K(d)
+        self.use_k.visible = k_rec is not None and (chatter or 1.001 * k_rec < self.params.controller.K)
+        if k_rec is not None:
+            self.use_k.label = f"Use recommended K = {k_rec:.4g} s/rad"
+        self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: `{self.origin}`."
+
+    def _reject(self, message: str) -> None:
+        self.error = message
+        self.warnings.content = warnings_html([], message)
+        self.client.add_notification("Input rejected — nothing simulated", message, color="red",
+                                     auto_close_seconds=12.0)
+
+    def _job_failed(self, exc: Exception) -> None:
+        if isinstance(exc, ValueError):
+            self._reject(str(exc))
+        else:
+            traceback.print_exception(exc, file=sys.stderr)
+            self.client.add_notification("Internal error", f"{type(exc).__name__}: {exc}", color="red")
+        self._show_text_safely()
+
+    def _show_text_safely(self) -> None:
+        with contextlib.suppress(Exception):  # the client may be gone
+            self.status.content = f"Ready — {self.runs} run(s) in this session."
+
+    def _set_busy(self, busy: bool) -> None:
+        self.simulate_button.disabled = busy
+        self.results.sweep_button.disabled = busy
+        if busy:
+            self.status.content = "Working…"
+
+    def _export_state(self) -> tuple[DriveParams, Comparison, str, list[str]]:
+        d = self.comparison.derived
+        return self.params, self.comparison, self.origin, list(d.warnings) + run_warnings(self.comparison)
+
+    def close(self) -> None:
+        """Stop the worker and the replay (client disconnected)."""
+        self.worker.close()
+        self.results.replay.close()
+
+
+def _add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,
+                  submit: Callable[[Callable[[], None]], Any]) -> None:
+    """Second mode: the BLDC speed-control tab, when :mod:`app.ui_bldc` is installed."""
+    try:
+        from app.ui_bldc import build_bldc_tab
+    except ImportError:
+        return
+    with tabs.add_tab("BLDC speed SMC", viser.Icon.ENGINE):
+        build_bldc_tab(client, submit)
+
+
+def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", port: int = 8080,
+                  scene_3d: bool = True, environment_map: bool = False,
+                  ) -> tuple[viser.ViserServer, AppConfig]:
+    """Start the viser server with one :class:`Session` per connecting client.
+
+    Parameters
+    ----------
+    params : DriveParams  Start-up inputs of every new session.
+    origin : str          Preset name or file they came from.
+    host, port            Bind address; viser moves to the next free port if taken (see ``get_port``).
+    scene_3d : bool       Show the 3D rotors (tests switch it off).
+    environment_map : bool  viser's HDRI background (off by default: it stalls software WebGL).
+
+    Returns
+    -------
+    (viser.ViserServer, AppConfig)
+        The running server and its settings (``config.sessions`` maps client id → Session).
+    """
+    server = viser.ViserServer(host=host, port=port, verbose=False)
+    server.gui.set_panel_label("PMSM commissioning (FDSMC)")
+    if not environment_map:  # the HDRI stalls software WebGL for seconds
+        server.scene.configure_environment_map(hdri=None)
+    config = AppConfig(params, origin, scene_3d)
+
+    @server.on_client_connect
+    def _(client: viser.ClientHandle) -> None:
+        config.sessions[client.client_id] = Session(client, config)
+
+    @server.on_client_disconnect
+    def _(client: viser.ClientHandle) -> None:
+        session = config.sessions.pop(client.client_id, None)
+        if session is not None:
+            session.close()
+
+    return server, config
+
+
+__all__ = ["AppConfig", "Session", "comparison_or_derived", "create_server"]

@@ -1,0 +1,130 @@
+"""Pure text for the page: derived-values table, warnings, savings estimate (no viser here).
+
+The derived values are rendered generically from :func:`app.derived_view.derived_rows` so that
+new rows appear on the page without changes here.
+"""
+
+from __future__ import annotations
+
+import html
+from dataclasses import dataclass
+from typing import Any
+
+from app.derived_view import derived_rows
+from control.derivations import Derived
+
+#: Joules per kilowatt-hour [J/kWh].
+J_PER_KWH = 3.6e6
+
+
+def recommended_K(derived: Derived) -> float | None:
+    """The recommended boundary-layer gain K [s/rad] if the derivations provide one, else None."""
+    for owner in (derived, getattr(derived, "gain", None), getattr(derived, "feasibility", None)):
+        for name in ("recommended_K", "K_recommended", "K_rec"):
+            value = getattr(owner, name, None)
+            if isinstance(value, int | float) and not isinstance(value, bool) and value > 0:
+                return float(value)
+    return None
+
+
+def derived_markdown(derived: Derived) -> str:
+    """Markdown table of the derived values with units and equation numbers."""
+    lines = ["| quantity | symbol | value | unit | ref. |", "|---|---|--:|---|---|"]
+    for r in derived_rows(derived):
+        lines.append(f"| {r.label} | {r.symbol} | {r.text()} | {r.unit} | {r.ref} |")
+    k_rec = recommended_K(derived)
+    if k_rec is not None and not any(r.symbol in ("K_rec", "K_recommended") for r in derived_rows(derived)):
+        lines.append(f"| Recommended boundary-layer gain | K_rec | {k_rec:.5g} | s/rad | eq. (45) |")
+    return "\n".join(lines)
+
+
+def run_warnings(comparison: Any) -> list[str]:
+    """Warnings from the simulated runs: unstable, chatter, saturation."""
+    out: list[str] = []
+    k_rec = recommended_K(comparison.derived)
+    for run in (comparison.fdsmc, comparison.conventional):
+        if run is None:
+            continue
+        m, name = run.metrics, "FDSMC" if run.controller == "fdsmc" else "Conventional"
+        if m.get("stable") is False:
+            out.append(f"Unstable run ({name}): {m.get('reason') or 'diverged'}.")
+            continue
+        if m.get("chatter"):
+            hint = f" Recommended K = {k_rec:.4g} s/rad." if k_rec else " Reduce K, eq. (45)."
+            freq = m.get("chatter_frequency_Hz")
+            at = f" at about {freq:.3g} Hz" if isinstance(freq, float) else ""
+            out.append(f"Chatter ({name}): the demanded acceleration switches{at} during the cruise."
+                       + hint)
+        sat = m.get("saturated_s")
+        if isinstance(sat, float) and sat > 0.0:
+            out.append(f"Saturation ({name}): voltage/current limited for {sat:.4g} s.")
+    return out
+
+
+def warnings_html(items: list[str], error: str | None = None) -> str:
+    """A red box listing the input error and the warnings; a green line when there are none."""
+    if error is None and not items:
+        return ('<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:#2b8a3e;'
+                'font-size:0.85em">✔ No warnings.</div>')
+    parts = []
+    if error is not None:
+        parts.append(f'<div data-role="input-error" style="font-weight:600">⛔ Input error — nothing '
+                     f'simulated: {html.escape(error)}</div>')
+    if items:
+        lis = "".join(f"<li>{html.escape(w)}</li>" for w in items)
+        parts.append(f'<div style="font-weight:600">⚠ {len(items)} warning(s)</div>'
+                     f'<ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul>')
+    return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
+            'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>")
+
+
+@dataclass(frozen=True)
+class AnnualSavings:
+    """Energy and money the FDSMC saves per axis and year vs the conventional controller.
+
+    Attributes
+    ----------
+    per_cycle_J : float   Electrical input energy saved per manoeuvre [J] (negative = costs more).
+    kWh_per_year : float  Saved energy per year [kWh].
+    money_per_year : float  Saved money per year [currency].
+    """
+
+    per_cycle_J: float
+    kWh_per_year: float
+    money_per_year: float
+
+
+def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
+                   price_per_kWh: float) -> AnnualSavings | None:
+    """Savings on the net electrical input energy over the simulated horizon; None without both runs.
+
+    Parameters
+    ----------
+    comparison : sim.engine.Comparison
+    cycles_per_hour : float  Manoeuvres per hour [1/h].
+    hours_per_year : float   Operating hours per year [h].
+    price_per_kWh : float    Energy price [currency/kWh].
+    """
+    f, c = comparison.fdsmc, comparison.conventional
+    if f is None or c is None or not (f.metrics.get("stable") and c.metrics.get("stable")):
+        return None
+    e_f, e_c = f.metrics.get("electrical_in_total_J"), c.metrics.get("electrical_in_total_J")
+    if not isinstance(e_f, float) or not isinstance(e_c, float):
+        return None
+    per_cycle = e_c - e_f
+    kwh = per_cycle * cycles_per_hour * hours_per_year / J_PER_KWH
+    return AnnualSavings(per_cycle, kwh, kwh * price_per_kWh)
+
+
+def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
+    """Markdown summary of :func:`annual_savings`."""
+    if s is None:
+        return "_Simulate both controllers (stable runs) to estimate the savings._"
+    verb = "saves" if s.per_cycle_J >= 0 else "**costs more**:"
+    return (f"FDSMC {verb} **{abs(s.per_cycle_J):.4g} J** electrical input per cycle → "
+            f"**{s.kWh_per_year:.4g} kWh/year** and **{s.money_per_year:.4g} {currency}/year** per axis "
+            "(negative = the conventional controller is cheaper).")
+
+
+__all__ = ["AnnualSavings", "annual_savings", "derived_markdown", "recommended_K", "run_warnings",
+           "savings_markdown", "warnings_html"]
