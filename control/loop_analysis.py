@@ -181,7 +181,7 @@ def discrete_loop(
     return Z
 
 
-def _reduce_shift_mode(M: np.ndarray) -> np.ndarray:
+def reduce_shift_mode(M: np.ndarray) -> np.ndarray:
     """Remove the structural mode θ_r = θ̂_r = const of the cruise law (θ̂ not fed back).
 
     In the coordinates (e = θ − θ̂, θ̂) the θ̂ column only feeds itself; dropping it leaves the
@@ -204,7 +204,7 @@ def stability_measure(
     """Largest Re(s) [1/s] (continuous) or largest |z| − 1 [-] (sampled); < 0 means stable."""
     M = continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
     if law == "cruise":
-        M = _reduce_shift_mode(M)
+        M = reduce_shift_mode(M)
     ev = np.linalg.eigvals(M)
     return float(np.max(ev.real)) if f_s is None else float(np.max(np.abs(ev)) - 1.0)
 
