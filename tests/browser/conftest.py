@@ -1,0 +1,127 @@
+"""Browser-test fixtures, reusable by every UI test: an in-process server, Chromium, a page.
+
+* ``ui_server`` (session): the web UI on a free loopback port, 3D view and HDRI off.
+* ``browser`` (session): Debian's Chromium driven by Playwright (never ``playwright install``).
+* ``page`` (function): a fresh 1400×900 context + page, connected and showing the phase plane.
+* :func:`figure` reads a Plotly figure out of the page by its ``layout.meta.id``.
+
+Missing Chromium or Playwright: a failure when ``CI=true``, a skip otherwise.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+CHROMIUM = os.environ.get("CHROMIUM_PATH", "/usr/bin/chromium")
+LAUNCH_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking",
+               "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"]
+VIEWPORT = {"width": 1400, "height": 900}
+ARTIFACTS = Path(__file__).resolve().parents[2] / "test-artifacts"
+TIMEOUT_MS = 30_000
+
+
+def _missing(reason: str) -> None:
+    if os.environ.get("CI") == "true":
+        pytest.fail(f"CI=true: {reason}")
+    pytest.skip(reason)
+
+
+def free_port() -> int:
+    """A currently free TCP port on 127.0.0.1."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@dataclass
+class UiServer:
+    """A running web UI: its URL, the viser server and the app config (sessions by client id)."""
+
+    url: str
+    server: Any
+    config: Any
+
+
+@pytest.fixture(scope="session")
+def ui_server() -> Iterator[UiServer]:
+    """The web UI with the default preset, in-process on a free loopback port."""
+    from app.presets import DEFAULT_PRESET, load_preset
+    from app.ui_session import create_server
+
+    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, host="127.0.0.1",
+                                   port=free_port(), scene_3d=False, environment_map=False)
+    try:
+        yield UiServer(f"http://127.0.0.1:{server.get_port()}", server, config)
+    finally:
+        server.stop()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Any]:
+    """Playwright's Chromium (Debian's binary)."""
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        _missing("playwright is not installed")
+    if not (Path(CHROMIUM).exists() or shutil.which(CHROMIUM)):
+        _missing(f"chromium not found at {CHROMIUM} (apt-get install chromium)")
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, args=LAUNCH_ARGS)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+def open_page(browser: Any, url: str) -> tuple[Any, Any]:
+    """A new context + page at ``url``, waited until the phase plane is drawn. Returns (context, page)."""
+    context = browser.new_context(viewport=VIEWPORT, accept_downloads=True)
+    page = context.new_page()
+    page.set_default_timeout(TIMEOUT_MS)
+    page.goto(url)
+    page.get_by_role("button", name="Simulate").wait_for()
+    page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')]"
+                           ".some(e => e.layout && e.layout.meta && e.layout.meta.id === 'phase_plane')")
+    return context, page
+
+
+@pytest.fixture
+def page(browser: Any, ui_server: UiServer) -> Iterator[Any]:
+    """A connected page of the web UI (own browser context = own session)."""
+    context, pg = open_page(browser, ui_server.url)
+    try:
+        yield pg
+    finally:
+        context.close()
+
+
+FIGURE_JS = """(id) => {
+  const el = [...document.querySelectorAll('.js-plotly-plot')]
+    .find(e => e.layout && e.layout.meta && e.layout.meta.id === id);
+  if (!el) return null;
+  // _fullData holds the decoded arrays (data keeps Plotly's base64 "bdata" form).
+  return {meta: el.layout.meta, title: el.layout.title && el.layout.title.text,
+          traces: el._fullData.map(t => ({name: t.name, n: t.x ? t.x.length : 0,
+                                          y: Array.from(t.y || []).slice(0, 4000)}))};
+}"""
+
+
+def figure(page: Any, figure_id: str) -> dict[str, Any] | None:
+    """The figure with ``layout.meta.id == figure_id`` as drawn in the page (names, lengths, meta)."""
+    return page.evaluate(FIGURE_JS, figure_id)
+
+
+def set_number(page: Any, label: str, value: float | str) -> None:
+    """Type a value into the number field labelled ``label`` and leave the field (blur)."""
+    field = page.get_by_label(label, exact=True)
+    field.fill(str(value))
+    field.press("Tab")
+    page.wait_for_timeout(120)  # viser throttles GUI messages to one per 50 ms

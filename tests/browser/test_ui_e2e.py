@@ -1,0 +1,112 @@
+"""End-to-end tests of the web UI in a real Chromium (issue 4)."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from pathlib import Path
+
+from app.presets import DEFAULT_PRESET, dumps_preset, load_preset, loads_preset
+from control.derivations import derive
+from tests.browser.conftest import ARTIFACTS, figure, open_page, set_number
+
+
+def _phase_omega_p(page) -> float:
+    return float(figure(page, "phase_plane")["meta"]["omega_p"])
+
+
+def _wait_phase_omega_p(page, omega_p: float) -> None:
+    page.wait_for_function(
+        "(w) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"
+        " && e.layout.meta.id === 'phase_plane' && Math.abs(e.layout.meta.omega_p - w) < 1e-6 * w"
+        " && e.data.some(t => t.name === 'Conventional trajectory'))", arg=omega_p)
+
+
+def test_derived_alpha_max_of_default_preset(page):
+    d = derive(load_preset(DEFAULT_PRESET))
+    text = f"{d.alpha.alpha_max:.5g}"  # derived_rows format: 2651.2 rad/s²
+    assert page.get_by_text(text, exact=True).count() >= 1
+    assert "α_max" in page.content()
+
+
+def test_change_T_m_simulate_draws_both_trajectories_and_new_boundary(page):
+    params = load_preset(DEFAULT_PRESET)
+    new = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=1.4))
+    omega_p = derive(new).profile.omega_p
+    assert abs(omega_p - _phase_omega_p(page)) > 1.0
+    set_number(page, "T_m manoeuvre time [s]", 1.4)
+    page.get_by_role("button", name="Simulate").click()
+    _wait_phase_omega_p(page, omega_p)
+    fig = figure(page, "phase_plane")
+    names = {t["name"]: t for t in fig["traces"]}
+    assert names["FDSMC trajectory"]["n"] > 100
+    assert names["Conventional trajectory"]["n"] > 100
+    boundary = names["Switching boundary, eq. (41)"]["y"]
+    # Both horizontal segments of eq. (41) sit at ∓ω_p of the new manoeuvre.
+    assert abs(max(boundary) - omega_p) < 1e-6 * omega_p
+    assert abs(min(boundary) + omega_p) < 1e-6 * omega_p
+
+
+def test_invalid_value_shows_message_and_simulates_nothing(page, ui_server):
+    before = _phase_omega_p(page)
+    runs_before = {cid: s.runs for cid, s in ui_server.config.sessions.items()}
+    set_number(page, "J_r rotor inertia [kg·m²]", -0.1)
+    page.get_by_role("button", name="Simulate").click()
+    error = page.locator("[data-role=input-error]")
+    error.wait_for()
+    message = error.inner_text()
+    assert "J_r" in message and "-0.1" in message and "allowed" in message
+    page.wait_for_timeout(300)
+    assert {cid: s.runs for cid, s in ui_server.config.sessions.items()
+            if cid in runs_before} == runs_before
+    assert _phase_omega_p(page) == before
+
+
+def _download(page, label: str) -> str:
+    with page.expect_download() as info:
+        page.get_by_role("button", name=label).click()
+    return Path(info.value.path()).read_text(encoding="utf-8")
+
+
+def test_import_export_round_trip_and_c_header(page, tmp_path):
+    params = load_preset(DEFAULT_PRESET)
+    uploaded = dataclasses.replace(
+        params, name="imported_case", source="browser test",
+        manoeuvre=dataclasses.replace(params.manoeuvre, T_m=1.8),
+        load=dataclasses.replace(params.load, F_v=0.3333333333333333))
+    path = tmp_path / "imported_case.yaml"
+    path.write_text(dumps_preset(uploaded), encoding="utf-8")
+    page.locator("input[type=file]").set_input_files(str(path))
+    _wait_phase_omega_p(page, derive(uploaded).profile.omega_p)
+    assert page.get_by_label("T_m manoeuvre time [s]", exact=True).input_value() == "1.8"
+    page.get_by_text("Export", exact=True).click()
+    exported = _download(page, "Drive parameters (YAML)")
+    assert loads_preset(exported, "export.yaml") == uploaded
+    header = _download(page, "C header for firmware")
+    match = re.search(r"#define FDSMC_OMEGA_P\s+\(([^)]+)\)", header)
+    assert match is not None
+    assert abs(float(match.group(1)) - derive(uploaded).profile.omega_p) <= 1e-12 * float(match.group(1))
+
+
+def test_two_browser_contexts_keep_separate_values(browser, ui_server):
+    ctx_a, page_a = open_page(browser, ui_server.url)
+    ctx_b, page_b = open_page(browser, ui_server.url)
+    try:
+        params = load_preset(DEFAULT_PRESET)
+        new = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=2.2))
+        set_number(page_a, "T_m manoeuvre time [s]", 2.2)
+        page_a.get_by_role("button", name="Simulate").click()
+        _wait_phase_omega_p(page_a, derive(new).profile.omega_p)
+        page_b.wait_for_timeout(300)
+        assert page_b.get_by_label("T_m manoeuvre time [s]", exact=True).input_value() == "1"
+        assert abs(_phase_omega_p(page_b) - derive(params).profile.omega_p) < 1e-9
+    finally:
+        ctx_a.close()
+        ctx_b.close()
+
+
+def test_screenshot_of_main_view(page):
+    ARTIFACTS.mkdir(exist_ok=True)
+    out = ARTIFACTS / "ui_main.png"
+    page.screenshot(path=str(out))
+    assert out.stat().st_size > 20_000
