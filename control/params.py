@@ -207,6 +207,10 @@ class Controller:
         Controller sample rate [Hz], or ``"continuous"`` to evaluate the controller continuously.
     delay_samples : int
         Computation delay of the digital controller [samples] (0 or 1).
+    V_dc : float
+        Inverter DC-link voltage [V]; limits |u_dq| ≤ V_dc/√3. 0 = ideal inverter (the paper).
+    i_max : float
+        Inverter current limit on |i_q| [A]. 0 = none (the paper).
     """
 
     T_si: float
@@ -217,11 +221,14 @@ class Controller:
     alpha_max_rule: str = "paper"
     f_s: float | str = 20000.0
     delay_samples: int = 0
+    V_dc: float = 0.0
+    i_max: float = 0.0
 
     def __post_init__(self) -> None:
         _check_fields(self, "controller", {
             "T_si": (0.0, 10.0, True, "s"), "T_salpha": (0.0, 10.0, True, "s"),
             "T_so": (0.0, 10.0, True, "s"), "K": (0.0, 1e9, True, "s/rad"),
+            "V_dc": (0.0, 1e5, False, "V"), "i_max": (0.0, 1e6, False, "A"),
         })
         if self.T_c != "T_a":
             if isinstance(self.T_c, str):

@@ -149,7 +149,7 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str) -> np.ndar
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
     prm[[kn.P_G1, kn.P_G2]] = (d.conventional.g1, d.conventional.g2)
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
-    prm[[kn.P_UMAX, kn.P_IMAX]] = (getattr(ctrl, "u_max", 0.0), getattr(ctrl, "i_max", 0.0))
+    prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), ctrl.i_max)  # 0 = no limit
     prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
     w_scale = max(m.omega_b, pr.omega_p, abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
     i_scale = max(m.Gamma_max, d.alpha.torque_needed) / torque_constant(m)

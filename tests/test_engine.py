@@ -206,7 +206,21 @@ def test_infeasible_manoeuvre_raises_parameter_error(paper_params):
         simulate(paper_params, "pid")
 
 
-def test_delay_sample_and_inverter_limits_run(paper_params):
+def test_one_sample_delay_still_reaches_target(paper_params):
     p = _recommended(_with(paper_params, "controller", delay_samples=1, f_s=20000.0))
     m = simulate(p, "fdsmc").metrics
     assert m["stable"] and abs(m["theta_error_at_Tm_rad"]) < 0.02 * p.manoeuvre.theta_dem
+
+
+def test_inverter_limits_are_respected_and_reported(paper_params):
+    """|u_dq| ≤ V_dc/√3 and |i_q| ≲ i_max; time saturated > 0; energy balance still closes."""
+    p = _recommended(_with(paper_params, "controller", V_dc=700.0, i_max=100.0))
+    ideal = compare(_recommended(paper_params))
+    cmp = compare(p)
+    for run, free in ((cmp.fdsmc, ideal.fdsmc), (cmp.conventional, ideal.conventional)):
+        m = run.metrics
+        assert free.metrics["saturated_s"] == 0.0 and m["saturated_s"] > 0.0
+        assert m["u_peak_V"] <= 700.0 / math.sqrt(3.0) * (1 + 1e-9)
+        assert m["i_q_peak_A"] < 106.0  # the limit holds di_q/dt = 0 one sample late at most
+        assert m["energy_balance_residual_pct"] < 0.1
+    assert abs(cmp.fdsmc.metrics["theta_error_at_Tm_rad"]) < 0.02 * p.manoeuvre.theta_dem
