@@ -15,6 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from control.derivations import Derived
+from control.params import DriveParams
+from sim import kernel as kn
 from sim import signals
 
 #: Thresholds of the chatter criterion (fractions of α_max) and the smoothing window [s].
@@ -108,3 +111,93 @@ def response_metrics(
         "theta_error_at_Tm_rad": theta_at_Tm - theta_dem,
         "overshoot_rad": signals.overshoot(theta_r, 0.0, theta_dem),
     }
+
+
+def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
+    """Energies at T_m and at the end of the run, stored energies and the balance residual [J]."""
+    snap, end = info[kn.I_SNAP: kn.I_SNAP + kn.N_X], info[kn.I_END: kn.I_END + kn.N_X]
+    m = params.motor
+
+    def kinetic(x: np.ndarray) -> float:
+        return float(0.5 * params.J_total * x[kn.X_W] ** 2)
+
+    def magnetic(x: np.ndarray) -> float:
+        return float(0.75 * (m.L_d * x[kn.X_ID] ** 2 + m.L_q * x[kn.X_IQ] ** 2))
+
+    out: dict[str, float] = {}
+    for suffix, x in (("", snap), ("_total", end)):
+        out[f"friction{suffix}_J"] = float(x[kn.X_EF])
+        out[f"copper{suffix}_J"] = float(x[kn.X_ECU])
+        out[f"electrical_in{suffix}_J"] = float(x[kn.X_EEL])
+        out[f"motoring{suffix}_J"] = float(x[kn.X_EMOT])
+        out[f"regenerated{suffix}_J"] = float(x[kn.X_EMOT] - x[kn.X_EEL])
+        out[f"load_work{suffix}_J"] = float(x[kn.X_ELOAD])
+    out["kinetic_at_Tm_J"] = float(kinetic(snap))
+    out["kinetic_end_J"] = kinetic(end)
+    out["magnetic_end_J"] = magnetic(end)
+    stored = out["kinetic_end_J"] + out["magnetic_end_J"]
+    losses = out["copper_total_J"] + out["friction_total_J"] + out["load_work_total_J"]
+    residual = out["electrical_in_total_J"] - losses - stored
+    out["energy_balance_residual_J"] = float(residual)
+    ref = max(abs(out["electrical_in_total_J"]), out["motoring_total_J"], 1e-12)
+    out["energy_balance_residual_pct"] = float(100.0 * abs(residual) / ref)
+    return out
+
+
+def _chatter_window(params: DriveParams, d: Derived, controller: str) -> tuple[float, float]:
+    T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
+    if controller == "conventional":
+        return 0.2 * T_m, T_m
+    cruise = T_m - 4.0 * T_a
+    return T_a + 0.2 * cruise, T_a + 0.8 * cruise
+
+
+def run_metrics(
+    params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
+    alpha_dem: np.ndarray, omega_r: np.ndarray, info: np.ndarray,
+) -> dict[str, float | bool | str | None]:
+    """All metrics of one run from the (decimated) trace and the kernel's ``info`` vector.
+
+    Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
+    every number becomes None, ``stable`` False and ``reason`` says why.
+    """
+    failed = bool(info[kn.I_FAILED])
+    met: dict[str, float | bool | str | None] = {}
+    energies = energy_metrics(params, info)
+    theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
+    resp = response_metrics(t, theta_r, params.manoeuvre.theta_dem, theta_Tm)
+    cv = detect_chatter(t, alpha_dem, omega_r, _chatter_window(params, d, controller),
+                        d.alpha.alpha_max)
+    met.update(energies)
+    met.update(resp)
+    met.update({
+        "omega_peak_rad_s": float(info[kn.I_PW]),
+        "i_q_peak_A": float(info[kn.I_PIQ]),
+        "i_d_peak_A": float(info[kn.I_PID]),
+        "u_peak_V": float(info[kn.I_PU]),
+        "torque_peak_Nm": float(info[kn.I_PTQ]),
+        "saturated_s": float(info[kn.I_TSAT]),
+        "chatter": bool(cv.chatter),
+        "chatter_alpha_ptp_rad_s2": cv.ptp,
+        "chatter_frequency_Hz": cv.frequency_Hz,
+        "cruise_omega_ptp_rad_s": cv.omega_ptp,
+        "stable": not failed,
+        "reason": None,
+    })
+    if failed:
+        for k, v in met.items():
+            if isinstance(v, float) and k != "saturated_s":
+                met[k] = None
+        met["chatter"] = False
+        met["reason"] = _unstable_reason(d, float(info[kn.I_TFAIL]))
+    return met
+
+
+def _unstable_reason(d: Derived, t_fail: float) -> str:
+    text = f"diverged at t = {t_fail:.4g} s (a state became non-finite or left its bound)"
+    s = d.sample_rate
+    if s is not None and not s.stable:
+        need = f"≥ {s.f_s_min:.4g} Hz" if s.f_s_min is not None else "a faster controller"
+        text += (f": f_s = {s.f_s:g} Hz is too slow for T_so/T_sα (sampled inner loops + observer "
+                 f"have spectral radius {s.spectral_radius:.4f} ≥ 1; needs {need})")
+    return text
