@@ -34,6 +34,8 @@ TAIL_FRACTION = 0.3
 CONTINUOUS_STEP_S = 5e-6
 #: Most trace points kept per run (energies and peaks use every step).
 MAX_POINTS = 20000
+#: Most kernel steps per run (≈ 5 s of computing); longer runs are refused, not hung.
+MAX_STEPS = 20_000_000
 #: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
 PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
 
@@ -129,6 +131,12 @@ def _grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: int)
     else:
         T_s = 1.0 / float(ctrl.f_s)
         n_steps, h, sub = int(math.ceil(t_end / T_s)), T_s / n_sub, n_sub
+    if n_steps > MAX_STEPS:
+        rate = f"RK4 steps of {h_continuous:g} s" if ctrl.is_continuous else f"samples at f_s = {ctrl.f_s:g} Hz"
+        t_max = MAX_STEPS / n_steps * params.manoeuvre.T_m
+        raise ParameterError(
+            f"manoeuvre.T_m = {params.manoeuvre.T_m:g} s needs {n_steps:.3g} {rate}: allowed "
+            f"T_m ≤ {t_max:.4g} s (at most {MAX_STEPS:.0e} steps per run)")
     decim = max(1, int(math.ceil(n_steps / max_points)))
     return _Grid(ctrl.is_continuous, h, n_steps, sub, decim, n_steps // decim + 1)
 

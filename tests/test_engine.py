@@ -204,6 +204,16 @@ def test_infeasible_manoeuvre_raises_parameter_error(paper_params):
         compare(p)
     with pytest.raises(ParameterError, match="controller"):
         simulate(paper_params, "pid")
+    with pytest.raises(ParameterError, match=r"manoeuvre.T_m = 5000 s .* allowed T_m ≤"):
+        simulate(_with(paper_params, "manoeuvre", T_m=5000.0), "fdsmc")  # refused, not hung
+
+
+def test_negative_demand_is_mirror_image(paper_params):
+    p = _recommended(paper_params)
+    pos = simulate(p, "fdsmc").metrics
+    neg = simulate(_with(p, "manoeuvre", theta_dem=-p.manoeuvre.theta_dem), "fdsmc").metrics
+    assert neg["friction_J"] == pytest.approx(pos["friction_J"], rel=1e-9)
+    assert neg["theta_error_at_Tm_rad"] == pytest.approx(-pos["theta_error_at_Tm_rad"], rel=1e-6, abs=1e-9)
 
 
 def test_one_sample_delay_still_reaches_target(paper_params):
