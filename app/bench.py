@@ -12,6 +12,7 @@ import statistics
 import time
 
 from app.cli import add_preset_arguments
+from app.cli_bldc import bench_figure
 from app.presets import load_preset
 from control.derivations import derive
 from sim.engine import CONTINUOUS_STEP_S, compare, run_steps, table1_sweep
@@ -58,4 +59,5 @@ def run(args: argparse.Namespace) -> int:
     sk, sr = n_k / tk, n_r / tr
     print(f"kernel throughput (digital, 1 RK4 substep/sample): compiled {sk:,.0f} samples/s, "
           f"plain-Python reference {sr:,.0f} samples/s, speed-up ×{sk / sr:,.0f}")
+    print(bench_figure())  # BLDC mode: 2000 rpm scenario, simulated s per wall s
     return 0

@@ -104,15 +104,19 @@ def rk4_hold(y: np.ndarray, v_a: float, v_b: float, v_c: float, T_L: float, prm:
     ``work`` is a scratch array of shape (5, N_X).
     """
     k1, k2, k3, k4, tmp = work[0], work[1], work[2], work[3], work[4]
-    for _ in range(n_sub):
+    for _ in range(n_sub):  # explicit loops: no temporary arrays in the hot path
         plant_derivative(y, v_a, v_b, v_c, T_L, prm, table, k1)
-        tmp[:] = y + 0.5 * h * k1
+        for j in range(N_X):
+            tmp[j] = y[j] + 0.5 * h * k1[j]
         plant_derivative(tmp, v_a, v_b, v_c, T_L, prm, table, k2)
-        tmp[:] = y + 0.5 * h * k2
+        for j in range(N_X):
+            tmp[j] = y[j] + 0.5 * h * k2[j]
         plant_derivative(tmp, v_a, v_b, v_c, T_L, prm, table, k3)
-        tmp[:] = y + h * k3
+        for j in range(N_X):
+            tmp[j] = y[j] + h * k3[j]
         plant_derivative(tmp, v_a, v_b, v_c, T_L, prm, table, k4)
-        y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        for j in range(N_X):
+            y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
 
 
 @njit(cache=True)

@@ -80,3 +80,12 @@ def test_reachability_hyperbola_eq24():
     assert not bad.ok and bad.violated
     lo, hi = bad.violated[-1]
     assert 0.0 < lo < hi
+
+
+def test_one_rk4_step_per_sample_is_converged():
+    """The default N_SUB = 1 (h = 50 µs) against 4 substeps: metrics agree to 1e-3 relative."""
+    p = load_preset("bldc_smc_paper", ["scenario.active=2000rpm"])
+    a, b = simulate_bldc(p, n_sub=1).metrics, simulate_bldc(p, n_sub=4).metrics
+    for key in ("torque_ripple_pct", "copper_loss_J", "overshoot_rpm", "electrical_in_total_J"):
+        assert a[key] == pytest.approx(b[key], rel=1e-3)
+    assert abs(a["speed_error_ss_rpm"] - b["speed_error_ss_rpm"]) < 1e-3
