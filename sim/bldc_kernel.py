@@ -120,13 +120,29 @@ def rk4_hold(y: np.ndarray, v_a: float, v_b: float, v_c: float, T_L: float, prm:
 
 
 @njit(cache=True)
+def speed_law(ctrl: int, eps: float, z: np.ndarray, prm: np.ndarray) -> tuple[float, float]:
+    """Torque reference T* [N·m] and σ_ω [rad/s] of the chosen speed loop; updates z[0]."""
+    T_s, T_max = prm[P_TS], prm[P_TMAX]
+    if ctrl == C_SMC_INTEGRAL:  # eq. (16) in [2], integral by forward Euler
+        sigma = z[0] + eps
+        z[0] += T_s * _i_rate(eps, prm[P_LAM0], prm[P_EPSL])
+        return _t_ref(sigma, prm[P_KW], T_max), sigma
+    if ctrl == C_SMC_PLAIN:
+        return _t_plain(eps, prm[P_KW], T_max), eps
+    sigma = eps + z[0] / prm[P_KPW]
+    T_ref = _pi_out(z[0], eps, prm[P_KPW], T_max)
+    z[0] = _pi_int(z[0], eps, prm[P_KPW], prm[P_KIW], T_s, T_max)
+    return T_ref, sigma
+
+
+@njit(cache=True)
 def control_step(y: np.ndarray, z: np.ndarray, prm: np.ndarray, out: np.ndarray) -> None:
     """One sample of the chosen drive; updates integrators ``z`` = [I_ω, I_d, I_q] in place.
 
     ``out`` receives [v_α, v_β, T*, σ_ω, i_dx, i_qx, i*_qx] (SI units).
     """
     ctrl = int(prm[P_CTRL])
-    T_s, T_max = prm[P_TS], prm[P_TMAX]
+    T_s = prm[P_TS]
     i_al, i_be = _ab(y[0], y[1], -y[0] - y[1])
     th = prm[P_NPP] * y[3]
     eps = prm[P_WREF] - y[2]
@@ -138,17 +154,7 @@ def control_step(y: np.ndarray, z: np.ndarray, prm: np.ndarray, out: np.ndarray)
         f_al, f_be = _ab(Pm * _trap(th), Pm * _trap(th - TWO_PI / 3.0), Pm * _trap(th - 2.0 * TWO_PI / 3.0))
         a_x, phi = _gain_angle(f_al, f_be, Pm)
     i_d, i_q = _to_dqx(i_al, i_be, a_x, phi)
-    if ctrl == C_SMC_INTEGRAL:
-        sigma = z[0] + eps
-        T_ref = _t_ref(sigma, prm[P_KW], T_max)
-        z[0] += T_s * _i_rate(eps, prm[P_LAM0], prm[P_EPSL])
-    elif ctrl == C_SMC_PLAIN:
-        sigma = eps
-        T_ref = _t_plain(eps, prm[P_KW], T_max)
-    else:
-        sigma = eps + z[0] / prm[P_KPW]
-        T_ref = _pi_out(z[0], eps, prm[P_KPW], T_max)
-        z[0] = _pi_int(z[0], eps, prm[P_KPW], prm[P_KIW], T_s, T_max)
+    T_ref, sigma = speed_law(ctrl, eps, z, prm)
     i_q_ref = T_ref / prm[P_KTS]
     if ctrl == C_PI_SINUSOIDAL:
         e_d, e_q = -i_d, i_q_ref - i_q
