@@ -20,6 +20,8 @@ from control.sliding_mode import boundary_speed
 
 #: Most points drawn per trace.
 MAX_POINTS = 2000
+#: Most points per trace in the (24-trace) time plots.
+MAX_POINTS_TIME = 1500
 #: Line colours per controller.
 COLOURS = {"fdsmc": "#1f6fd1", "conventional": "#e8590c"}
 LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional"}
@@ -171,7 +173,7 @@ def make_time_plots_figure(comparison: Any) -> go.Figure:
     t_end = 0.0
     for key, run in runs(comparison):
         tr = run.trace
-        i = decimate_index(len(tr.t))
+        i = decimate_index(len(tr.t), MAX_POINTS_TIME)
         t_end = max(t_end, float(tr.t[-1]))
         for row, (_, unit, signals) in enumerate(TIME_ROWS, start=1):
             for attr, label, dash in signals:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -29,7 +30,8 @@ from app.figures import (
 from app.ui_scene import RotorScene
 
 FRAME_HZ = 20.0
-CURSOR_HZ = 5.0
+CURSOR_HZ = 2.0
+AUTOPLAY_DELAY_S = 0.4
 SPEEDS = {"0.1×": 0.1, "0.25×": 0.25, "0.5×": 0.5, "1×": 1.0}
 _CURSOR = "__cursor__"
 
@@ -87,8 +89,9 @@ class Replay:
     """Play/pause/replay buttons, time slider and speed; drives the figures and the 3D scene."""
 
     def __init__(self, gui: viser.GuiApi, phase: viser.GuiPlotlyHandle,
-                 time_plots: viser.GuiPlotlyHandle, scene: RotorScene | None) -> None:
-        self._phase, self._time_plots, self._scene = phase, time_plots, scene
+                 time_plots: viser.GuiPlotlyHandle, scene: RotorScene | None,
+                 flush: Callable[[], None] = lambda: None) -> None:
+        self._phase, self._time_plots, self._scene, self._flush = phase, time_plots, scene, flush
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -113,6 +116,7 @@ class Replay:
         """Show a new comparison: whole figures first, then (optionally) replay from t = 0."""
         self.pause()
         set_figure_json(self._phase, make_phase_plane_figure(comparison).to_json())
+        self._flush()  # the phase plane goes out before the larger figures are even built
         with self._lock:
             self._comparison = comparison
             self._phase_tpl = PhaseTemplate(comparison)
@@ -122,7 +126,7 @@ class Replay:
         self.slider.max = self._t_end
         self.slider.step = self._t_end / 1000.0
         if autoplay:
-            self.play(restart=True)
+            self.play(restart=True, delay=AUTOPLAY_DELAY_S)  # the browser draws the whole result first
         else:
             self.seek(self._t_end)
 
@@ -140,15 +144,15 @@ class Replay:
             self._scene.show({key: float(np.interp(t_now, run.trace.t, run.trace.theta_r))
                               for key, run in runs(comparison)})
 
-    def play(self, restart: bool = False) -> None:
-        """Start (or restart from t = 0) the replay thread."""
+    def play(self, restart: bool = False, delay: float = 0.0) -> None:
+        """Start (or restart from t = 0) the replay thread, after ``delay`` [s]."""
         self.pause()
         if self._phase_tpl is None:
             return
         if restart or self._t_now >= self._t_end:
             self._t_now = 0.0
         self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name="ui-replay", daemon=True)
+        self._thread = threading.Thread(target=self._run, args=(delay,), name="ui-replay", daemon=True)
         self._thread.start()
 
     def pause(self) -> None:
@@ -159,7 +163,9 @@ class Replay:
             thread.join(timeout=2.0)
         self._thread = None
 
-    def _run(self) -> None:
+    def _run(self, delay: float) -> None:
+        if self._stop.wait(delay):
+            return
         period, every = 1.0 / FRAME_HZ, max(1, round(FRAME_HZ / CURSOR_HZ))
         t0, wall0, n = self._t_now, time.monotonic(), 0
         while not self._stop.is_set():

@@ -56,7 +56,7 @@ class ResultsPanel:
         with time_tab:
             self.time_plots = gui.add_plotly(make_time_plots_figure(comparison), aspect=ASPECT_TIME)
         with phase_tab:
-            self.replay = Replay(gui, self.phase, self.time_plots, scene)
+            self.replay = Replay(gui, self.phase, self.time_plots, scene, flush=client.flush)
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
             self.energy = gui.add_plotly(make_energy_figure(comparison), aspect=ASPECT_SMALL)
             self.bars = gui.add_plotly(make_energy_bars_figure(comparison), aspect=ASPECT_SMALL)

@@ -115,6 +115,9 @@ class Session:
         except InputError as exc:
             self._reject(str(exc))
             return False
+        if self.worker.busy:
+            return self.submit(lambda: None)  # refused, with the "busy" note
+        self.results.replay.pause()  # frees the browser for the new result
         return self.submit(lambda: self._run(params))
 
     def submit(self, fn: Callable[[], None]) -> bool:
