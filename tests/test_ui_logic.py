@@ -1,0 +1,86 @@
+"""UI logic without a browser: worker (no overlapping runs), text panels, input parsing, serve args."""
+
+from __future__ import annotations
+
+import dataclasses
+import threading
+import time
+
+import pytest
+
+from app.serve import is_loopback
+from app.ui_inputs import InputError, parse_steps
+from app.ui_results import parse_T_m_list
+from app.ui_text import annual_savings, derived_markdown, recommended_K, run_warnings, warnings_html
+from app.ui_worker import Worker
+from control.derivations import derive
+from sim.engine import compare
+
+
+def test_worker_refuses_a_second_job_while_one_runs():
+    busy: list[bool] = []
+    gate, ran = threading.Event(), []
+    w = Worker(busy.append, lambda exc: None)
+    assert w.submit(lambda: (gate.wait(5), ran.append(1))) is not None
+    assert w.submit(lambda: ran.append(2)) is None  # double-click: refused
+    gate.set()
+    for _ in range(100):
+        if not w.busy:
+            break
+        time.sleep(0.01)
+    assert ran == [1] and busy == [True, False]
+    assert w.submit(lambda: ran.append(3)).result(5) is None and ran == [1, 3]
+    w.close()
+
+
+def test_worker_reports_errors_instead_of_losing_them():
+    errors: list[Exception] = []
+    w = Worker(lambda b: None, errors.append)
+    w.submit(lambda: 1 / 0).result(5)
+    assert isinstance(errors[0], ZeroDivisionError) and not w.busy
+    w.close()
+
+
+def test_derived_markdown_lists_alpha_max_and_recommended_K(paper_params):
+    d = derive(paper_params)
+    text = derived_markdown(d)
+    assert f"| {d.alpha.alpha_max:.5g} | rad/s² |" in text
+    k_rec = recommended_K(d)
+    assert k_rec is not None and k_rec < paper_params.controller.K
+    assert f"{k_rec:.5g}" in text
+
+
+def test_warnings_html_escapes_and_flags_errors():
+    box = warnings_html(["T_m < T_m,min"], error="motor.J_r = -0.1 <bad>")
+    assert 'data-role="input-error"' in box and "&lt;bad&gt;" in box and "T_m &lt; T_m,min" in box
+    assert "No warnings" in warnings_html([])
+
+
+def test_run_warnings_and_savings(paper_params):
+    c = compare(paper_params)
+    warnings = run_warnings(c)
+    assert any(w.startswith("Chatter (FDSMC)") and "Recommended K" in w for w in warnings)
+    s = annual_savings(c, 600.0, 4000.0, 0.25)
+    e_f = c.fdsmc.metrics["electrical_in_total_J"]
+    e_c = c.conventional.metrics["electrical_in_total_J"]
+    assert s.per_cycle_J == pytest.approx(e_c - e_f)
+    assert s.kWh_per_year == pytest.approx((e_c - e_f) * 600 * 4000 / 3.6e6)
+    assert s.money_per_year == pytest.approx(0.25 * s.kWh_per_year)
+    assert annual_savings(dataclasses.replace(c, fdsmc=None), 1, 1, 1) is None
+
+
+def test_parse_steps_and_T_m_list():
+    assert parse_steps("0.5:10, 1.2:0") == [{"t": 0.5, "Gamma_Le": 10.0}, {"t": 1.2, "Gamma_Le": 0.0}]
+    assert parse_steps("  ") == []
+    with pytest.raises(InputError, match="allowed 't:Γ_Le' pairs"):
+        parse_steps("0.5-10")
+    assert parse_T_m_list("1.0, 1.4;1.8") == [1.0, 1.4, 1.8]
+    with pytest.raises(ValueError, match="allowed 0 < T_m"):
+        parse_T_m_list("1.0, -2")
+    with pytest.raises(ValueError, match="not a number"):
+        parse_T_m_list("1.0, x")
+
+
+def test_loopback_detection():
+    assert is_loopback("127.0.0.1") and is_loopback("localhost") and is_loopback("::1")
+    assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.5")
