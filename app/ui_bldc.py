@@ -73,8 +73,10 @@ def metrics_markdown(comp: BldcComparison) -> str:
 class BldcTab:
     """Widgets and actions of the BLDC tab of one client."""
 
-    def __init__(self, client: viser.ClientHandle, submit: Callable[[Callable[[], None]], Any]) -> None:
+    def __init__(self, client: viser.ClientHandle, submit: Callable[[Callable[[], None]], Any],
+                 figures_container: Any = None) -> None:
         self.client, self.gui, self._submit = client, client.gui, submit
+        self._figures_container = figures_container
         self.params: BldcParams = load_preset(PRESET)
         self.comparison: BldcComparison | None = None
         self._build()
@@ -95,7 +97,8 @@ class BldcTab:
         self.upload.on_upload(self._uploaded)
         self.run_button = gui.add_button("Simulate BLDC", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.run_button.on_click(lambda _: self.simulate())
-        self.status = gui.add_markdown("Ready — press **Simulate BLDC**.")
+        self.status = gui.add_markdown("Ready — press **Simulate BLDC**; the figures are in the results "
+                                       "panel's **BLDC figures** tab.")
         self.warnings = gui.add_markdown("")
         with gui.add_folder("Scenario", expand_by_default=False):
             self.w_ref = gui.add_number("ω* [rpm]", rad_s_to_rpm(p.case.omega_ref), step=10.0)
@@ -107,7 +110,7 @@ class BldcTab:
                 self.inputs[label] = gui.add_number(label, value, step=step)
         with gui.add_folder("Metrics", expand_by_default=True):
             self.metrics = gui.add_markdown("No run yet.")
-        with gui.add_folder("Figures", expand_by_default=True):
+        with self._figures_container or gui.add_folder("Figures", expand_by_default=True):
             self.fig_speed = gui.add_plotly(_placeholder("bldc_speed", "Speed"), aspect=ASPECT)
             self.fig_torque = gui.add_plotly(_placeholder("bldc_torque", "Torque"), aspect=ASPECT)
             self.fig_sigma = gui.add_plotly(_placeholder("bldc_sigma", "σ_ω"), aspect=ASPECT)
@@ -222,6 +225,11 @@ class BldcTab:
                                        save_immediately=True)
 
 
-def build_bldc_tab(client: viser.ClientHandle, submit: Callable[[Callable[[], None]], Any]) -> BldcTab:
-    """Build the BLDC tab in the current GUI container of ``client``; returns its handle object."""
-    return BldcTab(client, submit)
+def build_bldc_tab(client: viser.ClientHandle, submit: Callable[[Callable[[], None]], Any],
+                   figures_container: Any = None) -> BldcTab:
+    """Build the BLDC tab in the current GUI container of ``client``; returns its handle object.
+
+    ``figures_container`` (e.g. a tab of the wide results panel) receives the figures; without
+    it they go into a folder of the current container.
+    """
+    return BldcTab(client, submit, figures_container)

@@ -83,8 +83,8 @@ class Session:
         tabs = gui.add_tab_group()
         with tabs.add_tab("Position drive (FDSMC)"):
             self._controls()
-        _add_bldc_tab(self.client, tabs, self.submit)
         self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep)
+        _add_bldc_tab(self.client, tabs, self.submit, self.results.panel)
         self.results.panel.dock_right()
         self.results.panel.set_width(RESULTS_WIDTH)
 
@@ -223,14 +223,15 @@ class Session:
 
 
 def _add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,
-                  submit: Callable[[Callable[[], None]], Any]) -> None:
-    """Second mode: the BLDC speed-control tab, when :mod:`app.ui_bldc` is installed."""
+                  submit: Callable[[Callable[[], None]], Any], results: Any) -> None:
+    """Second mode: the BLDC tab (inputs left, figures in a "BLDC figures" tab of ``results``)."""
     try:
         from app.ui_bldc import build_bldc_tab
     except ImportError:
         return
+    figures_tab = results.add_tab("BLDC figures", viser.Icon.ENGINE)
     with tabs.add_tab("BLDC speed SMC", viser.Icon.ENGINE):
-        build_bldc_tab(client, submit)
+        build_bldc_tab(client, submit, figures_tab)
 
 
 def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", port: int = 8080,

@@ -18,6 +18,7 @@ def _open_tab(page) -> None:
 def test_bldc_tab_runs_paper_scenario_and_shows_metrics_and_speed_figure(page):
     _open_tab(page)
     page.get_by_role("button", name="Simulate BLDC").click()
+    page.get_by_role("tab", name="BLDC figures").click()  # the figures live in the wide results panel
     page.wait_for_function(FIG_JS, arg="bldc_speed", timeout=60_000)
     page.get_by_text("Steady-state speed error").first.wait_for()
     # metrics table: one row per metric, one column per drive
