@@ -12,6 +12,7 @@ from app.cli import add_preset_arguments
 from app.derived_view import derived_json
 from app.presets import load_preset
 from sim.engine import Comparison, RunResult, compare
+from sim.verdicts import run_warnings
 
 #: Trace columns written by ``--csv``: (Trace field, header, unit).
 CSV_COLUMNS = (
@@ -74,6 +75,7 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
             out[run.controller] = dict(run.metrics)
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
+    out["run_warnings"] = run_warnings(cmp)
     return finite_or_none(out)
 
 
@@ -118,16 +120,7 @@ def print_summary(cmp: Comparison) -> None:
         print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
               f"(eq. (52) predicts {_fmt(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
         print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
-    for r in runs:
-        if not r.metrics["stable"]:
-            print(f"\n! {r.controller}: UNSTABLE — {r.metrics['reason']}")
-        elif r.metrics["chatter"]:
-            g = cmp.derived.gain
-            rec = f" Recommended K = {g.K_recommended:.4g} s/rad (K_limit = {g.K_limit:.4g})." if g else ""
-            print(f"\n! {r.controller}: chatter — α_dem swings {r.metrics['chatter_alpha_ptp_rad_s2']:.4g} rad/s² "
-                  f"peak-to-peak at ≈ {r.metrics['chatter_frequency_Hz']:.0f} Hz during the cruise: the "
-                  f"boundary-layer gain is above the loop's stability limit.{rec}")
-    for w in cmp.derived.warnings:
+    for w in run_warnings(cmp) + list(cmp.derived.warnings):
         print(f"  ! {w}")
 
 

@@ -22,11 +22,12 @@ from app.ui_files import FilesPanel
 from app.ui_inputs import InputError, InputsPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
-from app.ui_text import derived_markdown, recommended_K, run_warnings, warnings_html
+from app.ui_text import derived_markdown, warnings_html
 from app.ui_worker import Worker
 from control.derivations import derive
 from control.params import DriveParams, ParameterError
 from sim.engine import PAPER_TABLE1, Comparison, compare, table1_sweep
+from sim.verdicts import recommended_K, run_warnings
 
 #: Widths of the control panel (left) and the results panel (right) [px].
 CONTROL_WIDTH, RESULTS_WIDTH = 430, 780

@@ -17,48 +17,12 @@ from control.derivations import Derived
 J_PER_KWH = 3.6e6
 
 
-def recommended_K(derived: Derived) -> float | None:
-    """The recommended boundary-layer gain K [s/rad] if the derivations provide one, else None."""
-    for owner in (derived, getattr(derived, "gain", None), getattr(derived, "feasibility", None)):
-        for name in ("recommended_K", "K_recommended", "K_rec"):
-            value = getattr(owner, name, None)
-            if isinstance(value, int | float) and not isinstance(value, bool) and value > 0:
-                return float(value)
-    return None
-
-
 def derived_markdown(derived: Derived) -> str:
     """Markdown table of the derived values with units and equation numbers."""
     lines = ["| quantity | symbol | value | unit | ref. |", "|---|---|--:|---|---|"]
     for r in derived_rows(derived):
         lines.append(f"| {r.label} | {r.symbol} | {r.text()} | {r.unit} | {r.ref} |")
-    k_rec = recommended_K(derived)
-    if k_rec is not None and not any(r.symbol in ("K_rec", "K_recommended") for r in derived_rows(derived)):
-        lines.append(f"| Recommended boundary-layer gain | K_rec | {k_rec:.5g} | s/rad | eq. (45) |")
     return "\n".join(lines)
-
-
-def run_warnings(comparison: Any) -> list[str]:
-    """Warnings from the simulated runs: unstable, chatter, saturation."""
-    out: list[str] = []
-    k_rec = recommended_K(comparison.derived)
-    for run in (comparison.fdsmc, comparison.conventional):
-        if run is None:
-            continue
-        m, name = run.metrics, "FDSMC" if run.controller == "fdsmc" else "Conventional"
-        if m.get("stable") is False:
-            out.append(f"Unstable run ({name}): {m.get('reason') or 'diverged'}.")
-            continue
-        if m.get("chatter"):
-            hint = f" Recommended K = {k_rec:.4g} s/rad." if k_rec else " Reduce K, eq. (45)."
-            freq = m.get("chatter_frequency_Hz")
-            at = f" at about {freq:.3g} Hz" if isinstance(freq, float) else ""
-            out.append(f"Chatter ({name}): the demanded acceleration switches{at} during the cruise."
-                       + hint)
-        sat = m.get("saturated_s")
-        if isinstance(sat, float) and sat > 0.0:
-            out.append(f"Saturation ({name}): voltage/current limited for {sat:.4g} s.")
-    return out
 
 
 def warnings_html(items: list[str], error: str | None = None) -> str:
@@ -126,5 +90,5 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
             "(negative = the conventional controller is cheaper).")
 
 
-__all__ = ["AnnualSavings", "annual_savings", "derived_markdown", "recommended_K", "run_warnings",
+__all__ = ["AnnualSavings", "annual_savings", "derived_markdown",
            "savings_markdown", "warnings_html"]

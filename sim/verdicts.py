@@ -1,0 +1,80 @@
+"""Verdicts on simulated runs: instability, chatter, saturation and the real drive's limits.
+
+One place composes these messages, for the CLI, the web UI and the exported report.
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+from control.derivations import Derived
+from control.model import available_voltage
+from sim.engine import Comparison, RunResult
+
+NAMES = {"fdsmc": "FDSMC", "conventional": "Conventional"}
+
+
+def recommended_K(derived: Derived) -> float | None:
+    """Recommended boundary-layer gain K [s/rad] from the loop analysis, or None if none helps."""
+    g = derived.gain
+    return g.K_recommended if g is not None and g.K_recommended > 0.0 else None
+
+
+def _chatter(run: RunResult, derived: Derived) -> str:
+    m = run.metrics
+    k_rec = recommended_K(derived)
+    hint = f" Recommended K = {k_rec:.4g} s/rad." if k_rec else " Reduce K, eq. (45)."
+    freq = m.get("chatter_frequency_Hz")
+    at = f" at about {freq:.3g} Hz" if isinstance(freq, float) else ""
+    return (f"Chatter ({NAMES[run.controller]}): the demanded acceleration switches{at} during the cruise — "
+            f"the boundary-layer gain is above the loop's stability limit.{hint}")
+
+
+def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
+    """Simulated peaks that the real drive cannot deliver (Γ_max, available voltage, ω_b).
+
+    Parameters
+    ----------
+    run : RunResult
+        A stable run.
+    derived : Derived
+        Derivations of the same case (motor limits).
+
+    Returns
+    -------
+    list of str
+        One message per limit exceeded.
+    """
+    m, motor, name = run.metrics, derived.params.motor, NAMES[run.controller]
+    out: list[str] = []
+    torque, volts, speed = m.get("torque_peak_Nm"), m.get("u_peak_V"), m.get("omega_peak_rad_s")
+    u_avail = available_voltage(motor)
+    if isinstance(torque, float) and torque > motor.Gamma_max:
+        out.append(f"Not feasible on the real drive ({name}): peak torque {torque:.4g} N·m > "
+                   f"Γ_max = {motor.Gamma_max:g} N·m.")
+    if isinstance(volts, float) and volts > u_avail:
+        out.append(f"Not feasible on the real drive ({name}): peak |u_dq| {volts:.4g} V > "
+                   f"{u_avail:.4g} V available (√(2/3)·V_0).")
+    if isinstance(speed, float) and speed > motor.omega_b:
+        out.append(f"Not feasible on the real drive ({name}): peak speed {speed:.4g} rad/s > "
+                   f"ω_b = {motor.omega_b:g} rad/s.")
+    return out
+
+
+def run_warnings(comparison: Comparison) -> list[str]:
+    """Warnings from the simulated runs: unstable, chatter, saturation, drive limits exceeded."""
+    out: list[str] = []
+    for run in (comparison.fdsmc, comparison.conventional):
+        if run is None:
+            continue
+        m, name = run.metrics, NAMES[run.controller]
+        if m.get("stable") is False:
+            out.append(f"Unstable run ({name}): {m.get('reason') or 'diverged'}.")
+            continue
+        if m.get("chatter"):
+            out.append(_chatter(run, comparison.derived))
+        sat = m.get("saturated_s")
+        if isinstance(sat, float) and sat > 0.0:
+            out.append(f"Saturation ({name}): voltage/current limited for {sat:.4g} s.")
+        out += limit_warnings(run, comparison.derived)
+    return out

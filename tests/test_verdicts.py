@@ -1,0 +1,41 @@
+"""Post-simulation verdicts: the real drive's limits are checked against the simulated peaks."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from control.model import available_voltage
+from sim.engine import compare
+from sim.verdicts import limit_warnings, recommended_K, run_warnings
+
+
+@pytest.fixture(scope="module")
+def quiet_paper(paper_params):
+    """Paper preset (section 5) with the recommended K: no chatter, but α_max needs ≈ 400 N·m."""
+    from control.derivations import derive
+
+    k = recommended_K(derive(paper_params))
+    return compare(dataclasses.replace(paper_params, controller=dataclasses.replace(paper_params.controller, K=k)))
+
+
+def test_paper_case_exceeds_torque_and_voltage_of_the_real_drive(quiet_paper):
+    fd = quiet_paper.fdsmc
+    msgs = limit_warnings(fd, quiet_paper.derived)
+    # the simulated peaks, not the predictions, are quoted
+    assert any(f"{fd.metrics['torque_peak_Nm']:.4g} N·m > Γ_max = 40 N·m" in m for m in msgs)
+    u_avail = available_voltage(quiet_paper.derived.params.motor)
+    assert fd.metrics["u_peak_V"] > u_avail
+    assert any("peak |u_dq|" in m for m in msgs)
+    assert not any(m.startswith("Chatter") for m in run_warnings(quiet_paper))
+
+
+def test_a_drive_big_enough_gets_no_limit_warning(quiet_paper):
+    p = quiet_paper.derived.params
+    big = dataclasses.replace(p, motor=dataclasses.replace(p.motor, Gamma_max=2000.0, V_0=3000.0, omega_b=400.0))
+    from control.derivations import derive
+
+    d = derive(big)
+    assert limit_warnings(quiet_paper.fdsmc, d) == []
+    assert limit_warnings(quiet_paper.conventional, d) == []
