@@ -24,6 +24,7 @@ The inertia is the user's estimate J_r + J_L from the preset; the controller kno
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -227,14 +228,7 @@ def gain_limit(d: Derived, law: str, f_s: float | None, delay: int = 0) -> float
         if unstable(float(K)):
             if prev is None:
                 return 0.0
-            lo, hi = prev, float(K)
-            while hi / lo > 1.005:
-                mid = math.sqrt(lo * hi)
-                if unstable(mid):
-                    hi = mid
-                else:
-                    lo = mid
-            return hi
+            return geometric_bisect(unstable, prev, float(K), 1.005)
         prev = float(K)
     return math.inf
 
@@ -318,10 +312,18 @@ def minimum_sample_rate(d: Derived, delay: int = 0) -> float | None:
     lo = 100.0
     if not unstable(lo):
         return lo
-    while hi / lo > 1.01:
+    return geometric_bisect(lambda fs: not unstable(fs), lo, hi, 1.01)
+
+
+def geometric_bisect(flips: Callable[[float], bool], lo: float, hi: float, ratio: float) -> float:
+    """Smallest x in (lo, hi] with ``flips(x)`` true, given flips(lo) false and flips(hi) true.
+
+    Bisection on a log scale until hi/lo ≤ ``ratio``; returns the upper end (where it flips).
+    """
+    while hi / lo > ratio:
         mid = math.sqrt(lo * hi)
-        if unstable(mid):
-            lo = mid
-        else:
+        if flips(mid):
             hi = mid
+        else:
+            lo = mid
     return hi
