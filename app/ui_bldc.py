@@ -25,7 +25,7 @@ from app.figures_bldc import (
     make_speed_figure,
     make_torque_figure,
 )
-from app.presets import dumps_preset, load_preset
+from app.presets import dumps_preset, load_preset, loads_preset
 from app.units import kHz_to_Hz, mH_to_H, rad_s_to_rpm, rpm_to_rad_s
 from control.bldc_design import bldc_design
 from control.bldc_params import BldcParams
@@ -89,6 +89,7 @@ class BldcTab:
                          "(Monteiro et al.): paper drive vs plain tanh SMC vs sinusoidal dq PI.")
         names = [c.name for c in p.scenario.cases]
         self.scenario = gui.add_dropdown("Scenario", names, initial_value=p.scenario.active)
+        self.scenario.on_update(lambda _: self._scenario_chosen())
         self.emf = gui.add_dropdown("Machine back-EMF", ("ideal", "distorted", "measured"),
                                     initial_value=p.machine.emf)
         self.emf.on_update(self._emf_chosen)
@@ -120,22 +121,28 @@ class BldcTab:
             self.fig_reach = gui.add_plotly(_placeholder("bldc_reach", "Reachability"), aspect=ASPECT)
         self.download = gui.add_button("Download BLDC preset (YAML)", icon=viser.Icon.DOWNLOAD)
         self.download.on_click(lambda _: self._download())
+        self.import_preset = gui.add_upload_button("Import BLDC preset (YAML)", icon=viser.Icon.UPLOAD,
+                                                   mime_type=".yaml,.yml,text/yaml,text/plain")
+        self.import_preset.on_upload(lambda _: self._imported())
 
     # ---- inputs -------------------------------------------------------------------------------
     def collect(self) -> BldcParams:
         """Parameters from the widgets; ParameterError naming field, value and range if bad."""
         p = self.params
         sections: dict[str, dict[str, Any]] = {"machine": {}, "mechanics": {}, "inverter": {}, "gains": {}}
-        for label, sec, name, to_si, _, _ in FIELDS:
+        for label, sec, name, to_si, from_si, _ in FIELDS:
             raw = self.inputs[label].value
             if raw is None:
                 raise ParameterError(f"{label} is empty: allowed a number")
-            sections[sec][name] = to_si(raw) if name != "n_pp" else raw
+            current = getattr(getattr(p, sec), name)
+            # an untouched field keeps its exact SI value (export → import gives back the same inputs)
+            sections[sec][name] = current if raw == from_si(current) else to_si(raw)
         sections["machine"]["emf"] = self.emf.value
         new = {sec: dataclasses.replace(getattr(p, sec), **vals) for sec, vals in sections.items()}
         case = next(c for c in p.scenario.cases if c.name == self.scenario.value)
-        case = dataclasses.replace(case, omega_ref=rpm_to_rad_s(float(self.w_ref.value)),
-                                   t_end=float(self.t_end.value))
+        w_rpm = float(self.w_ref.value)
+        omega_ref = case.omega_ref if w_rpm == rad_s_to_rpm(case.omega_ref) else rpm_to_rad_s(w_rpm)
+        case = dataclasses.replace(case, omega_ref=omega_ref, t_end=float(self.t_end.value))
         cases = tuple(case if c.name == case.name else c for c in p.scenario.cases)
         scen = dataclasses.replace(p.scenario, active=case.name, cases=cases)
         return dataclasses.replace(p, scenario=scen, **new)
@@ -180,6 +187,13 @@ class BldcTab:
         self.status.content = (f"Done: scenario **{params.case.name}**, back-EMF **{params.machine.emf}**, "
                                f"{sim_s:g} s simulated in {comp.wall_s * 1e3:.0f} ms.")
 
+    def _scenario_chosen(self) -> None:
+        """Show the chosen scenario's reference speed and duration."""
+        case = next((c for c in self.params.scenario.cases if c.name == self.scenario.value), None)
+        if case is not None:
+            self.w_ref.value = rad_s_to_rpm(case.omega_ref)
+            self.t_end.value = case.t_end
+
     def _emf_chosen(self, event: viser.GuiEvent) -> None:
         if event.client is None:
             return
@@ -213,6 +227,34 @@ class BldcTab:
         note = (f"Loaded **{f.name}**: phase shifts {shifts}; fundamental offset vs the ideal trapezoid "
                 f"{measured.offset_deg:+.1f}° (the controller assumes 0°).")
         self.status.content = note
+        self._show_design()
+
+    def _imported(self) -> None:
+        f = self.import_preset.value
+        try:
+            params = loads_preset(f.content.decode("utf-8"), f.name)
+        except UnicodeDecodeError:
+            self.status.content = f"**Import rejected — nothing changed:** {f.name} is not UTF-8 text"
+            return
+        except (ParameterError, ValueError) as exc:
+            self.status.content = f"**Import rejected — nothing changed:** {exc}"
+            return
+        if not isinstance(params, BldcParams):
+            self.status.content = (f"**Import rejected — nothing changed:** {f.name} is a position-drive "
+                                   "preset: import it in the *Position drive (FDSMC)* tab")
+            return
+        self.apply(params)
+        self.status.content = f"Imported **{params.name}** ({f.name}) — press **Simulate BLDC**."
+
+    def apply(self, params: BldcParams) -> None:
+        """Show ``params`` in every widget of the tab and make them the tab's parameters."""
+        self.params = params
+        for label, sec, name, _, from_si, _ in FIELDS:
+            self.inputs[label].value = from_si(getattr(getattr(params, sec), name))
+        self.scenario.options = [c.name for c in params.scenario.cases]
+        self.scenario.value = params.scenario.active
+        self._scenario_chosen()
+        self.emf.value = params.machine.emf
         self._show_design()
 
     def _download(self) -> None:

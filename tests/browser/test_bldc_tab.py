@@ -49,3 +49,44 @@ def test_bldc_tab_rejects_bad_input_with_message(page):
     msg.wait_for()
     text = msg.inner_text() + page.content()
     assert "inverter.V_dc" in text and "allowed" in text
+
+
+def test_bldc_import_scenario_switch_and_export_round_trip(page, tmp_path):
+    import dataclasses
+    from pathlib import Path
+
+    from app.presets import dumps_preset, load_preset, loads_preset
+
+    params = load_preset("bldc_smc_paper")
+    uploaded = dataclasses.replace(params, name="bldc_imported", source="browser test",
+                                   inverter=dataclasses.replace(params.inverter, V_dc=310.0),
+                                   scenario=dataclasses.replace(params.scenario, active="2000rpm"))
+    path = tmp_path / "bldc_imported.yaml"
+    path.write_text(dumps_preset(uploaded), encoding="utf-8")
+    _open_tab(page)
+    with page.expect_file_chooser() as chooser:
+        page.get_by_role("button", name="Import BLDC preset (YAML)").click()
+    chooser.value.set_files(str(path))
+    page.get_by_text("Imported", exact=False).first.wait_for()
+    page.get_by_text("Machine, load, inverter, gains", exact=True).click()
+    assert float(page.get_by_label("V_dc [V]", exact=True).input_value()) == 310.0
+    page.get_by_text("Scenario", exact=True).nth(1).click()  # the folder (index 0 is the dropdown label)
+    assert abs(float(page.get_by_label("ω* [rpm]", exact=True).input_value()) - 2000.0) < 1e-6
+    with page.expect_download() as info:
+        page.get_by_role("button", name="Download BLDC preset (YAML)").click()
+    exported = loads_preset(Path(info.value.path()).read_text(encoding="utf-8"), "export.yaml")
+    assert exported == uploaded
+
+
+def test_bldc_import_of_a_position_preset_is_rejected_and_changes_nothing(page, tmp_path):
+    from app.presets import DEFAULT_PRESET, PRESET_DIR
+
+    _open_tab(page)
+    page.get_by_text("Machine, load, inverter, gains", exact=True).click()
+    with page.expect_file_chooser() as chooser:
+        page.get_by_role("button", name="Import BLDC preset (YAML)").click()
+    chooser.value.set_files(str(PRESET_DIR / f"{DEFAULT_PRESET}.yaml"))
+    msg = page.locator("p", has_text="Import rejected").first
+    msg.wait_for()
+    assert "position-drive preset" in msg.inner_text()
+    assert float(page.get_by_label("V_dc [V]", exact=True).input_value()) == 300.0  # unchanged
