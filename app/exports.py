@@ -1,8 +1,8 @@
 """Exports: the drive parameter file (YAML / JSON / C header), CSV time series, an offline HTML report.
 
 The YAML file is a valid preset (written by :func:`app.presets.dumps_preset`, so it re-imports
-to exactly the same inputs in the UI and the CLI) followed by the derived drive gains as
-commented ``# NAME: value  # [unit] reference`` lines. The JSON file holds the same inputs and
+to exactly the same inputs in the UI and the CLI) followed by ``exported_from`` and the derived
+``drive_gains`` as data, one ``NAME: value  # [unit] reference`` line each. The JSON file holds the same inputs and
 gains as data, plus the full ``derive --json`` object. The C header ``#define``s every gain in
 upper case with its unit in a comment.
 """
@@ -76,12 +76,17 @@ def _num(x: float) -> str:
 
 
 def parameter_yaml(params: DriveParams, d: Derived, origin: str) -> str:
-    """Drive parameter file as YAML: an importable preset + the drive gains in comments."""
+    """Drive parameter file as YAML: an importable preset + ``exported_from`` + ``drive_gains`` data.
+
+    ``drive_gains`` maps each upper-case gain name to its SI value, with the unit and equation in
+    a comment on the same line. On import the gains are recomputed from the inputs (the preset
+    loader ignores ``drive_gains`` and ``exported_from``), so export → import is exact.
+    """
     head = [f"# Drive parameter file — {TOOL}, {_dt.date.today().isoformat()}",
-            f"# Inputs from: {origin}. All values SI (see docs/nomenclature.md).",
-            "# Re-import: upload this file in the web UI, or `python -m app derive <file>`."]
-    tail = ["", "# Derived drive gains (SI; not read back on import — they follow from the inputs):"]
-    tail += [f"# {g.name}: {_num(g.value)}  # [{g.unit}] {g.ref}" for g in drive_gains(d)]
+            "# All values SI (see docs/nomenclature.md). Re-import: upload this file in the web UI, or",
+            "# `python -m app derive <file>`; drive_gains are then recomputed from the inputs."]
+    tail = [f"exported_from: {json.dumps(origin)}", "drive_gains:"]
+    tail += [f"  {g.name}: {_num(g.value)}  # [{g.unit}] {g.ref}" for g in drive_gains(d)]
     tail += [f"# warning: {w}" for w in d.warnings]
     return "\n".join(head) + "\n" + dumps_preset(params) + "\n".join(tail) + "\n"
 

@@ -29,6 +29,9 @@ PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 MAX_BYTES = 256 * 1024
 DEFAULT_PRESET = "paper_12kw_pmsm"
 _TOP_KEYS = ("schema", "name", "source", "mode")
+#: Top-level keys an exported drive parameter file adds; informational, ignored on import (the
+#: gains are recomputed from the inputs).
+_EXPORT_KEYS = ("exported_from", "drive_gains")
 
 #: Parameter dataclass per preset mode. Other modes register themselves here.
 MODES: dict[str, type] = {"position": DriveParams}
@@ -143,7 +146,7 @@ def parse_preset(raw: Any) -> Any:
         raise PresetError(f"mode = {mode!r} is not known{_hint(str(mode), list(MODES))}")
     cls = MODES[mode]
     sections = [f.name for f in dataclasses.fields(cls) if f.name not in ("name", "source")]
-    allowed = list(_TOP_KEYS) + list(sections)
+    allowed = list(_TOP_KEYS) + list(_EXPORT_KEYS) + list(sections)
     for key in raw:
         if key not in allowed:
             raise PresetError(f"unknown top-level key {key!r}{_hint(str(key), allowed)}")

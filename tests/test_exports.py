@@ -18,7 +18,7 @@ from app.exports import (
     trace_csv,
 )
 from app.figures import make_phase_plane_figure
-from app.presets import loads_preset
+from app.presets import loads_preset, loads_raw
 from app.ui_files import parse_upload, safe_stem
 from control.derivations import derive
 from control.params import ParameterError
@@ -33,8 +33,12 @@ def derived(paper_params):
 def test_yaml_export_reimports_to_identical_inputs(paper_params, derived):
     text = parameter_yaml(paper_params, derived, "paper_12kw_pmsm")
     assert loads_preset(text, "export.yaml") == paper_params
-    assert f"# OBS_K1: {derived.observer.K1!r}" in text
-    assert "# ALPHA_MAX:" in text and "[rad/s^2]" in text
+    raw = loads_raw(text, "export.yaml")
+    gains = raw["drive_gains"]  # the gains are data the drive can read, not comments
+    assert raw["exported_from"] == "paper_12kw_pmsm"
+    assert gains["OBS_K1"] == derived.observer.K1 and gains["ALPHA_MAX"] == derived.alpha.alpha_max
+    assert gains["OBS_L4"] == float(derived.observer_discrete.L[3])
+    assert f"OBS_K1: {derived.observer.K1!r}  # [1/s]" in text  # unit on the same line
 
 
 def test_json_export_holds_inputs_and_every_gain(paper_params, derived):
