@@ -234,11 +234,11 @@ def simulate(
     prm = pack_parameters(params, d, controller)
     step_t, step_v = _load_steps(params)
     Phi, Gam, Lo = _observer_arrays(d)
-    out = np.zeros((g.n_out, kn.N_CH))
+    out = np.zeros((kn.N_CH, g.n_out))
     info = np.zeros(kn.N_INFO)
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
                   params.controller.delay_samples, g.decim, out, info)
-    trace = _trace(out[: int(info[kn.I_NOUT])])
+    trace = _trace(out[:, : int(info[kn.I_NOUT])])
     met = run_metrics(params, d, controller, trace.t, trace.theta_r, trace.alpha_dem, trace.omega_r, info)
     return RunResult(controller, trace, met)
 
@@ -262,19 +262,19 @@ def run_steps(
     Phi, Gam, Lo = _observer_arrays(d)
     cont = params.controller.is_continuous
     h = h_continuous if cont else 1.0 / float(params.controller.f_s) / n_sub
-    out = np.zeros((1, kn.N_CH))
+    out = np.zeros((kn.N_CH, 1))
     info = np.zeros(kn.N_INFO)
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
                   params.controller.delay_samples, int(n_steps) + 1, out, info)
     return info[kn.I_END: kn.I_END + kn.N_X].copy()
 
 
-def _trace(rows: np.ndarray) -> Trace:
-    finite = np.all(np.isfinite(rows), axis=1)
+def _trace(chans: np.ndarray) -> Trace:
+    """Trace from the kernel's channel-major output (each row is one contiguous channel)."""
+    finite = np.all(np.isfinite(chans), axis=0)
     if not np.all(finite):
-        rows = rows[: int(np.argmin(finite))]
-    cols = {name: np.ascontiguousarray(rows[:, i]) for i, name in enumerate(kn.CHANNELS)}
-    return Trace(**cols)
+        chans = chans[:, : int(np.argmin(finite))]
+    return Trace(**{name: chans[i] for i, name in enumerate(kn.CHANNELS)})
 
 
 def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:

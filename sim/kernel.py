@@ -229,7 +229,7 @@ def observer_update(p: tuple, o: tuple, a_em: float, Phi: np.ndarray, Gam: np.nd
 @_helper
 def record(row: np.ndarray, t: float, p: tuple, o: tuple, u: tuple, prm: np.ndarray,
            step_t: np.ndarray, step_v: np.ndarray) -> None:
-    """Write one trace row (channels in CHANNELS order); u = (u_d, u_q, α_dem, α̂, S)."""
+    """Write one trace sample (channels in CHANNELS order); u = (u_d, u_q, α_dem, α̂, S)."""
     dp = plant_rhs(t, p, u[0], u[1], prm, step_t, step_v)
     T_em = electromagnetic_torque(p[X_ID], p[X_IQ], prm)
     row[0], row[1], row[2], row[3], row[4] = t, p[X_TH], p[X_W], p[X_ID], p[X_IQ]
@@ -292,7 +292,7 @@ def step_sample(p: tuple, o: tuple, hold: tuple, continuous: bool,
 def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray,
                Gam: np.ndarray, Lo: np.ndarray, continuous: bool, h: float, n_steps: int,
                n_sub: int, delay: int, decim: int, out: np.ndarray, info: np.ndarray) -> None:
-    """Integrate one run from rest; fills ``out`` (trace rows) and ``info`` (see I_* indices).
+    """Integrate one run from rest; fills ``out`` (N_CH × samples) and ``info`` (I_* indices).
 
     Digital mode: ``n_steps`` samples of period n_sub·h; controller and observer at each
     sample, voltages held (one sample later if ``delay``), n_sub RK4 substeps in between.
@@ -304,8 +304,8 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
     info[:] = 0.0
     for k in range(n_steps):
         u, o_next, hold, rec, sat = step_sample(p, o, hold, continuous, delay, prm, Phi, Gam, Lo)
-        if k % decim == 0 and n_out < out.shape[0]:
-            record(out[n_out], t, p, o, rec, prm, step_t, step_v)
+        if k % decim == 0 and n_out < out.shape[1]:
+            record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
             n_out += 1
         pk = peaks(pk, p, u[0], u[1], prm)
         t_sat += h * n_sub if sat else 0.0

@@ -50,15 +50,12 @@ class ChatterVerdict:
 
 
 def hysteretic_sign_changes(r: np.ndarray, hyst: float) -> int:
-    """Number of sign changes of ``r`` counting only swings beyond ±``hyst``."""
-    state, count = 0, 0
-    for v in r:
-        s = 1 if v > hyst else (-1 if v < -hyst else 0)
-        if s != 0 and s != state:
-            if state != 0:
-                count += 1
-            state = s
-    return count
+    """Number of sign changes of ``r`` counting only swings beyond ±``hyst``.
+
+    Samples inside ±hyst are ignored; every change between consecutive remaining signs counts.
+    """
+    s = np.sign(r)[np.abs(r) > hyst]
+    return int(np.count_nonzero(s[1:] != s[:-1]))
 
 
 def detect_chatter(

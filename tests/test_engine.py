@@ -234,3 +234,14 @@ def test_inverter_limits_are_respected_and_reported(paper_params):
         assert m["i_q_peak_A"] < 106.0  # the limit holds di_q/dt = 0 one sample late at most
         assert m["energy_balance_residual_pct"] < 0.1
     assert abs(cmp.fdsmc.metrics["theta_error_at_Tm_rad"]) < 0.02 * p.manoeuvre.theta_dem
+
+
+def test_hysteretic_sign_changes_counts_half_cycles_and_ignores_small_noise():
+    """A sine of k periods has 2k half-cycles, i.e. 2k − 1 sign changes; noise inside ±hyst none."""
+    from sim.metrics import hysteretic_sign_changes
+
+    t = np.linspace(0.0, 1.0, 20001)
+    for k in (1, 4, 37):
+        r = np.sin(2.0 * np.pi * k * t)
+        assert hysteretic_sign_changes(r, 0.1) == 2 * k - 1
+        assert hysteretic_sign_changes(0.05 * r, 0.1) == 0
