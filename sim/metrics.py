@@ -2,10 +2,12 @@
 
 Chatter criterion (documented in ``docs/paper_reproduction.md``): inside the evaluation window
 (the middle 60 % of the planned cruise segment for the FDSMC, [0.2·T_m, T_m] for the
-conventional law) take the high-pass part r = α_dem − (moving average of α_dem over 5 ms). The
-loop chatters when r swings by more than 20 % of α_max peak-to-peak **and** r changes sign (with
-a hysteresis of 2.5 % of α_max) at least 8 times, i.e. a sustained oscillation of the demanded
-acceleration at ≥ 100 Hz-scale frequencies with an amplitude comparable to the control range —
+conventional law; at most its central 0.25 s), sampled at every controller step (not the
+decimated trace, so that a limit cycle is never aliased away), take the high-pass part
+r = α_dem − (moving average of α_dem over 5 ms). The loop chatters when r swings by more than
+20 % of α_max peak-to-peak **and** r changes sign (with a hysteresis of 2.5 % of α_max) at least
+8 times, i.e. a sustained oscillation of the demanded acceleration at ≥ 100 Hz-scale frequencies
+with an amplitude comparable to the control range —
 the limit cycle of a too-high boundary-layer gain K — not a single transient.
 """
 
@@ -25,6 +27,17 @@ CHATTER_PTP_FRACTION = 0.2
 CHATTER_HYSTERESIS_FRACTION = 0.025
 CHATTER_MIN_SIGN_CHANGES = 8
 CHATTER_SMOOTHING_S = 0.005
+#: Longest chatter evaluation window [s] (its centre part is kept).
+CHATTER_MAX_WINDOW_S = 0.25
+
+
+@dataclass(frozen=True)
+class WindowSamples:
+    """Full-resolution samples of the chatter window: t [s], α_dem [rad/s²], ω_r [rad/s]."""
+
+    t: np.ndarray
+    alpha_dem: np.ndarray
+    omega_r: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -78,10 +91,7 @@ def detect_chatter(
         return ChatterVerdict(False, 0.0, 0, 0.0, 0.0, window)
     ts, a = t[sel], alpha_dem[sel]
     dt = float(np.median(np.diff(ts)))
-    n = max(1, int(round(CHATTER_SMOOTHING_S / dt)))
-    kernel = np.ones(n) / n
-    smooth = np.convolve(np.pad(a, (n // 2, n - 1 - n // 2), mode="edge"), kernel, mode="valid")
-    r = a - smooth
+    r = a - moving_average(a, max(1, int(round(CHATTER_SMOOTHING_S / dt))))
     ptp = float(np.ptp(r))
     changes = hysteretic_sign_changes(r, CHATTER_HYSTERESIS_FRACTION * alpha_max)
     chatter = ptp > CHATTER_PTP_FRACTION * alpha_max and changes >= CHATTER_MIN_SIGN_CHANGES
@@ -141,19 +151,41 @@ def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
     return out
 
 
-def _chatter_window(params: DriveParams, d: Derived, controller: str) -> tuple[float, float]:
+def moving_average(a: np.ndarray, n: int) -> np.ndarray:
+    """Centred moving average of ``a`` over ``n`` samples (edges padded), O(len(a))."""
+    c = np.concatenate(([0.0], np.cumsum(np.pad(a, (n // 2, n - 1 - n // 2), mode="edge"))))
+    return (c[n:] - c[:-n]) / n
+
+
+def chatter_window(params: DriveParams, d: Derived, controller: str) -> tuple[float, float]:
+    """Chatter evaluation window (t0, t1) [s]: see the module docstring."""
     T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
     if controller == "conventional":
-        return 0.2 * T_m, T_m
-    cruise = T_m - 4.0 * T_a
-    return T_a + 0.2 * cruise, T_a + 0.8 * cruise
+        t0, t1 = 0.2 * T_m, T_m
+    else:
+        cruise = T_m - 4.0 * T_a
+        t0, t1 = T_a + 0.2 * cruise, T_a + 0.8 * cruise
+    if t1 - t0 > CHATTER_MAX_WINDOW_S:
+        mid = 0.5 * (t0 + t1)
+        t0, t1 = mid - 0.5 * CHATTER_MAX_WINDOW_S, mid + 0.5 * CHATTER_MAX_WINDOW_S
+    return t0, t1
+
+
+def chatter_window_steps(window: tuple[float, float], T_step: float) -> tuple[int, int]:
+    """First step index and number of steps [-] of ``window`` [s] for steps of T_step [s]."""
+    t0, t1 = window
+    if t1 <= t0:
+        return 0, 0
+    k0 = int(np.ceil(t0 / T_step))
+    return k0, max(0, int(np.floor(t1 / T_step)) - k0 + 1)
 
 
 def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
-    alpha_dem: np.ndarray, omega_r: np.ndarray, info: np.ndarray,
+    samples: WindowSamples, info: np.ndarray,
 ) -> dict[str, float | bool | str | None]:
-    """All metrics of one run from the (decimated) trace and the kernel's ``info`` vector.
+    """All metrics of one run from the (decimated) trace, the full-resolution chatter-window
+    ``samples`` and the kernel's ``info`` vector.
 
     Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
     every number becomes None, ``stable`` False and ``reason`` says why.
@@ -163,8 +195,8 @@ def run_metrics(
     energies = energy_metrics(params, info)
     theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
     resp = response_metrics(t, theta_r, params.manoeuvre.theta_dem, theta_Tm)
-    cv = detect_chatter(t, alpha_dem, omega_r, _chatter_window(params, d, controller),
-                        d.alpha.alpha_max)
+    cv = detect_chatter(samples.t, samples.alpha_dem, samples.omega_r,
+                        chatter_window(params, d, controller), d.alpha.alpha_max)
     met.update(energies)
     met.update(resp)
     met.update({
