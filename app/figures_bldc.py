@@ -21,7 +21,8 @@ from sim.bldc_engine import LABELS, BldcComparison
 
 RPM = 60.0 / (2.0 * math.pi)
 MAX_POINTS = 3000
-COLORS = {"smc_integral": "#1f77b4", "smc_plain": "#ff7f0e", "pi_sinusoidal": "#2ca02c"}
+COLORS = {"smc_integral": "#1f77b4", "smc_plain": "#ff7f0e", "pi_sinusoidal": "#2ca02c", "six_step": "#9467bd"}
+PHASE_COLORS = ("#d62728", "#2ca02c", "#1f77b4")
 _MARGIN = {"l": 55, "r": 15, "t": 40, "b": 40}
 
 
@@ -111,17 +112,25 @@ def make_sigma_figure(comp: BldcComparison) -> go.Figure:
     return _layout(fig, "bldc_sigma", "Sliding variable σ_ω, eq. (16)")
 
 
-def make_currents_figure(comp: BldcComparison, controller: str = "smc_integral") -> go.Figure:
-    """Phase currents i_a, i_b, i_c of one drive."""
-    r = comp.run(controller)
-    tr = r.trace
-    k = _stride(tr.t.size)
-    fig = go.Figure()
-    for j, name in enumerate("abc"):
-        fig.add_scatter(x=tr.t[::k], y=tr.i_abc[j, ::k], name=f"i_{name}")
-    fig.update_xaxes(title="t [s]")
-    fig.update_yaxes(title="phase current [A]")
-    return _layout(fig, "bldc_currents", f"Phase currents — {LABELS[controller]}")
+def make_currents_figure(comp: BldcComparison,
+                         controllers: tuple[str, ...] = ("smc_integral", "six_step")) -> go.Figure:
+    """Phase currents i_a, i_b, i_c, one row per drive of ``controllers`` present in ``comp``.
+
+    By default the paper's drive (currents shaped by dq_x) above six-step (120° square waves).
+    """
+    names = [c for c in controllers if any(r.controller == c for r in comp.runs)] or [comp.runs[0].controller]
+    fig = make_subplots(rows=len(names), cols=1, shared_xaxes=True, vertical_spacing=0.1,
+                        subplot_titles=[LABELS[c] for c in names])
+    for row, c in enumerate(names, start=1):
+        tr = comp.run(c).trace
+        k = _stride(tr.t.size)
+        for j, phase in enumerate("abc"):
+            fig.add_scatter(x=tr.t[::k], y=tr.i_abc[j, ::k], name=f"i_{phase}", legendgroup=phase,
+                            showlegend=row == 1, line={"color": PHASE_COLORS[j], "width": 1}, row=row, col=1)
+        fig.update_yaxes(title="i [A]", row=row, col=1)
+    fig.update_xaxes(title="t [s]", row=len(names), col=1)
+    fig.update_annotations(font={"size": 11})
+    return _layout(fig, "bldc_currents", "Phase currents", height=200 + 150 * len(names))
 
 
 def make_reachability_figure(design: BldcDesign) -> go.Figure:

@@ -31,7 +31,7 @@ from control.bldc_design import bldc_design
 from control.bldc_params import BldcParams
 from control.params import ParameterError
 from sim.bldc_emf import machine_table
-from sim.bldc_engine import LABELS, BldcComparison, compare_bldc
+from sim.bldc_engine import CONTROLLERS, LABELS, BldcComparison, compare_bldc
 
 PRESET = "bldc_smc_paper"
 ASPECT = 0.75
@@ -85,8 +85,8 @@ class BldcTab:
     # ---- layout -------------------------------------------------------------------------------
     def _build(self) -> None:
         gui, p = self.gui, self.params
-        gui.add_markdown("Sliding-mode vector speed control of a trapezoidal-EMF PMSM "
-                         "(Monteiro et al.): paper drive vs plain tanh SMC vs sinusoidal dq PI.")
+        gui.add_markdown("Sliding-mode vector speed control of a trapezoidal-EMF PMSM (Monteiro et al.): "
+                         "paper drive vs plain tanh SMC vs sinusoidal dq PI vs six-step (120° currents).")
         names = [c.name for c in p.scenario.cases]
         self.scenario = gui.add_dropdown("Scenario", names, initial_value=p.scenario.active)
         self.scenario.on_update(lambda _: self._scenario_chosen())
@@ -167,7 +167,7 @@ class BldcTab:
         return bool(self._submit(lambda: self._run(params)))
 
     def _run(self, params: BldcParams) -> None:
-        self.status.content = "Simulating… (3 drives)"
+        self.status.content = f"Simulating… ({len(CONTROLLERS)} drives)"
         self.run_button.disabled = True
         try:
             comp = compare_bldc(params)

@@ -23,7 +23,8 @@ class BldcDesign:
     Attributes
     ----------
     K_Tx : float                 n_pp·√(3/2)·Φ_m, eq. (9) [N·m/A] (used for i*_qx).
-    K_T_fig7 : float             2·n_pp·Φ_M of Fig. 7 (six-step line-current constant) [N·m/A].
+    K_T_fig7 : float             2·n_pp·Φ_M of Fig. 7 (six-step line-current constant, used for
+                                 the six-step drive's I* = T*/K_T) [N·m/A].
     i_qx_max : float             T_max/K_Tx [A].
     current : CurrentLoopDesign  Sampled tanh current loop figures.
     pi : PiVectorDesign          Matched gains of the sinusoidal PI comparator.

@@ -9,7 +9,9 @@ Controllers:
 * ``smc_integral`` — the paper's drive [2]: dq_x (ideal a_x, θ_x) + tanh current SMC
   (eqs. (13)–(14)) + integral sliding surface with anti-windup (eqs. (15)–(16));
 * ``smc_plain`` — the same without the integral term (σ_ω = ε_ω);
-* ``pi_sinusoidal`` — conventional sinusoidal dq vector control with PI loops.
+* ``pi_sinusoidal`` — conventional sinusoidal dq vector control with PI loops;
+* ``six_step`` — 120° square-wave current commutation from θ_e (Fig. 1 of [2]) with the paper's
+  integral speed surface, I* = T*/(2·n_pp·Φ_M) (:mod:`control.bldc_six_step`).
 
 [2] Monteiro, de Castro, de Almeida, the SMC-BLDC paper.
 """
@@ -30,11 +32,12 @@ from sim import bldc_kernel as kn
 from sim.bldc_emf import machine_table
 from sim.bldc_metrics import run_metrics
 
-CONTROLLERS = ("smc_integral", "smc_plain", "pi_sinusoidal")
+CONTROLLERS = ("smc_integral", "smc_plain", "pi_sinusoidal", "six_step")
 LABELS = {
     "smc_integral": "dq_x + SMC, integral surface (paper)",
     "smc_plain": "dq_x + SMC, plain tanh (no integral)",
     "pi_sinusoidal": "sinusoidal dq + PI",
+    "six_step": "six-step 120° commutation + integral surface",
 }
 #: RK4 steps per controller sample [-]: at 20 kHz, 1 step (h = 50 µs, ω_e·h ≤ 0.03 rad at
 #: 2000 rpm) gives the same metrics as 4 steps to < 1e-3 relative (tests/test_bldc_model.py).
@@ -50,7 +53,8 @@ class BldcTrace:
     t [s]; omega [rad/s] mechanical speed; omega_ref [rad/s]; T_L [N·m] load torque;
     T_EL [N·m] electromagnetic torque, eq. (3); T_ref [N·m] torque reference; sigma [rad/s]
     σ_ω of eq. (16) (ε_ω for the plain law, ε + I/K_p for PI); i_abc [A] shape (3, n);
-    i_dx, i_qx [A] currents in the controller's frame; i_qx_ref [A]; v_phase [V] winding
+    i_dx, i_qx [A] currents in the controller's frame (six-step: open-phase current and line
+    current of the conducting pair); i_qx_ref [A] (six-step: I*); v_phase [V] winding
     voltages v_x − v_n, shape (3, n); theta_e [rad]; E_in [J] electrical input energy;
     E_copper, E_friction, E_load [J] cumulative losses / load work (integrated with the plant);
     E_kin [J] ½·J·(ω² − ω_0²); E_mag [J] ½·(L_s − M_s)·Σi_x².
@@ -121,7 +125,8 @@ def pack_parameters(params: BldcParams, design: BldcDesign, controller: str) -> 
     prm[[kn.P_WREF, kn.P_W0]] = (case.omega_ref, case.omega_0)
     pi = design.pi
     prm[[kn.P_KPW, kn.P_KIW, kn.P_KPI, kn.P_KII]] = (pi.K_p_w, pi.K_i_w, pi.K_p_i, pi.K_i_i)
-    prm[kn.P_KTS] = pi.K_T if controller == "pi_sinusoidal" else design.K_Tx
+    K_T = {"pi_sinusoidal": pi.K_T, "six_step": design.K_T_fig7}
+    prm[kn.P_KTS] = K_T.get(controller, design.K_Tx)
     prm[kn.P_CTRL] = CONTROLLERS.index(controller)
     return prm
 

@@ -9,7 +9,9 @@ integrated as a state (as are the copper, friction and load energies), so the en
 balance is exact to the RK4 error.
 
 Controllers (codes ``C_*``) reuse the control laws of ``control/`` compiled here with numba,
-so there is one implementation of each law.
+so there is one implementation of each law. The vector drives command an αβ voltage limited to
+the inscribed circle; six-step (``C_SIX_STEP``) commands phase voltages whose line voltage is
+limited by its own law to V_dc (inside the inverter's hexagon, see :mod:`control.bldc_six_step`).
 
 [2] Monteiro, de Castro, de Almeida, the SMC-BLDC paper.
 """
@@ -24,6 +26,7 @@ from numba import njit
 from control import bldc_current_smc as cur
 from control import bldc_pi_vector as piv
 from control import bldc_plain_smc as plain
+from control import bldc_six_step as six
 from control import bldc_speed_smc as spd
 from control import dqx
 
@@ -42,9 +45,12 @@ _t_ref = _jit(spd.torque_reference)
 _t_plain = _jit(plain.plain_torque_reference)
 _pi_out = _jit(piv.pi_output)
 _pi_int = _jit(piv.pi_integrate)
+_six_signs = _jit(six.commutation_signs)
+_six_ff = _jit(six.open_phase_feedforward)
+_six_v = _jit(six.six_step_voltages)
 
 TWO_PI = 2.0 * math.pi
-C_SMC_INTEGRAL, C_SMC_PLAIN, C_PI_SINUSOIDAL = 0, 1, 2
+C_SMC_INTEGRAL, C_SMC_PLAIN, C_PI_SINUSOIDAL, C_SIX_STEP = 0, 1, 2, 3
 
 # parameter vector indices
 (P_R, P_L, P_NPP, P_PHIM, P_J, P_B, P_VDC, P_TS, P_KI, P_KW, P_TMAX, P_LAM0, P_EPSL, P_WREF,
@@ -123,7 +129,7 @@ def rk4_hold(y: np.ndarray, v_a: float, v_b: float, v_c: float, T_L: float, prm:
 def speed_law(ctrl: int, eps: float, z: np.ndarray, prm: np.ndarray) -> tuple[float, float]:
     """Torque reference T* [N·m] and σ_ω [rad/s] of the chosen speed loop; updates z[0]."""
     T_s, T_max = prm[P_TS], prm[P_TMAX]
-    if ctrl == C_SMC_INTEGRAL:  # eq. (16) in [2], integral by forward Euler
+    if ctrl in (C_SMC_INTEGRAL, C_SIX_STEP):  # eq. (16) in [2], integral by forward Euler
         sigma = z[0] + eps
         z[0] += T_s * _i_rate(eps, prm[P_LAM0], prm[P_EPSL])
         return _t_ref(sigma, prm[P_KW], T_max), sigma
@@ -136,16 +142,12 @@ def speed_law(ctrl: int, eps: float, z: np.ndarray, prm: np.ndarray) -> tuple[fl
 
 
 @njit(cache=True)
-def control_step(y: np.ndarray, z: np.ndarray, prm: np.ndarray, out: np.ndarray) -> None:
-    """One sample of the chosen drive; updates integrators ``z`` = [I_ω, I_d, I_q] in place.
-
-    ``out`` receives [v_α, v_β, T*, σ_ω, i_dx, i_qx, i*_qx] (SI units).
-    """
-    ctrl = int(prm[P_CTRL])
+def vector_current_step(ctrl: int, y: np.ndarray, z: np.ndarray, i_q_ref: float, prm: np.ndarray
+                        ) -> tuple[float, float, float, float]:
+    """Current loop of the vector drives: (v_α, v_β) [V] and (i_dx, i_qx) [A]; updates z[1:3]."""
     T_s = prm[P_TS]
     i_al, i_be = _ab(y[0], y[1], -y[0] - y[1])
     th = prm[P_NPP] * y[3]
-    eps = prm[P_WREF] - y[2]
     V_lim = prm[P_VDC] / math.sqrt(2.0)
     if ctrl == C_PI_SINUSOIDAL:
         a_x, phi = 1.0, th
@@ -154,8 +156,6 @@ def control_step(y: np.ndarray, z: np.ndarray, prm: np.ndarray, out: np.ndarray)
         f_al, f_be = _ab(Pm * _trap(th), Pm * _trap(th - TWO_PI / 3.0), Pm * _trap(th - 2.0 * TWO_PI / 3.0))
         a_x, phi = _gain_angle(f_al, f_be, Pm)
     i_d, i_q = _to_dqx(i_al, i_be, a_x, phi)
-    T_ref, sigma = speed_law(ctrl, eps, z, prm)
-    i_q_ref = T_ref / prm[P_KTS]
     if ctrl == C_PI_SINUSOIDAL:
         e_d, e_q = -i_d, i_q_ref - i_q
         v_d = _pi_out(z[1], e_d, prm[P_KPI], V_lim)
@@ -168,6 +168,36 @@ def control_step(y: np.ndarray, z: np.ndarray, prm: np.ndarray, out: np.ndarray)
         v_q = _v_tanh(i_q_ref, i_q, prm[P_KI], V_ax)
     v_al, v_be = _from_dqx(v_d, v_q, a_x, phi)
     v_al, v_be = _limit(v_al, v_be, V_lim)
+    return v_al, v_be, i_d, i_q
+
+
+@njit(cache=True)
+def six_step_current_step(y: np.ndarray, i_ref: float, prm: np.ndarray) -> tuple[float, float, float, float]:
+    """Six-step current loop: (v_α, v_β) [V], open-phase current and line current [A]."""
+    i_a, i_b = y[0], y[1]
+    th, Pm = prm[P_NPP] * y[3], prm[P_PHIM]
+    s_a, s_b, s_c = _six_signs(th)
+    v_ff = _six_ff(Pm * _trap(th), Pm * _trap(th - TWO_PI / 3.0), Pm * _trap(th - 2.0 * TWO_PI / 3.0),
+                   s_a, s_b, s_c, prm[P_NPP] * y[2])
+    v_a, v_b, v_c, i_line, i_fl = _six_v(i_ref, i_a, i_b, -i_a - i_b, s_a, s_b, s_c, v_ff, prm[P_KI], prm[P_VDC])
+    v_al, v_be = _ab(v_a, v_b, v_c)
+    return v_al, v_be, i_fl, i_line
+
+
+@njit(cache=True)
+def control_step(y: np.ndarray, z: np.ndarray, prm: np.ndarray, out: np.ndarray) -> None:
+    """One sample of the chosen drive; updates integrators ``z`` = [I_ω, I_d, I_q] in place.
+
+    ``out`` receives [v_α, v_β, T*, σ_ω, i_dx, i_qx, i*_qx] (SI units); for six-step the last
+    three are the open-phase current, the line current of the conducting pair and I*.
+    """
+    ctrl = int(prm[P_CTRL])
+    T_ref, sigma = speed_law(ctrl, prm[P_WREF] - y[2], z, prm)
+    i_q_ref = T_ref / prm[P_KTS]
+    if ctrl == C_SIX_STEP:
+        v_al, v_be, i_d, i_q = six_step_current_step(y, i_q_ref, prm)
+    else:
+        v_al, v_be, i_d, i_q = vector_current_step(ctrl, y, z, i_q_ref, prm)
     out[0], out[1], out[2], out[3], out[4], out[5], out[6] = v_al, v_be, T_ref, sigma, i_d, i_q, i_q_ref
 
 

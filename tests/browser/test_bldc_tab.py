@@ -24,11 +24,12 @@ def test_bldc_tab_runs_paper_scenario_and_shows_metrics_and_speed_figure(page):
     # metrics table: one row per metric, one column per drive
     row = page.locator("tr", has_text="Steady-state speed error").first
     cells = [c.strip() for c in row.locator("td").all_inner_texts()]
-    assert cells[1] == "rpm" and len(cells) == 5
-    integral, plain = float(cells[2]), float(cells[3])
-    assert integral < 0.5 < plain
+    assert cells[1] == "rpm" and len(cells) == 6  # metric, unit, then the four drives
+    integral, plain, six_step = float(cells[2]), float(cells[3]), float(cells[5])
+    assert integral < 0.5 < plain and six_step < 0.5
     ripple = [c.strip() for c in page.locator("tr", has_text="Torque ripple").first.locator("td").all_inner_texts()]
     assert float(ripple[2]) < float(ripple[4])  # dq_x SMC vs sinusoidal dq PI
+    assert float(ripple[2]) < float(ripple[5])  # dq_x SMC vs six-step
     fig = figure(page, "bldc_speed")
     names = {t["name"]: t for t in fig["traces"]}
     assert {"ω*", "T_L"} <= set(names)
