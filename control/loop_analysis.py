@@ -38,6 +38,8 @@ if TYPE_CHECKING:  # derivations imports this module
 
 #: Default gain margin of the recommended K [-] (2 = 6 dB).
 GAIN_MARGIN = 2.0
+#: Smallest acceptable damping ratio of the ideal sloped-segment loop [-].
+ZETA_SLOPE_MIN = 0.5
 LAWS = ("cruise", "slope", "conventional")
 _N = 7  # [i_q, θ, ω, θ̂, ω̂, L̂0, L̂1]
 
@@ -57,6 +59,11 @@ class GainRecommendation:
     K_ok : bool              K < K_limit (no limit cycle expected).
     margin_of_K : float      K_limit/K, the gain margin of the preset's K [-].
     mode : str               "continuous" or "f_s = … Hz".
+    zeta_slope : float       Damping ratio √(α_max·K·T_c)/2 of the ideal sloped-segment loop
+                             s² + α_max·K·s + α_max·K/T_c, with the preset's K if K_ok, else with
+                             K_recommended [-].
+    T_c_min : float          T_c giving ζ = 1 with K_limit_cruise/margin, 4/(α_max·K) [s].
+    zeta_slope_recommended : float  The same damping ratio with K_recommended [-].
     """
 
     K_limit: float
@@ -68,6 +75,9 @@ class GainRecommendation:
     K_ok: bool
     margin_of_K: float
     mode: str
+    zeta_slope: float = math.nan
+    T_c_min: float = math.nan
+    zeta_slope_recommended: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -211,26 +221,43 @@ def stability_measure(
 
 
 def gain_limit(d: Derived, law: str, f_s: float | None, delay: int = 0) -> float:
-    """Smallest K [s/rad] at which the linearised loop with ``law`` becomes unstable.
+    """Upper stability limit in K [s/rad] of the linearised loop with ``law``.
 
     K is scanned on a log grid (2 points per decade, 1e−5 … 1e6 s/rad, scaled by
-    1000/α_max), the first unstable K is refined by bisection to 0.5 %. Returns 0 if the loop is
-    unstable for every K (the inner loops themselves are unstable) and ``inf`` if it never is.
+    1000/α_max); above the largest stable grid K the first unstable one is refined by bisection
+    to 0.5 %. Returns 0 if the loop is unstable for every K (inner loops unstable, or a sloped
+    segment too poorly damped, see :func:`slope_damping`) and ``inf`` if it never is.
     """
     parts = None if f_s is None else sampled_parts(d, f_s)
 
     def unstable(K: float) -> bool:
         return stability_measure(d, law, K, f_s, delay, parts) >= 0.0
 
-    grid = np.logspace(-5, 6, 23) * 1000.0 / d.alpha.alpha_max
-    prev = None
-    for K in grid:
-        if unstable(float(K)):
-            if prev is None:
-                return 0.0
-            return geometric_bisect(unstable, prev, float(K), 1.005)
-        prev = float(K)
-    return math.inf
+    grid = [float(K) for K in np.logspace(-5, 6, 23) * 1000.0 / d.alpha.alpha_max]
+    flags = [unstable(K) for K in grid]
+    if all(flags):
+        return 0.0
+    last_stable = max(i for i, f in enumerate(flags) if not f)
+    if last_stable == len(grid) - 1:
+        return math.inf
+    return geometric_bisect(unstable, grid[last_stable], grid[last_stable + 1], 1.005)
+
+
+def slope_damping(alpha_max: float, K: float, T_c: float) -> float:
+    """Damping ratio of the ideal sloped-segment loop, √(α_max·K·T_c)/2 [-].
+
+    Inside the boundary layer on the sloped segment of eq. (41) in [1], eq. (46) gives
+    α_dem = −α_max·K·(ω_r + θ_re/T_c); with α = α_dem (eq. (15), plant θ̈ = u) the loop is
+    s² + α_max·K·s + α_max·K/T_c. With T_c = T_a (eq. (59)) α_max·T_c = ω_p, so a slow
+    manoeuvre (small ω_p) needs K·ω_p ≳ 4 for a non-oscillating approach to θ_dem.
+
+    Parameters
+    ----------
+    alpha_max : float  [rad/s²]
+    K : float          [s/rad]
+    T_c : float        [s]
+    """
+    return math.sqrt(alpha_max * K * T_c) / 2.0
 
 
 def _f_s(d: Derived) -> float | None:
@@ -255,10 +282,17 @@ def recommend_K(d: Derived, margin: float = GAIN_MARGIN) -> GainRecommendation:
     f_s, delay = _f_s(d), d.params.controller.delay_samples
     k_c = gain_limit(d, "cruise", f_s, delay)
     k_s = gain_limit(d, "slope", f_s, delay)
-    k_lim = min(k_c, k_s)
-    K = d.params.controller.K
+    # A sloped segment unstable for every K is a damping problem (see slope_damping), reported
+    # by zeta_slope/T_c_min; the limit-cycle bound is then the cruise segment's.
+    k_lim = min(k_c, k_s) if k_s > 0.0 else k_c
+    K, a_max = d.params.controller.K, d.alpha.alpha_max
     mode = "continuous" if f_s is None else f"f_s = {f_s:g} Hz"
-    return GainRecommendation(k_lim, k_c, k_s, margin, k_lim / margin, K, k_lim > K, k_lim / K, mode)
+    k_ok = k_lim > K
+    zeta = slope_damping(a_max, K if k_ok else k_lim / margin, d.profile.T_c)
+    T_c_min = 4.0 * margin / (a_max * k_c) if 0.0 < k_c < math.inf else math.nan
+    zeta_rec = slope_damping(a_max, k_lim / margin, d.profile.T_c)
+    return GainRecommendation(k_lim, k_c, k_s, margin, k_lim / margin, K, k_ok, k_lim / K, mode,
+                              zeta, T_c_min, zeta_rec)
 
 
 def loop_warnings(g: GainRecommendation, s: SampleRateCheck) -> tuple[str, ...]:
@@ -276,7 +310,24 @@ def loop_warnings(g: GainRecommendation, s: SampleRateCheck) -> tuple[str, ...]:
             f"{g.K_limit:.4g} s/rad of the linearised FDSMC loop ({g.mode}): the outer loop will "
             f"chatter (limit cycle) and waste copper energy. Recommended K = {g.K_recommended:.4g} "
             f"s/rad (gain margin {g.margin:g}).")
+    if s.stable and g.zeta_slope < ZETA_SLOPE_MIN:
+        w.append(_slope_warning(g))
     return tuple(w)
+
+
+def _slope_warning(g: GainRecommendation) -> str:
+    """Advice when the ideal sloped-segment loop is poorly damped (ζ < ZETA_SLOPE_MIN)."""
+    k = g.K if g.K_ok else g.K_recommended
+    lin = ("the linearised sloped segment is unstable for every K" if g.K_limit_slope == 0.0
+           else f"linearised slope limit K = {g.K_limit_slope:.4g} s/rad")
+    if g.zeta_slope_recommended >= ZETA_SLOPE_MIN:
+        fix = f"Raise K to the recommended {g.K_recommended:.4g} s/rad (ζ = {g.zeta_slope_recommended:.2g})."
+    else:
+        fix = (f"Set controller.T_c ≥ {g.T_c_min:.3g} s (ζ = 1 at K = "
+               f"{g.K_limit_cruise / g.margin:.4g} s/rad; T_c ≪ T_m keeps the timing).")
+    return (f"Sloped segment (eq. 41, deceleration) poorly damped with K = {k:.4g} s/rad: "
+            f"ζ ≈ √(α_max·K·T_c)/2 = {g.zeta_slope:.2g} ({lin}). α_max·T_c is small (= ω_p when "
+            f"T_c = T_a, eq. 59), so the drive will oscillate about θ_dem. {fix}")
 
 
 def sample_rate_check(d: Derived) -> SampleRateCheck:

@@ -25,7 +25,7 @@ from control.derivations import Derived, derive
 from control.model import torque_constant
 from control.params import DriveParams, ParameterError
 from sim import kernel as kn
-from sim.metrics import WindowSamples, chatter_window, chatter_window_steps, run_metrics
+from sim.metrics import WindowSamples, chatter_window_steps, chatter_windows, run_metrics
 
 CONTROLLERS = ("fdsmc", "conventional")
 #: Simulated horizon beyond T_m, as a fraction of T_m [-].
@@ -237,12 +237,15 @@ def simulate(
     out = np.zeros((kn.N_CH, g.n_out))
     info = np.zeros(kn.N_INFO)
     T_step = g.h * g.n_sub
-    k_win, n_win = chatter_window_steps(chatter_window(params, d, controller), T_step)
-    win = np.zeros((2, n_win))
+    windows = chatter_windows(params, d, controller, g.n_steps * T_step)
+    steps = [chatter_window_steps(w, T_step) for w in windows.values()]
+    k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
+    win = np.zeros((2 * len(steps), max(n for _, n in steps)))
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
                   params.controller.delay_samples, g.decim, out, info, k_win, win)
     trace = _trace(out[:, : int(info[kn.I_NOUT])])
-    samples = WindowSamples((k_win + np.arange(n_win)) * T_step, win[0], win[1])
+    samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, win[2 * j, :n], win[2 * j + 1, :n])
+               for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
     met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, info)
     return RunResult(controller, trace, met)
 
@@ -269,7 +272,8 @@ def run_steps(
     out = np.zeros((kn.N_CH, 1))
     info = np.zeros(kn.N_INFO)
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
-                  params.controller.delay_samples, int(n_steps) + 1, out, info, 0, np.zeros((2, 0)))
+                  params.controller.delay_samples, int(n_steps) + 1, out, info,
+                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)))
     return info[kn.I_END: kn.I_END + kn.N_X].copy()
 
 

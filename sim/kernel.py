@@ -292,11 +292,12 @@ def step_sample(p: tuple, o: tuple, hold: tuple, continuous: bool,
 def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray,
                Gam: np.ndarray, Lo: np.ndarray, continuous: bool, h: float, n_steps: int,
                n_sub: int, delay: int, decim: int, out: np.ndarray, info: np.ndarray,
-               k_win: int, win: np.ndarray) -> None:
+               k_win: np.ndarray, win: np.ndarray) -> None:
     """Integrate one run from rest; fills ``out`` (N_CH × samples) and ``info`` (I_* indices).
 
-    ``win`` (2 × n) receives α_dem and ω_r of every step k_win … k_win + n − 1 at full
-    resolution (the chatter test's window, independent of the trace decimation).
+    For each window j, rows 2j and 2j + 1 of ``win`` receive α_dem and ω_r of every step
+    k_win[j] … k_win[j] + n − 1 at full resolution (the chatter test's windows, independent of
+    the trace decimation).
 
     Digital mode: ``n_steps`` samples of period n_sub·h; controller and observer at each
     sample, voltages held (one sample later if ``delay``), n_sub RK4 substeps in between.
@@ -311,8 +312,9 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
         if k % decim == 0 and n_out < out.shape[1]:
             record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
             n_out += 1
-        if 0 <= k - k_win < win.shape[1]:
-            win[0, k - k_win], win[1, k - k_win] = rec[2], p[X_W]
+        for j in range(k_win.size):
+            if 0 <= k - k_win[j] < win.shape[1]:
+                win[2 * j, k - k_win[j]], win[2 * j + 1, k - k_win[j]] = rec[2], p[X_W]
         pk = peaks(pk, p, u[0], u[1], prm)
         t_sat += h * n_sub if sat else 0.0
         p0, o, t0 = p, o_next, t

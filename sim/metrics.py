@@ -1,14 +1,15 @@
 """Run metrics of one closed-loop simulation: energies, response figures, chatter detection.
 
-Chatter criterion (documented in ``docs/paper_reproduction.md``): inside the evaluation window
-(the middle 60 % of the planned cruise segment for the FDSMC, [0.2·T_m, T_m] for the
-conventional law; at most its central 0.25 s), sampled at every controller step (not the
-decimated trace, so that a limit cycle is never aliased away), take the high-pass part
-r = α_dem − (moving average of α_dem over 5 ms). The loop chatters when r swings by more than
-20 % of α_max peak-to-peak **and** r changes sign (with a hysteresis of 2.5 % of α_max) at least
-8 times, i.e. a sustained oscillation of the demanded acceleration at ≥ 100 Hz-scale frequencies
-with an amplitude comparable to the control range —
-the limit cycle of a too-high boundary-layer gain K — not a single transient.
+Chatter criterion (documented in ``docs/paper_reproduction.md``), applied to two windows:
+``cruise`` — the middle 60 % of the planned cruise segment for the FDSMC, [0.2·T_m, T_m] for the
+conventional law (at most its central 0.25 s) — and ``hold`` — the second half of the tail after
+T_m (at most its last 0.25 s), where the drive should rest at θ_dem. Each window is sampled at
+every controller step (not the decimated trace, so that a limit cycle is never aliased away).
+Take the high-pass part r = α_dem − (moving average of α_dem over 5 ms). The loop chatters when
+r swings by more than 20 % of α_max peak-to-peak **and** r changes sign (with a hysteresis of
+2.5 % of α_max) at least 8 times, i.e. a sustained oscillation of the demanded acceleration with
+an amplitude comparable to the control range — the limit cycle of a too-high boundary-layer gain
+K or of a poorly damped sloped segment — not a single transient.
 """
 
 from __future__ import annotations
@@ -33,8 +34,9 @@ CHATTER_MAX_WINDOW_S = 0.25
 
 @dataclass(frozen=True)
 class WindowSamples:
-    """Full-resolution samples of the chatter window: t [s], α_dem [rad/s²], ω_r [rad/s]."""
+    """Full-resolution samples of one chatter window (t0, t1) [s]: t [s], α_dem [rad/s²], ω_r [rad/s]."""
 
+    window: tuple[float, float]
     t: np.ndarray
     alpha_dem: np.ndarray
     omega_r: np.ndarray
@@ -157,8 +159,18 @@ def moving_average(a: np.ndarray, n: int) -> np.ndarray:
     return (c[n:] - c[:-n]) / n
 
 
-def chatter_window(params: DriveParams, d: Derived, controller: str) -> tuple[float, float]:
-    """Chatter evaluation window (t0, t1) [s]: see the module docstring."""
+def chatter_windows(
+    params: DriveParams, d: Derived, controller: str, t_end: float
+) -> dict[str, tuple[float, float]]:
+    """Chatter evaluation windows (t0, t1) [s] ``cruise`` and ``hold``: see the module docstring.
+
+    Parameters
+    ----------
+    params : DriveParams
+    d : Derived
+    controller : str
+    t_end : float  End of the simulated horizon [s].
+    """
     T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
     if controller == "conventional":
         t0, t1 = 0.2 * T_m, T_m
@@ -168,7 +180,8 @@ def chatter_window(params: DriveParams, d: Derived, controller: str) -> tuple[fl
     if t1 - t0 > CHATTER_MAX_WINDOW_S:
         mid = 0.5 * (t0 + t1)
         t0, t1 = mid - 0.5 * CHATTER_MAX_WINDOW_S, mid + 0.5 * CHATTER_MAX_WINDOW_S
-    return t0, t1
+    h0 = max(T_m + 0.5 * (t_end - T_m), t_end - CHATTER_MAX_WINDOW_S)
+    return {"cruise": (t0, t1), "hold": (h0, t_end)}
 
 
 def chatter_window_steps(window: tuple[float, float], T_step: float) -> tuple[int, int]:
@@ -182,7 +195,7 @@ def chatter_window_steps(window: tuple[float, float], T_step: float) -> tuple[in
 
 def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
-    samples: WindowSamples, info: np.ndarray,
+    samples: dict[str, WindowSamples], info: np.ndarray,
 ) -> dict[str, float | bool | str | None]:
     """All metrics of one run from the (decimated) trace, the full-resolution chatter-window
     ``samples`` and the kernel's ``info`` vector.
@@ -195,8 +208,10 @@ def run_metrics(
     energies = energy_metrics(params, info)
     theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
     resp = response_metrics(t, theta_r, params.manoeuvre.theta_dem, theta_Tm)
-    cv = detect_chatter(samples.t, samples.alpha_dem, samples.omega_r,
-                        chatter_window(params, d, controller), d.alpha.alpha_max)
+    verdicts = {name: detect_chatter(s.t, s.alpha_dem, s.omega_r, s.window, d.alpha.alpha_max)
+                for name, s in samples.items()}
+    phase = next((name for name, v in verdicts.items() if v.chatter), None)
+    cv = verdicts[phase or "cruise"]
     met.update(energies)
     met.update(resp)
     met.update({
@@ -206,10 +221,12 @@ def run_metrics(
         "u_peak_V": float(info[kn.I_PU]),
         "torque_peak_Nm": float(info[kn.I_PTQ]),
         "saturated_s": float(info[kn.I_TSAT]),
-        "chatter": bool(cv.chatter),
+        "chatter": phase is not None,
+        "chatter_phase": phase,
         "chatter_alpha_ptp_rad_s2": cv.ptp,
         "chatter_frequency_Hz": cv.frequency_Hz,
-        "cruise_omega_ptp_rad_s": cv.omega_ptp,
+        "cruise_omega_ptp_rad_s": verdicts["cruise"].omega_ptp,
+        "hold_omega_ptp_rad_s": verdicts["hold"].omega_ptp,
         "stable": not failed,
         "reason": None,
     })
@@ -217,7 +234,7 @@ def run_metrics(
         for k, v in met.items():
             if isinstance(v, float) and k != "saturated_s":
                 met[k] = None
-        met["chatter"] = False
+        met["chatter"], met["chatter_phase"] = False, None
         met["reason"] = _unstable_reason(d, float(info[kn.I_TFAIL]))
     return met
 

@@ -26,8 +26,10 @@ def _chatter(run: RunResult, derived: Derived) -> str:
     hint = f" Recommended K = {k_rec:.4g} s/rad." if k_rec else " Reduce K, eq. (45)."
     freq = m.get("chatter_frequency_Hz")
     at = f" at about {freq:.3g} Hz" if isinstance(freq, float) else ""
-    return (f"Chatter ({NAMES[run.controller]}): the demanded acceleration switches{at} during the cruise — "
-            f"the boundary-layer gain is above the loop's stability limit.{hint}")
+    where = ("while holding θ_dem after T_m" if m.get("chatter_phase") == "hold"
+             else "during the cruise")
+    return (f"Chatter ({NAMES[run.controller]}): the demanded acceleration switches{at} {where} — "
+            f"the linearised loop is unstable at this K (boundary layer).{hint}")
 
 
 def limit_warnings(run: RunResult, derived: Derived) -> list[str]:

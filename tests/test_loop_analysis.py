@@ -113,3 +113,37 @@ def test_derived_carries_verdicts_and_warning():
     assert any("Recommended K" in w for w in d.warnings)
     ok = derive(dataclasses.replace(d.params, controller=dataclasses.replace(d.params.controller, K=0.3)))
     assert not any("Boundary-layer gain" in w for w in ok.warnings)
+
+
+def test_slope_damping_matches_ideal_loop_eigenvalues():
+    """ζ of s² + α_max·K·s + α_max·K/T_c (eqs. 41, 46 with the plant θ̈ = u of eq. (15))."""
+    from control.loop_analysis import slope_damping
+
+    for a_max, K, T_c in ((2651.0, 0.3, 0.024), (2651.0, 0.3, 3.8e-4), (100.0, 2.0, 0.05)):
+        s = np.roots([1.0, a_max * K, a_max * K / T_c])
+        zeta = -s.real.max() / abs(s[0]) if np.iscomplex(s[0]) else None
+        z = slope_damping(a_max, K, T_c)
+        if zeta is not None:
+            assert z == pytest.approx(zeta, rel=1e-9)
+        else:  # real roots ⇔ ζ ≥ 1
+            assert z >= 1.0
+
+
+def test_slow_manoeuvre_sloped_segment_needs_larger_T_c():
+    """T_m = 60 s: ω_p = α_max·T_a ≈ 1 rad/s, so with T_c = T_a (eq. 59) the sloped segment is
+    poorly damped for every K below the limit cycle bound. The analysis still recommends K from
+    the cruise limit, warns, and its T_c advice removes the oscillation in the simulation."""
+    d = derive(_params("manoeuvre.T_m=60"))
+    g = d.gain
+    assert g.K_limit == g.K_limit_cruise > 0.1  # not "no K helps"
+    assert g.zeta_slope_recommended < 0.5
+    assert any("Sloped segment" in w and "controller.T_c ≥" in w for w in d.warnings)
+    base = ["manoeuvre.T_m=60", f"controller.K={g.K_recommended}"]
+    bad = simulate(_params(*base), "fdsmc").metrics
+    assert bad["chatter"] and bad["chatter_phase"] == "hold"  # limit cycle about θ_dem
+    fixed_p = _params(*base, f"controller.T_c={g.T_c_min}")
+    assert not any("Sloped segment" in w for w in derive(fixed_p).warnings)
+    good = simulate(fixed_p, "fdsmc").metrics
+    assert not good["chatter"]
+    assert good["copper_total_J"] < 1e-2 * bad["copper_total_J"]
+    assert abs(good["theta_error_at_Tm_rad"]) < 0.02 * 60.0
