@@ -215,6 +215,7 @@ def run_metrics(
     met.update(energies)
     met.update(resp)
     met.update({
+        "theta_dem_rad": float(params.manoeuvre.theta_dem),
         "omega_peak_rad_s": float(info[kn.I_PW]),
         "i_q_peak_A": float(info[kn.I_PIQ]),
         "i_d_peak_A": float(info[kn.I_PID]),
@@ -232,7 +233,7 @@ def run_metrics(
     })
     if failed:
         for k, v in met.items():
-            if isinstance(v, float) and k != "saturated_s":
+            if isinstance(v, float) and k not in ("saturated_s", "theta_dem_rad"):
                 met[k] = None
         met["chatter"], met["chatter_phase"] = False, None
         met["reason"] = _unstable_reason(d, float(info[kn.I_TFAIL]))

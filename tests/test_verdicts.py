@@ -39,3 +39,16 @@ def test_a_drive_big_enough_gets_no_limit_warning(quiet_paper):
     d = derive(big)
     assert limit_warnings(quiet_paper.fdsmc, d) == []
     assert limit_warnings(quiet_paper.conventional, d) == []
+
+
+def test_target_missed_is_reported_not_hidden_behind_a_saving(paper_params, quiet_paper):
+    """T_c = 5 s (≫ T_m) makes the FDSMC decelerate far too slowly: it is still 49 rad short at
+    T_m, so its low friction is no 'saving'. The comparator (2.44 % short by design) is not
+    flagged; the quiet paper case flags nothing."""
+    assert not any("Target missed" in w for w in run_warnings(quiet_paper))
+    slow = dataclasses.replace(paper_params, controller=dataclasses.replace(
+        paper_params.controller, K=quiet_paper.derived.gain.K_recommended, T_c=5.0))
+    cmp = compare(slow)
+    msgs = [w for w in run_warnings(cmp) if "Target missed" in w]
+    assert len(msgs) == 1 and "FDSMC" in msgs[0]
+    assert abs(cmp.fdsmc.metrics["theta_error_at_Tm_rad"]) > 0.02 * paper_params.manoeuvre.theta_dem
