@@ -5,6 +5,7 @@ Shared by the CLI (``derive``), the web UI's derived-values panel and the parame
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -108,7 +109,9 @@ def derived_json(d: Derived) -> dict[str, Any]:
         "warnings": list(d.warnings),
     }
     if d.gain is not None:
-        out["loop"] = {k: getattr(d.gain, k) for k in d.gain.__dataclass_fields__}
+        loop = {k: getattr(d.gain, k) for k in d.gain.__dataclass_fields__}
+        # JSON has no NaN/inf: a limit that does not exist (never/always unstable) becomes null
+        out["loop"] = {k: None if isinstance(x, float) and not math.isfinite(x) else x for k, x in loop.items()}
     if d.sample_rate is not None:
         out["sample_rate"] = {k: getattr(d.sample_rate, k) for k in d.sample_rate.__dataclass_fields__}
     if d.observer_discrete is not None:

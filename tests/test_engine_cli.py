@@ -19,9 +19,14 @@ RUN_KEYS = {
 }
 
 
+def _strict(token: str) -> float:
+    raise AssertionError(f"{token} is not valid JSON")
+
+
 def _json(capsys, *argv: str) -> dict:
+    """Parse the command's stdout as strict JSON (NaN/Infinity rejected)."""
     assert main(list(argv)) == 0
-    return json.loads(capsys.readouterr().out)
+    return json.loads(capsys.readouterr().out, parse_constant=_strict)
 
 
 def test_simulate_json_contract(capsys):
