@@ -98,8 +98,8 @@ class BldcTab:
         self.upload.on_upload(self._uploaded)
         self.run_button = gui.add_button("Simulate BLDC", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.run_button.on_click(lambda _: self.simulate())
-        self.status = gui.add_markdown("Ready — press **Simulate BLDC**; the figures are in the results "
-                                       "panel's **BLDC figures** tab.")
+        self.status = gui.add_markdown("Ready — press **Simulate BLDC**; the metrics and figures are in "
+                                       "the results panel's **BLDC figures** tab.")
         self.warnings = gui.add_markdown("")
         with gui.add_folder("Scenario", expand_by_default=False):
             self.w_ref = gui.add_number("ω* [rpm]", rad_s_to_rpm(p.case.omega_ref), step=10.0)
@@ -109,9 +109,9 @@ class BldcTab:
             for label, sec, name, _, from_si, step in FIELDS:
                 value = from_si(getattr(getattr(p, sec), name))
                 self.inputs[label] = gui.add_number(label, value, step=step)
-        with gui.add_folder("Metrics", expand_by_default=True):
-            self.metrics = gui.add_markdown("No run yet.")
         with self._figures_container or gui.add_folder("Figures", expand_by_default=True):
+            with gui.add_folder("Metrics", expand_by_default=True):
+                self.metrics = gui.add_markdown("No run yet — press **Simulate BLDC**.")
             self.fig_speed = gui.add_plotly(_placeholder("bldc_speed", "Speed"), aspect=ASPECT)
             self.fig_torque = gui.add_plotly(_placeholder("bldc_torque", "Torque"), aspect=ASPECT)
             self.fig_sigma = gui.add_plotly(_placeholder("bldc_sigma", "σ_ω"), aspect=ASPECT)
