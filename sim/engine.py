@@ -34,6 +34,8 @@ TAIL_FRACTION = 0.3
 CONTINUOUS_STEP_S = 5e-6
 #: Largest h·λ_max of continuous mode (λ_max the fastest designed pole) [-]; 5 µs at T_so = 0.2 ms.
 CONTINUOUS_STEP_RATIO = 0.1875
+#: Largest RK4 plant substep between controller samples in digital mode [s].
+PLANT_STEP_MAX_S = 5e-5
 #: Most trace points kept per run (energies and peaks use every step).
 MAX_POINTS = 20000
 #: Most kernel steps per run (≈ 5 s of computing); longer runs are refused, not hung.
@@ -138,6 +140,16 @@ def continuous_step(params: DriveParams, h_max: float = CONTINUOUS_STEP_S) -> fl
     return min(h_max, CONTINUOUS_STEP_RATIO / lam)
 
 
+def plant_substeps(params: DriveParams) -> int:
+    """RK4 substeps per sample [-] so that the plant step is ≤ PLANT_STEP_MAX_S and ≤ 0.2 rad
+    of the fastest electrical angle p·max(ω_b, 2.1·|θ_dem|/T_m) (the comparator peaks at
+    Δθ·5.6/(e·T_m)); 1 at 20 kHz for the paper's motor."""
+    m = params.motor
+    w_e = m.p * max(m.omega_b, 2.1 * abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
+    h_max = min(PLANT_STEP_MAX_S, 0.2 / w_e)
+    return max(1, int(math.ceil(1.0 / (float(params.controller.f_s) * h_max) - 1e-9)))
+
+
 def _grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: int) -> _Grid:
     t_end = (1.0 + TAIL_FRACTION) * params.manoeuvre.T_m
     ctrl = params.controller
@@ -146,7 +158,8 @@ def _grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: int)
         n_steps, h, sub = int(math.ceil(t_end / h_continuous)), h_continuous, 1
     else:
         T_s = 1.0 / float(ctrl.f_s)
-        n_steps, h, sub = int(math.ceil(t_end / T_s)), T_s / n_sub, n_sub
+        sub = max(n_sub, plant_substeps(params))
+        n_steps, h = int(math.ceil(t_end / T_s)), T_s / sub
     if n_steps > MAX_STEPS:
         rate = (f"RK4 steps of {h_continuous:g} s (continuous mode: the step follows the fastest of "
                 "T_so, T_sα, T_si)" if ctrl.is_continuous else f"samples at f_s = {ctrl.f_s:g} Hz")
@@ -228,7 +241,7 @@ def simulate(
     derived : Derived or None
         ``derive(params)`` if already computed.
     n_sub : int
-        RK4 substeps per sample in digital mode [-].
+        Least RK4 substeps per sample in digital mode [-] (more if :func:`plant_substeps` asks).
     h_continuous : float
         Largest RK4 step in continuous mode [s] (see :func:`continuous_step`).
     max_points : int

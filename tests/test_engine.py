@@ -269,3 +269,19 @@ def test_continuous_step_follows_the_fastest_designed_pole(continuous_paper):
     m = simulate(fast, "fdsmc").metrics
     assert m["stable"] and not m["chatter"]
     assert m["friction_J"] == pytest.approx(derive(fast).energy.W_fdsmc, rel=3e-3)
+
+
+def test_slow_digital_controller_plant_substeps_converged():
+    """A 2 kHz controller (T_so = 2 ms, T_sα = 10 ms, stable by the sample-rate check) gets 10 RK4
+    plant substeps of 50 µs per sample; doubling them changes the friction by < 0.05 %."""
+    from sim.engine import plant_substeps
+
+    base = ["controller.T_so=0.002", "controller.T_salpha=0.01", "controller.f_s=2000"]
+    d = derive(load_preset("paper_12kw_pmsm", base))
+    assert d.sample_rate.stable
+    p = load_preset("paper_12kw_pmsm", [*base, f"controller.K={d.gain.K_recommended}"])
+    assert plant_substeps(p) == 10
+    m1, m2 = simulate(p, "fdsmc").metrics, simulate(p, "fdsmc", n_sub=20).metrics
+    assert m1["stable"] and not m1["chatter"]
+    assert abs(m1["friction_J"] / m2["friction_J"] - 1.0) < 5e-4
+    assert m1["energy_balance_residual_pct"] < 0.1
