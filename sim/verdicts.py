@@ -7,7 +7,10 @@ One place composes these messages, for the CLI, the web UI and the exported repo
 
 from __future__ import annotations
 
+import math
+
 from control.derivations import Derived
+from control.loop_analysis import ZETA_SLOPE_MIN
 from control.model import available_voltage
 from sim.engine import Comparison, RunResult
 
@@ -20,16 +23,27 @@ def recommended_K(derived: Derived) -> float | None:
     return g.K_recommended if g is not None and g.K_recommended > 0.0 else None
 
 
+def _chatter_hint(derived: Derived) -> str:
+    """What to change: K above its limit, or a poorly damped sloped segment (T_c too small)."""
+    g = derived.gain
+    if g is None or g.K_limit <= 0.0:
+        return " Reduce K, eq. (45)."
+    if not g.K_ok:
+        return f" Recommended K = {g.K_recommended:.4g} s/rad."
+    if g.zeta_slope < ZETA_SLOPE_MIN and math.isfinite(g.T_c_min):
+        return (f" The sloped segment is poorly damped (ζ ≈ {g.zeta_slope:.2g}): set "
+                f"controller.T_c ≥ {g.T_c_min:.3g} s.")
+    return f" Reduce K below the recommended {g.K_recommended:.4g} s/rad."
+
+
 def _chatter(run: RunResult, derived: Derived) -> str:
     m = run.metrics
-    k_rec = recommended_K(derived)
-    hint = f" Recommended K = {k_rec:.4g} s/rad." if k_rec else " Reduce K, eq. (45)."
     freq = m.get("chatter_frequency_Hz")
     at = f" at about {freq:.3g} Hz" if isinstance(freq, float) else ""
     where = ("while holding θ_dem after T_m" if m.get("chatter_phase") == "hold"
              else "during the cruise")
     return (f"Chatter ({NAMES[run.controller]}): the demanded acceleration switches{at} {where} — "
-            f"the linearised loop is unstable at this K (boundary layer).{hint}")
+            f"a limit cycle of the sliding-mode loop at this K and T_c.{_chatter_hint(derived)}")
 
 
 def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
