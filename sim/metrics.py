@@ -236,15 +236,19 @@ def run_metrics(
             if isinstance(v, float) and k not in ("saturated_s", "theta_dem_rad"):
                 met[k] = None
         met["chatter"], met["chatter_phase"] = False, None
-        met["reason"] = _unstable_reason(d, float(info[kn.I_TFAIL]))
+        met["reason"] = _unstable_reason(d, controller, float(info[kn.I_TFAIL]))
     return met
 
 
-def _unstable_reason(d: Derived, t_fail: float) -> str:
+def _unstable_reason(d: Derived, controller: str, t_fail: float) -> str:
     text = f"diverged at t = {t_fail:.4g} s (a state became non-finite or left its bound)"
     s = d.sample_rate
     if s is not None and not s.stable:
         need = f"≥ {s.f_s_min:.4g} Hz" if s.f_s_min is not None else "a faster controller"
         text += (f": f_s = {s.f_s:g} Hz is too slow for T_so/T_sα (sampled inner loops + observer "
                  f"have spectral radius {s.spectral_radius:.4f} ≥ 1; needs {need})")
+    elif controller == "fdsmc" and d.gain is not None and not d.gain.K_ok:
+        g = d.gain
+        text += (f": K = {g.K:g} s/rad exceeds the limit K_limit = {g.K_limit:.4g} s/rad of the "
+                 f"linearised FDSMC loop ({g.mode}); recommended K = {g.K_recommended:.4g} s/rad")
     return text

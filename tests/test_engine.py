@@ -285,3 +285,14 @@ def test_slow_digital_controller_plant_substeps_converged():
     assert m1["stable"] and not m1["chatter"]
     assert abs(m1["friction_J"] / m2["friction_J"] - 1.0) < 5e-4
     assert m1["energy_balance_residual_pct"] < 0.1
+
+
+def test_divergence_near_the_sample_rate_limit_names_the_K_limit(paper_params):
+    """Just above f_s,min = 10.69 kHz the inner loops are stable (ρ < 1) but the FDSMC loop
+    tolerates only K ≈ 0.018 s/rad: K = 0.2 diverges and the reason says why; K_rec is stable."""
+    p = _with(paper_params, "controller", f_s=10700.0, K=0.2)
+    d = derive(p)
+    assert d.sample_rate.stable and not d.gain.K_ok
+    m = simulate(p, "fdsmc", d).metrics
+    assert m["stable"] is False and "K_limit" in m["reason"]
+    assert simulate(_with(p, "controller", K=d.gain.K_recommended), "fdsmc").metrics["stable"]
