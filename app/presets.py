@@ -59,8 +59,15 @@ def _describe(tp: Any) -> str:
     return "a list of mappings"
 
 
+#: A decimal number in exponent form without a dot, e.g. ``2e-4``: YAML 1.1 (PyYAML) reads it as
+#: text, but engineers write it so; it is accepted as a number.
+_EXPONENT_NUMBER = re.compile(r"^[+-]?\d+[eE][+-]?\d+$")
+
+
 def _coerce(name: str, value: Any, tp: Any) -> Any:
     """Check ``value`` against the annotation ``tp``; parse nested dataclasses."""
+    if isinstance(value, str) and _EXPONENT_NUMBER.match(value.strip()):
+        value = float(value)
     number = isinstance(value, int | float) and not isinstance(value, bool)
     if tp is float and number:
         return float(value)

@@ -116,6 +116,18 @@ def test_overrides():
         load_preset("paper_12kw_pmsm", ["T_m=1"])
 
 
+def test_exponent_numbers_without_a_dot_are_numbers():
+    """PyYAML (YAML 1.1) reads 2e-4 as text; engineers write it so, the loader takes it as a number."""
+    p = load_preset("paper_12kw_pmsm", ["controller.T_so=2e-4", "motor.J_r=3E-2"])
+    assert p.controller.T_so == 2e-4 and p.motor.J_r == 0.03
+    raw = _raw()
+    raw["controller"]["T_so"] = "2e-4"
+    assert presets.parse_preset(raw).controller.T_so == 2e-4
+    raw["controller"]["T_so"] = "2e-4 s"
+    with pytest.raises(PresetError, match="wrong type"):
+        presets.parse_preset(raw)
+
+
 def test_yaml_safety_and_size():
     with pytest.raises(PresetError, match="not valid YAML at line"):
         loads_preset("schema: 1\nmotor: [\n")
