@@ -153,6 +153,11 @@ class InputsPanel:
         self.delay.value = str(c.delay_samples)
         self._shown["tc_ms"], self._shown["fs_khz"] = self.tc_ms.value, self.fs_khz.value
 
+    def set_T_c(self, T_c: float) -> None:
+        """Select "T_c given below" and show ``T_c`` [s] (e.g. "use T_c,min")."""
+        self.tc_rule.value = TC_RULES[1]
+        self.tc_ms.value = units.s_to_ms(T_c)
+
     def set_value(self, key: str, value_si: float) -> None:
         """Set one numeric field from an SI value (e.g. "use recommended K")."""
         f = next(f for f in FIELDS if f"{f.section}.{f.name}" == key)

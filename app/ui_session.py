@@ -27,7 +27,7 @@ from app.ui_worker import Worker
 from control.derivations import derive
 from control.params import DriveParams, ParameterError
 from sim.engine import PAPER_TABLE1, Comparison, compare, table1_sweep
-from sim.verdicts import recommended_K, run_warnings
+from sim.verdicts import T_c_advice, recommended_K, run_warnings
 
 #: Widths of the control panel (left) and the results panel (right) [px].
 CONTROL_WIDTH, RESULTS_WIDTH = 430, 780
@@ -102,6 +102,8 @@ class Session:
         self.warnings = gui.add_html("")
         self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
         self.use_k.on_click(lambda _: self._use_recommended_k())
+        self.use_tc = gui.add_button("Use T_c,min", visible=False, color="orange")
+        self.use_tc.on_click(lambda _: self._use_T_c_min())
         with gui.add_form(None) as form:
             self.inputs = InputsPanel(gui, self.params)
         form.on_submit(lambda _: self.simulate())
@@ -173,6 +175,12 @@ class Session:
             self.inputs.set_value("controller.K", k_rec)
             self.simulate()
 
+    def _use_T_c_min(self) -> None:
+        T_c = T_c_advice(self.comparison.derived)
+        if T_c is not None:
+            self.inputs.set_T_c(T_c)
+            self.simulate()
+
     # ---- feedback -----------------------------------------------------------------------------
     def _show_text(self) -> None:
         d = self.comparison.derived
@@ -187,6 +195,10 @@ class Session:
         self.use_k.visible = k_rec is not None and (chatter or 1.001 * k_rec < self.params.controller.K)
         if k_rec is not None:
             self.use_k.label = f"Use recommended K = {k_rec:.4g} s/rad"
+        T_c = T_c_advice(d)
+        self.use_tc.visible = T_c is not None
+        if T_c is not None:
+            self.use_tc.label = f"Use T_c = {T_c * 1e3:.4g} ms (damps the approach to θ_dem)"
         self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: `{self.origin}`."
 
     def _reject(self, message: str) -> None:

@@ -36,6 +36,11 @@ def ms_to_s(t_ms: float) -> float:
     return t_ms * 1e-3
 
 
+def s_to_ms(t: float) -> float:
+    """Time [s] → [ms]."""
+    return t * 1e3
+
+
 def kHz_to_Hz(f_kHz: float) -> float:
     """Frequency [kHz] → [Hz]."""
     return f_kHz * 1e3

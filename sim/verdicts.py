@@ -36,6 +36,19 @@ def _chatter_hint(derived: Derived) -> str:
     return f" Reduce K below the recommended {g.K_recommended:.4g} s/rad."
 
 
+def T_c_advice(derived: Derived) -> float | None:
+    """T_c,min [s] when the sloped segment is poorly damped even with the recommended K, else None.
+
+    On the −1/T_c line the ideal loop is s² + α_max·K·s + α_max·K/T_c, damping √(α_max·K·T_c)/2;
+    with K capped by the chatter limit, a small T_c (e.g. T_c = T_a on slow manoeuvres) limit-cycles
+    about θ_dem. T_c,min gives ζ = 1 with the recommended K (``control.loop_analysis``).
+    """
+    g = derived.gain
+    if g is None or not math.isfinite(g.T_c_min) or g.zeta_slope_recommended >= ZETA_SLOPE_MIN:
+        return None
+    return g.T_c_min if derived.profile.T_c < g.T_c_min else None
+
+
 def _chatter(run: RunResult, derived: Derived) -> str:
     m = run.metrics
     freq = m.get("chatter_frequency_Hz")

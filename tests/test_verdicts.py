@@ -8,7 +8,7 @@ import pytest
 
 from control.model import available_voltage
 from sim.engine import compare
-from sim.verdicts import limit_warnings, recommended_K, run_warnings
+from sim.verdicts import T_c_advice, limit_warnings, recommended_K, run_warnings
 
 
 @pytest.fixture(scope="module")
@@ -52,3 +52,22 @@ def test_target_missed_is_reported_not_hidden_behind_a_saving(paper_params, quie
     msgs = [w for w in run_warnings(cmp) if "Target missed" in w]
     assert len(msgs) == 1 and "FDSMC" in msgs[0]
     assert abs(cmp.fdsmc.metrics["theta_error_at_Tm_rad"]) > 0.02 * paper_params.manoeuvre.theta_dem
+
+
+def test_slow_manoeuvre_gets_T_c_advice_that_removes_the_limit_cycle(paper_params):
+    """T_m = 60 s: T_c = T_a ≈ 0.38 ms gives ζ ≈ 0.28 on the −1/T_c line even with the
+    recommended K, and the run limit-cycles about θ_dem; T_c,min = 4/(α_max·K_rec) cures it."""
+    from control.derivations import derive
+
+    slow = dataclasses.replace(paper_params, manoeuvre=dataclasses.replace(paper_params.manoeuvre, T_m=60.0))
+    d = derive(slow)
+    T_c = T_c_advice(d)
+    k_rec = recommended_K(d)
+    assert T_c == pytest.approx(4.0 / (d.alpha.alpha_max * k_rec), rel=1e-9)
+    assert T_c_advice(derive(paper_params)) is None  # T_m = 1 s: the slope is well damped
+    with_k = dataclasses.replace(slow.controller, K=k_rec)
+    before = compare(dataclasses.replace(slow, controller=with_k)).fdsmc
+    after = compare(dataclasses.replace(slow, controller=dataclasses.replace(with_k, T_c=T_c))).fdsmc
+    assert before.metrics["chatter"] and before.metrics["chatter_phase"] == "hold"
+    assert not after.metrics["chatter"]
+    assert after.metrics["copper_total_J"] < 0.01 * before.metrics["copper_total_J"]

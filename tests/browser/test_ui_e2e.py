@@ -110,3 +110,37 @@ def test_screenshot_of_main_view(page):
     out = ARTIFACTS / "ui_main.png"
     page.screenshot(path=str(out))
     assert out.stat().st_size > 20_000
+
+
+def _runs_done(page) -> int:
+    match = re.search(r"Ready — (\d+) run\(s\) in this session", page.inner_text("body"))
+    return int(match.group(1)) if match else -1
+
+
+def _click_and_wait_for_run(page, button) -> None:
+    n = _runs_done(page)
+    button.click()
+    page.wait_for_function("(n) => document.body.innerText.includes(`Ready — ${n} run(s) in this session`)",
+                           arg=n + 1)
+
+
+def test_recommended_K_then_T_c_min_one_click_fixes(page):
+    """Slow manoeuvre (T_m = 60 s): K = 1000 chatters → "Use recommended K"; the approach to θ_dem
+    is then poorly damped with T_c = T_a → "Use T_c = …" selects T_c,min and the chatter is gone."""
+    from sim.verdicts import T_c_advice
+
+    params = load_preset(DEFAULT_PRESET)
+    slow = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=60.0))
+    set_number(page, "T_m manoeuvre time [s]", 60)
+    _click_and_wait_for_run(page, page.get_by_role("button", name="Simulate"))
+    _wait_phase_omega_p(page, derive(slow).profile.omega_p)
+    _click_and_wait_for_run(page, page.get_by_role("button", name=re.compile(r"^Use recommended K")))
+    # with the recommended K the run still limit-cycles about θ_dem (hold phase)
+    assert "Chatter (FDSMC)" in page.inner_text("body")
+    use_tc = page.get_by_role("button", name=re.compile(r"^Use T_c = "))
+    T_c_ms = 1e3 * T_c_advice(derive(slow))
+    assert f"{T_c_ms:.4g} ms" in use_tc.inner_text()
+    _click_and_wait_for_run(page, use_tc)
+    assert "Chatter (FDSMC)" not in page.inner_text("body")
+    assert abs(float(page.get_by_label("T_c sliding time const. [ms]", exact=True).input_value()) - T_c_ms) < 1e-6
+    assert not use_tc.is_visible()
