@@ -107,11 +107,6 @@ class Replay:
         self.buttons.on_click(self._on_button)
         self.slider.on_update(self._on_slider)
 
-    @property
-    def playing(self) -> bool:
-        """True while the replay thread runs."""
-        return self._thread is not None and self._thread.is_alive()
-
     def load(self, comparison: Any, autoplay: bool = True) -> None:
         """Show a new comparison: whole figures first, then (optionally) replay from t = 0."""
         self.pause()

@@ -218,14 +218,6 @@ class BldcScenario:
             )
         object.__setattr__(self, "T_L_steps", steps)
 
-    def T_L_at(self, t: float) -> float:
-        """Load torque at time t [N·m]."""
-        value = self.T_L_0
-        for s in self.T_L_steps:
-            if t >= s.t:
-                value = s.T_L
-        return value
-
     @property
     def segments(self) -> tuple[tuple[float, float], ...]:
         """Constant-load intervals (t_start, t_stop) [s]."""

@@ -35,7 +35,10 @@ def lambda_of_error(eps: float, lambda_0: float, eps_lambda: float) -> float:
 
 
 def integral_rate(eps: float, lambda_0: float, eps_lambda: float) -> float:
-    """d/dt of the integral part of eq. (16) in [2]: λ(ε)·ε [rad/s²]."""
+    """d/dt of the integral part of eq. (16) in [2]: λ(ε)·ε [rad/s²].
+
+    :func:`lambda_of_error` written out, because the BLDC kernel compiles this function alone.
+    """
     r = eps / eps_lambda
     return lambda_0 * eps / (1.0 + r * r)
 
@@ -111,7 +114,7 @@ def reachability_check(lambda_0: float, eps_lambda: float, omega_ref: float, J: 
     """
     span = eps_span if eps_span is not None else max(abs(omega_ref), 20.0 * eps_lambda)
     eps = np.linspace(-span, span, n)
-    lam = lambda_0 / (1.0 + (eps / eps_lambda) ** 2)
+    lam = lambda_of_error(eps, lambda_0, eps_lambda)
     bound = reachability_bound(eps, omega_ref, J, B, T_max, T_L_max)
     bad = np.where(np.isnan(bound), False, lam >= bound)
     return ReachabilityCheck(eps, lam, bound, _intervals(eps, bad), not bool(bad.any()))

@@ -1,29 +1,13 @@
-"""Shared post-processing of simulated time series: energy integrals and response metrics.
+"""Shared post-processing of simulated time series: response metrics.
 
-Used by both modes (FDSMC position control and BLDC speed control) so that energies and metrics
-are computed one way only. All inputs are numpy arrays in SI units on a common time grid ``t``.
+Used by both modes (FDSMC position control and BLDC speed control) so that metrics are computed
+one way only (energies are integrated as extra states of each kernel). All inputs are numpy
+arrays in SI units on a common time grid ``t``.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
-
-
-def cumulative_energy(t: np.ndarray, power: np.ndarray) -> np.ndarray:
-    """Running integral ∫power dt by the trapezoid rule, starting at 0 [J].
-
-    Parameters
-    ----------
-    t : numpy.ndarray      Time [s].
-    power : numpy.ndarray  Power [W].
-    """
-    return cumulative_trapezoid(power, t, initial=0.0)
-
-
-def value_at(t: np.ndarray, y: np.ndarray, t_query: float) -> float:
-    """Linear interpolation of ``y`` at ``t_query`` (clamped to the record)."""
-    return float(np.interp(t_query, t, y))
 
 
 def first_entry_time(t: np.ndarray, y: np.ndarray, target: float, band: float) -> float | None:
