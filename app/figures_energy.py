@@ -20,6 +20,14 @@ ENERGIES = (
 )
 
 
+def _styled(fig: go.Figure, fid: str, title: str, legend_y: float, **layout: Any) -> go.Figure:
+    """The common layout of the energy figures: id in ``meta``, title, margins, legend below."""
+    fig.update_layout(meta={"id": fid}, template="plotly_white", title={"text": title, "x": 0.01},
+                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
+                      legend={"orientation": "h", "y": legend_y}, **layout)
+    return fig
+
+
 def make_energy_figure(comparison: Any) -> go.Figure:
     """Cumulative friction, copper and electrical input energy [J] vs time for both controllers.
 
@@ -39,12 +47,7 @@ def make_energy_figure(comparison: Any) -> go.Figure:
             fig.add_scatter(x=f32(tr.t[i]), y=f32(getattr(tr, attr)[i]), mode="lines",
                             name=f"{LABELS[key]} {label}", legendgroup=key,
                             line={"color": COLOURS[key], "dash": dash, "width": 2})
-    fig.update_layout(meta={"id": "energy_time"}, template="plotly_white",
-                      title={"text": "Energy vs time", "x": 0.01},
-                      xaxis_title="t [s]", yaxis_title="energy [J]",
-                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
-                      legend={"orientation": "h", "y": -0.18})
-    return fig
+    return _styled(fig, "energy_time", "Energy vs time", -0.18, xaxis_title="t [s]", yaxis_title="energy [J]")
 
 
 def energy_total(run: Any, attr: str, metric: str) -> float:
@@ -79,11 +82,7 @@ def make_energy_bars_figure(comparison: Any) -> go.Figure:
                     text=[f"{v:.4g} J" for v in totals], textposition="outside")
     title = (f"Totals — FDSMC saves {_pct(comparison.saving_friction_pct)} friction, "
              f"{_pct(comparison.saving_electrical_pct)} electrical input")
-    fig.update_layout(meta={"id": "energy_bars"}, template="plotly_white", barmode="group",
-                      title={"text": title, "x": 0.01}, yaxis_title="energy [J]",
-                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
-                      legend={"orientation": "h", "y": -0.15})
-    return fig
+    return _styled(fig, "energy_bars", title, -0.15, barmode="group", yaxis_title="energy [J]")
 
 
 def make_table1_figure(rows: Sequence[Any], paper: Mapping[float, float] | None = None) -> go.Figure:
@@ -114,12 +113,8 @@ def make_table1_figure(rows: Sequence[Any], paper: Mapping[float, float] | None 
         xs = sorted(paper)
         fig.add_scatter(x=xs, y=[paper[x] for x in xs], mode="markers", name="paper, Table 1",
                         marker={"symbol": "x", "size": 11, "color": "#c92a2a"})
-    fig.update_layout(meta={"id": "table1"}, template="plotly_white",
-                      title={"text": "Friction saving vs manoeuvre time (Table 1)", "x": 0.01},
-                      xaxis_title="T_m [s]", yaxis_title="saving [%]",
-                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
-                      legend={"orientation": "h", "y": -0.2})
-    return fig
+    return _styled(fig, "table1", "Friction saving vs manoeuvre time (Table 1)", -0.2,
+                   xaxis_title="T_m [s]", yaxis_title="saving [%]")
 
 
 __all__ = ["ENERGIES", "energy_total", "make_energy_bars_figure", "make_energy_figure",
