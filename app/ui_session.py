@@ -25,7 +25,7 @@ from app.ui_scene import RotorScene
 from app.ui_text import derived_markdown, warnings_html
 from app.ui_worker import Worker
 from control.derivations import derive
-from control.params import DriveParams, ParameterError
+from control.params import DriveParams
 from sim.engine import PAPER_TABLE1, Comparison, compare, table1_sweep
 from sim.verdicts import T_c_advice, recommended_K, run_warnings
 
@@ -35,10 +35,10 @@ CONTROL_WIDTH, RESULTS_WIDTH = 430, 780
 
 def comparison_or_derived(params: DriveParams) -> Comparison:
     """Simulate both controllers; for an infeasible case, the derivations alone (no runs)."""
-    try:
-        return compare(params)
-    except ParameterError:
-        return Comparison(derive(params), None, None, None, None)
+    d = derive(params)  # a ParameterError here is an input error for the caller
+    if not d.profile.feasible:
+        return Comparison(d, None, None, None, None)
+    return compare(params, derived=d)
 
 
 @dataclass

@@ -325,7 +325,8 @@ def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:
 
 
 def compare(
-    params: DriveParams, controllers: tuple[str, ...] = CONTROLLERS, **options: float
+    params: DriveParams, controllers: tuple[str, ...] = CONTROLLERS, derived: Derived | None = None,
+    **options: float,
 ) -> Comparison:
     """Simulate both controllers on the same case (thread-safe; the kernel releases the GIL).
 
@@ -334,6 +335,8 @@ def compare(
     params : DriveParams
     controllers : tuple of str
         Any of ``"fdsmc"``, ``"conventional"``.
+    derived : Derived or None
+        ``derive(params)`` if already computed.
     **options
         Passed to :func:`simulate` (``n_sub``, ``h_continuous``, ``max_points``).
 
@@ -344,7 +347,7 @@ def compare(
     """
     for c in controllers:
         _check_controller(c)
-    d = derive(params)
+    d = derive(params) if derived is None else derived
     _check_feasible(d)
     runs: dict[str, RunResult] = {}
     if len(controllers) > 1:
