@@ -21,6 +21,7 @@ from control.loop_analysis import (
     sample_rate_check,
 )
 from control.model import ModelCoefficients, model_coefficients
+from control.nameplate import nameplate_consistency
 from control.observer import DiscreteObserver, ObserverGains, discrete_observer, observer_gains
 from control.params import DriveParams
 from control.profile import VelocityProfile, friction_energy_eq52, velocity_profile
@@ -145,4 +146,5 @@ def _warnings(
             f"Voltage needed at ω_p with the peak torque, {feas.u_needed_peak:.4g} V, exceeds the "
             f"available {feas.u_available:.4g} V (V_dc/√3, or √(2/3)·V_0 without V_dc)."
         )
+    w += [f"Nameplate: {x.text}" for x in nameplate_consistency(params.motor)]
     return tuple(w)
