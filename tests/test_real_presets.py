@@ -123,3 +123,29 @@ def test_derive_runs_and_manoeuvre_is_feasible(case):
     assert d.feasibility.speed_ok and d.feasibility.voltage_ok
     assert d.gain.K_ok and d.gain.K_recommended >= params.controller.K
     assert not any("Infeasible" in w for w in d.warnings)
+
+
+#: Σ-II predecessors whose printed inertia (mechanical) time constant τ_m [s], rotor inertia J
+#: [kg·m²] and inductive time constant T_el [s] give the estimated R_s and L of the Σ-7 presets:
+#: SGMPH-02A/-04A from the Σ-II SGDH User's Manual Table 8.2 (p. 8-7), SGMSH-50AA from the Sigma II
+#: User's Manual section 8.1.4 (p. 8-15).
+PREDECESSOR = {
+    "yaskawa_sgm7j_02a": (0.54e-3, 0.193e-4, 7.4e-3),
+    "yaskawa_sgm7j_04a": (0.36e-3, 0.331e-4, 8.6e-3),
+    "yaskawa_sgm7a_50a": (0.59e-3, 12.3e-4, 14.7e-3),
+}
+
+
+def test_mechanical_time_constant_definition_on_the_siemens_datasheet():
+    """τ_m = 3·R_ph·J/k_T² reproduces the printed T_mech = 1.3 ms of the 1FT7044-AK7 (Table 4-8)."""
+    ds = REAL["siemens_1ft7044_ak7"]
+    assert 3.0 * ds.R_s * ds.J_r / ds.Kt**2 == pytest.approx(1.3e-3, abs=0.05e-3)
+
+
+@pytest.mark.parametrize("name", sorted(PREDECESSOR))
+def test_estimated_resistance_and_inductance_follow_the_stated_method(name):
+    m = load_preset(name).motor
+    tau_m, J_pred, T_el = PREDECESSOR[name]
+    R_expected = tau_m * REAL[name].Kt**2 / (3.0 * J_pred)
+    assert m.R_s == pytest.approx(R_expected, rel=1e-9)
+    assert m.L_d == m.L_q == pytest.approx(T_el * R_expected, rel=1e-9)
