@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-from control import conventional, fdc, sliding_mode
+from control import conventional, fdc, inverter, sliding_mode
 
 # ---- prm indices -------------------------------------------------------------------------
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
@@ -82,22 +82,9 @@ def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0:
 @_helper
 def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
                   prm: np.ndarray) -> tuple[float, float, bool]:
-    """Optional inverter limits: current limit on i_q, then |u_dq| ≤ u_max. Returns flag."""
-    sat = False
-    i_max = prm[P_IMAX]
-    if i_max > 0.0 and abs(i_q) >= i_max:
-        # u_q that holds di_q/dt = 0 (eq. 2); do not push |i_q| further.
-        u_hold = (prm[P_C] * omega_hat * i_d + prm[P_D] * i_q + prm[P_E] * omega_hat) / prm[P_G]
-        if (u_q - u_hold) * i_q > 0.0:
-            u_q = u_hold
-            sat = True
-    u_max = prm[P_UMAX]
-    mag = math.sqrt(u_d * u_d + u_q * u_q)
-    if u_max > 0.0 and mag > u_max:
-        u_d *= u_max / mag
-        u_q *= u_max / mag
-        sat = True
-    return u_d, u_q, sat
+    """Optional inverter limits of :func:`control.inverter.limit_voltage`. Returns the flag."""
+    return inverter.limit_voltage(u_d, u_q, i_d, i_q, omega_hat, prm[P_IMAX], prm[P_UMAX], prm[P_C], prm[P_D],
+                                  prm[P_E], prm[P_G])
 
 
 @_helper
