@@ -132,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         write_csv(args.csv, [r for r in (cmp.fdsmc, cmp.conventional) if r is not None])
     if args.json:
-        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False))
+        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False, allow_nan=False))
     else:
         print_summary(cmp)
     return 0

@@ -69,12 +69,12 @@ def test_wrong_type():
 @pytest.mark.parametrize(
     ("section", "key", "value", "match"),
     [
-        ("motor", "J_r", -0.1, r"motor.J_r = -0.1 .*allowed > 0"),
-        ("motor", "R_s", 0.0, r"motor.R_s = 0.0 .*allowed > 0"),
+        ("motor", "J_r", -0.1, r"motor.J_r = -0.1 .*allowed 1e-09 ≤ value ≤ 10000"),
+        ("motor", "R_s", 0.0, r"motor.R_s = 0.0 .*allowed 0 < value ≤ 10000"),
         ("motor", "p", 2.5, r"motor.p = 2.5 .*integer"),
         ("motor", "psi_pm", math.nan, r"motor.psi_pm = nan"),
         ("controller", "T_so", math.inf, r"controller.T_so = inf"),
-        ("load", "J_L", -1.0, r"load.J_L = -1.0 .*allowed ≥ 0"),
+        ("load", "J_L", -1.0, r"load.J_L = -1.0 .*allowed 0 ≤ value ≤ 10000"),
         ("controller", "alpha_max_rule", "fast", r"alpha_max_rule = 'fast' .*paper, torque_limit"),
         ("controller", "f_s", "fast", r"controller.f_s = 'fast'"),
     ],
