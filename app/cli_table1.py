@@ -17,7 +17,7 @@ import sys
 
 from app.cli import add_preset_arguments
 from app.cli_simulate import finite_or_none
-from app.presets import load_preset
+from app.preset_modes import load_mode_preset
 from control.params import ParameterError
 from sim.engine import PAPER_TABLE1, Table1Row, table1_sweep
 
@@ -65,7 +65,7 @@ def _fmt(v: float | None) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep and print the table (or JSON)."""
-    params = load_preset(args.preset, args.overrides)
+    params = load_mode_preset(args.preset, args.overrides, mode="position")
     tms = parse_tm(args.tm)
 
     def progress(done: int, total: int) -> None:

@@ -12,7 +12,8 @@ import ipaddress
 import sys
 import time
 
-from app.presets import DEFAULT_PRESET, load_preset
+from app.preset_modes import load_mode_preset
+from app.presets import DEFAULT_PRESET
 from control.derivations import derive
 
 
@@ -40,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     """Start the server, print the URL and serve until Ctrl-C."""
     if not 1 <= args.port <= 65535:
         raise ValueError(f"--port = {args.port} is out of range: allowed 1 … 65535")
-    params = load_preset(args.preset)
+    params = load_mode_preset(args.preset, mode="position")
     derive(params)  # a preset the derivations reject fails here, with its message
     if not is_loopback(args.host):
         print(f"warning: binding to {args.host}: the tool is reachable from other machines on the "
