@@ -278,9 +278,11 @@ def loads_raw(text: str, origin: str = "<text>") -> Any:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise PresetError(f"{origin} is not valid YAML{where}: {problem}") from None
+        raise PresetError(f"{origin} is not valid YAML{where}: {problem}: allowed plain YAML text") from None
     except RecursionError:
-        raise PresetError(f"{origin} is nested too deeply") from None
+        raise PresetError(f"{origin} is nested too deeply: allowed ≤ {MAX_DEPTH} levels") from None
+    except PresetError as exc:  # duplicate key, tag: say where
+        raise PresetError(f"{origin}: {exc}") from None
 
 
 def _schema(value: Any) -> int | None:
@@ -305,7 +307,7 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
             raise PresetError(f"--set {item!r}: unknown section {section!r}{_hint(section, known)}")
         value = loads_raw(text, f"--set {key}") if text.strip() else None
         if value is None:
-            raise PresetError(f"--set {item!r} has no value")
+            raise PresetError(f"--set {item!r} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
         aliases = units.ALIASES.get(section, {})
         target = _field_of(name, aliases, [units.KE_KEY])
         for other in [k for k in raw[section] if _field_of(str(k), aliases, [units.KE_KEY]) == target]:

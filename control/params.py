@@ -131,8 +131,8 @@ class Motor:
 
     def __post_init__(self) -> None:
         spec = {
-            "V_0": (1.0, 1e5, False, "V"), "P_r": (0.0, 1e8, True, "W"), "omega_b": (0.0, 1e5, True, "rad/s"),
-            "Gamma_max": (0.0, 1e6, True, "N·m"), "psi_pm": (0.0, 100.0, True, "Wb"),
+            "V_0": (1.0, 1e5, False, "V"), "P_r": (1e-3, 1e8, False, "W"), "omega_b": (0.0, 1e5, True, "rad/s"),
+            "Gamma_max": (1e-6, 1e6, False, "N·m"), "psi_pm": (1e-6, 100.0, False, "Wb"),
             "L_d": (1e-9, 10.0, False, "H"), "L_q": (1e-9, 10.0, False, "H"), "R_s": (0.0, 1e4, True, "Ω"),
             "J_r": (1e-9, 1e4, False, "kg·m²"),
         }
