@@ -164,7 +164,8 @@ def parse_preset(raw: Any) -> Any:
         With a message naming the field, the value and the allowed range or type.
     """
     if not isinstance(raw, dict):
-        raise PresetError("a preset must be a YAML mapping with schema, name, source and sections")
+        raise PresetError(f"a preset must be a YAML mapping: got {type(raw).__name__}; allowed a mapping "
+                          "with schema, name, source and sections")
     if _schema(raw.get("schema")) != SCHEMA:
         raise PresetError(f"schema = {raw.get('schema')!r} is not supported: allowed schema: {SCHEMA}")
     mode = raw.get("mode", "position")
