@@ -11,7 +11,6 @@ firmware is accurate. The C code itself is in :mod:`app.c_template`.
 
 from __future__ import annotations
 
-import datetime as _dt
 import math
 from dataclasses import dataclass
 
@@ -140,7 +139,7 @@ def _define(k: CConstant) -> str:
 def controller_header(params: DriveParams, d: Derived, schema: int) -> str:
     """Text of ``fdsmc_controller.h`` for the derived design ``d`` of ``params``."""
     defines = "\n".join(_define(k) for k in controller_constants(params, d))
-    return HEADER.substitute(tool=TOOL, date=_dt.date.today().isoformat(), name=_ascii(params.name),
+    return HEADER.substitute(tool=TOOL, name=_ascii(params.name),
                              source=_ascii(params.source), schema=schema, constants=defines)
 
 

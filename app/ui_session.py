@@ -18,7 +18,7 @@ from typing import Any
 import viser
 
 from app.presets import list_presets, load_preset
-from app.ui_files import FilesPanel
+from app.ui_files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui_inputs import InputError, InputsPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
@@ -225,9 +225,19 @@ class Session:
         if busy:
             self.status.content = "Working…"
 
-    def _export_state(self) -> tuple[DriveParams, Comparison, str, list[str]]:
-        d = self.comparison.derived
-        return self.params, self.comparison, self.origin, list(d.warnings) + run_warnings(self.comparison)
+    def _export_state(self) -> Comparison:
+        """The simulated case, if it is what the page shows; else ExportRefusedError saying what differs."""
+        if self.worker.busy:
+            raise ExportRefusedError("A run is in progress: export when it has finished.")
+        try:
+            shown = self.inputs.collect()
+        except ValueError as exc:
+            raise ExportRefusedError(f"The inputs shown are not valid, so nothing was exported: {exc}") from None
+        changed = uncommitted(shown, self.comparison.derived.params)
+        if changed:
+            raise ExportRefusedError("Inputs edited but not simulated — press Simulate, then export. "
+                                "Not committed: " + "; ".join(changed))
+        return self.comparison
 
     def close(self) -> None:
         """Stop the worker and the replay (client disconnected)."""

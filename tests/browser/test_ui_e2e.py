@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+import io
 import re
+import zipfile
 from pathlib import Path
 
 from app.presets import DEFAULT_PRESET, dumps_preset, load_preset, loads_preset
@@ -62,10 +64,10 @@ def test_invalid_value_shows_message_and_simulates_nothing(page, ui_server):
     assert _phase_omega_p(page) == before
 
 
-def _download(page, label: str) -> str:
+def _download(page, label: str) -> tuple[str, bytes]:
     with page.expect_download() as info:
         page.get_by_role("button", name=label).click()
-    return Path(info.value.path()).read_text(encoding="utf-8")
+    return info.value.suggested_filename, Path(info.value.path()).read_bytes()
 
 
 def test_import_export_round_trip_and_c_header(page, tmp_path):
@@ -80,12 +82,30 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
     _wait_phase_omega_p(page, derive(uploaded).profile.omega_p)
     assert page.get_by_label("T_m manoeuvre time [s]", exact=True).input_value() == "1.8"
     page.get_by_text("Export", exact=True).click()
-    exported = _download(page, "Drive parameters (YAML)")
-    assert loads_preset(exported, "export.yaml") == uploaded
-    header = _download(page, "C header for firmware")
+    name, exported = _download(page, "Drive parameters (YAML)")
+    assert name == "imported_case.yaml" and loads_preset(exported.decode(), "export.yaml") == uploaded
+    name, archive = _download(page, "C controller module (.h + .c, zip)")
+    assert name == "imported_case_fdsmc_controller.zip"
+    with zipfile.ZipFile(io.BytesIO(archive)) as zf:
+        assert sorted(zf.namelist()) == ["fdsmc_controller.c", "fdsmc_controller.h"]
+        header = zf.read("fdsmc_controller.h").decode()
+    assert "Drive: imported_case" in header and "Source: browser test" in header
     match = re.search(r"#define FDSMC_OMEGA_P\s+\(([^)]+)\)", header)
     assert match is not None
     assert abs(float(match.group(1)) - derive(uploaded).profile.omega_p) <= 1e-12 * float(match.group(1))
+
+
+def test_export_of_edited_but_unsimulated_inputs_is_refused(page):
+    """An export describes the inputs shown: after an edit without Simulate it is refused with a
+    message naming the uncommitted field, and nothing is downloaded."""
+    set_number(page, "T_m manoeuvre time [s]", 1.4)
+    page.get_by_text("Export", exact=True).click()
+    downloads: list[object] = []
+    page.on("download", downloads.append)
+    page.get_by_role("button", name="Drive parameters (YAML)").click()
+    note = page.get_by_text(re.compile(r"Not committed: manoeuvre\.T_m = 1\.4 \(simulated: 1\.0\)"))
+    note.wait_for(timeout=10000)
+    assert downloads == []
 
 
 def test_two_browser_contexts_keep_separate_values(browser, ui_server):
