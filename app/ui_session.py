@@ -227,16 +227,14 @@ class Session:
 
     def _export_state(self) -> Comparison:
         """The simulated case, if it is what the page shows; else ExportRefusedError saying what differs."""
-        if self.worker.busy:
-            raise ExportRefusedError("A run is in progress: export when it has finished.")
         try:
             shown = self.inputs.collect()
         except ValueError as exc:
             raise ExportRefusedError(f"The inputs shown are not valid, so nothing was exported: {exc}") from None
         changed = uncommitted(shown, self.comparison.derived.params)
         if changed:
-            raise ExportRefusedError("Inputs edited but not simulated — press Simulate, then export. "
-                                "Not committed: " + "; ".join(changed))
+            raise ExportRefusedError("Inputs edited but not simulated — press Simulate (or wait for the run in "
+                                     "progress), then export. Not committed: " + "; ".join(changed))
         return self.comparison
 
     def close(self) -> None:
