@@ -2,11 +2,12 @@
 the simulator's digital mode: what the drive will run is what was simulated.
 
 The module is compiled with the system C compiler and loaded with :mod:`ctypes` (standard
-library, no build step or extra package: the shared object is called directly from the test,
-sample by sample, between RK4 steps of :class:`sim.plant.PlantInTheLoop`).
+library, no build step or extra package: the shared object is called directly from Python,
+sample by sample, between RK4 steps of :class:`sim.plant.PlantInTheLoop`; see app/c_verify.py).
 
 Agreement = max |C − simulator| / max |simulator| over the run (error relative to the signal's
-peak), for θ_r, ω_r, i_q and the energies, at every controller sample of the 1.3 s horizon.
+peak), for θ_r, ω_r, i_q and the energies, at every controller sample of the 1.3 s horizon
+(``python -m app.c_verify`` prints the figures).
 Measured (paper preset, 20 kHz): double ≤ 6e-10 at the paper's K = 1000 (limit-cycling loop),
 ≤ 2e-7 with delay and inverter limits; float32 at the recommended K: θ_r 1e-8, ω_r 8e-7,
 i_q 2.6e-5, energies ≤ 1.3e-6.
@@ -14,27 +15,21 @@ i_q 2.6e-5, energies ≤ 1.3e-6.
 
 from __future__ import annotations
 
-import ctypes
 import os
 import re
-import shutil
 import subprocess
 from pathlib import Path
 
-import numpy as np
 import pytest
 
+from app.c_verify import CFLAGS, agreement, build, closed_loop, compiler, write_module
 from app.export_c import controller_files
 from app.presets import SCHEMA, load_preset
 from control.derivations import derive
 from control.params import ParameterError
 from sim.engine import simulate
-from sim.plant import PlantInTheLoop
 
 ROOT = Path(__file__).resolve().parent.parent
-CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wdouble-promotion", "-Wconversion"]
-#: Signals compared: name → index in PlantInTheLoop.x (same as the Trace channel).
-SIGNALS = {"theta_r": 2, "omega_r": 3, "i_q": 1, "E_friction": 4, "E_copper": 5, "E_electrical": 6}
 #: float32 tolerance: ε(float32) = 6e-8 per operation; the observer (pole at 37 500 rad/s) and the
 #: acceleration loop (3/T_sα = 3000 1/s) amplify the rounding of the estimates into i_q by ~400
 #: (measured 2.6e-5 of the peak); 1e-4 leaves a factor 4 and still rejects any wrong constant or
@@ -43,7 +38,7 @@ FLOAT_TOL = 1e-4
 
 
 def _compiler() -> str:
-    cc = shutil.which("cc") or shutil.which("gcc")
+    cc = compiler()
     if cc is None:
         if os.environ.get("CI") == "true":
             pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
@@ -52,56 +47,8 @@ def _compiler() -> str:
 
 
 def _write(folder: Path, params) -> None:
-    for name, text in controller_files(params, derive(params), SCHEMA).items():
-        (folder / name).write_text(text, encoding="utf-8")
-
-
-def _build(folder: Path, single: bool) -> ctypes.CDLL:
-    so = folder / ("libfdsmc_f.so" if single else "libfdsmc_d.so")
-    defines = ["-DFDSMC_USE_FLOAT"] if single else []
-    subprocess.run([_compiler(), *CFLAGS, *defines, "-shared", "-fPIC", "-O2", str(folder / "fdsmc_controller.c"),
-                    "-o", str(so), "-lm"], check=True, capture_output=True, text=True)
-    return ctypes.CDLL(str(so))
-
-
-def _types(single: bool):
-    real, angle = (ctypes.c_float if single else ctypes.c_double), ctypes.c_double
-
-    class State(ctypes.Structure):
-        _fields_ = [("z0", angle), ("z", real * 3), ("theta_ref", angle), ("u_hold", real * 2)]
-
-    class Output(ctypes.Structure):
-        _fields_ = [("u_d", real), ("u_q", real), ("theta_hat", angle), ("omega_hat", real),
-                    ("Gamma_L_hat", real), ("alpha_dem", real), ("S", real), ("saturated", ctypes.c_int)]
-
-    return real, angle, State, Output
-
-
-def closed_loop(lib: ctypes.CDLL, single: bool, params, controller: str = "fdsmc") -> np.ndarray:
-    """Plant states at every sample with the C module as the controller (rows: samples)."""
-    real, angle, State, Output = _types(single)
-    step = lib.fdsmc_step if controller == "fdsmc" else lib.fdsmc_step_conventional
-    lib.fdsmc_init.argtypes = [ctypes.POINTER(State), angle]
-    step.argtypes = [ctypes.POINTER(State), angle, real, real, angle, ctypes.POINTER(Output)]
-    state, out = State(), Output()
-    lib.fdsmc_init(ctypes.byref(state), 0.0)
-    plant, theta_dem = PlantInTheLoop(params), params.manoeuvre.theta_dem
-    rows = np.zeros((plant.n_samples, len(plant.x)))
-    for k in range(plant.n_samples):
-        x = plant.x
-        rows[k] = x
-        step(ctypes.byref(state), x[2], x[0], x[1], theta_dem, ctypes.byref(out))
-        plant.step(out.u_d, out.u_q)
-    return rows
-
-
-def agreement(params, rows: np.ndarray, controller: str = "fdsmc") -> dict[str, float]:
-    """Max error relative to the peak of each signal, C closed loop vs. the simulator."""
-    trace = simulate(params, controller, max_points=rows.shape[0] + 1).trace
-    n = min(rows.shape[0], trace.t.size)
-    assert n == rows.shape[0]  # the simulator kept every sample
-    return {name: float(np.max(np.abs(rows[:n, i] - getattr(trace, name)[:n])) / np.max(np.abs(getattr(trace, name))))
-            for name, i in SIGNALS.items()}
+    _compiler()
+    write_module(folder, params)
 
 
 PAPER_K_REC = ["controller.K=0.3"]  # the recommended K of the paper preset (0.302 s/rad)
@@ -115,7 +62,7 @@ CASES = {
 def test_double_build_reproduces_digital_mode(tmp_path, case):
     params = load_preset("paper_12kw_pmsm", CASES[case])
     _write(tmp_path, params)
-    err = agreement(params, closed_loop(_build(tmp_path, False), False, params))
+    err = agreement(params, closed_loop(build(tmp_path, False), False, params))
     assert max(err.values()) < 1e-6, err
     if case == "delay_limits":  # the limits acted, so the test exercised them
         assert simulate(params, "fdsmc").metrics["saturated_s"] > 0.01
@@ -124,7 +71,7 @@ def test_double_build_reproduces_digital_mode(tmp_path, case):
 def test_double_build_conventional_step_reproduces_comparator(tmp_path):
     params = load_preset("paper_12kw_pmsm")
     _write(tmp_path, params)
-    rows = closed_loop(_build(tmp_path, False), False, params, "conventional")
+    rows = closed_loop(build(tmp_path, False), False, params, "conventional")
     err = agreement(params, rows, "conventional")
     assert max(err.values()) < 1e-6, err
 
@@ -132,7 +79,7 @@ def test_double_build_conventional_step_reproduces_comparator(tmp_path):
 def test_float32_build_within_tolerance(tmp_path):
     params = load_preset("paper_12kw_pmsm", PAPER_K_REC)
     _write(tmp_path, params)
-    err = agreement(params, closed_loop(_build(tmp_path, True), True, params))
+    err = agreement(params, closed_loop(build(tmp_path, True), True, params))
     assert max(err.values()) < FLOAT_TOL, err
     assert err["theta_r"] < 1e-6  # the position the drive reaches
 
@@ -143,7 +90,7 @@ def test_float32_build_in_the_papers_limit_cycle(tmp_path):
     and the friction energy — what the manoeuvre is designed for — still agree to 1e-3."""
     params = load_preset("paper_12kw_pmsm")
     _write(tmp_path, params)
-    err = agreement(params, closed_loop(_build(tmp_path, True), True, params))
+    err = agreement(params, closed_loop(build(tmp_path, True), True, params))
     assert err["theta_r"] < 1e-3 and err["E_friction"] < 1e-3, err
 
 
@@ -160,7 +107,7 @@ def test_readme_example_compiles(tmp_path, single):
     params = load_preset("paper_12kw_pmsm")
     _write(tmp_path, params)
     example = readme_example()
-    assert "fdsmc_step(" in example and len(example.splitlines()) <= 20
+    assert "fdsmc_step(" in example and len(example.splitlines()) <= 15
     (tmp_path / "isr.c").write_text(example, encoding="utf-8")
     defines = ["-DFDSMC_USE_FLOAT"] if single else []
     subprocess.run([_compiler(), *CFLAGS, *defines, "-c", str(tmp_path / "isr.c"), "-o", str(tmp_path / "isr.o")],
