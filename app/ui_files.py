@@ -11,6 +11,7 @@ changes nothing.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from typing import Any
 
@@ -37,7 +38,7 @@ class ExportRefusedError(ValueError):
 
 def _flat(params: DriveParams) -> dict[str, Any]:
     raw = to_raw(params)
-    out = {k: raw[k] for k in ("name", "source")}
+    out: dict[str, Any] = {}
     for section, fields in raw.items():
         if isinstance(fields, dict):
             out.update({f"{section}.{k}": v for k, v in fields.items()})
@@ -45,7 +46,8 @@ def _flat(params: DriveParams) -> dict[str, Any]:
 
 
 def uncommitted(shown: DriveParams, committed: DriveParams) -> list[str]:
-    """``field = shown (simulated: value)`` for every input that differs (SI units)."""
+    """``field = shown (simulated: value)`` for every input that differs (SI units); name and
+    source are not simulated inputs (the Export folder sets them)."""
     a, b = _flat(shown), _flat(committed)
     return [f"{k} = {a[k]!r} (simulated: {b.get(k)!r})" for k in a if a[k] != b.get(k)]
 
@@ -64,20 +66,33 @@ def parse_upload(name: str, content: bytes) -> DriveParams:
     return params
 
 
-class FilesPanel:
-    """"Export" folder with one button per export format, and the upload button.
+def renamed(cmp: Comparison, name: str, source: str) -> Comparison:
+    """The case with the name and source written into the exports (both must be non-blank)."""
+    for field, text in (("name", name), ("source", source)):
+        if not text.strip():
+            raise ExportRefusedError(f"Export › {field} = {text!r} is empty: allowed any non-blank text "
+                                     "(the file name and the file's header come from it)")
+    params = dataclasses.replace(cmp.derived.params, name=name.strip(), source=source.strip())
+    return dataclasses.replace(cmp, derived=dataclasses.replace(cmp.derived, params=params))
 
-    ``state`` returns the simulated case to export or raises :class:`ExportRefusedError`.
+
+class FilesPanel:
+    """"Export" folder (name, source and one button per export format), and the upload button.
+
+    ``state`` returns the simulated case to export or raises :class:`ExportRefusedError`; the
+    name and source typed in the folder replace the case's in every file (and the file name).
     """
 
     def __init__(self, client: viser.ClientHandle, state: Callable[[], Comparison],
-                 on_import: Callable[[DriveParams, str], None]) -> None:
+                 on_import: Callable[[DriveParams, str], None], params: DriveParams) -> None:
         self._client, self._state, self._on_import = client, state, on_import
         gui = client.gui
         self.upload = gui.add_upload_button("Import preset (YAML/JSON)", icon=viser.Icon.UPLOAD,
                                             mime_type=".yaml,.yml,.json,text/yaml,application/json,text/plain")
         self.upload.on_upload(self._uploaded)
         with gui.add_folder("Export", expand_by_default=False):
+            self.name = gui.add_text("Name (file name)", params.name)
+            self.source = gui.add_text("Source", params.source)
             self.buttons = {}
             for label, fmt in EXPORTS.items():
                 button = gui.add_button(label, icon=viser.Icon.DOWNLOAD)
@@ -86,7 +101,7 @@ class FilesPanel:
 
     def _export(self, fmt: str) -> None:
         try:
-            name, content = export_download(fmt, self._state())
+            name, content = export_download(fmt, renamed(self._state(), self.name.value, self.source.value))
         except (ExportRefusedError, ParameterError) as exc:
             self._client.add_notification("Not exported", str(exc), color="yellow", auto_close_seconds=12.0)
             return
@@ -100,7 +115,12 @@ class FilesPanel:
             self._client.add_notification("Import rejected — nothing changed", str(exc), color="red",
                                           auto_close_seconds=15.0)
             return
+        self.show_names(params)
         self._on_import(params, f.name)
 
+    def show_names(self, params: DriveParams) -> None:
+        """Show the name and source of newly loaded inputs (a preset chosen or a file imported)."""
+        self.name.value, self.source.value = params.name, params.source
 
-__all__ = ["EXPORTS", "ExportRefusedError", "FilesPanel", "parse_upload", "safe_stem", "uncommitted"]
+
+__all__ = ["EXPORTS", "ExportRefusedError", "FilesPanel", "parse_upload", "renamed", "safe_stem", "uncommitted"]

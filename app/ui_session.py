@@ -95,7 +95,7 @@ class Session:
         self.preset = gui.add_dropdown("Preset", names, initial_value=self.origin if self.origin in names
                                        else names[0])
         self.preset.on_update(self._preset_chosen)
-        self.files = FilesPanel(self.client, self._export_state, self._imported)
+        self.files = FilesPanel(self.client, self._export_state, self._imported, self.params)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.simulate_button.on_click(lambda _: self.simulate())
         self.status = gui.add_markdown("Ready.")
@@ -161,6 +161,7 @@ class Session:
         except ValueError as exc:
             self._reject(str(exc))
             return
+        self.files.show_names(params)
         self._imported(params, self.preset.value)
 
     def _imported(self, params: DriveParams, origin: str) -> None:

@@ -190,3 +190,12 @@ def test_upload_rejects_bad_files_with_clear_messages(paper_params, case):
     assert parse_upload("ok.yaml", parameter_yaml(case).encode()) == paper_params
     assert parse_upload("ok.json", parameter_json(case).encode()) == paper_params
     assert safe_stem("../my motor*") == "my_motor"
+
+
+def test_page_rename_sets_file_name_and_refuses_blank(case):
+    from app.ui_files import ExportRefusedError, renamed
+
+    name, content = export_download("yaml", renamed(case, " line 3 axis ", "nameplate"))
+    assert name == "line_3_axis.yaml" and loads_raw(content.decode())["source"] == "nameplate"
+    with pytest.raises(ExportRefusedError, match="name = ' ' is empty"):
+        renamed(case, " ", "x")

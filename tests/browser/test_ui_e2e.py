@@ -8,6 +8,8 @@ import re
 import zipfile
 from pathlib import Path
 
+from playwright.sync_api import expect
+
 from app.presets import DEFAULT_PRESET, dumps_preset, load_preset, loads_preset
 from control.derivations import derive
 from tests.browser.conftest import ARTIFACTS, figure, open_page, set_number
@@ -70,6 +72,15 @@ def _download(page, label: str) -> tuple[str, bytes]:
     return info.value.suggested_filename, Path(info.value.path()).read_bytes()
 
 
+def _set_text(page, label: str, value: str) -> None:
+    """Type into viser's text field labelled ``label`` (its <label for> does not name the input)."""
+    field = page.locator(f"xpath=//label[normalize-space()='{label}']/ancestor::div[.//input][1]//input").first
+    field.fill(value)
+    field.press("Tab")
+    expect(field).to_have_value(value)
+    page.wait_for_timeout(120)  # viser throttles GUI messages to one per 50 ms
+
+
 def test_import_export_round_trip_and_c_header(page, tmp_path):
     params = load_preset(DEFAULT_PRESET)
     uploaded = dataclasses.replace(
@@ -93,6 +104,12 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
     match = re.search(r"#define FDSMC_OMEGA_P\s+\(\(fdsmc_real\)([^)]+)\)", header)
     assert match is not None
     assert abs(float(match.group(1)) - derive(uploaded).profile.omega_p) <= 1e-12 * float(match.group(1))
+    _set_text(page, "Name (file name)", "acme servo axis 2")  # name and source say what the motor is
+    _set_text(page, "Source", "ACME data sheet")
+    name, exported = _download(page, "Drive parameters (JSON)")
+    assert name == "acme_servo_axis_2.json"
+    assert loads_preset(exported.decode(), name) == dataclasses.replace(
+        uploaded, name="acme servo axis 2", source="ACME data sheet")
 
 
 def test_export_of_edited_but_unsimulated_inputs_is_refused(page):
