@@ -58,6 +58,23 @@ class AnnualSavings:
     money_per_year: float
 
 
+def design_markdown(dd: Any) -> str:
+    """Verdict of "Design for this drive" (:class:`sim.design.DriveDesign`): clean, or what prevents it."""
+    c = dd.params.controller
+    head = ("**Design: clean** — simulated peaks within the drive's limits, on target at T_m, no chatter."
+            if dd.clean else "**Design: not clean** — see the constraints below.")
+    lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "
+                   f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms"]
+    lines += [f"- {'✗' if x.violated else '·'} {_md_text(x.text)}" for x in dd.limiting]
+    lines += [f"- note: {_md_text(n)}" for n in dd.notes]
+    return "\n\n".join(lines[:2]) + "\n\n" + "\n".join(lines[2:])
+
+
+def _md_text(text: str) -> str:
+    """Escape Markdown/HTML control characters of a message for a Markdown element."""
+    return "".join("\\" + ch if ch in "\\`*_{}[]<>#|" else ch for ch in text)
+
+
 def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
                    price_per_kWh: float) -> AnnualSavings | None:
     """Savings on the net electrical input energy over the simulated horizon; None without both runs.
@@ -90,5 +107,5 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
             "(negative = the conventional controller is cheaper).")
 
 
-__all__ = ["AnnualSavings", "annual_savings", "derived_markdown",
+__all__ = ["design_markdown", "AnnualSavings", "annual_savings", "derived_markdown",
            "savings_markdown", "warnings_html"]

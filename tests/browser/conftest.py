@@ -119,9 +119,14 @@ def figure(page: Any, figure_id: str) -> dict[str, Any] | None:
     return page.evaluate(FIGURE_JS, figure_id)
 
 
+def field(page: Any, label: str) -> Any:
+    """The input of the GUI row labelled ``label`` (viser's text inputs are not linked to their label)."""
+    return page.locator(f'xpath=//label[normalize-space(.)="{label}"]/ancestor::*[.//input][1]//input').first
+
+
 def set_number(page: Any, label: str, value: float | str) -> None:
     """Type a value into the number field labelled ``label`` and leave the field (blur)."""
-    field = page.get_by_label(label, exact=True)
-    field.fill(str(value))
-    field.press("Tab")
+    field_ = field(page, label)
+    field_.fill(str(value))
+    field_.press("Tab")
     page.wait_for_timeout(120)  # viser throttles GUI messages to one per 50 ms

@@ -12,7 +12,7 @@ from playwright.sync_api import expect
 
 from app.presets import DEFAULT_PRESET, dumps_preset, load_preset, loads_preset
 from control.derivations import derive
-from tests.browser.conftest import ARTIFACTS, figure, open_page, set_number
+from tests.browser.conftest import ARTIFACTS, field, figure, open_page, set_number
 
 
 def _phase_omega_p(page) -> float:
@@ -91,7 +91,7 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
     path.write_text(dumps_preset(uploaded), encoding="utf-8")
     page.locator("input[type=file]").set_input_files(str(path))
     _wait_phase_omega_p(page, derive(uploaded).profile.omega_p)
-    assert page.get_by_label("T_m manoeuvre time [s]", exact=True).input_value() == "1.8"
+    assert field(page, "T_m manoeuvre time [s]").input_value() == "1.8"
     page.get_by_text("Export", exact=True).click()
     name, exported = _download(page, "Drive parameters (YAML)")
     assert name == "imported_case.yaml" and loads_preset(exported.decode(), "export.yaml") == uploaded
@@ -135,7 +135,7 @@ def test_two_browser_contexts_keep_separate_values(browser, ui_server):
         page_a.get_by_role("button", name="Simulate").click()
         _wait_phase_omega_p(page_a, derive(new).profile.omega_p)
         page_b.wait_for_timeout(300)
-        assert page_b.get_by_label("T_m manoeuvre time [s]", exact=True).input_value() == "1"
+        assert field(page_b, "T_m manoeuvre time [s]").input_value() == "1"
         assert abs(_phase_omega_p(page_b) - derive(params).profile.omega_p) < 1e-9
     finally:
         ctx_a.close()
@@ -186,5 +186,5 @@ def test_recommended_K_then_T_c_min_one_click_fixes(page):
     assert f"{T_c_ms:.4g} ms" in use_tc.inner_text()
     _click_and_wait_for_run(page, use_tc)
     assert "Chatter (FDSMC)" not in page.inner_text("body")
-    assert abs(float(page.get_by_label("T_c sliding time const. [ms]", exact=True).input_value()) - T_c_ms) < 1e-6
+    assert abs(float(field(page, "T_c sliding time const. [ms]").input_value()) - T_c_ms) < 1e-6
     assert not use_tc.is_visible()
