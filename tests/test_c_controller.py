@@ -24,9 +24,9 @@ import pytest
 
 from app.c_verify import CFLAGS, agreement, build, closed_loop, compiler, write_module
 from app.export_c import controller_files
-from app.presets import SCHEMA, load_preset
+from app.presets import SCHEMA, list_presets, load_preset
 from control.derivations import derive
-from control.params import ParameterError
+from control.params import DriveParams, ParameterError
 from sim.engine import simulate
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -131,3 +131,12 @@ def test_continuous_mode_is_refused_with_the_field_named():
     params = load_preset("paper_12kw_pmsm", ["controller.f_s=continuous"])
     with pytest.raises(ParameterError, match="controller.f_s"):
         controller_files(params, derive(params), SCHEMA)
+
+
+@pytest.mark.parametrize("preset", [n for n in list_presets() if isinstance(load_preset(n), DriveParams)])
+def test_every_shipped_preset_compiles_in_both_builds(tmp_path, preset):
+    params = load_preset(preset)
+    _write(tmp_path, params)
+    for single in (False, True):
+        lib = build(tmp_path, single)
+        assert hasattr(lib, "fdsmc_step") and hasattr(lib, "fdsmc_step_conventional")
