@@ -169,6 +169,7 @@ def test_cli_name_and_source_options_rename_the_export(tmp_path):
     data = json.loads(out.read_text())
     assert (data["name"], data["source"], data["controller"]["K"]) == ("line 3 axis", "nameplate", 0.3)
     assert main(["export", "paper_12kw_pmsm", "--format", "c", "-o", str(out)]) == 2  # a file, not a folder
+    assert main(["export", "bldc_smc_paper", "--format", "yaml", "-o", str(tmp_path / "b.yaml")]) == 2
 
 
 def test_uncommitted_names_each_edited_field(paper_params):
@@ -199,3 +200,27 @@ def test_page_rename_sets_file_name_and_refuses_blank(case):
     assert name == "line_3_axis.yaml" and loads_raw(content.decode())["source"] == "nameplate"
     with pytest.raises(ExportRefusedError, match="name = ' ' is empty"):
         renamed(case, " ", "x")
+
+
+@pytest.mark.parametrize("fmt", ["yaml", "json"])
+def test_round_trip_in_continuous_mode(tmp_path, paper_params, fmt):
+    """The controller evaluated continuously (no f_s): no discrete gains, same round trip."""
+    params = dataclasses.replace(paper_params, controller=dataclasses.replace(paper_params.controller,
+                                                                              f_s="continuous", K=0.3))
+    cmp = compare(params)
+    ((name, first),) = export_files(fmt, cmp).items()
+    data = loads_raw(first.decode(), name) if fmt == "yaml" else json.loads(first)
+    assert data["controller"]["f_s"] == "continuous" and "OBS_L1" not in data["drive_gains"]
+    assert loads_preset(first.decode(), name) == params
+    assert export_files(fmt, compare(loads_preset(first.decode(), name)))[name] == first
+    with pytest.raises(ParameterError, match="controller.f_s = 'continuous' cannot be exported as C"):
+        export_files("c", cmp)
+
+
+def test_bldc_mode_presets_load_from_yaml_and_json():
+    from app.presets import dumps_preset, to_raw
+
+    bldc = load_preset("bldc_smc_paper")
+    assert loads_preset(dumps_preset(bldc), "b.yaml") == bldc
+    assert loads_preset(json.dumps(to_raw(bldc)), "b.json") == bldc
+    assert to_raw(bldc)["schema"] == SCHEMA
