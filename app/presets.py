@@ -295,11 +295,19 @@ def loads_json_raw(text: str, origin: str = "<text>") -> Any:
     if len(text.encode("utf-8", "replace")) > MAX_BYTES:
         raise PresetError(f"{origin} is too large: allowed ≤ {MAX_BYTES // 1024} KiB")
     try:
-        return json.loads(text, parse_constant=_no_constant)
+        return json.loads(text, parse_constant=_no_constant, object_pairs_hook=_unique_keys)
     except json.JSONDecodeError as exc:
         raise PresetError(f"{origin} is not valid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}") from None
     except RecursionError:
         raise PresetError(f"{origin} is nested too deeply") from None
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    keys = [k for k, _ in pairs]
+    dup = next((k for k in keys if keys.count(k) > 1), None)
+    if dup is not None:
+        raise PresetError(f"key {dup!r} is given more than once in a JSON object: allowed once")
+    return dict(pairs)
 
 
 def _no_constant(name: str) -> Any:
@@ -308,8 +316,13 @@ def _no_constant(name: str) -> Any:
 
 def loads_any_raw(text: str, origin: str = "<text>") -> Any:
     """JSON (``*.json``, or text starting with ``{``) or YAML text → plain Python data."""
-    if origin.lower().endswith(".json") or text.lstrip().startswith("{"):
+    if origin.lower().endswith(".json"):
         return loads_json_raw(text, origin)
+    if text.lstrip().startswith("{"):  # JSON text; a YAML flow mapping falls back to YAML
+        try:
+            return loads_json_raw(text, origin)
+        except PresetError:
+            pass
     return loads_raw(text, origin)
 
 

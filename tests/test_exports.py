@@ -110,6 +110,8 @@ def test_json_rejects_non_finite_and_bad_text(case):
         loads_preset('{"schema": 2,', "x.json")
     with pytest.raises(ValueError, match="NaN is not allowed"):
         loads_preset(parameter_json(case).replace('"T_m": 1.0', '"T_m": NaN'), "x.json")
+    with pytest.raises(ValueError, match="key 'T_m' is given more than once"):
+        loads_preset(parameter_json(case).replace('"T_m": 1.0', '"T_m": 1.0, "T_m": 2.0'), "x.json")
 
 
 def test_csv_one_table_with_units_in_headers(case):
