@@ -47,7 +47,7 @@ typedef double fdsmc_real;
 #endif
 /* Angles (theta_r, theta_dem, theta_hat) are double even in the float32 build: float32 resolves
  * 60 rad only to 3.8 urad, and the observer (bandwidth FDSMC_OBS_Q) would turn that into current
- * noise. Four double additions per sample; -DFDSMC_ANGLE_FLOAT makes them float at that cost. */
+ * noise. A few double operations per sample; -DFDSMC_ANGLE_FLOAT makes them float at that cost. */
 #ifdef FDSMC_ANGLE_FLOAT
 typedef float fdsmc_angle;
 #else
