@@ -14,6 +14,7 @@ import plotly.graph_objects as go
 import plotly.io as pio
 
 from app.derived_view import derived_rows
+from app.export_c import TOOL
 from app.figures import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
 from app.figures_energy import make_energy_bars_figure, make_energy_figure
 from app.presets import to_raw
@@ -21,7 +22,6 @@ from control.model import available_voltage
 from sim.engine import Comparison
 from sim.verdicts import run_warnings
 
-TOOL = "pmsm-commissioning (FDSMC)"
 #: Height of each time-plot row and of every other figure [px].
 ROW_HEIGHT_PX, FIGURE_HEIGHT_PX = 280, 520
 

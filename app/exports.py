@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from app.derived_view import derived_rows
-from app.export_c import controller_files
+from app.export_c import TOOL, controller_files
 from app.presets import SCHEMA, dumps, to_raw
 from app.units import SI_UNITS
 from control.derivations import Derived
@@ -35,7 +35,6 @@ from control.params import ParameterError
 from sim.engine import Comparison
 from sim.verdicts import run_warnings
 
-TOOL = "pmsm-commissioning (FDSMC)"
 FORMATS = ("yaml", "json", "c", "csv", "html")
 
 
