@@ -26,7 +26,7 @@ import pytest
 
 from app.c_verify import CFLAGS, agreement, build, closed_loop, compiler, write_module
 from app.export_c import controller_files
-from app.presets import DEFAULT_PRESET, SCHEMA, list_presets, load_preset
+from app.presets import SCHEMA, list_presets, load_preset
 from control.derivations import derive
 from control.params import DriveParams, ParameterError
 from sim.engine import simulate
@@ -137,7 +137,7 @@ def test_continuous_mode_is_refused_with_the_field_named():
 
 
 #: The shipped real-motor presets (the paper preset has its own tests above: its K = 1000 limit-cycles).
-REAL_MOTORS = [n for n in list_presets() if n != DEFAULT_PRESET and isinstance(load_preset(n), DriveParams)]
+REAL_MOTORS = [n for n in list_presets() if n != "paper_12kw_pmsm" and isinstance(load_preset(n), DriveParams)]
 
 
 @pytest.mark.parametrize("preset", REAL_MOTORS)
