@@ -13,7 +13,7 @@ from app.exports import trace_csv
 from app.presets import load_preset
 from control.params import ParameterError
 from sim.engine import Comparison, compare
-from sim.verdicts import run_warnings
+from sim.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
 SUMMARY = (
@@ -68,6 +68,7 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["run_warnings"] = run_warnings(cmp)
+    out["comparator_notes"] = comparator_notes(cmp)
     return finite_or_none(out)
 
 
@@ -103,7 +104,7 @@ def print_summary(cmp: Comparison) -> None:
         print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
               f"(eq. (52) predicts {_fmt(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
         print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
-    for w in run_warnings(cmp) + list(cmp.derived.warnings):
+    for w in run_warnings(cmp) + list(cmp.derived.warnings) + comparator_notes(cmp):
         print(f"  ! {w}")
 
 

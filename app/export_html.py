@@ -20,7 +20,7 @@ from app.figures_energy import make_energy_bars_figure, make_energy_figure
 from app.presets import to_raw
 from control.model import available_voltage
 from sim.engine import Comparison
-from sim.verdicts import run_warnings
+from sim.verdicts import comparator_notes, run_warnings
 
 #: Height of each time-plot row and of every other figure [px].
 ROW_HEIGHT_PX, FIGURE_HEIGHT_PX = 280, 520
@@ -112,7 +112,7 @@ def html_report(cmp: Comparison) -> str:
     raw = to_raw(params)
     inputs = [(sec, k, str(v)) for sec in ("motor", "load", "controller", "manoeuvre") for k, v in raw[sec].items()]
     derived = [(r.label, r.symbol, r.text(), r.unit, r.ref) for r in derived_rows(d)]
-    warnings = list(d.warnings) + run_warnings(cmp)
+    warnings = list(d.warnings) + run_warnings(cmp) + comparator_notes(cmp)
     warn = "".join(f"<li>{html.escape(w)}</li>" for w in warnings) or "<li>none</li>"
     plots = [pio.to_html(fig, full_html=False, include_plotlyjs=(i == 0), div_id=f"figure{i}",
                          default_height=f"{fig.layout.height}px") for i, fig in enumerate(report_figures(cmp))]

@@ -33,7 +33,7 @@ from app.units import SI_UNITS
 from control.derivations import Derived
 from control.params import ParameterError
 from sim.engine import Comparison
-from sim.verdicts import run_warnings
+from sim.verdicts import comparator_notes, run_warnings
 
 FORMATS = ("yaml", "json", "c", "csv", "html")
 
@@ -98,7 +98,8 @@ def verdicts(cmp: Comparison) -> dict[str, Any]:
     """Feasibility, design warnings, run warnings and savings of one case."""
     d = cmp.derived
     return {"feasible": bool(d.profile.feasible), "warnings": list(d.warnings),
-            "run_warnings": run_warnings(cmp), "saving_friction_pct": cmp.saving_friction_pct,
+            "run_warnings": run_warnings(cmp), "comparator_notes": comparator_notes(cmp),
+            "saving_friction_pct": cmp.saving_friction_pct,
             "saving_electrical_pct": cmp.saving_electrical_pct}
 
 

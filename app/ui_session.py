@@ -29,7 +29,7 @@ from control.nameplate import nameplate_consistency
 from control.params import DriveParams
 from sim.design import design_drive
 from sim.engine import PAPER_TABLE1, Comparison, compare, table1_sweep
-from sim.verdicts import T_c_advice, recommended_K, run_warnings
+from sim.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
 
 #: Widths of the control panel (left) and the results panel (right) [px].
 CONTROL_WIDTH, RESULTS_WIDTH = 430, 780
@@ -220,7 +220,7 @@ class Session:
         items = list(d.warnings) + run_warnings(self.comparison) + self._nameplate_warnings()
         if self.comparison.fdsmc is None:
             items.append("Not simulated: the manoeuvre is infeasible (see above).")
-        self.warnings.content = warnings_html(items, self.error)
+        self.warnings.content = warnings_html(items, self.error, comparator_notes(self.comparison))
         chatter = any(r is not None and r.metrics.get("chatter")
                       for r in (self.comparison.fdsmc, self.comparison.conventional))
         k_rec = recommended_K(d)

@@ -25,11 +25,15 @@ def derived_markdown(derived: Derived) -> str:
     return "\n".join(lines)
 
 
-def warnings_html(items: list[str], error: str | None = None) -> str:
-    """A red box listing the input error and the warnings; a green line when there are none."""
+def warnings_html(items: list[str], error: str | None = None, notes: list[str] | None = None) -> str:
+    """A red box listing the input error and the warnings, a green line when there are none, and the
+    ``notes`` (e.g. about the comparator) in a grey box below."""
+    extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
+                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html.escape(n)}</div>'
+                    for n in notes or [])
     if error is None and not items:
         return ('<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:#2b8a3e;'
-                'font-size:0.85em">✔ No warnings.</div>')
+                'font-size:0.85em">✔ No warnings.</div>' + extra)
     parts = []
     if error is not None:
         parts.append(f'<div data-role="input-error" style="font-weight:600">⛔ Input error — nothing '
@@ -39,7 +43,7 @@ def warnings_html(items: list[str], error: str | None = None) -> str:
         parts.append(f'<div style="font-weight:600">⚠ {len(items)} warning(s)</div>'
                      f'<ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
-            'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>")
+            'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>" + extra)
 
 
 @dataclass(frozen=True)
