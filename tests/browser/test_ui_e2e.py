@@ -73,11 +73,12 @@ def _download(page, label: str) -> tuple[str, bytes]:
 
 
 def _set_text(page, label: str, value: str) -> None:
-    """Type into viser's text field labelled ``label`` (its <label for> does not name the input)."""
-    field = page.locator(f"xpath=//label[normalize-space()='{label}']/ancestor::div[.//input][1]//input").first
-    field.fill(value)
-    field.press("Tab")
-    expect(field).to_have_value(value)
+    """Type into the text field labelled ``label`` and wait until it shows the text."""
+    box = page.locator(f'xpath=//label[normalize-space(.)="{label}"]/ancestor::*[.//input or .//textarea][1]'
+                       '//*[self::input or self::textarea]').first
+    box.fill(value)
+    box.press("Tab")
+    expect(box).to_have_value(value)
     page.wait_for_timeout(120)  # viser throttles GUI messages to one per 50 ms
 
 
