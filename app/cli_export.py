@@ -14,7 +14,7 @@ from pathlib import Path
 
 from app.cli import add_preset_arguments
 from app.exports import FORMATS, export_files
-from app.presets import load_preset
+from app.preset_modes import load_mode_preset
 from control.derivations import derive
 from control.params import DriveParams, ParameterError
 from sim.engine import Comparison, compare
@@ -38,9 +38,7 @@ def case(params: DriveParams) -> Comparison:
 
 def run(args: argparse.Namespace) -> int:
     """Load, simulate, write the export; prints the paths written."""
-    params = load_preset(args.preset, args.overrides)
-    if not isinstance(params, DriveParams):
-        raise ParameterError(f"preset {args.preset!r} is not a position-drive (FDSMC) preset: allowed mode position")
+    params = load_mode_preset(args.preset, args.overrides, mode="position")
     renamed = {k: v for k, v in (("name", args.name), ("source", args.source)) if v is not None}
     params = dataclasses.replace(params, **renamed)
     files = export_files(args.format, case(params))

@@ -115,7 +115,6 @@ class FilesPanel:
             self._client.add_notification("Import rejected — nothing changed", str(exc), color="red",
                                           auto_close_seconds=15.0)
             return
-        self.show_names(params)
         self._on_import(params, f.name)
 
     def show_names(self, params: DriveParams) -> None:

