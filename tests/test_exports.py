@@ -90,7 +90,7 @@ def test_schema_1_preset_and_schema_1_exports_still_load(paper_params):
                            "inputs": {"schema": 1, "name": "old", "source": "s", **_sections(paper_params)},
                            "gains": {}, "derived": {}})
     assert loads_preset(old_json, "old.json") == dataclasses.replace(paper_params, name="old", source="s")
-    with pytest.raises(ValueError, match="schema = 3 is not supported: allowed schema: 1 or 2"):
+    with pytest.raises(ValueError, match="schema = '3' is not supported: allowed schema: 1 or 2"):
         loads_preset(old_yaml.replace("schema: 1", "schema: 3"))
 
 
