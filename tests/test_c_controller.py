@@ -8,9 +8,9 @@ sample by sample, between RK4 steps of :class:`sim.plant.PlantInTheLoop`; see ap
 Agreement = max |C − simulator| / max |simulator| over the run (error relative to the signal's
 peak), for θ_r, ω_r, i_q and the energies, at every controller sample of the 1.3 s horizon
 (``python -m app.c_verify`` prints the figures).
-Measured (paper preset, 20 kHz): double ≤ 6e-10 at the paper's K = 1000 (limit-cycling loop),
-≤ 2e-7 with delay and inverter limits; float32 at the recommended K: θ_r 1e-8, ω_r 8e-7,
-i_q 2.6e-5, energies ≤ 1.3e-6.
+Measured (paper preset, 20 kHz): double ≤ 7e-9 at the paper's K = 1000 (limit-cycling loop),
+≤ 2e-7 with delay and inverter limits; float32 at the recommended K: θ_r 1.6e-8, ω_r 1.1e-6,
+i_q 2.5e-5, energies ≤ 2e-6.
 """
 
 from __future__ import annotations
