@@ -167,7 +167,8 @@ def parse_preset(raw: Any) -> Any:
         With a message naming the field, the value and the allowed range or type.
     """
     if not isinstance(raw, dict):
-        raise PresetError("a preset must be a YAML mapping with schema, name, source and sections")
+        raise PresetError("a preset must be a mapping: allowed a YAML or JSON mapping with schema, name, "
+                          "source and sections")
     raw = migrate(raw)
     mode = raw.get("mode", "position")
     if mode not in MODES:
