@@ -161,7 +161,8 @@ def parse_preset(raw: Any) -> Any:
         With a message naming the field, the value and the allowed range or type.
     """
     if not isinstance(raw, dict):
-        raise PresetError("a preset must be a YAML mapping with schema, name, source and sections")
+        raise PresetError(f"a preset = {str(raw)[:40]!r} is not a mapping: allowed a YAML mapping with schema, name, "
+                          "source and one mapping per section")
     if _schema(raw.get("schema")) != SCHEMA:
         raise PresetError(f"schema = {raw.get('schema')!r} is not supported: allowed schema: {SCHEMA}")
     mode = raw.get("mode", "position")
