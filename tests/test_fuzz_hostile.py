@@ -212,7 +212,7 @@ def _emf_csv(rows: int, three: bool) -> list[list[str]]:
     return out
 
 
-@settings(FUZZ, max_examples=150)
+@settings(FUZZ, max_examples=120)
 @given(rows=st.integers(0, 200), three=st.booleans(), edits=st.lists(
     st.tuples(st.integers(0, 10**6), st.integers(0, 3), value_texts), max_size=3),
     sep=st.sampled_from([",", ";", "\t", " "]), header=st.booleans(), yaml=st.booleans())
