@@ -1,0 +1,133 @@
+"""Drive-log import: the shipped example logs, this tool's own CSV export, and bad logs."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from app import log_io
+from app.cli_simulate import write_csv
+from app.log_io import LogError, parse_log, read_log
+from app.presets import load_preset, loads_log_mapping
+from control.identification import identify
+from sim.engine import simulate
+from sim.synthetic_log import LOG_OVERRIDES, TRUE_LOAD, TRUE_MOTOR, perturbed
+
+DATA = Path(__file__).resolve().parent / "data"
+TOLERANCE = {"R_s": 0.02, "L_d": 0.02, "L_q": 0.02, "psi_pm": 0.02, "J_total": 0.03, "F_v": 0.10}
+
+
+def _truth() -> dict[str, float]:
+    true = perturbed(load_preset("paper_12kw_pmsm", LOG_OVERRIDES))
+    return {**TRUE_MOTOR, "J_total": true.J_total, "F_v": TRUE_LOAD["F_v"], "Gamma_Le": TRUE_LOAD["Gamma_Le"]}
+
+
+@pytest.mark.parametrize("name, mapping", [("drive_log_dq.csv", None),
+                                           ("drive_log_phases.csv", "drive_log_phases.map.yaml")])
+def test_shipped_logs_identify_the_true_plant(name, mapping):
+    """Through the same import path as a real log: R_s, L, Ψ_PM within 2 %, J within 3 %,
+    F_v within 10 %, and every true value inside its 95 % interval."""
+    mp = loads_log_mapping((DATA / mapping).read_text(encoding="utf-8")) if mapping else None
+    log = read_log(DATA / name, mapping=mp, p=5)
+    assert (DATA / name).stat().st_size < 300_000
+    assert log.T_s == pytest.approx(1e-4)
+    r = identify(log.signals, 5)
+    truth = _truth()
+    for key, value in truth.items():
+        e = r.get(key)
+        assert e.ci95[0] <= value <= e.ci95[1], (key, e)
+        if key in TOLERANCE:
+            assert abs(e.value / value - 1.0) < TOLERANCE[key], (key, e.value)
+
+
+def test_park_transform_of_phase_currents_is_exact():
+    t = np.arange(100) * 1e-3
+    th = 0.3 * t * 100
+    i_d, i_q, p = 2.0 + 0.0 * t, 5.0 * np.sin(t * 30), 4
+    cols = []
+    for shift in (0.0, -2 * math.pi / 3, 2 * math.pi / 3):
+        cols.append(i_d * np.cos(p * th + shift) - i_q * np.sin(p * th + shift))
+    lines = ["t [s],theta_r [rad],i_a [A],i_b [A],i_c [A]"] + [
+        ",".join(f"{v:.12g}" for v in row) for row in zip(t, th, *cols, strict=True)]
+    log = parse_log("\n".join(lines), p=p)
+    assert np.allclose(log.signals["i_d"], i_d, atol=1e-9) and np.allclose(log.signals["i_q"], i_q, atol=1e-9)
+
+
+def test_units_in_header_are_converted_to_si():
+    rows = [f"{k * 0.5},{k * 0.1},12000,{k}" for k in range(30)]  # 0.1 rev per 0.5 ms = 12000 rpm
+    log = parse_log("t [ms],theta_r [rev],omega_r [rpm],i_q [mA]\n" + "\n".join(rows))
+    assert log.signals["t"][2] == pytest.approx(1e-3)
+    assert log.signals["theta_r"][1] == pytest.approx(0.1 * 2 * math.pi)
+    assert log.signals["i_q"][3] == pytest.approx(3e-3)
+    assert log.signals["omega_r"][0] == pytest.approx(400 * math.pi)
+
+
+def test_own_simulate_csv_is_accepted_without_mapping(tmp_path):
+    """``simulate --csv`` output (both runs in one file) is a log: --run picks one, and its
+    signals equal the simulated trace."""
+    params = load_preset("paper_12kw_pmsm", ["manoeuvre.theta_dem=3", "manoeuvre.T_m=0.6",
+                                             "controller.f_s=5000", "controller.T_so=0.002",
+                                             "controller.T_salpha=0.005"])
+    runs = [simulate(params, c, max_points=2000) for c in ("fdsmc", "conventional")]
+    path = tmp_path / "sim.csv"
+    write_csv(str(path), runs)
+    with pytest.raises(LogError, match="choose one"):
+        read_log(path)
+    log = read_log(path, run="conventional")
+    n = log.signals["t"].size
+    assert np.allclose(log.signals["i_q"], runs[1].trace.i_q[:n], rtol=1e-8, atol=1e-9)
+    assert {"theta_r", "omega_r", "i_d", "u_q"} <= set(log.signals)
+
+
+def _log(lines: list[str], header: str = "t [s],i_q [A]") -> str:
+    return "\n".join([header, *lines])
+
+
+GOOD = [f"{k * 1e-3},{k}" for k in range(40)]
+
+
+@pytest.mark.parametrize("text, match", [
+    (_log(GOOD[:5] + [GOOD[3]] + GOOD[6:]), r"time does not increase at line 7"),
+    (_log(GOOD[:10] + ["0.010,", "0.011,nan"] + GOOD[12:]), r"2 empty/NaN/inf value\(s\), first at line 12"),
+    (_log(GOOD, "t [s],i_q [A],torque [N*m]").replace("\n", ",1\n") + ",1", r"unknown column\(s\) 'torque \[N\*m\]'"),
+    (_log(GOOD, "t [s],i_q [furlong]"), r"unit 'furlong' is not allowed for i_q: allowed A, mA"),
+    (_log(GOOD, "t [s],i_q"), r"column 'i_q' has no unit"),
+    (_log(GOOD[:10] + GOOD[15:]), r"gap of 0.006 s before line 12"),
+    (_log(GOOD[:10] + ["0.010,abc"] + GOOD[11:]), r"line 12, column 'i_q \[A\]': 'abc' is not a number"),
+    (_log(GOOD[:10] + ["0.010,1,2"] + GOOD[11:]), r"line 12: 3 fields, the header has 2"),
+    (_log(GOOD, "i_d [A],i_q [A]"), r"no time column"),
+    (_log(GOOD[:5]), r"5 data rows: allowed ≥ 20"),
+    ("", r"the log is empty"),
+])
+def test_bad_logs_get_a_clear_error_naming_line_and_column(text, match):
+    with pytest.raises(LogError, match=match):
+        parse_log(text)
+
+
+def test_speed_logged_in_rpm_but_labelled_rad_s_is_caught():
+    rows = [f"{k * 1e-3},{k * 1e-2},{10.0 * 60 / (2 * math.pi)}" for k in range(100)]
+    with pytest.raises(LogError, match=r"disagree.*check their units"):
+        parse_log("t [s],theta_r [rad],omega_r [rad/s]\n" + "\n".join(rows))
+
+
+def test_too_many_rows_and_too_large_files_are_refused_before_parsing(tmp_path, monkeypatch):
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:  # sparse: 10^7 rows of ~60 bytes would be 600 MB
+        fh.seek(600 * 2**20)
+        fh.write(b"\n")
+    with pytest.raises(LogError, match=r"big.csv is 600.0 MB: allowed ≤ 50 MB"):
+        read_log(big)
+    monkeypatch.setattr(log_io, "MAX_ROWS", 30)
+    with pytest.raises(LogError, match=r"the log has 40 rows: allowed ≤ 30"):
+        parse_log(_log(GOOD))
+
+
+def test_mapping_names_columns_and_unknown_mapped_column_is_an_error():
+    text = "Zeit;Strom\n" + "\n".join(f"{k};{k * 2}" for k in range(30))
+    log = parse_log(text, mapping=loads_log_mapping("Zeit: t [ms]\nStrom: i_q [mA]\n"))
+    assert log.signals["i_q"][5] == pytest.approx(10e-3) and log.columns["i_q"] == "Strom"
+    with pytest.raises(LogError, match=r"column 'Spannung' is not in the log's header"):
+        parse_log(text, mapping={"Spannung": "u_q [V]", "Zeit": "t [ms]"})
