@@ -131,3 +131,42 @@ def test_mapping_names_columns_and_unknown_mapped_column_is_an_error():
     assert log.signals["i_q"][5] == pytest.approx(10e-3) and log.columns["i_q"] == "Strom"
     with pytest.raises(LogError, match=r"column 'Spannung' is not in the log's header"):
         parse_log(text, mapping={"Spannung": "u_q [V]", "Zeit": "t [ms]"})
+
+
+def test_cli_log_json_overlay_of_own_export_is_exact_and_identifies_the_shipped_log(tmp_path, capsys):
+    """A log that is this tool's own simulation of the same preset overlays with zero error
+    and equal input energy; a rest period before the move is found as the move start."""
+    import json
+
+    from app.cli import main
+
+    params = load_preset("example_log_drive")
+    run = simulate(params, "fdsmc")
+    path = tmp_path / "own.csv"
+    write_csv(str(path), [run])
+    assert main(["log", str(path), "--preset", "example_log_drive", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    ov = out["overlay"]
+    assert ov["t0_s"] == pytest.approx(0.0, abs=1e-9)
+    assert ov["theta_r"]["rms_error"] < 1e-6 and ov["i_q"]["peak_error"] < 1e-6 and ov["i_q"]["unit"] == "A"
+    e = ov["electrical_energy"]
+    assert e["measured"] == pytest.approx(e["simulated"], rel=2e-3)
+
+    assert main(["log", str(DATA / "drive_log_dq.csv"), "--preset", "example_log_drive", "--identify",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["overlay"]["t0_s"] == pytest.approx(0.12, abs=2e-3)  # after 4 × 30 ms of injection
+    ident = out["identified"]
+    assert ident["voltage_delay_samples"] == 1
+    assert ident["R_s"]["ci95"][0] <= TRUE_MOTOR["R_s"] <= ident["R_s"]["ci95"][1]
+    assert ident["L_d"]["unit"] == "H" and ident["J_total"]["stderr"] > 0
+
+
+def test_cli_log_bad_file_is_one_line_exit_2(tmp_path, capsys):
+    from app.cli import main
+
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t [s],i_q [A]\n" + "\n".join(f"{1 - k * 1e-3},{k}" for k in range(30)), encoding="utf-8")
+    assert main(["log", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: column 't [s]': time does not increase at line 3") and "Traceback" not in err
