@@ -89,7 +89,8 @@ def _print(log: DriveLog, ov: Overlay, ident: Identification | None) -> None:
     for e in ov.errors:
         print(f"{e.signal:10s}{e.rms_error:14.5g}{e.peak_error:14.5g}  {e.unit}")
     if ov.energy_measured_J is not None:
-        print(f"\nElectrical input energy: measured {ov.energy_measured_J:.5g} J, simulated {ov.energy_simulated_J:.5g} J")
+        print(f"\nElectrical input energy: measured {ov.energy_measured_J:.5g} J, "
+              f"simulated {ov.energy_simulated_J:.5g} J")
     if ident is None:
         return
     print(f"\n{'parameter':10s}{'value':>14s}{'std. error':>14s}{'95 % interval':>30s}  unit")
