@@ -13,6 +13,7 @@ import sys
 #: sub-command → (module, help)
 COMMANDS: dict[str, tuple[str, str]] = {
     "derive": ("app.cli_derive", "derive α_max, observer gains, profile, comparator gains, energies"),
+    "design": ("app.cli_design", "design a clean setting for this drive and verify it by simulation"),
     "simulate": ("app.cli_simulate", "simulate the FDSMC and the conventional controller"),
     "table1": ("app.cli_table1", "Table-1 sweep of the friction saving over manoeuvre times"),
     "bench": ("app.bench", "print speed figures of the simulation engine"),

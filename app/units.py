@@ -117,3 +117,27 @@ ALIASES: dict[str, dict[str, Alias]] = {
 
 #: Keys needing more than one field to convert (Ke needs the pole pairs).
 KE_KEY = "Ke_Vrms_krpm"
+
+
+def kt_nm_per_arms_to_psi_pm(Kt_Nm_Arms: float, p: int) -> float:
+    """Torque constant Kt [N·m per A_rms] → Ψ_PM [Wb] (amplitude-invariant dq, i_d = 0).
+
+    Γ = (3/2)·p·Ψ_PM·i_q with i_q the phase-current peak √2·I_rms (eq. (5) in [1]), so
+    Kt = (3/2)·√2·p·Ψ_PM.
+    """
+    return Kt_Nm_Arms / (1.5 * math.sqrt(2.0) * p)
+
+
+def psi_pm_to_kt_nm_per_arms(psi_pm: float, p: int) -> float:
+    """Ψ_PM [Wb] → Kt [N·m per A_rms]; inverse of :func:`kt_nm_per_arms_to_psi_pm`."""
+    return psi_pm * 1.5 * math.sqrt(2.0) * p
+
+
+def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
+    """Ψ_PM [Wb] → Ke [V_rms line-to-line per krpm]; inverse of :func:`ke_vrms_krpm_to_psi_pm`."""
+    return psi_pm * p * rpm_to_rad_s(1000.0) / math.sqrt(2.0 / 3.0)
+
+
+def kgcm2_to_kgm2(J_kgcm2: float) -> float:
+    """Inertia [kg·cm²] → [kg·m²]."""
+    return J_kgcm2 * 1e-4

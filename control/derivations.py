@@ -14,15 +14,18 @@ from control.conventional import ConventionalGains, conventional_gains, friction
 from control.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
 from control.loop_analysis import (
     GainRecommendation,
+    LoopModel,
     SampleRateCheck,
     loop_warnings,
     recommend_K,
     sample_rate_check,
 )
 from control.model import ModelCoefficients, model_coefficients
+from control.nameplate import nameplate_consistency
 from control.observer import DiscreteObserver, ObserverGains, discrete_observer, observer_gains
 from control.params import DriveParams
 from control.profile import VelocityProfile, friction_energy_eq52, velocity_profile
+from control.transient import acceleration_overshoot
 
 
 @dataclass(frozen=True)
@@ -88,9 +91,11 @@ def derive(params: DriveParams) -> Derived:
     Derived
     """
     coeff = model_coefficients(params.motor)
-    alpha = alpha_max(params)
     obs = observer_gains(params.controller.T_so, coeff.M)
     ctrl = params.controller
+    f_s = None if ctrl.is_continuous else float(ctrl.f_s)
+    eta = acceleration_overshoot(LoopModel(coeff, params, obs), f_s, ctrl.delay_samples)
+    alpha = alpha_max(params, eta)
     obs_d = None if ctrl.is_continuous else discrete_observer(obs, coeff.M, float(ctrl.f_s))
     prof = velocity_profile(params.manoeuvre.theta_dem, alpha.alpha_max, params.manoeuvre.T_m, ctrl.T_c)
     feas = feasibility(params, alpha, prof.omega_p)
@@ -125,19 +130,21 @@ def _warnings(
         w.append(
             f"α_max = {alpha.alpha_max:.5g} rad/s² ({alpha.rule} rule) needs "
             f"{alpha.torque_needed:.4g} N·m on the total inertia J_r + J_L = "
-            f"{params.J_total:.4g} kg·m², more than Γ_max = {params.motor.Gamma_max:g} N·m: "
-            "the inverter/motor will saturate during acceleration (use alpha_max_rule: torque_limit)."
+            f"{params.J_total:.4g} kg·m² (inner-loop overshoot η = {alpha.overshoot:.3g} included), "
+            f"more than the drive's {feas.Gamma_max:.4g} N·m: the inverter/motor will saturate during "
+            "acceleration (use alpha_max_rule: torque_limit, or Design for this drive)."
         )
     elif not feas.torque_ok:
         w.append(
-            f"Peak torque {feas.torque_needed:.4g} N·m (acceleration + friction at ω_p + load) "
-            f"exceeds Γ_max = {feas.Gamma_max:g} N·m."
+            f"Peak torque {feas.torque_needed:.4g} N·m (acceleration with the inner-loop overshoot "
+            f"η = {alpha.overshoot:.3g}, friction at ω_p and load) exceeds the drive's {feas.Gamma_max:.4g} N·m."
         )
     if not feas.speed_ok:
         w.append(f"Peak speed ω_p = {feas.omega_p:.4g} rad/s exceeds the base speed ω_b = {feas.omega_b:g} rad/s.")
     if not feas.voltage_ok:
         w.append(
             f"Voltage needed at ω_p with the peak torque, {feas.u_needed_peak:.4g} V, exceeds the "
-            f"available {feas.u_available:.4g} V (√(2/3)·V_0)."
+            f"available {feas.u_available:.4g} V (V_dc/√3, or √(2/3)·V_0 without V_dc)."
         )
+    w += [f"Nameplate: {x.text}" for x in nameplate_consistency(params.motor)]
     return tuple(w)

@@ -10,6 +10,32 @@ from dataclasses import dataclass
 
 from control.model import available_voltage, model_coefficients, torque_constant
 from control.params import DriveParams, ParameterError
+from control.profile import peak_speed, shortest_manoeuvre_time
+
+#: Relative precision of the steady-state limit checks [-]: the model's torque and voltage estimates
+#: are not more exact than this, so a peak within it of a limit is not reported as exceeding it.
+LIMIT_TOLERANCE = 0.005
+
+
+def exceeds(value: float, limit: float) -> bool:
+    """True when ``value`` exceeds ``limit`` by more than :data:`LIMIT_TOLERANCE` (relative)."""
+    return value > limit * (1.0 + LIMIT_TOLERANCE)
+
+
+def torque_limit(params: DriveParams) -> float:
+    """Torque the drive can deliver [N·m]: Γ_max, or less where the inverter's i_max caps i_q.
+
+    Γ = (3/2)·p·Ψ_PM·i_q at i_d = 0 (eq. (5) in [1]); ``controller.i_max`` = 0 means no inverter limit.
+    """
+    g = params.motor.Gamma_max
+    i_max = params.controller.i_max
+    return min(g, torque_constant(params.motor) * i_max) if i_max > 0.0 else g
+
+
+def voltage_limit(params: DriveParams) -> float:
+    """Largest |u_dq| [V]: V_dc/√3 of the inverter (space-vector limit) when given, else √(2/3)·V_0."""
+    V_dc = params.controller.V_dc
+    return V_dc / math.sqrt(3.0) if V_dc > 0.0 else available_voltage(params.motor)
 
 
 @dataclass(frozen=True)
@@ -23,28 +49,34 @@ class AlphaMax:
     rule : str
         ``"paper"`` (α_max = H·P_r/V_0, section 5 of [1]) or ``"torque_limit"``.
     torque_needed : float
-        Torque to accelerate the **total** inertia at α_max against the external load,
-        α_max·(J_r + J_L) + |Γ_Le| [N·m].
+        Torque to accelerate the **total** inertia at α_max against the external load, including
+        the inner loops' overshoot: η·α_max·(J_r + J_L) + |Γ_Le| [N·m].
     torque_ok : bool
-        torque_needed ≤ Γ_max.
+        torque_needed ≤ the drive's torque limit (Γ_max, or i_max's torque), within the tolerance.
+    overshoot : float
+        η, peak of the true acceleration over a step of α_dem (:mod:`control.transient`) [-].
     """
 
     alpha_max: float
     rule: str
     torque_needed: float
     torque_ok: bool
+    overshoot: float = 1.0
 
 
-def alpha_max(params: DriveParams) -> AlphaMax:
+def alpha_max(params: DriveParams, overshoot: float = 1.0) -> AlphaMax:
     """α_max under the preset's rule and the torque it needs on the total inertia.
 
-    ``paper``: α_max = H·P_r/V_0 (section 5 of [1]; H from eq. (4)). ``torque_limit``:
-    α_max = (Γ_max − |Γ_Le|)/(J_r + J_L), the largest acceleration the motor can hold for the
-    whole inertia, eq. (4b), with the external load torque subtracted.
+    ``paper``: α_max = H·P_r/V_0 (section 5 of [1]; H from eq. (4)). ``torque_limit``: the
+    largest α_max whose peak torque η·α_max·(J_r + J_L) + F_v·ω_p + |Γ_Le| stays within the drive's
+    torque limit Γ_lim (:func:`torque_limit`), eq. (4b) with the inner loops' overshoot η, the
+    friction at the peak speed ω_p of eq. (60) (itself a function of α_max) and the external load.
 
     Parameters
     ----------
     params : DriveParams
+    overshoot : float
+        η ≥ 1 of :func:`control.transient.acceleration_overshoot` [-].
 
     Returns
     -------
@@ -57,17 +89,34 @@ def alpha_max(params: DriveParams) -> AlphaMax:
     """
     m, load = params.motor, params.load
     Gamma_Le = abs(load.Gamma_Le)
+    eta = overshoot if math.isfinite(overshoot) else 1.0
     if params.controller.alpha_max_rule == "paper":
         a = model_coefficients(m).H * m.P_r / m.V_0
     else:
-        if m.Gamma_max <= Gamma_Le:
-            raise ParameterError(
-                f"load.Gamma_Le = {load.Gamma_Le:g} N·m leaves no torque for acceleration: "
-                f"allowed |Γ_Le| < Γ_max = {m.Gamma_max:g} N·m"
-            )
-        a = (m.Gamma_max - Gamma_Le) / params.J_total
-    needed = a * params.J_total + Gamma_Le
-    return AlphaMax(a, params.controller.alpha_max_rule, needed, needed <= m.Gamma_max * (1 + 1e-9))
+        a = _torque_limited_alpha(params, eta)
+    needed = eta * a * params.J_total + Gamma_Le
+    return AlphaMax(a, params.controller.alpha_max_rule, needed, not exceeds(needed, torque_limit(params)), eta)
+
+
+def _torque_limited_alpha(params: DriveParams, eta: float) -> float:
+    """Largest α [rad/s²] with η·α·J + F_v·ω_p(α) + |Γ_Le| ≤ Γ_lim (bisection to 1e-9)."""
+    lim, Gamma_Le, J = torque_limit(params), abs(params.load.Gamma_Le), params.J_total
+    if lim <= Gamma_Le:
+        raise ParameterError(
+            f"load.Gamma_Le = {params.load.Gamma_Le:g} N·m leaves no torque for acceleration: "
+            f"allowed |Γ_Le| < the drive's torque limit {lim:g} N·m (Γ_max, i_max)"
+        )
+    th, T_m, F_v = params.manoeuvre.theta_dem, params.manoeuvre.T_m, params.load.F_v
+
+    def peak(a: float) -> float:
+        w_p = peak_speed(th, a, max(T_m, shortest_manoeuvre_time(th, a)))
+        return eta * a * J + F_v * w_p + Gamma_Le
+
+    lo, hi = 0.0, (lim - Gamma_Le) / (eta * J)
+    while hi - lo > 1e-9 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if peak(mid) <= lim else (lo, mid)
+    return lo
 
 
 @dataclass(frozen=True)
@@ -79,14 +128,14 @@ class Feasibility:
     omega_p : float            Peak speed [rad/s].
     omega_b : float            Base speed [rad/s].
     speed_ok : bool            ω_p ≤ ω_b.
-    torque_needed : float      Peak torque: α_max·J_total + F_v·ω_p + |Γ_Le| [N·m].
-    Gamma_max : float          Motor torque limit [N·m].
-    torque_ok : bool           torque_needed ≤ Γ_max.
+    torque_needed : float      Peak torque: η·α_max·J_total + F_v·ω_p + |Γ_Le| [N·m].
+    Gamma_max : float          The drive's torque limit, Γ_max or i_max's torque [N·m].
+    torque_ok : bool           torque_needed ≤ Gamma_max (within LIMIT_TOLERANCE).
     i_q_needed : float         Quadrature current for torque_needed [A].
     u_needed_peak : float      |u_dq| at ω_p with torque_needed (end of acceleration) [V].
     u_needed_cruise : float    |u_dq| at ω_p with the cruise torque F_v·ω_p + |Γ_Le| [V].
-    u_available : float        √(2/3)·V_0 [V].
-    voltage_ok : bool          u_needed_peak ≤ u_available.
+    u_available : float        V_dc/√3, or √(2/3)·V_0 without an inverter limit [V].
+    voltage_ok : bool          u_needed_peak ≤ u_available (within LIMIT_TOLERANCE).
     """
 
     omega_p: float
@@ -130,19 +179,20 @@ def feasibility(params: DriveParams, alpha: AlphaMax, omega_p: float) -> Feasibi
     """
     m, load = params.motor, params.load
     cruise = load.F_v * omega_p + abs(load.Gamma_Le)
-    peak = alpha.alpha_max * params.J_total + cruise
+    peak = alpha.overshoot * alpha.alpha_max * params.J_total + cruise
+    lim = torque_limit(params)
     u_peak = dq_voltage(params, omega_p, peak)
-    u_avail = available_voltage(m)
+    u_avail = voltage_limit(params)
     return Feasibility(
         omega_p=omega_p,
         omega_b=m.omega_b,
-        speed_ok=omega_p <= m.omega_b,
+        speed_ok=not exceeds(omega_p, m.omega_b),
         torque_needed=peak,
-        Gamma_max=m.Gamma_max,
-        torque_ok=peak <= m.Gamma_max,
+        Gamma_max=lim,
+        torque_ok=not exceeds(peak, lim),
         i_q_needed=peak / torque_constant(m),
         u_needed_peak=u_peak,
         u_needed_cruise=dq_voltage(params, omega_p, cruise),
         u_available=u_avail,
-        voltage_ok=u_peak <= u_avail,
+        voltage_ok=not exceeds(u_peak, u_avail),
     )

@@ -31,7 +31,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.linalg import expm
 
-from control.observer import DiscreteObserver, discrete_observer
+from control.model import ModelCoefficients
+from control.observer import DiscreteObserver, ObserverGains, discrete_observer
+from control.params import DriveParams
 
 if TYPE_CHECKING:  # derivations imports this module
     from control.derivations import Derived
@@ -112,9 +114,15 @@ def _outer_gains(d: Derived, law: str, K: float) -> tuple[float, float]:
 
 def control_row(d: Derived, law: str, K: float) -> np.ndarray:
     """u_q = row·z, the linear part of eq. (14) in [1] at i_d = 0 with the outer law [V per state]."""
-    c, T_sa = d.coefficients, d.params.controller.T_salpha
-    a_th, a_w = _outer_gains(d, law, K)
-    f = 3.0 / T_sa
+    return fdc_row(d.coefficients, d.params.controller.T_salpha, *_outer_gains(d, law, K))
+
+
+def fdc_row(c: ModelCoefficients, T_salpha: float, a_th: float, a_w: float) -> np.ndarray:
+    """u_q = row·z of eq. (14) in [1] at i_d = 0 for α_dem = a_th·θ̂ + a_w·ω̂ [V per state].
+
+    The demand itself enters u_q with the factor :func:`fdc_input_gain`.
+    """
+    f = 3.0 / T_salpha
     row = np.zeros(_N)
     row[0] = (c.D - f) / c.G  # −(3/T_sα)·H·i_q/H + D·i_q
     row[3] = f * a_th / c.H / c.G
@@ -124,22 +132,50 @@ def control_row(d: Derived, law: str, K: float) -> np.ndarray:
     return row
 
 
+def fdc_input_gain(c: ModelCoefficients, T_salpha: float) -> float:
+    """∂u_q/∂α_dem of eq. (14) in [1]: (3/T_sα)/(H·G) [V·s²/rad]."""
+    return 3.0 / T_salpha / c.H / c.G
+
+
 def plant_matrices(d: Derived) -> tuple[np.ndarray, np.ndarray]:
     """Continuous plant [i_q, θ_r, ω_r] with input u_q, eqs. (2), (3), (4b) at i_d = 0."""
-    c, p = d.coefficients, d.params
+    return plant_matrices_of(d.coefficients, d.params)
+
+
+def plant_matrices_of(c: ModelCoefficients, p: DriveParams) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`plant_matrices` from the model coefficients and the parameters alone."""
     J_r, J_t = p.motor.J_r, p.J_total
     A = np.array([[-c.D, 0.0, -c.E], [0.0, 0.0, 1.0], [J_r * c.H / J_t, 0.0, -p.load.F_v / J_t]])
     b = np.array([c.G, 0.0, 0.0])
     return A, b
 
 
+@dataclass(frozen=True)
+class LoopModel:
+    """What the linearised loop needs besides the outer law: model, parameters, observer gains."""
+
+    coefficients: ModelCoefficients
+    params: DriveParams
+    observer: ObserverGains
+
+
+def loop_model(d: Derived) -> LoopModel:
+    """The :class:`LoopModel` of a derived case."""
+    return LoopModel(d.coefficients, d.params, d.observer)
+
+
 def continuous_loop(d: Derived, law: str, K: float) -> np.ndarray:
     """Closed-loop matrix (7×7) of the continuous implementation [1/s]."""
-    Ap, bp = plant_matrices(d)
-    o, c = d.observer, d.coefficients
+    return continuous_matrix(loop_model(d), control_row(d, law, K))
+
+
+def continuous_matrix(lm: LoopModel, row: np.ndarray) -> np.ndarray:
+    """Closed-loop matrix (7×7) [1/s] of plant, continuous observer and the control ``row``."""
+    Ap, bp = plant_matrices_of(lm.coefficients, lm.params)
+    o, c = lm.observer, lm.coefficients
     A = np.zeros((_N, _N))
     A[:3, :3] = Ap
-    A[:3, :] += np.outer(bp, control_row(d, law, K))
+    A[:3, :] += np.outer(bp, row)
     e = np.zeros(_N)
     e[1], e[3] = 1.0, -1.0  # e_o = θ − θ̂ (corrected eq. (15))
     A[3, 4] = 1.0
@@ -159,10 +195,10 @@ class SampledParts:
     observer: DiscreteObserver
 
 
-def sampled_parts(d: Derived, f_s: float) -> SampledParts:
+def sampled_parts(d: Derived | LoopModel, f_s: float) -> SampledParts:
     """Plant [i_q, θ_r, ω_r] discretised exactly for held u_q, and the observer, at ``f_s`` [Hz]."""
     T_s = 1.0 / f_s
-    Ap, bp = plant_matrices(d)
+    Ap, bp = plant_matrices_of(d.coefficients, d.params)
     aug = np.zeros((4, 4))
     aug[:3, :3], aug[:3, 3] = Ap * T_s, bp * T_s
     E = expm(aug)
@@ -174,19 +210,24 @@ def discrete_loop(
 ) -> np.ndarray:
     """Closed-loop transition matrix of the sampled implementation (7×7, or 8×8 with delay)."""
     sp = sampled_parts(d, f_s) if parts is None else parts
+    return discrete_matrix(sp, d.coefficients.H, control_row(d, law, K), delay)
+
+
+def discrete_matrix(sp: SampledParts, H: float, row7: np.ndarray, delay: int) -> np.ndarray:
+    """Transition matrix (7×7, or 8×8 holding the delayed u_q) of the sampled loop with ``row7``."""
     Ad, bd, od = sp.Ad, sp.bd, sp.observer
     n = _N + delay
     Z = np.zeros((n, n))
     Z[:3, :3] = Ad
     row = np.zeros(n)
-    row[:_N] = control_row(d, law, K)
+    row[:_N] = row7
     if delay:
         Z[:3, _N] = bd
         Z[_N] = row
     else:
         Z[:3] += np.outer(bd, row)
     Z[3:7, 3:7] = od.Phi
-    Z[3:7, 0] += od.Gamma * d.coefficients.H
+    Z[3:7, 0] += od.Gamma * H
     Z[3:7, 1] += od.L
     Z[3:7, 3] -= od.L
     return Z

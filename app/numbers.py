@@ -1,0 +1,71 @@
+"""The one parser for numbers typed by engineers: page fields, ``--set`` overrides and preset files.
+
+A number means what it looks like: decimal or scientific notation, an optional sign, and spaces
+(or thin spaces) only as thousands separators between groups of three digits (``1 000``). Nothing
+else is a number: ``1,5`` (a decimal comma is ambiguous), ``1.2.3``, ``0x10``, ``1_000``,
+``1:30`` (YAML 1.1 sexagesimal), ``nan``, ``inf``, empty text. The value is Python's correctly
+rounded ``float`` of the digits as typed — never rounded to a display precision.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+_GROUPED = r"\d{1,3}(?:[ \u2009\u202f]\d{3})+"
+_NUMBER = re.compile(
+    rf"^[+-]?(?:(?:{_GROUPED}|\d+)(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?$"
+)
+FORMS = "decimal or scientific notation, e.g. 4.86e-5, -0.5, 1e3 or 1 000"
+
+
+class NumberFormatError(ValueError):
+    """Text that is not a number in decimal or scientific notation; the message names the field."""
+
+
+def parse_number(text: str, field: str) -> float:
+    """Parse ``text`` typed for ``field`` into a float, exactly as typed.
+
+    Parameters
+    ----------
+    text : str
+        What the user typed; surrounding white space is ignored.
+    field : str
+        Field name shown in the message, e.g. ``"motor.J_r"``.
+
+    Returns
+    -------
+    float
+        The correctly rounded double of the decimal number written.
+
+    Raises
+    ------
+    NumberFormatError
+        When ``text`` is not decimal or scientific notation, or overflows a double.
+    """
+    stripped = text.strip()
+    if not _NUMBER.match(stripped):
+        shown = repr(text) if stripped else "empty"
+        raise NumberFormatError(f"{field} = {shown} is not a number: allowed {FORMS}")
+    value = float(re.sub(r"[ \u2009\u202f]", "", stripped))
+    if not math.isfinite(value):
+        raise NumberFormatError(f"{field} = {text!r} is too large: allowed |value| < 1.8e308")
+    return value
+
+
+def parse_integer(text: str, field: str) -> int:
+    """Parse ``text`` as a whole number (``4``, ``4.0`` or ``1e1``); :class:`NumberFormatError` otherwise."""
+    value = parse_number(text, field)
+    if not value.is_integer():
+        raise NumberFormatError(f"{field} = {text!r} is not a whole number: allowed integers, e.g. 4")
+    return int(value)
+
+
+def format_number(value: float) -> str:
+    """Shortest text that parses back to exactly ``value`` (``repr`` of the double)."""
+    if isinstance(value, int) or float(value).is_integer() and abs(value) < 1e16:
+        return str(int(value))
+    return repr(float(value))
+
+
+__all__ = ["FORMS", "NumberFormatError", "format_number", "parse_integer", "parse_number"]
