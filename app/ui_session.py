@@ -20,6 +20,7 @@ import viser
 from app.presets import list_presets, load_preset
 from app.ui_files import FilesPanel
 from app.ui_inputs import InputError, InputsPanel
+from app.ui_log import LogPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
 from app.ui_text import derived_markdown, warnings_html
@@ -96,6 +97,7 @@ class Session:
                                        else names[0])
         self.preset.on_update(self._preset_chosen)
         self.files = FilesPanel(self.client, self._export_state, self._imported)
+        self.log_panel = LogPanel(self)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.simulate_button.on_click(lambda _: self.simulate())
         self.status = gui.add_markdown("Ready.")

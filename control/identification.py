@@ -1,7 +1,8 @@
 """Least-squares identification of the PMSM model of [1] from a sampled drive log.
 
 Nothing is differentiated: each equation is integrated over non-overlapping windows of the log
-and the window integrals are fitted by ordinary least squares.
+and the window integrals are fitted by least squares (instrumental variables for the current
+differences Δi, whose sample noise would otherwise bias the inductances towards zero).
 
 * Electrical, eqs. (1)–(2) in [1] multiplied out (amplitude-invariant dq, ω_r mechanical)::
 
@@ -20,6 +21,11 @@ and the window integrals are fitted by ordinary least squares.
 
 A parameter the log does not excite is refused with the reason instead of being reported.
 
+Standard errors are the classical ones of the fit. Consecutive windows share their edge
+samples, so the current noise enters as a difference (negatively correlated rows): the
+intervals of the slowly varying terms (R_s, Ψ_PM, J, F_v) are then conservative (wider than
+the scatter of the estimates), those of the inductances about right.
+
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
 
@@ -35,6 +41,8 @@ from scipy.stats import t as student_t
 MAX_REL_STDERR = 0.2
 #: Sample delays tried between logged and applied voltage [samples].
 DELAYS = (0, 1, 2, 3)
+#: Samples either side averaged into the instrument of Δi [-].
+NEIGHBOURS = 5
 
 
 @dataclass(frozen=True)
@@ -96,28 +104,32 @@ ELECTRICAL = (("R_s", "Ω"), ("L_d", "H"), ("L_q", "H"), ("psi_pm", "Wb"))
 MECHANICAL = (("J_total", "kg·m²"), ("F_v", "N·m·s/rad"), ("Gamma_Le", "N·m"))
 
 
-def _ols(A: np.ndarray, y: np.ndarray) -> _Fit:
-    """Ordinary least squares with the classical standard errors σ̂²·(AᵀA)⁻¹."""
+def _ols(A: np.ndarray, y: np.ndarray, Z: np.ndarray | None = None) -> _Fit:
+    """Least squares with the classical standard errors σ̂²·(AᵀA)⁻¹; with instruments ``Z``
+    (same shape as ``A``) the instrumental-variable estimate (ZᵀA)⁻¹Zᵀy and its covariance
+    σ̂²·(ZᵀA)⁻¹ZᵀZ(AᵀZ)⁻¹, which stays unbiased when a regressor carries noise."""
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0.0] = 1.0
     As = A / scale
-    x, *_ = np.linalg.lstsq(As, y, rcond=None)
+    Zs = As if Z is None else Z / scale
+    ZA_inv = np.linalg.pinv(Zs.T @ As)
+    x = ZA_inv @ (Zs.T @ y)
     r = y - As @ x
     dof = max(1, A.shape[0] - A.shape[1])
-    s2 = float(r @ r) / dof
-    cov = s2 * np.linalg.pinv(As.T @ As)
+    cov = float(r @ r) / dof * ZA_inv @ (Zs.T @ Zs) @ ZA_inv.T
     return _Fit(x / scale, np.sqrt(np.maximum(np.diag(cov), 0.0)) / scale, dof, float(r @ r), A.shape[0])
 
 
-def _edges(n: int, w: int) -> np.ndarray:
-    """Window boundaries (sample indices) of non-overlapping windows of ``w`` intervals."""
-    return np.arange(0, n - 1, w)[: (n - 1) // w + 1]
+def _windows(n: int, w: int) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end sample indices of consecutive windows of ``w`` intervals in ``n`` samples."""
+    a = np.arange(0, n - w, w)
+    return a, a + w
 
 
-def _window_sums(per_interval: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """Sum of a per-interval quantity over each window [edges[j], edges[j+1])."""
+def _window_sums(per_interval: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Sum of a per-interval quantity over each window [a, b) of intervals."""
     c = np.concatenate([[0.0], np.cumsum(per_interval)])
-    return c[edges[1:]] - c[edges[:-1]]
+    return c[b] - c[a]
 
 
 def _estimates(fit: _Fit | None, spec: tuple[tuple[str, str], ...], refused: dict[str, str],
@@ -139,21 +151,41 @@ def _estimates(fit: _Fit | None, spec: tuple[tuple[str, str], ...], refused: dic
     return out
 
 
+def _neighbours(i: np.ndarray) -> np.ndarray:
+    """Mean of the NEIGHBOURS samples either side of each sample, the sample itself left out.
+
+    Used as the instrument for Δi: it follows the current (exactly where it is linear) but not
+    the noise of the sample itself, which sits in the regressor Δi and would bias L to zero.
+    """
+    m = NEIGHBOURS
+    if i.size <= 2 * m:
+        return i
+    kernel = np.ones(2 * m + 1) / (2 * m)
+    kernel[m] = 0.0
+    out = np.convolve(i, kernel, mode="same")
+    out[:m], out[-m:] = i[:m], i[-m:]
+    return out
+
+
 def _electrical_rows(t: np.ndarray, th: np.ndarray, i_d: np.ndarray, i_q: np.ndarray, u_d: np.ndarray,
-                     u_q: np.ndarray, p: int, delay: int, w: int) -> tuple[np.ndarray, np.ndarray, float]:
+                     u_q: np.ndarray, p: int, delay: int, w: int
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Window-integrated rows of eqs. (1)–(2) in [1]; columns R_s, L_d, L_q, Ψ_PM."""
     n = t.size - delay
     t, th, i_d, i_q = t[delay:], th[delay:], i_d[delay:], i_q[delay:]
     u_d, u_q = u_d[:n], u_q[:n]
     dt, dth = np.diff(t), np.diff(th)
     md, mq = 0.5 * (i_d[1:] + i_d[:-1]), 0.5 * (i_q[1:] + i_q[:-1])
-    e = _edges(n, w)
-    S = lambda v: _window_sums(v, e)  # noqa: E731
-    zero = np.zeros(e.size - 1)
-    A_d = np.column_stack([S(md * dt), S(np.diff(i_d)), -p * S(mq * dth), zero])
-    A_q = np.column_stack([S(mq * dt), p * S(md * dth), S(np.diff(i_q)), p * S(dth)])
-    y = np.concatenate([S(u_d[:-1] * dt), S(u_q[:-1] * dt)])
-    return np.vstack([A_d, A_q]), y, float(np.mean(np.diff(t[e])))
+    a, b = _windows(n, w)
+    S = lambda v: _window_sums(v, a, b)  # noqa: E731
+    D = lambda x: x[b] - x[a]  # noqa: E731
+    zero = np.zeros(a.size)
+    A_d = np.column_stack([S(md * dt), D(i_d), -p * S(mq * dth), zero])
+    A_q = np.column_stack([S(mq * dt), p * S(md * dth), D(i_q), p * S(dth)])
+    Z_d, Z_q = A_d.copy(), A_q.copy()
+    Z_d[:, 1], Z_q[:, 2] = D(_neighbours(i_d)), D(_neighbours(i_q))
+    y_d, y_q = S(u_d[:-1] * dt), S(u_q[:-1] * dt)
+    return np.vstack([A_d, A_q]), np.concatenate([y_d, y_q]), np.vstack([Z_d, Z_q]), float(np.mean(t[b] - t[a]))
 
 
 def _electrical_refusals(th: np.ndarray, i_d: np.ndarray, i_q: np.ndarray, p: int) -> dict[str, str]:
@@ -187,8 +219,8 @@ def identify_electrical(t: np.ndarray, theta_r: np.ndarray, i_d: np.ndarray, i_q
     for delay in DELAYS:
         if t.size - delay < 4 * w:
             break
-        A, y, T_w = _electrical_rows(t, theta_r, i_d, i_q, u_d, u_q, p, delay, w)
-        fit = _ols(A[:, cols], y)
+        A, y, Z, T_w = _electrical_rows(t, theta_r, i_d, i_q, u_d, u_q, p, delay, w)
+        fit = _ols(A[:, cols], y, Z[:, cols])
         if best is None or fit.rss / fit.rows < best[0]:
             best = (fit.rss / fit.rows, delay, fit, T_w)
     if best is None:
@@ -222,17 +254,17 @@ def identify_mechanical(t: np.ndarray, theta_r: np.ndarray, omega_r: np.ndarray,
                "no acceleration")
         refused = {"J_total": why, "F_v": why}
     w = max(2, int(round(window_s / float(np.median(np.diff(t))))))
-    e = _edges(t.size, w)
-    if e.size < 5:
+    a, b = _windows(t.size, w)
+    if a.size < 4:
         reason = f"the log is too short: fewer than 4 windows of {window_s:g} s"
         return [Estimate(n, u, refused=reason) for n, u in MECHANICAL], None, 0
     dt = np.diff(t)
-    A = np.column_stack([np.diff(omega_r[e]), np.diff(theta_r[e]), np.diff(t[e])])
-    y = _window_sums(0.5 * (Gamma_em[1:] + Gamma_em[:-1]) * dt, e)
+    A = np.column_stack([omega_r[b] - omega_r[a], theta_r[b] - theta_r[a], t[b] - t[a]])
+    y = _window_sums(0.5 * (Gamma_em[1:] + Gamma_em[:-1]) * dt, a, b)
     active = [name for name, _ in MECHANICAL if name not in refused]
     cols = [i for i, (name, _) in enumerate(MECHANICAL) if name in active]
     fit = _ols(A[:, cols], y)
-    T_w = float(np.mean(np.diff(t[e])))
+    T_w = float(np.mean(t[b] - t[a]))
     return _estimates(fit, MECHANICAL, refused, active), float(np.sqrt(fit.rss / fit.rows)) / T_w, fit.rows
 
 

@@ -51,21 +51,23 @@ class LogNoise:
 class Injection:
     """Standstill d-axis current injection before the move: i_d,dem = levels[k] for ``dwell`` [s] each."""
 
-    levels: tuple[float, ...] = (10.0, -10.0, 5.0, 0.0)
-    dwell: float = 0.03
+    levels: tuple[float, ...] = (10.0, -10.0, 10.0, -10.0, 10.0, -10.0, 5.0, 0.0)
+    dwell: float = 0.015
 
 
 #: Overrides of the nominal preset for the example logs: a short move the torque limit allows,
-#: a slower acceleration loop and observer for a 10 kHz drive with one sample of delay.
+#: a slower acceleration loop and observer for a 10 kHz drive with one sample of delay, and a
+#: boundary-layer gain K below the loop's stability limit (no chatter).
 LOG_OVERRIDES = (
-    "manoeuvre.theta_dem=3", "manoeuvre.T_m=0.4", "controller.f_s=10000", "controller.delay_samples=1",
+    "manoeuvre.theta_dem=3", "manoeuvre.T_m=0.45", "controller.K=1.0", "controller.f_s=10000",
+    "controller.delay_samples=1",
     "controller.alpha_max_rule=torque_limit", "controller.T_salpha=0.005", "controller.T_so=0.001",
 )
 #: True plant of the example logs (SI): differs from the paper's motor and load.
 TRUE_MOTOR = {"R_s": 0.12, "L_d": 0.0048, "L_q": 0.006, "psi_pm": 0.36}
 TRUE_LOAD = {"J_L": 0.10, "F_v": 0.5, "Gamma_Le": 1.5}
-#: Duration of the example logs [s]: injection (4 × 30 ms) and the move with a short tail.
-LOG_DURATION = 0.62
+#: Duration of the example logs [s]: injection (8 × 15 ms), the move (0.45 s) and a short tail.
+LOG_DURATION = 0.68
 
 
 def perturbed(nominal: DriveParams, motor: dict[str, float] = TRUE_MOTOR,

@@ -155,7 +155,7 @@ def test_cli_log_json_overlay_of_own_export_is_exact_and_identifies_the_shipped_
     assert main(["log", str(DATA / "drive_log_dq.csv"), "--preset", "example_log_drive", "--identify",
                  "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["overlay"]["t0_s"] == pytest.approx(0.12, abs=2e-3)  # after 4 × 30 ms of injection
+    assert out["overlay"]["t0_s"] == pytest.approx(0.12, abs=2e-3)  # after 8 × 15 ms of injection
     ident = out["identified"]
     assert ident["voltage_delay_samples"] == 1
     assert ident["R_s"]["ci95"][0] <= TRUE_MOTOR["R_s"] <= ident["R_s"]["ci95"][1]
