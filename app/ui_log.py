@@ -132,10 +132,10 @@ class LogPanel:
             self.s.client.add_notification("Log rejected", str(exc), color="red", auto_close_seconds=15.0)
             return
         self.identified, self.log_name = run_identification(log, self.s.params), name
-        self.summary.content = overlay_markdown(log, ov)
+        self._show(make_log_overlay_figure(ov, name))
         self.table.content = identified_markdown(self.identified)
         self.apply.visible = any(e.value is not None for e in self.identified.estimates)
-        self._show(make_log_overlay_figure(ov, name))
+        self.summary.content = overlay_markdown(log, ov)
 
     def _show(self, fig: Any) -> None:
         if self._figure is None:

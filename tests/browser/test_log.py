@@ -25,6 +25,8 @@ def test_upload_log_overlay_identify_apply_and_simulate_again(page, ui_server, t
     runs = session.runs
     page.get_by_text("Drive log (measured)").click()
     page.get_by_role("button", name="Load example log").click()
+    page.get_by_text(re.compile(r"drive_log_dq\.csv: 6800 samples at 10000 Hz")).wait_for()
+    page.get_by_role("tab", name="Drive log").click()
     page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')]"
                            ".some(e => e.layout && e.layout.meta && e.layout.meta.id === 'log-overlay')")
     _runs_text(page, runs + 1)
@@ -33,6 +35,9 @@ def test_upload_log_overlay_identify_apply_and_simulate_again(page, ui_server, t
     shutil.copy(EXAMPLE_LOG, mine)
     page.locator("input[type=file][accept*='.csv']").set_input_files(str(mine))
     page.get_by_text(re.compile(r"bench_log\.csv: 6800 samples at 10000 Hz")).wait_for()
+    page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && "
+                           "e.layout.meta && e.layout.meta.id === 'log-overlay' && "
+                           "e.layout.title.text.includes('bench_log.csv'))")
     fig = figure(page, "log-overlay")
     assert "bench_log.csv" in fig["title"] and {t["name"] for t in fig["traces"]} == {"measured", "simulated"}
     body = page.inner_text("body")
@@ -42,13 +47,10 @@ def test_upload_log_overlay_identify_apply_and_simulate_again(page, ui_server, t
 
     page.get_by_role("button", name="Apply identified values").click()
     _runs_text(page, runs + 2)
-    params = session.params
+    params = session.params  # the new run's inputs, collected from the page's fields
     assert abs(params.motor.R_s / TRUE_MOTOR["R_s"] - 1.0) < 0.02
     assert abs(params.motor.L_q / TRUE_MOTOR["L_q"] - 1.0) < 0.02
     assert "identified from drive log bench_log.csv" in params.source
-    field = page.get_by_label(re.compile(r"^R_s"), exact=False).first
-    assert abs(float(field.input_value()) / (1e3 * params.motor.R_s) - 1.0) < 1e-3 or abs(
-        float(field.input_value()) / params.motor.R_s - 1.0) < 1e-3
 
 
 def test_bad_log_upload_is_rejected_with_the_reason(page, tmp_path):
