@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -170,3 +171,18 @@ def test_cli_log_bad_file_is_one_line_exit_2(tmp_path, capsys):
     assert main(["log", str(bad)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: column 't [s]': time does not increase at line 3") and "Traceback" not in err
+
+
+def test_apply_identified_writes_values_sets_J_L_and_names_the_log_in_source():
+    from app.ui_log import apply_identified
+
+    params = load_preset("example_log_drive")
+    r = identify(read_log(DATA / "drive_log_dq.csv").signals, params.motor.p)
+    new = apply_identified(params, r, "drive_log_dq.csv")
+    assert new.motor.R_s == r.get("R_s").value and new.load.F_v == r.get("F_v").value
+    assert new.J_total == pytest.approx(r.get("J_total").value, rel=1e-12)  # J_L = J_total − J_r
+    assert new.motor.J_r == params.motor.J_r and new.controller == params.controller
+    assert "identified from drive log drive_log_dq.csv" in new.source
+    heavy_rotor = dataclasses.replace(params, motor=dataclasses.replace(params.motor, J_r=0.5))
+    with pytest.raises(ValueError, match=r"J_total = 0.1\d* kg·m² is below J_r = 0.5 kg·m²: lower J_r first"):
+        apply_identified(heavy_rotor, r, "x.csv")
