@@ -6,8 +6,9 @@ Accepted layouts (comma, semicolon or tab separated; ``#`` lines are comments):
 * a header row of names followed by a row of units (this tool's older ``simulate --csv``);
 * any header plus a mapping (YAML ``column: signal [unit]``, read by :mod:`app.presets`).
 
-Signals: t, theta_r, omega_r, i_d, i_q, u_d, u_q, or phase currents i_a, i_b (i_c) with
-theta_e (or theta_r and the pole pairs) instead of i_d, i_q. Columns of this tool's own export
+Signals: t, theta_r, omega_r, i_d, i_q, u_d, u_q, or phase currents i_a, i_b (i_c) and phase
+voltages u_a, u_b (u_c) with theta_e (or theta_r and the pole pairs) instead of the dq ones
+(a missing third phase is −(a + b): no neutral current). Columns of this tool's own export
 that are not signals (alpha, S, E_friction …) are ignored; a file with several runs
 (``fdsmc.theta_r``, ``theta_r (conventional)`` …) needs ``run`` to pick one. Nothing is
 filled in or resampled silently: NaNs, gaps, unsorted time or a unit that is not allowed for
@@ -40,9 +41,10 @@ RUNS = ("fdsmc", "conventional")
 #: signal → physical kind
 SIGNALS = {"t": "time", "theta_r": "angle", "theta_e": "angle", "omega_r": "speed", "i_d": "current",
            "i_q": "current", "u_d": "voltage", "u_q": "voltage", "i_a": "current", "i_b": "current",
-           "i_c": "current"}
+           "i_c": "current", "u_a": "voltage", "u_b": "voltage", "u_c": "voltage"}
 _ALIASES = {"time": "t", "theta": "theta_r", "omega": "omega_r", "id": "i_d", "iq": "i_q", "ud": "u_d",
-            "uq": "u_q", "v_d": "u_d", "v_q": "u_q", "ia": "i_a", "ib": "i_b", "ic": "i_c"}
+            "uq": "u_q", "v_d": "u_d", "v_q": "u_q", "ia": "i_a", "ib": "i_b", "ic": "i_c", "ua": "u_a",
+            "ub": "u_b", "uc": "u_c", "v_a": "u_a", "v_b": "u_b", "v_c": "u_c"}
 #: kind → unit → factor to SI
 UNITS: dict[str, dict[str, float]] = {
     "time": {"s": 1.0, "ms": units.ms_to_s(1.0), "us": 1e-6, "µs": 1e-6},
@@ -228,23 +230,32 @@ def _check_time(t: np.ndarray, line_no: list[int], header: str) -> float:
     return T_s
 
 
+def _park(a: np.ndarray, b: np.ndarray, c: np.ndarray, th_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Amplitude-invariant Park transform (as eq. (58) in [1]): phase quantities → (d, q)."""
+    s = 2.0 * np.pi / 3.0
+    d = 2.0 / 3.0 * (a * np.cos(th_e) + b * np.cos(th_e - s) + c * np.cos(th_e + s))
+    q = -2.0 / 3.0 * (a * np.sin(th_e) + b * np.sin(th_e - s) + c * np.sin(th_e + s))
+    return d, q
+
+
 def _dq_from_phases(sig: dict[str, np.ndarray], cols: dict[str, str], p: int | None) -> list[str]:
-    """i_d, i_q from phase currents (amplitude-invariant Park transform, as eq. (58) in [1])."""
-    if "i_d" in sig or "i_a" not in sig or "i_b" not in sig:
-        return []
-    if "theta_e" in sig:
-        th_e = sig["theta_e"]
-    elif "theta_r" in sig and p is not None:
-        th_e = p * sig["theta_r"]
-    else:
-        raise LogError("phase currents i_a, i_b need theta_e (or theta_r and the pole pairs) for i_d, i_q")
-    i_c = sig.get("i_c", -sig["i_a"] - sig["i_b"])
-    a = 2.0 * np.pi / 3.0
-    k = 2.0 / 3.0
-    sig["i_d"] = k * (sig["i_a"] * np.cos(th_e) + sig["i_b"] * np.cos(th_e - a) + i_c * np.cos(th_e + a))
-    sig["i_q"] = -k * (sig["i_a"] * np.sin(th_e) + sig["i_b"] * np.sin(th_e - a) + i_c * np.sin(th_e + a))
-    cols["i_d"] = cols["i_q"] = "Park transform of the phase currents"
-    return ["i_d, i_q computed from the phase currents (amplitude-invariant Park transform)"]
+    """i_d, i_q (u_d, u_q) from phase currents (voltages) and θ_e = p·θ_r when the log has no dq."""
+    notes = []
+    for x in ("i", "u"):
+        a, b, c = f"{x}_a", f"{x}_b", f"{x}_c"
+        if f"{x}_d" in sig or a not in sig or b not in sig:
+            continue
+        if "theta_e" in sig:
+            th_e = sig["theta_e"]
+        elif "theta_r" in sig and p is not None:
+            th_e = p * sig["theta_r"]
+        else:
+            raise LogError(f"phase signals {a}, {b} need theta_e (or theta_r and the pole pairs) for {x}_d, {x}_q")
+        sig[f"{x}_d"], sig[f"{x}_q"] = _park(sig[a], sig[b], sig.get(c, -sig[a] - sig[b]), th_e)
+        cols[f"{x}_d"] = cols[f"{x}_q"] = f"Park transform of {a}, {b}" + (f", {c}" if c in sig else "")
+        notes.append(f"{x}_d, {x}_q computed from the phase {'currents' if x == 'i' else 'voltages'} "
+                     "(amplitude-invariant Park transform)")
+    return notes
 
 
 def _check_speed_units(sig: dict[str, np.ndarray], cols: dict[str, str]) -> None:

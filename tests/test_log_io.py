@@ -44,17 +44,19 @@ def test_shipped_logs_identify_the_true_plant(name, mapping):
             assert abs(e.value / value - 1.0) < TOLERANCE[key], (key, e.value)
 
 
-def test_park_transform_of_phase_currents_is_exact():
+def test_park_transform_of_phase_currents_and_voltages_is_exact():
+    """Three phase currents and two phase voltages (u_c = −u_a − u_b) of known dq values."""
     t = np.arange(100) * 1e-3
     th = 0.3 * t * 100
-    i_d, i_q, p = 2.0 + 0.0 * t, 5.0 * np.sin(t * 30), 4
+    i_d, i_q, u_d, u_q, p = 2.0 + 0.0 * t, 5.0 * np.sin(t * 30), -1.0 + t, 40.0 + 0.0 * t, 4
     cols = []
-    for shift in (0.0, -2 * math.pi / 3, 2 * math.pi / 3):
-        cols.append(i_d * np.cos(p * th + shift) - i_q * np.sin(p * th + shift))
-    lines = ["t [s],theta_r [rad],i_a [A],i_b [A],i_c [A]"] + [
+    for d, q, shifts in ((i_d, i_q, (0.0, -2 * math.pi / 3, 2 * math.pi / 3)), (u_d, u_q, (0.0, -2 * math.pi / 3))):
+        cols += [d * np.cos(p * th + s) - q * np.sin(p * th + s) for s in shifts]
+    lines = ["t [s],theta_r [rad],i_a [A],i_b [A],i_c [A],u_a [V],u_b [V]"] + [
         ",".join(f"{v:.12g}" for v in row) for row in zip(t, th, *cols, strict=True)]
     log = parse_log("\n".join(lines), p=p)
-    assert np.allclose(log.signals["i_d"], i_d, atol=1e-9) and np.allclose(log.signals["i_q"], i_q, atol=1e-9)
+    for name, want in (("i_d", i_d), ("i_q", i_q), ("u_d", u_d), ("u_q", u_q)):
+        assert np.allclose(log.signals[name], want, atol=1e-9), name
 
 
 def test_units_in_header_are_converted_to_si():
@@ -186,3 +188,15 @@ def test_apply_identified_writes_values_sets_J_L_and_names_the_log_in_source():
     heavy_rotor = dataclasses.replace(params, motor=dataclasses.replace(params.motor, J_r=0.5))
     with pytest.raises(ValueError, match=r"J_total = 0.1\d* kg·m² is below J_r = 0.5 kg·m²: lower J_r first"):
         apply_identified(heavy_rotor, r, "x.csv")
+
+
+def test_overlay_figure_draws_measured_and_simulated_and_its_energy_matches_the_overlay():
+    from app.figures_log import cumulative_input_energy, make_log_overlay_figure
+    from sim.log_overlay import overlay
+
+    params = load_preset("example_log_drive")
+    ov = overlay(read_log(DATA / "drive_log_dq.csv").signals, simulate(params, "fdsmc").trace)
+    fig = make_log_overlay_figure(ov, "drive_log_dq.csv")
+    assert fig.layout.meta["id"] == "log-overlay" and {t.name for t in fig.data} == {"measured", "simulated"}
+    assert cumulative_input_energy(ov.t, ov.measured)[-1] == pytest.approx(ov.energy_measured_J, rel=1e-12)
+    assert cumulative_input_energy(ov.t, ov.simulated)[-1] == pytest.approx(ov.energy_simulated_J, rel=0.01)
