@@ -12,7 +12,7 @@ from app.cli import add_preset_arguments
 from app.derived_view import derived_json
 from app.presets import load_preset
 from sim.engine import Comparison, RunResult, compare
-from sim.verdicts import run_warnings
+from sim.verdicts import comparator_notes, run_warnings
 
 #: Trace columns written by ``--csv``: (Trace field, header, unit).
 CSV_COLUMNS = (
@@ -76,6 +76,7 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["run_warnings"] = run_warnings(cmp)
+    out["comparator_notes"] = comparator_notes(cmp)
     return finite_or_none(out)
 
 
@@ -120,7 +121,7 @@ def print_summary(cmp: Comparison) -> None:
         print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
               f"(eq. (52) predicts {_fmt(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
         print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
-    for w in run_warnings(cmp) + list(cmp.derived.warnings):
+    for w in run_warnings(cmp) + list(cmp.derived.warnings) + comparator_notes(cmp):
         print(f"  ! {w}")
 
 

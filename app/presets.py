@@ -27,7 +27,10 @@ from control.params import DriveParams, ParameterError
 SCHEMA = 1
 PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 MAX_BYTES = 256 * 1024
-DEFAULT_PRESET = "paper_12kw_pmsm"
+#: The page's start-up preset: a real catalogue servo with a verified clean design.
+DEFAULT_PRESET = "siemens_1ft7044_ak7"
+#: The FDSMC paper's drive (section 5 of [1]), for reproduction.
+PAPER_PRESET = "paper_12kw_pmsm"
 _TOP_KEYS = ("schema", "name", "source", "mode")
 #: Top-level keys an exported drive parameter file adds; informational, ignored on import (the
 #: gains are recomputed from the inputs).
@@ -286,7 +289,7 @@ def save_preset(params: Any, path: str | Path) -> None:
 
 
 __all__ = [
-    "DEFAULT_PRESET", "MODES", "ParameterError", "PresetError", "apply_overrides", "dumps",
+    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "ParameterError", "PresetError", "apply_overrides", "dumps",
     "dumps_preset", "list_presets", "load_preset", "loads_preset", "parse_preset", "save_preset",
     "to_raw",
 ]

@@ -25,7 +25,9 @@ from app.figures_bldc import (
     make_speed_figure,
     make_torque_figure,
 )
+from app.numbers import NumberFormatError
 from app.presets import dumps_preset, load_preset, loads_preset
+from app.ui_numbers import NumberInput
 from app.units import kHz_to_Hz, mH_to_H, rad_s_to_rpm, rpm_to_rad_s
 from control.bldc_design import bldc_design
 from control.bldc_params import BldcParams
@@ -102,13 +104,16 @@ class BldcTab:
                                        "the results panel's **BLDC figures** tab.")
         self.warnings = gui.add_markdown("")
         with gui.add_folder("Scenario", expand_by_default=False):
-            self.w_ref = gui.add_number("ω* [rpm]", rad_s_to_rpm(p.case.omega_ref), step=10.0)
-            self.t_end = gui.add_number("t_end [s]", p.case.t_end, step=0.05)
-        self.inputs: dict[str, Any] = {}
+            self.w_ref = NumberInput(gui, "ω* [rpm]")
+            self.w_ref.show(rad_s_to_rpm(p.case.omega_ref), exact=p.case.omega_ref)
+            self.t_end = NumberInput(gui, "t_end [s]")
+            self.t_end.show(p.case.t_end)
+        self.inputs: dict[str, NumberInput] = {}
         with gui.add_folder("Machine, load, inverter, gains", expand_by_default=False):
-            for label, sec, name, _, from_si, step in FIELDS:
-                value = from_si(getattr(getattr(p, sec), name))
-                self.inputs[label] = gui.add_number(label, value, step=step)
+            for label, sec, name, _, from_si, _step in FIELDS:
+                si = getattr(getattr(p, sec), name)
+                self.inputs[label] = NumberInput(gui, label)
+                self.inputs[label].show(from_si(si), exact=si)
         with self._figures_container or gui.add_folder("Figures", expand_by_default=True):
             with gui.add_folder("Metrics", expand_by_default=True):
                 self.metrics = gui.add_markdown("No run yet — press **Simulate BLDC**.")
@@ -130,19 +135,19 @@ class BldcTab:
         """Parameters from the widgets; ParameterError naming field, value and range if bad."""
         p = self.params
         sections: dict[str, dict[str, Any]] = {"machine": {}, "mechanics": {}, "inverter": {}, "gains": {}}
-        for label, sec, name, to_si, from_si, _ in FIELDS:
-            raw = self.inputs[label].value
-            if raw is None:
-                raise ParameterError(f"{label} is empty: allowed a number")
-            current = getattr(getattr(p, sec), name)
-            # an untouched field keeps its exact SI value (export → import gives back the same inputs)
-            sections[sec][name] = current if raw == from_si(current) else to_si(raw)
+        try:
+            for label, sec, name, to_si, _from_si, _ in FIELDS:
+                # an untouched field keeps its exact SI value (export → import gives back the same inputs)
+                sections[sec][name] = self.inputs[label].read(f"{sec}.{name} ({label})", to_si,
+                                                              integer=to_si is int)
+            omega_ref = self.w_ref.read("scenario ω* [rpm]", rpm_to_rad_s)
+            t_end = self.t_end.read("scenario t_end [s]")
+        except NumberFormatError as exc:
+            raise ParameterError(str(exc)) from None
         sections["machine"]["emf"] = self.emf.value
         new = {sec: dataclasses.replace(getattr(p, sec), **vals) for sec, vals in sections.items()}
         case = next(c for c in p.scenario.cases if c.name == self.scenario.value)
-        w_rpm = float(self.w_ref.value)
-        omega_ref = case.omega_ref if w_rpm == rad_s_to_rpm(case.omega_ref) else rpm_to_rad_s(w_rpm)
-        case = dataclasses.replace(case, omega_ref=omega_ref, t_end=float(self.t_end.value))
+        case = dataclasses.replace(case, omega_ref=omega_ref, t_end=t_end)
         cases = tuple(case if c.name == case.name else c for c in p.scenario.cases)
         scen = dataclasses.replace(p.scenario, active=case.name, cases=cases)
         return dataclasses.replace(p, scenario=scen, **new)
@@ -191,8 +196,8 @@ class BldcTab:
         """Show the chosen scenario's reference speed and duration."""
         case = next((c for c in self.params.scenario.cases if c.name == self.scenario.value), None)
         if case is not None:
-            self.w_ref.value = rad_s_to_rpm(case.omega_ref)
-            self.t_end.value = case.t_end
+            self.w_ref.show(rad_s_to_rpm(case.omega_ref), exact=case.omega_ref)
+            self.t_end.show(case.t_end)
 
     def _emf_chosen(self, event: viser.GuiEvent) -> None:
         if event.client is None:
@@ -250,7 +255,8 @@ class BldcTab:
         """Show ``params`` in every widget of the tab and make them the tab's parameters."""
         self.params = params
         for label, sec, name, _, from_si, _ in FIELDS:
-            self.inputs[label].value = from_si(getattr(getattr(params, sec), name))
+            si = getattr(getattr(params, sec), name)
+            self.inputs[label].show(from_si(si), exact=si)
         self.scenario.options = [c.name for c in params.scenario.cases]
         self.scenario.value = params.scenario.active
         self._scenario_chosen()

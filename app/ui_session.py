@@ -23,12 +23,14 @@ from app.ui_inputs import InputError, InputsPanel
 from app.ui_log import LogPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
-from app.ui_text import derived_markdown, warnings_html
+from app.ui_text import derived_markdown, design_markdown, warnings_html
 from app.ui_worker import Worker
 from control.derivations import derive
+from control.nameplate import nameplate_consistency
 from control.params import DriveParams
+from sim.design import design_drive
 from sim.engine import PAPER_TABLE1, Comparison, compare, table1_sweep
-from sim.verdicts import T_c_advice, recommended_K, run_warnings
+from sim.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
 
 #: Widths of the control panel (left) and the results panel (right) [px].
 CONTROL_WIDTH, RESULTS_WIDTH = 430, 780
@@ -100,6 +102,11 @@ class Session:
         self.log_panel = LogPanel(self)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.simulate_button.on_click(lambda _: self.simulate())
+        self.design_button = gui.add_button("Design for this drive", icon=viser.Icon.WAND, color="blue",
+                                            hint="α_max, T_m, K and T_c for this nameplate, load and inverter, "
+                                                 "verified by simulation")
+        self.design_button.on_click(lambda _: self.design())
+        self.design_note = gui.add_markdown("")
         self.status = gui.add_markdown("Ready.")
         self.warnings = gui.add_html("")
         self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
@@ -125,6 +132,28 @@ class Session:
         self.results.replay.pause()  # frees the browser for the new result
         return self.submit(lambda: self._run(params))
 
+    def design(self) -> bool:
+        """Commit the inputs, design for this drive on the worker and show the verified design."""
+        try:
+            params = self.inputs.collect()
+        except InputError as exc:
+            self._reject(str(exc))
+            return False
+        self.results.replay.pause()
+        return self.submit(lambda: self._run_design(params))
+
+    def _run_design(self, params: DriveParams) -> None:
+        self.status.content = "Designing and verifying…"
+        dd = design_drive(params)
+        self.inputs.populate(dd.params)
+        self.params, self.error = dd.params, None
+        self.comparison = dd.comparison or comparison_or_derived(dd.params)
+        self.runs += 1
+        self.design_note.content = design_markdown(dd)
+        if self.comparison.fdsmc is not None:
+            self.results.show(self.comparison)
+        self._show_text()
+
     def submit(self, fn: Callable[[], None]) -> bool:
         """Run ``fn`` on this client's worker (one job at a time); False (with a note) if busy."""
         if self.worker.submit(fn) is None:
@@ -135,6 +164,7 @@ class Session:
 
     def _run(self, params: DriveParams) -> None:
         self.status.content = "Simulating…"
+        self.design_note.content = ""
         comparison = comparison_or_derived(params)  # ParameterError from derive → _job_failed
         self.params, self.comparison, self.error = params, comparison, None
         self.runs += 1
@@ -187,10 +217,11 @@ class Session:
     def _show_text(self) -> None:
         d = self.comparison.derived
         self.derived.content = derived_markdown(d)
-        items = list(d.warnings) + run_warnings(self.comparison)
+        self.inputs.show_T_c_in_force(d.profile.T_c)
+        items = list(d.warnings) + run_warnings(self.comparison) + self._nameplate_warnings()
         if self.comparison.fdsmc is None:
             items.append("Not simulated: the manoeuvre is infeasible (see above).")
-        self.warnings.content = warnings_html(items, self.error)
+        self.warnings.content = warnings_html(items, self.error, comparator_notes(self.comparison))
         chatter = any(r is not None and r.metrics.get("chatter")
                       for r in (self.comparison.fdsmc, self.comparison.conventional))
         k_rec = recommended_K(d)
@@ -202,6 +233,18 @@ class Session:
         if T_c is not None:
             self.use_tc.label = f"Use T_c = {T_c * 1e3:.4g} ms (damps the approach to θ_dem)"
         self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: `{self.origin}`."
+
+    def _nameplate_warnings(self) -> list[str]:
+        """Disagreements with the optional datasheet Kt / rated torque typed on the page."""
+        try:
+            extra = self.inputs.nameplate_checks()
+        except InputError as exc:
+            return [str(exc)]
+        if not extra:
+            return []
+        general = {x.text for x in nameplate_consistency(self.params.motor)}  # already in derive's warnings
+        return [f"Nameplate: {x.text}" for x in nameplate_consistency(self.params.motor, **extra)
+                if x.text not in general]
 
     def _reject(self, message: str) -> None:
         self.error = message
@@ -223,13 +266,15 @@ class Session:
 
     def _set_busy(self, busy: bool) -> None:
         self.simulate_button.disabled = busy
+        self.design_button.disabled = busy
         self.results.sweep_button.disabled = busy
         if busy:
             self.status.content = "Working…"
 
     def _export_state(self) -> tuple[DriveParams, Comparison, str, list[str]]:
         d = self.comparison.derived
-        return self.params, self.comparison, self.origin, list(d.warnings) + run_warnings(self.comparison)
+        return (self.params, self.comparison, self.origin,
+                list(d.warnings) + run_warnings(self.comparison) + comparator_notes(self.comparison))
 
     def close(self) -> None:
         """Stop the worker and the replay (client disconnected)."""

@@ -25,11 +25,15 @@ def derived_markdown(derived: Derived) -> str:
     return "\n".join(lines)
 
 
-def warnings_html(items: list[str], error: str | None = None) -> str:
-    """A red box listing the input error and the warnings; a green line when there are none."""
+def warnings_html(items: list[str], error: str | None = None, notes: list[str] | None = None) -> str:
+    """A red box listing the input error and the warnings, a green line when there are none, and the
+    ``notes`` (e.g. about the comparator) in a grey box below."""
+    extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
+                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html.escape(n)}</div>'
+                    for n in notes or [])
     if error is None and not items:
         return ('<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:#2b8a3e;'
-                'font-size:0.85em">✔ No warnings.</div>')
+                'font-size:0.85em">✔ No warnings.</div>' + extra)
     parts = []
     if error is not None:
         parts.append(f'<div data-role="input-error" style="font-weight:600">⛔ Input error — nothing '
@@ -39,7 +43,7 @@ def warnings_html(items: list[str], error: str | None = None) -> str:
         parts.append(f'<div style="font-weight:600">⚠ {len(items)} warning(s)</div>'
                      f'<ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
-            'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>")
+            'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>" + extra)
 
 
 @dataclass(frozen=True)
@@ -56,6 +60,23 @@ class AnnualSavings:
     per_cycle_J: float
     kWh_per_year: float
     money_per_year: float
+
+
+def design_markdown(dd: Any) -> str:
+    """Verdict of "Design for this drive" (:class:`sim.design.DriveDesign`): clean, or what prevents it."""
+    c = dd.params.controller
+    head = ("**Design: clean** — simulated peaks within the drive's limits, on target at T_m, no chatter."
+            if dd.clean else "**Design: not clean** — see the constraints below.")
+    lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "
+                   f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms"]
+    lines += [f"- {'✗' if x.violated else '·'} {_md_text(x.text)}" for x in dd.limiting]
+    lines += [f"- note: {_md_text(n)}" for n in dd.notes]
+    return "\n\n".join(lines[:2]) + "\n\n" + "\n".join(lines[2:])
+
+
+def _md_text(text: str) -> str:
+    """Escape Markdown/HTML control characters of a message for a Markdown element."""
+    return "".join("\\" + ch if ch in "\\`*_{}[]<>#|" else ch for ch in text)
 
 
 def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
@@ -90,5 +111,5 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
             "(negative = the conventional controller is cheaper).")
 
 
-__all__ = ["AnnualSavings", "annual_savings", "derived_markdown",
+__all__ = ["design_markdown", "AnnualSavings", "annual_savings", "derived_markdown",
            "savings_markdown", "warnings_html"]

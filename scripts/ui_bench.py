@@ -71,10 +71,10 @@ def page_load(browser, url: str) -> tuple[float, object, object]:
 
 
 def simulate_latency(page, runs: int, gap_s: float) -> list[float]:
-    from app.presets import DEFAULT_PRESET, load_preset
+    from app.presets import PAPER_PRESET, load_preset
     from control.derivations import derive
 
-    params = load_preset(DEFAULT_PRESET)
+    params = load_preset(PAPER_PRESET)
     out = []
     for i in range(runs):
         T_m = 1.0 + 0.05 * ((i % 2) + 1)

@@ -108,7 +108,9 @@ def _target_missed(run: RunResult) -> str | None:
 
 
 def run_warnings(comparison: Comparison) -> list[str]:
-    """Warnings from the simulated runs: unstable, chatter, saturation, drive limits exceeded."""
+    """Warnings from the simulated runs: unstable, chatter, target missed, the FDSMC's saturation and
+    drive limits, and savings that are not comparable. The comparator's own limit violations are
+    :func:`comparator_notes` (they do not concern the drive being commissioned)."""
     out: list[str] = []
     for run in (comparison.fdsmc, comparison.conventional):
         if run is None:
@@ -122,8 +124,42 @@ def run_warnings(comparison: Comparison) -> list[str]:
         miss = _target_missed(run)
         if miss:
             out.append(miss)
-        sat = m.get("saturated_s")
-        if isinstance(sat, float) and sat > 0.0:
-            out.append(f"Saturation ({name}): voltage/current limited for {sat:.4g} s.")
-        out += limit_warnings(run, comparison.derived)
+        if run.controller == "fdsmc":
+            out += _saturation(run) + limit_warnings(run, comparison.derived)
+    return out + _saving_verdicts(comparison)
+
+
+def _saturation(run: RunResult) -> list[str]:
+    sat = run.metrics.get("saturated_s")
+    if isinstance(sat, float) and sat > 0.0:
+        return [f"Saturation ({NAMES[run.controller]}): voltage/current limited for {sat:.4g} s."]
+    return []
+
+
+def comparator_notes(comparison: Comparison) -> list[str]:
+    """Where the conventional comparator (eq. (61) gains) itself exceeds the drive's limits: its
+    energy is then not a fair baseline for the saving."""
+    run = comparison.conventional
+    if run is None or run.metrics.get("stable") is False:
+        return []
+    issues = _saturation(run) + limit_warnings(run, comparison.derived)
+    if not issues:
+        return []
+    return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."]
+
+
+def _saving_verdicts(comparison: Comparison) -> list[str]:
+    """A friction saving above the theoretical bound 1 − 4/5.6 of eq. (53), or from a run that missed
+    its target, is not a saving: say so."""
+    saving, bound = comparison.saving_friction_pct, comparison.derived.energy.bound_pct
+    if saving is None:
+        return []
+    out: list[str] = []
+    missed = [r for r in (comparison.fdsmc, comparison.conventional) if r is not None and _target_missed(r)]
+    if missed:
+        out.append(f"Saving not comparable: {', '.join(NAMES[r.controller] for r in missed)} did not arrive "
+                   f"by T_m, so the {saving:.4g} % friction saving compares unequal manoeuvres.")
+    elif saving > bound + 0.05:
+        out.append(f"Saving {saving:.4g} % exceeds the theoretical bound {bound:.4g} % of eq. (53): the moves "
+                   "are not equal (check the arrival and the comparator), so the figure is not a saving.")
     return out

@@ -53,10 +53,10 @@ class UiServer:
 @pytest.fixture(scope="session")
 def ui_server() -> Iterator[UiServer]:
     """The web UI with the default preset, in-process on a free loopback port."""
-    from app.presets import DEFAULT_PRESET, load_preset
+    from app.presets import PAPER_PRESET, load_preset
     from app.ui_session import create_server
 
-    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, host="127.0.0.1",
+    server, config = create_server(load_preset(PAPER_PRESET), PAPER_PRESET, host="127.0.0.1",
                                    port=free_port(), scene_3d=False, environment_map=False)
     try:
         yield UiServer(f"http://127.0.0.1:{server.get_port()}", server, config)
@@ -119,9 +119,14 @@ def figure(page: Any, figure_id: str) -> dict[str, Any] | None:
     return page.evaluate(FIGURE_JS, figure_id)
 
 
+def field(page: Any, label: str) -> Any:
+    """The input of the GUI row labelled ``label`` (viser's text inputs are not linked to their label)."""
+    return page.locator(f'xpath=//label[normalize-space(.)="{label}"]/ancestor::*[.//input][1]//input').first
+
+
 def set_number(page: Any, label: str, value: float | str) -> None:
     """Type a value into the number field labelled ``label`` and leave the field (blur)."""
-    field = page.get_by_label(label, exact=True)
-    field.fill(str(value))
-    field.press("Tab")
+    field_ = field(page, label)
+    field_.fill(str(value))
+    field_.press("Tab")
     page.wait_for_timeout(120)  # viser throttles GUI messages to one per 50 ms

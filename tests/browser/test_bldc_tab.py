@@ -4,7 +4,7 @@ skips, under CI=true when Chromium is missing)."""
 
 from __future__ import annotations
 
-from tests.browser.conftest import figure
+from tests.browser.conftest import field, figure
 
 FIG_JS = ("(id) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"
           " && e.layout.meta.id === id && e.data.length >= 4)")
@@ -41,9 +41,9 @@ def test_bldc_tab_runs_paper_scenario_and_shows_metrics_and_speed_figure(page):
 def test_bldc_tab_rejects_bad_input_with_message(page):
     _open_tab(page)
     page.get_by_text("Machine, load, inverter, gains", exact=True).click()
-    field = page.get_by_label("V_dc [V]", exact=True)
-    field.fill("-5")
-    field.press("Tab")
+    inp = field(page, "V_dc [V]")
+    inp.fill("-5")
+    inp.press("Tab")
     page.wait_for_timeout(200)
     page.get_by_role("button", name="Simulate BLDC").click()
     msg = page.get_by_text("Rejected", exact=False).first
@@ -70,9 +70,9 @@ def test_bldc_import_scenario_switch_and_export_round_trip(page, tmp_path):
     chooser.value.set_files(str(path))
     page.get_by_text("Imported", exact=False).first.wait_for()
     page.get_by_text("Machine, load, inverter, gains", exact=True).click()
-    assert float(page.get_by_label("V_dc [V]", exact=True).input_value()) == 310.0
+    assert float(field(page, "V_dc [V]").input_value()) == 310.0
     page.get_by_text("Scenario", exact=True).nth(1).click()  # the folder (index 0 is the dropdown label)
-    assert abs(float(page.get_by_label("ω* [rpm]", exact=True).input_value()) - 2000.0) < 1e-6
+    assert abs(float(field(page, "ω* [rpm]").input_value()) - 2000.0) < 1e-6
     with page.expect_download() as info:
         page.get_by_role("button", name="Download BLDC preset (YAML)").click()
     exported = loads_preset(Path(info.value.path()).read_text(encoding="utf-8"), "export.yaml")
@@ -90,4 +90,4 @@ def test_bldc_import_of_a_position_preset_is_rejected_and_changes_nothing(page, 
     msg = page.locator("p", has_text="Import rejected").first
     msg.wait_for()
     assert "position-drive preset" in msg.inner_text()
-    assert float(page.get_by_label("V_dc [V]", exact=True).input_value()) == 300.0  # unchanged
+    assert float(field(page, "V_dc [V]").input_value()) == 300.0  # unchanged

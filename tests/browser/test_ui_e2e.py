@@ -6,9 +6,9 @@ import dataclasses
 import re
 from pathlib import Path
 
-from app.presets import DEFAULT_PRESET, dumps_preset, load_preset, loads_preset
+from app.presets import PAPER_PRESET, dumps_preset, load_preset, loads_preset
 from control.derivations import derive
-from tests.browser.conftest import ARTIFACTS, figure, open_page, set_number
+from tests.browser.conftest import ARTIFACTS, field, figure, open_page, set_number
 
 
 def _phase_omega_p(page) -> float:
@@ -23,14 +23,14 @@ def _wait_phase_omega_p(page, omega_p: float) -> None:
 
 
 def test_derived_alpha_max_of_default_preset(page):
-    d = derive(load_preset(DEFAULT_PRESET))
+    d = derive(load_preset(PAPER_PRESET))
     text = f"{d.alpha.alpha_max:.5g}"  # derived_rows format: 2651.2 rad/s²
     assert page.get_by_text(text, exact=True).count() >= 1
     assert "α_max" in page.content()
 
 
 def test_change_T_m_simulate_draws_both_trajectories_and_new_boundary(page):
-    params = load_preset(DEFAULT_PRESET)
+    params = load_preset(PAPER_PRESET)
     new = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=1.4))
     omega_p = derive(new).profile.omega_p
     assert abs(omega_p - _phase_omega_p(page)) > 1.0
@@ -69,7 +69,7 @@ def _download(page, label: str) -> str:
 
 
 def test_import_export_round_trip_and_c_header(page, tmp_path):
-    params = load_preset(DEFAULT_PRESET)
+    params = load_preset(PAPER_PRESET)
     uploaded = dataclasses.replace(
         params, name="imported_case", source="browser test",
         manoeuvre=dataclasses.replace(params.manoeuvre, T_m=1.8),
@@ -78,7 +78,7 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
     path.write_text(dumps_preset(uploaded), encoding="utf-8")
     page.locator("input[type=file][accept*='.yaml']").set_input_files(str(path))
     _wait_phase_omega_p(page, derive(uploaded).profile.omega_p)
-    assert page.get_by_label("T_m manoeuvre time [s]", exact=True).input_value() == "1.8"
+    assert field(page, "T_m manoeuvre time [s]").input_value() == "1.8"
     page.get_by_text("Export", exact=True).click()
     exported = _download(page, "Drive parameters (YAML)")
     assert loads_preset(exported, "export.yaml") == uploaded
@@ -92,13 +92,13 @@ def test_two_browser_contexts_keep_separate_values(browser, ui_server):
     ctx_a, page_a = open_page(browser, ui_server.url)
     ctx_b, page_b = open_page(browser, ui_server.url)
     try:
-        params = load_preset(DEFAULT_PRESET)
+        params = load_preset(PAPER_PRESET)
         new = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=2.2))
         set_number(page_a, "T_m manoeuvre time [s]", 2.2)
         page_a.get_by_role("button", name="Simulate").click()
         _wait_phase_omega_p(page_a, derive(new).profile.omega_p)
         page_b.wait_for_timeout(300)
-        assert page_b.get_by_label("T_m manoeuvre time [s]", exact=True).input_value() == "1"
+        assert field(page_b, "T_m manoeuvre time [s]").input_value() == "1"
         assert abs(_phase_omega_p(page_b) - derive(params).profile.omega_p) < 1e-9
     finally:
         ctx_a.close()
@@ -136,7 +136,7 @@ def test_recommended_K_then_T_c_min_one_click_fixes(page):
     is then poorly damped with T_c = T_a → "Use T_c = …" selects T_c,min and the chatter is gone."""
     from sim.verdicts import T_c_advice
 
-    params = load_preset(DEFAULT_PRESET)
+    params = load_preset(PAPER_PRESET)
     slow = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=60.0))
     set_number(page, "T_m manoeuvre time [s]", 60)
     _click_and_wait_for_run(page, page.get_by_role("button", name="Simulate"))
@@ -149,5 +149,5 @@ def test_recommended_K_then_T_c_min_one_click_fixes(page):
     assert f"{T_c_ms:.4g} ms" in use_tc.inner_text()
     _click_and_wait_for_run(page, use_tc)
     assert "Chatter (FDSMC)" not in page.inner_text("body")
-    assert abs(float(page.get_by_label("T_c sliding time const. [ms]", exact=True).input_value()) - T_c_ms) < 1e-6
+    assert abs(float(field(page, "T_c sliding time const. [ms]").input_value()) - T_c_ms) < 1e-6
     assert not use_tc.is_visible()

@@ -1,0 +1,78 @@
+"""A new user's first screen is a clean design of a real servo; "Design for this drive" makes one.
+
+The second motor is typed from its catalogue page as an engineer would (Yaskawa Σ-7 SGM7J-04A:
+400 W, 4.46 N·m peak, J_r = 0.486·10⁻⁴ kg·m² typed as 4.86e-5, Kt = 0.544 N·m/A_rms typed through
+the Kt selector) on top of the paper's settings (K = 1000, paper α_max rule), which are not clean.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from tests.browser.conftest import UiServer, field, free_port, open_page, set_number
+
+
+@pytest.fixture(scope="module")
+def default_server() -> Iterator[UiServer]:
+    from app.presets import DEFAULT_PRESET, load_preset
+    from app.ui_session import create_server
+
+    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(),
+                                   scene_3d=False)
+    try:
+        yield UiServer(f"http://127.0.0.1:{server.get_port()}", server, config)
+    finally:
+        server.stop()
+
+
+@pytest.fixture
+def page(browser: Any, default_server: UiServer) -> Iterator[Any]:
+    context, pg = open_page(browser, default_server.url)
+    try:
+        yield pg
+    finally:
+        context.close()
+
+
+def _latest(server: UiServer) -> Any:
+    return max(server.config.sessions.values(), key=lambda s: s.client.client_id)
+
+
+def test_default_page_is_a_clean_real_servo_design(page, default_server):
+    page.get_by_text("No warnings.", exact=False).first.wait_for()
+    assert page.locator('[data-role="warnings"]').count() == 0  # no red box
+    cmp = _latest(default_server).comparison
+    motor = cmp.derived.params.motor
+    assert motor.Gamma_max == 15.0  # the Siemens 1FT7044 preset, not the paper's drive
+    assert cmp.fdsmc.metrics["torque_peak_Nm"] <= 15.0 * 1.005
+
+
+def test_design_button_turns_a_typed_catalogue_servo_clean(page, default_server):
+    session = _latest(default_server)
+    page.get_by_text("Flux given as", exact=True).wait_for()
+    for label, value in [("V_0 rated (LL rms) [V]", "200"), ("P_r rated power [kW]", "0.4"),
+                         ("n_b rated speed [rpm]", "3000"), ("Γ_max peak torque [N·m]", "4.46"),
+                         ("p pole pairs [-]", "5"), ("J_r rotor inertia [kg·m²]", "4.86e-5"),
+                         ("J_L load inertia [kg·m²]", "2.43e-4"), ("K boundary-layer gain [s/rad]", "1000"),
+                         ("V_dc inverter DC link (0 = ideal) [V]", "325"),
+                         ("i_max inverter peak current (0 = none) [A]", "13.15"),
+                         ("θ_dem demanded angle [rad]", "62.83"), ("T_m manoeuvre time [s]", "0.5")]:
+        set_number(page, label, value)
+    dropdown = field(page, "Flux given as")
+    dropdown.click()
+    page.get_by_role("option", name="Kt [N·m/A_rms]").click()
+    page.get_by_text("Kt [N·m/A_rms]", exact=True).first.wait_for()
+    set_number(page, "Kt [N·m/A_rms]", "0.544")
+    page.get_by_role("button", name="Design for this drive").click()
+    page.get_by_text("Design: clean", exact=False).wait_for(timeout=120_000)
+    p = session.params
+    assert p.motor.J_r == 4.86e-5 and p.motor.Gamma_max == 4.46  # exactly as typed
+    assert p.motor.psi_pm == pytest.approx(0.544 / (1.5 * 2 ** 0.5 * 5), rel=1e-12)
+    assert p.controller.alpha_max_rule == "torque_limit" and p.controller.K < 1.0
+    m = session.comparison.fdsmc.metrics
+    assert m["torque_peak_Nm"] <= 4.46 * 1.005 and not m["chatter"]
+    assert m["i_q_peak_A"] <= 13.15 * 1.005
+    assert float(field(page, "K boundary-layer gain [s/rad]").input_value()) == pytest.approx(p.controller.K, rel=1e-9)

@@ -1,0 +1,125 @@
+"""Design for this drive: clean designs pass the simulated checks; refusals name the constraint."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from app.presets import load_preset
+from control.feasibility import torque_limit, voltage_limit
+from control.params import Controller, DriveParams, Load, Manoeuvre, Motor
+from sim.design import design_drive, run_checks
+from sim.verdicts import comparator_notes, run_warnings
+
+REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a")
+
+
+def _assert_clean_run(dd) -> None:
+    p, m = dd.params, dd.comparison.fdsmc.metrics
+    assert m["stable"] and not m["chatter"]
+    assert m["torque_peak_Nm"] <= torque_limit(p) * 1.005
+    assert m["u_peak_V"] <= voltage_limit(p) * 1.005
+    assert m["omega_peak_rad_s"] <= p.motor.omega_b * 1.005
+    if p.controller.i_max > 0:
+        assert m["i_q_peak_A"] <= p.controller.i_max * 1.005
+    assert abs(m["theta_error_at_Tm_rad"]) <= 0.02 * abs(p.manoeuvre.theta_dem)
+    assert run_checks(p, dd.comparison.fdsmc) == []
+
+
+@pytest.mark.parametrize("name", REAL)
+def test_real_presets_are_clean_as_shipped(name):
+    dd = design_drive(load_preset(name))
+    assert dd.clean, [c.text for c in dd.limiting]
+    _assert_clean_run(dd)
+    # the shipped preset already holds the design: its own run has no warning at all
+    shipped = load_preset(name)
+    assert pytest.approx(dd.params.controller.K, rel=1e-12) == shipped.controller.K
+    assert run_warnings(dd.comparison) == [] and dd.derived.warnings == ()
+
+
+def test_paper_drive_design_raises_T_m_to_the_feasible_minimum():
+    # Section 5 of [1]: Γ_max = 40 N·m on J = 0.15 kg·m² and F_v = 0.427 cannot move 60 rad in 1 s.
+    dd = design_drive(load_preset("paper_12kw_pmsm"))
+    assert dd.clean
+    t_m = next(c for c in dd.limiting if c.name == "T_m")
+    assert not t_m.violated and t_m.value == 1.0 and t_m.limit == dd.params.manoeuvre.T_m > 1.0
+    _assert_clean_run(dd)
+
+
+def test_too_slow_sample_rate_is_refused_naming_it():
+    p = load_preset("siemens_1ft7044_ak7", ["controller.f_s=400", "controller.T_so=0.0002"])
+    dd = design_drive(p)
+    assert not dd.clean and dd.comparison is None
+    c = next(c for c in dd.limiting if c.violated)
+    assert c.name == "sample_rate" and c.value == 400.0 and c.limit > 400.0 and "f_s" in c.text
+
+
+def test_comparator_over_the_limit_is_a_note_not_a_warning():
+    dd = design_drive(load_preset("siemens_1ft7044_ak7"))
+    notes = comparator_notes(dd.comparison)
+    assert notes and all(n.startswith("Comparator:") for n in notes)
+    assert not any("Conventional" in w for w in run_warnings(dd.comparison))
+
+
+@st.composite
+def drives(draw) -> DriveParams:
+    """Plausible servo drives: 0.1–20 kW, inertia ratio 0–20, move 0.1–500 rad, f_s 8–50 kHz."""
+    P = draw(st.floats(100.0, 20e3))
+    n_rpm = draw(st.sampled_from([1500.0, 2000.0, 3000.0, 4500.0]))
+    w_b = n_rpm * math.pi / 30.0
+    T_N = P / w_b
+    p = draw(st.integers(2, 6))
+    V_0 = draw(st.sampled_from([200.0, 400.0]))
+    psi = 0.6 * V_0 / (math.sqrt(1.5) * p * w_b)  # back-EMF 60 % of V_0 at rated speed
+    J_r = 1.5e-4 * T_N ** 1.3 * draw(st.floats(0.5, 2.0))
+    R_s = 0.02 * V_0 ** 2 / P * draw(st.floats(0.3, 2.0))
+    L = R_s * draw(st.floats(2e-3, 10e-3))
+    motor = Motor(V_0=V_0, P_r=P, omega_b=w_b, Gamma_max=3.0 * T_N, psi_pm=psi, L_d=L, L_q=L, R_s=R_s, p=p,
+                  J_r=J_r)
+    load = Load(J_L=J_r * draw(st.floats(0.0, 20.0)), F_v=0.02 * P / w_b ** 2)
+    ctrl = Controller(T_si=1e-3, T_salpha=3e-3, T_so=1e-3, K=1.0, f_s=draw(st.floats(8e3, 50e3)),
+                      delay_samples=1, V_dc=V_0 * math.sqrt(2.0) * 1.35 / math.sqrt(2.0),
+                      i_max=3.2 * T_N / (1.5 * p * psi))
+    move = Manoeuvre(theta_dem=draw(st.floats(0.1, 500.0)), T_m=draw(st.floats(0.05, 5.0)))
+    return DriveParams(motor, load, ctrl, move, name="random", source="hypothesis")
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(drives())
+def test_every_clean_design_passes_the_checks_and_every_refusal_names_a_constraint(params):
+    dd = design_drive(params)
+    if dd.clean:
+        _assert_clean_run(dd)
+    else:
+        violated = [c for c in dd.limiting if c.violated]
+        assert violated and all(c.name and c.text and math.isfinite(c.value) for c in violated)
+
+
+def test_design_keeps_the_users_nameplate():
+    p = load_preset("yaskawa_sgm7j_04a", ["controller.K=1000", "controller.alpha_max_rule=paper"])
+    dd = design_drive(p)
+    assert dataclasses.asdict(dd.params.motor) == dataclasses.asdict(p.motor)
+    assert dd.params.load == p.load and dd.params.manoeuvre.theta_dem == p.manoeuvre.theta_dem
+
+
+def test_design_cli_json_contract_and_loadable_preset(capsys, tmp_path):
+    import json
+
+    from app.cli import main
+    from app.presets import load_preset as load
+
+    out_file = tmp_path / "designed.yaml"
+    assert main(["design", "yaskawa_sgm7j_04a", "--set", "controller.K=1000", "--json", "-o", str(out_file)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["clean"] is True
+    assert set(out["design"]) >= {"alpha_max", "T_m", "K", "T_c", "f_s"}
+    for key in ("torque_peak_Nm", "i_peak_A", "u_peak_V", "theta_error_at_Tm_rad", "chatter"):
+        assert key in out["verified"]["fdsmc"] and key in out["verified"]["conventional"]
+    assert all({"name", "value", "limit", "violated"} <= set(c) for c in out["limiting"])
+    designed = load(str(out_file))  # a complete preset, no --set needed
+    assert designed.controller.K == out["design"]["K"] < 1.0
+    assert main(["design", "yaskawa_sgm7j_04a", "-o", "/nonexistent/dir/x.yaml"]) == 2
