@@ -4,6 +4,8 @@ Accepted layouts (comma, semicolon or tab separated; ``#`` lines are comments):
 
 * units in the header names: ``t [ms], theta_r [rad], omega_r [rpm], i_q [A], …``;
 * a header row of names followed by a row of units (this tool's older ``simulate --csv``);
+* unit suffixes in the names (``t_s``, ``omega_r_rad_s``, ``i_q_A``), with a ``controller``
+  column naming each row's run (the page's CSV export);
 * any header plus a mapping (YAML ``column: signal [unit]``, read by :mod:`app.presets`).
 
 Signals: t, theta_r, omega_r, i_d, i_q, u_d, u_q, or phase currents i_a, i_b (i_c) and phase
@@ -56,6 +58,11 @@ UNITS: dict[str, dict[str, float]] = {
 }
 #: Columns of this tool's own export that are not log signals (ignored).
 TOOL_COLUMNS = frozenset(CHANNELS) - frozenset(SIGNALS)
+#: Unit suffixes of names such as ``omega_r_rad_s`` (the page's CSV export).
+_SUFFIX_UNITS = {"s": "s", "ms": "ms", "us": "us", "rad": "rad", "deg": "deg", "rev": "rev", "rad_s": "rad/s",
+                 "rpm": "rpm", "A": "A", "mA": "mA", "V": "V", "mV": "mV"}
+#: Header names of a row-label column holding the run of each row.
+_RUN_LABELS = ("controller", "run")
 _UNIT_RE = re.compile(r"^(.*?)\s*\[\s*([^\]]*?)\s*\]\s*$")
 _RUN_RE = re.compile(r"(?:^|[\s._:(])(" + "|".join(RUNS) + r")(?:$|[\s._:)])")
 
@@ -94,8 +101,16 @@ class _Column:
 
 
 def _split_unit(head: str) -> tuple[str, str | None]:
+    """(name, unit) of ``name [unit]``, or of ``name_unit`` for a known signal or tool column."""
     m = _UNIT_RE.match(head)
-    return (m.group(1).strip(), m.group(2)) if m else (head.strip(), None)
+    if m:
+        return m.group(1).strip(), m.group(2)
+    name = head.strip()
+    for known in sorted([*SIGNALS, *TOOL_COLUMNS], key=len, reverse=True):
+        rest = name[len(known) + 1:]
+        if name.startswith(known + "_") and (rest in _SUFFIX_UNITS or known in TOOL_COLUMNS):
+            return known, _SUFFIX_UNITS.get(rest, rest)
+    return name, None
 
 
 def _signal_name(name: str) -> tuple[str, str | None]:
@@ -121,6 +136,8 @@ def _is_number(text: str) -> bool:
 def _columns_from_header(header: list[str], unit_row: list[str] | None) -> list[_Column]:
     cols = []
     for i, head in enumerate(header):
+        if head.strip().lower() in _RUN_LABELS:
+            continue
         name, unit = _split_unit(head)
         if unit is None and unit_row is not None:
             unit = unit_row[i].strip() or None
@@ -271,6 +288,23 @@ def _check_speed_units(sig: dict[str, np.ndarray], cols: dict[str, str]) -> None
                        "check their units (rpm vs rad/s, deg vs rad)")
 
 
+def _rows_of_run(lines: list[str], line_no: list[int], delim: str, header: list[str],
+                 run: str | None) -> tuple[list[str], list[int], str | None]:
+    """Only the rows of one run when a column labels each row's run (the page's CSV export)."""
+    idx = next((i for i, h in enumerate(header) if h.strip().lower() in _RUN_LABELS), None)
+    if idx is None:
+        return lines, line_no, run
+    labels = [r[idx].strip() if len(r) > idx else "" for r in csv.reader(lines, delimiter=delim)]
+    found = sorted(set(labels))
+    if run is None and len(found) > 1:
+        raise LogError(f"the file holds the runs {', '.join(found)}: choose one (--run {'|'.join(found)})")
+    chosen = run if run is not None else found[0]
+    if chosen not in found:
+        raise LogError(f"run = {chosen!r} is not in the file: allowed {', '.join(found)}")
+    keep = [k for k, label in enumerate(labels) if label == chosen]
+    return [lines[k] for k in keep], [line_no[k] for k in keep], None
+
+
 def parse_log(text: str, name: str = "<log>", *, mapping: dict[str, str] | None = None, run: str | None = None,
               p: int | None = None) -> DriveLog:
     """Validate and convert a log's text (see the module docstring); raises :class:`LogError`."""
@@ -282,6 +316,7 @@ def parse_log(text: str, name: str = "<log>", *, mapping: dict[str, str] | None 
         first = next(csv.reader([lines[0]], delimiter=delim))
         if len(first) == len(header) and not any(_is_number(x) for x in first if x.strip()):
             unit_row, lines, line_no = first, lines[1:], line_no[1:]
+    lines, line_no, run = _rows_of_run(lines, line_no, delim, header, run)
     cols = _columns_from_mapping(header, mapping) if mapping else _columns_from_header(header, unit_row)
     used, notes = _select(cols, run, mapping is not None)
     if len(lines) < MIN_ROWS:

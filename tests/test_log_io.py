@@ -200,3 +200,17 @@ def test_overlay_figure_draws_measured_and_simulated_and_its_energy_matches_the_
     assert fig.layout.meta["id"] == "log-overlay" and {t.name for t in fig.data} == {"measured", "simulated"}
     assert cumulative_input_energy(ov.t, ov.measured)[-1] == pytest.approx(ov.energy_measured_J, rel=1e-12)
     assert cumulative_input_energy(ov.t, ov.simulated)[-1] == pytest.approx(ov.energy_simulated_J, rel=0.01)
+
+
+def test_page_csv_export_with_unit_suffixes_and_run_column_is_accepted():
+    from app.exports import trace_csv
+    from sim.engine import compare
+
+    params = load_preset("example_log_drive")
+    cmp = compare(params)
+    text = trace_csv(cmp)
+    with pytest.raises(LogError, match="choose one"):
+        parse_log(text)
+    log = parse_log(text, "page.csv", run="conventional")
+    assert np.allclose(log.signals["omega_r"], cmp.conventional.trace.omega_r, rtol=1e-8, atol=1e-9)
+    assert np.allclose(log.signals["t"], cmp.conventional.trace.t, rtol=1e-8, atol=1e-12)
