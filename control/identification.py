@@ -1,6 +1,6 @@
 """Least-squares identification of the PMSM model of [1] from a sampled drive log.
 
-Nothing is differentiated: each equation is integrated over non-overlapping windows of the log
+Nothing is differentiated: each equation is integrated over consecutive windows of the log
 and the window integrals are fitted by least squares (instrumental variables for the current
 differences Δi, whose sample noise would otherwise bias the inductances towards zero).
 
@@ -22,9 +22,9 @@ differences Δi, whose sample noise would otherwise bias the inductances towards
 A parameter the log does not excite is refused with the reason instead of being reported.
 
 Standard errors are the classical ones of the fit. Consecutive windows share their edge
-samples, so the current noise enters as a difference (negatively correlated rows): the
-intervals of the slowly varying terms (R_s, Ψ_PM, J, F_v) are then conservative (wider than
-the scatter of the estimates), those of the inductances about right.
+samples, so the current noise enters as a difference (negatively correlated rows) and the
+intervals are conservative, most for the slowly varying terms: on the example logs the standard
+errors are 1.3× (J) to 13× (Ψ_PM) the scatter of the estimates over noise draws.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
