@@ -211,6 +211,16 @@ def _body(text: str) -> tuple[list[str], list[str], str, list[int]]:
 
 
 def _parse_rows(lines: list[str], line_no: list[int], delim: str, width: int, used: list[_Column]) -> np.ndarray:
+    """The used columns as floats: numpy's fast reader, or a row-by-row scan naming the bad cell."""
+    if all(ln.count(delim) == width - 1 for ln in lines):
+        try:
+            return np.loadtxt(lines, delimiter=delim, usecols=[c.index for c in used], ndmin=2, dtype=float)
+        except ValueError:
+            pass  # an empty or non-numeric cell: the scan names it
+    return _scan_rows(lines, line_no, delim, width, used)
+
+
+def _scan_rows(lines: list[str], line_no: list[int], delim: str, width: int, used: list[_Column]) -> np.ndarray:
     data = np.empty((len(lines), len(used)))
     for r, row in enumerate(csv.reader(lines, delimiter=delim)):
         if len(row) != width:

@@ -1,9 +1,10 @@
 """Overlay of a measured drive log on a simulated run: alignment, errors and input energy.
 
 The simulated move starts at t = 0 from θ_r = 0. In the log, the move start t0 is where θ_r
-(or ∫ω_r dt) first leaves its initial value by 1 % of the travel, refined by the shift that
-minimises the RMS position error; θ_r is referred to its value at t0. Errors are measured minus
-simulated on the log's samples from t0 to the end of the shorter record. The electrical input
+(or ∫ω_r dt) first leaves its initial value by 1 % of the travel, refined by the sample instant
+(up to 0.1·the simulated horizon earlier) that minimises the RMS position error; θ_r is
+referred to its value at t0. Errors are measured minus simulated on the log's samples from t0
+to the end of the shorter record. The electrical input
 energy is ∫ 3/2·(u_d·i_d + u_q·i_q) dt (amplitude-invariant dq, as eq. (58) in [1]) over the
 same window, for both; the logged voltage is held over each sample interval (zero-order hold,
 as a PWM inverter applies it) and the current is averaged over the interval.
@@ -79,7 +80,8 @@ def detect_move_start(signals: dict[str, np.ndarray], trace: Trace) -> float:
     coarse = float(t[int(np.argmax(np.abs(th - th[0]) > 0.01 * travel))])
     T = float(trace.t[-1])
     best, best_err = coarse, np.inf
-    for t0 in np.linspace(max(0.0, coarse - 0.1 * T), coarse, 201):
+    candidates = t[(t >= coarse - 0.1 * T) & (t <= coarse)]  # the log's own sample instants
+    for t0 in candidates[:: max(1, candidates.size // 400)]:
         sel = (t >= t0) & (t - t0 <= T)
         if sel.sum() < 2:
             continue

@@ -214,3 +214,22 @@ def test_page_csv_export_with_unit_suffixes_and_run_column_is_accepted():
     log = parse_log(text, "page.csv", run="conventional")
     assert np.allclose(log.signals["omega_r"], cmp.conventional.trace.omega_r, rtol=1e-8, atol=1e-9)
     assert np.allclose(log.signals["t"], cmp.conventional.trace.t, rtol=1e-8, atol=1e-12)
+
+
+def test_given_move_start_shifts_the_overlay_and_a_wrong_one_shows_in_the_errors():
+    """The own simulation behind 50 ms of rest: detected t0 = 50 ms with zero error; a t0 given
+    10 ms late leaves a position error of about ω·10 ms."""
+    from sim.log_overlay import overlay
+
+    run = simulate(load_preset("example_log_drive"), "fdsmc")
+    tr = run.trace
+    T_s = float(tr.t[1] - tr.t[0])
+    n0 = int(round(0.05 / T_s))
+    sig = {"t": np.concatenate([np.arange(n0) * T_s, tr.t + n0 * T_s]),
+           "theta_r": np.concatenate([np.zeros(n0), tr.theta_r]) + 1.0}
+    ov = overlay(sig, tr)
+    assert ov.t0_detected and ov.t0 == pytest.approx(0.05, abs=T_s)
+    assert ov.errors[0].signal == "theta_r" and ov.errors[0].rms_error < 1e-9
+    late = overlay(sig, tr, t0=0.06)
+    assert not late.t0_detected
+    assert late.errors[0].peak_error == pytest.approx(0.01 * np.max(np.abs(tr.omega_r)), rel=0.1)
