@@ -268,7 +268,7 @@ def simulate(
     info = np.zeros(kn.N_INFO)
     T_step = g.h * g.n_sub
     windows = chatter_windows(params, d, controller, g.n_steps * T_step)
-    steps = [chatter_window_steps(w, T_step) for w in windows.values()]
+    steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
     win = np.zeros((2 * len(steps), max(n for _, n in steps)))
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
