@@ -64,7 +64,8 @@ _SUFFIX_UNITS = {"s": "s", "ms": "ms", "us": "us", "rad": "rad", "deg": "deg", "
 #: Header names of a row-label column holding the run of each row.
 _RUN_LABELS = ("controller", "run")
 _UNIT_RE = re.compile(r"^(.*?)\s*\[\s*([^\]]*?)\s*\]\s*$")
-_RUN_RE = re.compile(r"(?:^|[\s._:(])(" + "|".join(RUNS) + r")(?:$|[\s._:)])")
+_RUN_RE = re.compile(r"(?:^|[\s._:(\[])(" + "|".join(RUNS) + r")(?:$|[\s._:)\]])")
+_SEP_RE = re.compile(r"[\s._:]*(\(\s*\)|\[\s*\])|^[\s._:]+|[\s._:]+(?=\s*\[)|[\s._:]+$")
 
 
 class LogError(ValueError):
@@ -113,16 +114,20 @@ def _split_unit(head: str) -> tuple[str, str | None]:
     return name, None
 
 
-def _signal_name(name: str) -> tuple[str, str | None]:
-    """(signal, run) of a header name such as ``fdsmc.theta_r`` or ``i_q (conventional)``."""
-    run = None
-    m = _RUN_RE.search(name)
-    if m:
-        run = m.group(1)
-        name = (name[: m.start(1)] + name[m.end(1):]).strip(" ._:()")
+def _split_run(head: str) -> tuple[str, str | None]:
+    """(header without the run, run) of e.g. ``fdsmc.theta_r [rad]``, ``i_q [A] (conventional)``,
+    ``omega_r_fdsmc [rad/s]``."""
+    m = _RUN_RE.search(head)
+    if not m:
+        return head.strip(), None
+    return _SEP_RE.sub("", head[: m.start(1)] + head[m.end(1):]).strip(), m.group(1)
+
+
+def _signal_name(name: str) -> str:
+    """The signal a header name stands for (aliases such as ``iq``, ``ω_r`` resolved)."""
     key = name.strip().lower().replace("ω", "omega").replace("θ", "theta")
     key = _ALIASES.get(key, key)
-    return (key if key in SIGNALS else name.strip()), run
+    return key if key in SIGNALS else name.strip()
 
 
 def _is_number(text: str) -> bool:
@@ -138,11 +143,11 @@ def _columns_from_header(header: list[str], unit_row: list[str] | None) -> list[
     for i, head in enumerate(header):
         if head.strip().lower() in _RUN_LABELS:
             continue
-        name, unit = _split_unit(head)
+        bare, run = _split_run(head)
+        name, unit = _split_unit(bare)
         if unit is None and unit_row is not None:
             unit = unit_row[i].strip() or None
-        signal, run = _signal_name(name)
-        cols.append(_Column(i, head.strip(), signal, unit, run))
+        cols.append(_Column(i, head.strip(), _signal_name(name), unit, run))
     return cols
 
 
@@ -155,7 +160,7 @@ def _columns_from_mapping(header: list[str], mapping: dict[str, str]) -> list[_C
             raise LogError(f"mapping: column {column!r} is not in the log's header "
                            f"({', '.join(repr(h.strip()) for h in header)})")
         name, unit = _split_unit(target)
-        signal, _ = _signal_name(name)
+        signal = _signal_name(name)
         if signal not in SIGNALS:
             raise LogError(f"mapping: {column!r} maps to {name!r}: allowed signals {', '.join(SIGNALS)}")
         cols.append(_Column(by_name[column], column, signal, unit, None))

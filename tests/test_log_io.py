@@ -233,3 +233,21 @@ def test_given_move_start_shifts_the_overlay_and_a_wrong_one_shows_in_the_errors
     late = overlay(sig, tr, t0=0.06)
     assert not late.t0_detected
     assert late.errors[0].peak_error == pytest.approx(0.01 * np.max(np.abs(tr.omega_r)), rel=0.1)
+
+
+@pytest.mark.parametrize("fmt", ["{run}.{sig} [{unit}]", "{sig} [{unit}] ({run})", "{sig}_{run} [{unit}]",
+                                 "{sig} ({run}) [{unit}]"])
+def test_wide_csv_with_units_in_header_and_two_runs_picks_the_run(fmt):
+    """A wide export with both runs side by side and units in the names (any of the usual
+    spellings of the run) is a log; ``run`` picks one."""
+    heads = ["t [s]"] + [fmt.format(run=r, sig=s, unit=u) for r in RUNS_ for s, u in (("theta_r", "rad"),
+                                                                                      ("i_q", "A"))]
+    rows = [f"{k * 1e-3},{k * 0.01},{k * 0.1},{-k * 0.01},{-k * 0.1}" for k in range(30)]
+    text = ",".join(heads) + "\n" + "\n".join(rows)
+    with pytest.raises(LogError, match="choose one"):
+        parse_log(text)
+    log = parse_log(text, run="conventional")
+    assert log.signals["theta_r"][3] == pytest.approx(-0.03) and log.signals["i_q"][3] == pytest.approx(-0.3)
+
+
+RUNS_ = ("fdsmc", "conventional")
