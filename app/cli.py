@@ -22,6 +22,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "bench": ("app.bench", "print speed figures of the simulation engine"),
     "serve": ("app.serve", "start the commissioning web UI"),
     "bldc": ("app.cli_bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
+    "log": ("app.cli_log", "import a drive log: overlay on the simulation, identify the motor and load"),
 }
 
 

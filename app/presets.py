@@ -484,3 +484,14 @@ __all__ = [
     "dumps_preset", "list_presets", "load_preset", "loads_preset", "parse_preset", "save_preset",
     "to_raw",
 ]
+
+
+def loads_log_mapping(text: str, origin: str = "<mapping>") -> dict[str, str]:
+    """A drive-log column mapping (YAML ``column: signal [unit]``) as a dict of strings."""
+    raw = loads_raw(text, origin)
+    if not isinstance(raw, dict) or not raw:
+        raise PresetError(f"{origin}: a mapping file needs lines 'column: signal [unit]', e.g. 'Iq: i_q [A]'")
+    bad = [k for k, v in raw.items() if not isinstance(v, str)]
+    if bad:
+        raise PresetError(f"{origin}: column {str(bad[0])!r} maps to {raw[bad[0]]!r}: allowed 'signal [unit]'")
+    return {str(k): v for k, v in raw.items()}

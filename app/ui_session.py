@@ -20,6 +20,7 @@ import viser
 from app.preset_modes import list_presets_of, load_mode_preset, require_mode
 from app.ui_files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui_inputs import InputError, InputsPanel
+from app.ui_log import LogPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
 from app.ui_text import checked_choice, derived_markdown, design_markdown, md_text, warnings_html
@@ -101,6 +102,7 @@ class Session:
         self.preset.on_update(self._preset_chosen)
         self._preset_shown = self.preset.value
         self.files = FilesPanel(self.client, self._export_state, self._imported, self.params)
+        self.log_panel = LogPanel(self)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.simulate_button.on_click(lambda _: self.simulate())
         self.design_button = gui.add_button("Design for this drive", icon=viser.Icon.WAND, color="blue",

@@ -92,7 +92,7 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
         load=dataclasses.replace(params.load, F_v=0.3333333333333333))
     path = tmp_path / "imported_case.yaml"
     path.write_text(dumps_preset(uploaded), encoding="utf-8")
-    page.locator("input[type=file]").set_input_files(str(path))
+    page.locator("input[type=file][accept*='.yaml']").set_input_files(str(path))
     _wait_phase_omega_p(page, derive(uploaded).profile.omega_p)
     assert field(page, "T_m manoeuvre time [s]").input_value() == "1.8"
     page.get_by_text("Export", exact=True).click()
