@@ -13,8 +13,9 @@ from app import log_io
 from app.cli_simulate import write_csv
 from app.log_io import LogError, parse_log, read_log
 from app.presets import load_preset, loads_log_mapping
+from control.derivations import derive
 from control.identification import identify
-from sim.engine import simulate
+from sim.engine import Comparison, simulate
 from sim.synthetic_log import LOG_OVERRIDES, TRUE_LOAD, TRUE_MOTOR, perturbed
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -76,7 +77,7 @@ def test_own_simulate_csv_is_accepted_without_mapping(tmp_path):
                                              "controller.T_salpha=0.005"])
     runs = [simulate(params, c, max_points=2000) for c in ("fdsmc", "conventional")]
     path = tmp_path / "sim.csv"
-    write_csv(str(path), runs)
+    write_csv(str(path), Comparison(derive(params), runs[0], runs[1], None, None))
     with pytest.raises(LogError, match="choose one"):
         read_log(path)
     log = read_log(path, run="conventional")
@@ -146,7 +147,7 @@ def test_cli_log_json_overlay_of_own_export_is_exact_and_identifies_the_shipped_
     params = load_preset("example_log_drive")
     run = simulate(params, "fdsmc")
     path = tmp_path / "own.csv"
-    write_csv(str(path), [run])
+    write_csv(str(path), Comparison(derive(params), run, None, None, None))
     assert main(["log", str(path), "--preset", "example_log_drive", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     ov = out["overlay"]
