@@ -57,6 +57,9 @@ def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None)
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the process exit code."""
+    from app.threads import limit_blas_threads
+
+    limit_blas_threads()
     args = build_parser().parse_args(argv)
     try:
         return int(args._run(args) or 0)

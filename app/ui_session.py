@@ -18,6 +18,7 @@ from typing import Any
 import viser
 
 from app.presets import list_presets, load_preset
+from app.threads import limit_blas_threads
 from app.ui_files import FilesPanel
 from app.ui_inputs import InputError, InputsPanel
 from app.ui_results import ResultsPanel
@@ -310,6 +311,7 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     (viser.ViserServer, AppConfig)
         The running server and its settings (``config.sessions`` maps client id → Session).
     """
+    limit_blas_threads()
     server = viser.ViserServer(host=host, port=port, verbose=False)
     server.gui.set_panel_label("PMSM commissioning (FDSMC)")
     if not environment_map:  # the HDRI stalls software WebGL for seconds
