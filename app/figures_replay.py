@@ -78,7 +78,7 @@ def replay_layout(comparison: Any, trace_names: list[str]) -> tuple[dict[str, An
         buttons.append({"label": f"▶ {label}", "method": "animate", "args": [f"__frames_{k}__", {
             "mode": "immediate", "frame": {"duration": 1e3 * t_end / speed / (n - 1), "redraw": False},
             "transition": {"duration": 0}}]})
-    buttons.append({"label": "⏸", "method": "animate", "args": [[None], {
+    buttons.append({"label": "Pause", "method": "animate", "args": [[None], {
         "mode": "immediate", "frame": {"duration": 0, "redraw": False}, "transition": {"duration": 0}}]})
     t_grid = np.linspace(0.0, t_end, SLIDER_STEPS + 1)
     marks = json.loads(_frames_json(comparison, now, t_grid))

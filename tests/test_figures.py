@@ -56,7 +56,7 @@ def test_replay_frames_put_the_markers_on_the_trajectories(comparison):
     names = [t["name"] for t in spec["data"]]
     now = [names.index("FDSMC now"), names.index("Conventional now")]
     buttons = spec["layout"]["updatemenus"][0]["buttons"]
-    assert [b["label"] for b in buttons] == [f"▶ {k}" for k in SPEEDS] + ["⏸"]
+    assert [b["label"] for b in buttons] == [f"▶ {k}" for k in SPEEDS] + ["Pause"]
     t_end = float(comparison.fdsmc.trace.t[-1])
     th = comparison.derived.params.manoeuvre.theta_dem
     for button, speed in zip(buttons, SPEEDS.values(), strict=False):

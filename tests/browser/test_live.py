@@ -8,8 +8,8 @@ from app.figures_replay import SPEEDS
 
 MARKER_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
-  const t = el.data.find(t => t.name === 'FDSMC now');
-  return [t.x[0], t.y[0], (t.text || [''])[0]];
+  const t = el._fullData.find(t => t.name === 'FDSMC now');
+  return [Number(t.x[0]), Number(t.y[0]), (t.text || [''])[0]];
 }"""
 COUNT_FRAMES_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
@@ -36,3 +36,41 @@ def test_in_plot_replay_moves_the_marker_without_server_traffic(page, ui_server)
     assert np.isclose(end[0], start[0], rtol=1e-3, atol=1e-6)  # back at the end of the trajectory
     # the server sent (nearly) nothing meanwhile: < 1 kB per animated frame
     assert sum(received[n0:]) < 1000 * frames
+
+
+BAND_JS = """() => {
+  const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
+  return el.data[0].name;
+}"""
+FDSMC_Y_JS = """() => {
+  const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
+  return Array.from(el._fullData.find(t => t.name === 'FDSMC trajectory').y);
+}"""
+
+
+def _slider(page, label: str):
+    return page.locator(f'xpath=//label[normalize-space(.)="{label}"]/ancestor::*[.//*[@role="slider"]][1]'
+                        '//*[@role="slider"]').first
+
+
+def test_dragging_the_K_slider_resimulates_with_the_latest_value(page):
+    """Key presses on the K slider (each a move, faster than a run): the last value is what runs,
+    it is the value the K field shows, and the trajectory changes (the band ±1/K of eq. (45) too)."""
+    from tests.browser.conftest import field
+
+    before_band, before_y = page.evaluate(BAND_JS), page.evaluate(FDSMC_Y_JS)
+    k_field = field(page, "K boundary-layer gain [s/rad]")
+    k0 = float(k_field.input_value())
+    thumb = _slider(page, "K [s/rad]")
+    thumb.focus()
+    for _ in range(4):
+        thumb.press("ArrowLeft")  # smaller K: wider boundary layer
+    k_shown = float(thumb.get_attribute("aria-valuenow"))
+    assert k_shown < k0
+    # the field holds the slider's value, and the phase plane is redrawn for exactly that K
+    page.wait_for_function(f"(k) => Math.abs(parseFloat(({BAND_JS})().split('±')[2]) * k - 1) < 6e-3",
+                           arg=k_shown)
+    assert abs(float(k_field.input_value()) - k_shown) <= 1e-9 * k_shown
+    assert page.evaluate(BAND_JS) != before_band
+    after_y = page.evaluate(FDSMC_Y_JS)
+    assert len(after_y) != len(before_y) or max(abs(a - b) for a, b in zip(after_y, before_y, strict=True)) > 1e-3
