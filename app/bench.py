@@ -13,6 +13,7 @@ import time
 
 from app.cli import add_preset_arguments
 from app.cli_bldc import bench_figure
+from app.preset_modes import load_mode_preset
 from app.presets import load_preset
 from control.derivations import derive
 from sim.engine import CONTINUOUS_STEP_S, compare, run_steps, table1_sweep
@@ -51,7 +52,7 @@ def _ms(wall_cpu: tuple[float, float]) -> str:
 def run(args: argparse.Namespace) -> int:
     """Print the speed figures."""
     base = args.overrides
-    p = load_preset(args.preset, [*base, "manoeuvre.T_m=2.6", "controller.f_s=20000"])
+    p = load_mode_preset(args.preset, [*base, "manoeuvre.T_m=2.6", "controller.f_s=20000"], mode="position")
     rep = max(5, args.repeat)
     first = _timed(compare, p)
     print(f"comparison T_m = 2.6 s (+30 % tail), f_s = 20 kHz, derive included ({rep} runs): first call "

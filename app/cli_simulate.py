@@ -8,9 +8,9 @@ import json
 import math
 from typing import Any
 
-from app.cli import add_preset_arguments
+from app.cli import add_preset_arguments, check_writable
 from app.derived_view import derived_json
-from app.presets import load_preset
+from app.preset_modes import load_mode_preset
 from sim.engine import Comparison, RunResult, compare
 from sim.verdicts import comparator_notes, run_warnings
 
@@ -127,13 +127,15 @@ def print_summary(cmp: Comparison) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Simulate and print (table or JSON); optionally write the CSV."""
-    params = load_preset(args.preset, args.overrides)
+    if args.csv:
+        check_writable(args.csv, "--csv")
+    params = load_mode_preset(args.preset, args.overrides, mode="position")
     ctrls = ("fdsmc", "conventional") if args.controller == "both" else (args.controller,)
     cmp = compare(params, ctrls)
     if args.csv:
         write_csv(args.csv, [r for r in (cmp.fdsmc, cmp.conventional) if r is not None])
     if args.json:
-        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False))
+        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False, allow_nan=False))
     else:
         print_summary(cmp)
     return 0
