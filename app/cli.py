@@ -77,6 +77,9 @@ def check_writable(path: str, option: str) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the process exit code."""
+    from app.threads import limit_blas_threads
+
+    limit_blas_threads()
     args = build_parser().parse_args(argv)
     try:
         return int(args._run(args) or 0)

@@ -10,7 +10,7 @@ from typing import Any
 
 import plotly.graph_objects as go
 
-from app.figures import COLOURS, LABELS, decimate_index, f32, runs
+from app.figures import COLOURS, LABELS, MAX_POINTS_TIME, f32, runs, stride_index, time_axis
 
 #: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
 ENERGIES = (
@@ -22,10 +22,44 @@ ENERGIES = (
 
 def _styled(fig: go.Figure, fid: str, title: str, legend_y: float, **layout: Any) -> go.Figure:
     """The common layout of the energy figures: id in ``meta``, title, margins, legend below."""
-    fig.update_layout(meta={"id": fid}, template="plotly_white", title={"text": title, "x": 0.01},
-                      margin={"l": 60, "r": 16, "t": 40, "b": 40},
-                      legend={"orientation": "h", "y": legend_y}, **layout)
+    fig.update_layout(_layout(fid, title, legend_y, **layout))
     return fig
+
+
+def _layout(fid: str, title: str, legend_y: float, **layout: Any) -> dict[str, Any]:
+    return {"meta": {"id": fid}, "template": "plotly_white", "title": {"text": title, "x": 0.01},
+            "margin": {"l": 60, "r": 16, "t": 40, "b": 40}, "legend": {"orientation": "h", "y": legend_y},
+            **layout}
+
+
+def energy_spec(comparison: Any) -> dict[str, Any]:
+    """Cumulative energies as a plain-dict figure (see :func:`make_energy_figure`)."""
+    data = []
+    for key, run in runs(comparison):
+        tr = run.trace
+        i = stride_index(len(tr.t), MAX_POINTS_TIME)
+        t = time_axis(tr.t[i])
+        for attr, _, label, dash in ENERGIES:
+            data.append({"type": "scatter", **t, "y": f32(getattr(tr, attr)[i]), "mode": "lines",
+                         "name": f"{LABELS[key]} {label}", "legendgroup": key,
+                         "line": {"color": COLOURS[key], "dash": dash, "width": 2}})
+    return {"data": data, "layout": _layout("energy_time", "Energy vs time", -0.18,
+                                            xaxis={"title": {"text": "t [s]"}},
+                                            yaxis={"title": {"text": "energy [J]"}})}
+
+
+def energy_bars_spec(comparison: Any) -> dict[str, Any]:
+    """Energy totals as a plain-dict figure (see :func:`make_energy_bars_figure`)."""
+    kinds = [label for _, _, label, _ in ENERGIES]
+    data = []
+    for key, run in runs(comparison):
+        totals = [energy_total(run, attr, metric) for attr, metric, _, _ in ENERGIES]
+        data.append({"type": "bar", "x": kinds, "y": totals, "name": LABELS[key], "marker": {"color": COLOURS[key]},
+                     "text": [f"{v:.4g} J" for v in totals], "textposition": "outside"})
+    title = (f"Totals — FDSMC saves {_pct(comparison.saving_friction_pct)} friction, "
+             f"{_pct(comparison.saving_electrical_pct)} electrical input")
+    return {"data": data, "layout": _layout("energy_bars", title, -0.15, barmode="group",
+                                            yaxis={"title": {"text": "energy [J]"}})}
 
 
 def make_energy_figure(comparison: Any) -> go.Figure:
@@ -39,15 +73,7 @@ def make_energy_figure(comparison: Any) -> go.Figure:
     -------
     plotly.graph_objects.Figure
     """
-    fig = go.Figure()
-    for key, run in runs(comparison):
-        tr = run.trace
-        i = decimate_index(len(tr.t))
-        for attr, _, label, dash in ENERGIES:
-            fig.add_scatter(x=f32(tr.t[i]), y=f32(getattr(tr, attr)[i]), mode="lines",
-                            name=f"{LABELS[key]} {label}", legendgroup=key,
-                            line={"color": COLOURS[key], "dash": dash, "width": 2})
-    return _styled(fig, "energy_time", "Energy vs time", -0.18, xaxis_title="t [s]", yaxis_title="energy [J]")
+    return go.Figure(energy_spec(comparison))
 
 
 def energy_total(run: Any, attr: str, metric: str) -> float:
@@ -74,15 +100,7 @@ def make_energy_bars_figure(comparison: Any) -> go.Figure:
     -------
     plotly.graph_objects.Figure
     """
-    fig = go.Figure()
-    kinds = [label for _, _, label, _ in ENERGIES]
-    for key, run in runs(comparison):
-        totals = [energy_total(run, attr, metric) for attr, metric, _, _ in ENERGIES]
-        fig.add_bar(x=kinds, y=totals, name=LABELS[key], marker_color=COLOURS[key],
-                    text=[f"{v:.4g} J" for v in totals], textposition="outside")
-    title = (f"Totals — FDSMC saves {_pct(comparison.saving_friction_pct)} friction, "
-             f"{_pct(comparison.saving_electrical_pct)} electrical input")
-    return _styled(fig, "energy_bars", title, -0.15, barmode="group", yaxis_title="energy [J]")
+    return go.Figure(energy_bars_spec(comparison))
 
 
 def make_table1_figure(rows: Sequence[Any], paper: Mapping[float, float] | None = None) -> go.Figure:
@@ -117,5 +135,6 @@ def make_table1_figure(rows: Sequence[Any], paper: Mapping[float, float] | None 
                    xaxis_title="T_m [s]", yaxis_title="saving [%]")
 
 
-__all__ = ["ENERGIES", "energy_total", "make_energy_bars_figure", "make_energy_figure",
+__all__ = ["ENERGIES", "energy_bars_spec", "energy_spec", "energy_total", "make_energy_bars_figure",
+           "make_energy_figure",
            "make_table1_figure"]

@@ -9,10 +9,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import plotly.graph_objects as go
 import viser
 
-from app.figures import make_phase_plane_figure, make_time_plots_figure
-from app.figures_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
+from app.figure_json import figure_json
+from app.figures_energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.numbers import NumberFormatError, parse_number
 from app.ui_replay import Replay, set_figure_json
 from app.ui_scene import RotorScene
@@ -53,14 +54,14 @@ class ResultsPanel:
         phase_tab = self.panel.add_tab("Phase plane", viser.Icon.CHART_DOTS)
         time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
         with phase_tab:
-            self.phase = gui.add_plotly(make_phase_plane_figure(comparison), aspect=ASPECT_PHASE)
+            self.phase = gui.add_plotly(go.Figure(), aspect=ASPECT_PHASE)
         with time_tab:
-            self.time_plots = gui.add_plotly(make_time_plots_figure(comparison), aspect=ASPECT_TIME)
+            self.time_plots = gui.add_plotly(go.Figure(), aspect=ASPECT_TIME)
         with phase_tab:
             self.replay = Replay(gui, self.phase, self.time_plots, scene, flush=client.flush)
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
-            self.energy = gui.add_plotly(make_energy_figure(comparison), aspect=ASPECT_SMALL)
-            self.bars = gui.add_plotly(make_energy_bars_figure(comparison), aspect=ASPECT_SMALL)
+            self.energy = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
+            self.bars = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
             self._build_savings(gui)
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
             self.t_m_list = gui.add_text("T_m list [s]", TABLE1_T_M)
@@ -91,8 +92,8 @@ class ResultsPanel:
         """Draw a new comparison: phase plane first (it is what the user waits for), then the rest."""
         self._comparison = comparison
         self.replay.load(comparison, autoplay=autoplay)
-        self.energy.figure = make_energy_figure(comparison)
-        self.bars.figure = make_energy_bars_figure(comparison)
+        set_figure_json(self.energy, figure_json(energy_spec(comparison)))
+        set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))
         self._update_savings()
 
     def _sweep_clicked(self, client: viser.ClientHandle) -> None:

@@ -18,12 +18,14 @@ from typing import Any
 import viser
 
 from app.preset_modes import list_presets_of, load_mode_preset, require_mode
+from app.threads import limit_blas_threads
 from app.ui_files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui_inputs import InputError, InputsPanel
 from app.ui_log import LogPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
 from app.ui_text import checked_choice, derived_markdown, design_markdown, md_text, warnings_html
+from app.ui_tuning import LiveTuning
 from app.ui_worker import Cancelled, Worker
 from app.web_guard import Guard, guarded
 from control.derivations import derive
@@ -74,6 +76,8 @@ class Session:
         self.comparison = config.initial()
         self.error: str | None = None
         self.runs = 0
+        self._tune_pending = False
+        self._recentre = True
         self.worker = Worker(self._set_busy, self._job_failed, name=f"ui-client-{client.client_id}")
         scene = RotorScene(client.scene) if config.scene_3d else None
         self._layout(scene)
@@ -118,6 +122,7 @@ class Session:
         self.use_k.on_click(lambda _: self._use_recommended_k())
         self.use_tc = gui.add_button("Use T_c,min", visible=False, color="orange")
         self.use_tc.on_click(lambda _: self._use_T_c_min())
+        self.tuning = LiveTuning(gui, self._apply_knob, self.tune)
         with gui.add_form(None) as form:
             self.inputs = InputsPanel(gui, self.params)
         form.on_submit(lambda _: self.simulate())
@@ -151,7 +156,7 @@ class Session:
         self.status.content = "Designing and verifying…"
         dd = design_drive(params)
         self.inputs.populate(dd.params)
-        self.params, self.error = dd.params, None
+        self.params, self.error, self._recentre = dd.params, None, True
         self.comparison = dd.comparison or comparison_or_derived(dd.params)
         self.runs += 1
         self.design_note.content = design_markdown(dd)
@@ -174,7 +179,34 @@ class Session:
         self.status.content = "Cancelling…"
         return True
 
-    def _run(self, params: DriveParams) -> None:
+    def tune(self) -> None:
+        """Simulate the inputs panel's latest values as soon as the worker is free (live tuning).
+
+        Moves while a run is in progress only mark the values as changed; one run of the latest
+        values follows (see :meth:`_tune_loop`). Nothing stale is queued.
+        """
+        self._tune_pending = True
+        if not self.worker.busy:
+            self.worker.submit(self._tune_loop)
+
+    def _tune_loop(self) -> None:
+        while self._tune_pending:
+            self._tune_pending = False
+            try:
+                params = self.inputs.collect()
+            except InputError as exc:
+                self._reject(str(exc))
+                return
+            self._run(params, autoplay=False)
+
+    def _apply_knob(self, key: str, value_si: float) -> None:
+        """Write a live-tuning slider's value into the inputs panel, as if typed."""
+        if key == "controller.T_c":
+            self.inputs.set_T_c(value_si)
+        else:
+            self.inputs.set_value(key, value_si)
+
+    def _run(self, params: DriveParams, autoplay: bool = True) -> None:
         self.status.content = "Simulating…"
         self.design_note.content = ""
         self.worker.checkpoint()
@@ -183,7 +215,7 @@ class Session:
         self.params, self.comparison, self.error = params, comparison, None
         self.runs += 1
         if comparison.fdsmc is not None:
-            self.results.show(comparison)
+            self.results.show(comparison, autoplay=autoplay)
         else:
             self.results.replay.load(comparison, autoplay=False)
         self._show_text()
@@ -223,7 +255,7 @@ class Session:
             self._reject(str(exc))
             return
         self.files.show_names(params)
-        self.origin = origin
+        self.origin, self._recentre = origin, True
         self.inputs.populate(params)
         self.params = params
         self.simulate()
@@ -245,6 +277,9 @@ class Session:
         d = self.comparison.derived
         self.derived.content = derived_markdown(d)
         self.inputs.show_T_c_in_force(d.profile.T_c)
+        if self._recentre:
+            self._recentre = False
+            self.tuning.centre(self.params, d.profile.T_c)
         items = list(d.warnings) + run_warnings(self.comparison) + self._nameplate_warnings()
         if self.comparison.fdsmc is None:
             items.append("Not simulated: the manoeuvre is infeasible (see above).")
@@ -296,6 +331,8 @@ class Session:
             self.status.content = f"Ready — {self.runs} run(s) in this session."
 
     def _set_busy(self, busy: bool) -> None:
+        if not busy and self._tune_pending:
+            self.worker.submit(self._tune_loop)  # a slider moved during the run: its latest value
         self.simulate_button.disabled = busy
         self.design_button.disabled = busy
         self.cancel_button.visible = busy
@@ -352,6 +389,7 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     (viser.ViserServer, AppConfig)
         The running server and its settings (``config.sessions`` maps client id → Session).
     """
+    limit_blas_threads()
     guard = guard or Guard.for_host(host)
     with guarded(guard):
         server = viser.ViserServer(host=host, port=port, verbose=False)

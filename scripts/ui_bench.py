@@ -1,14 +1,19 @@
 """Speed figures of the web UI, measured in Debian's Chromium (prints; no assertions).
 
-* page load → usable: navigation until the Simulate button and the phase plane are drawn;
-* Simulate click → both trajectories drawn: the paper preset at f_s = 20 kHz, T_m alternated so
-  that every click gives a new ω_p; until the page's phase plane holds both new trajectories;
-* replay frame rate actually drawn by the browser (phase plane, server-pushed);
-* server memory (RSS) idle and with 5 clients connected.
+* page open: time until the Simulate button and the phase plane are drawn, websocket bytes received;
+* per Simulate (paper preset, f_s = 20 kHz, T_m alternated so that every click gives a new ω_p):
+  server CPU (user + system of the server process, all threads, including the replay that
+  follows), websocket bytes received by the page including a full replay, and the round trip
+  click → both new trajectories drawn;
+* the same round trip with 1, 5 and 10 pages clicking at once;
+* replay frame rate actually drawn by the browser (phase plane) and the server traffic meanwhile;
+* server memory (RSS) idle and with the pages connected.
 
-The server runs as a separate ``python -m app serve`` process (as the README starts it).
+Websocket bytes are the decoded message payloads (msgpack) as the page receives them; the wire
+carries them deflate-compressed. The server runs as a separate ``python -m app serve`` process
+(as the README starts it).
 
-Usage: ``.venv/bin/python scripts/ui_bench.py [--runs 10]``
+Usage: ``.venv/bin/python scripts/ui_bench.py [--runs 6] [--clients 1,5,10]``
 """
 
 from __future__ import annotations
@@ -27,17 +32,49 @@ from playwright.sync_api import sync_playwright
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, VIEWPORT, free_port  # noqa: E402
+from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, VIEWPORT, field, free_port  # noqa: E402
 
+PRESET = "paper_12kw_pmsm"
 PHASE_READY = ("(w) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"
                " && e.layout.meta.id === 'phase_plane' && (w === null || Math.abs(e.layout.meta.omega_p - w)"
                " < 1e-6 * w) && e.data.some(t => t.name === 'Conventional trajectory'))")
-COUNT_FRAMES = """() => new Promise(resolve => {
+#: Resolves with the Date.now() at which the phase plane shows ω_p = w (polled every frame).
+WATCH_READY = "(w) => new Promise(r => { const f = () => (" + PHASE_READY + ")(w) ? r(Date.now()) " \
+              ": requestAnimationFrame(f); f(); })"
+COUNT_FRAMES = """(ms) => new Promise(resolve => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
   let n = 0; const on = () => { n += 1; };
-  el.on('plotly_afterplot', on);
-  setTimeout(() => { el.removeListener('plotly_afterplot', on); resolve(n); }, 2000);
+  el.on('plotly_afterplot', on); el.on('plotly_animatingframe', on);
+  setTimeout(() => { el.removeListener('plotly_afterplot', on);
+                     el.removeListener('plotly_animatingframe', on); resolve(n); }, ms);
 })"""
+PLAY_IN_PLOT = """(label) => {
+  const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
+  const menu = (el.layout.updatemenus || [])[0];
+  if (!menu) return false;
+  const b = menu.buttons.find(x => x.label === label);
+  window.Plotly.animate(el, ...b.args);
+  return true;
+}"""
+
+
+class WsCounter:
+    """Bytes and messages a page receives over its websockets."""
+
+    def __init__(self, page) -> None:
+        self.bytes = 0
+        self.messages = 0
+        page.on("websocket", lambda ws: ws.on("framereceived", self._add))
+
+    def _add(self, payload) -> None:
+        self.bytes += len(payload)
+        self.messages += 1
+
+
+def cpu_s(pid: int) -> float:
+    """User + system CPU time of a process (all threads) [s]."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def rss_mb(pid: int) -> float:
@@ -50,8 +87,8 @@ def rss_mb(pid: int) -> float:
 
 def start_server(port: int) -> subprocess.Popen:
     env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
-    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port)], cwd=ROOT, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port), "--preset", PRESET],
+                            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert proc.stdout is not None
     for line in proc.stdout:
         if "http://" in line and "commissioning" in line:
@@ -59,73 +96,98 @@ def start_server(port: int) -> subprocess.Popen:
     raise RuntimeError("server did not start")
 
 
-def page_load(browser, url: str) -> tuple[float, object, object]:
+def open_page(browser, url: str) -> tuple[float, int, object, object, WsCounter]:
     ctx = browser.new_context(viewport=VIEWPORT)
     page = ctx.new_page()
-    page.set_default_timeout(60_000)
+    page.set_default_timeout(120_000)
+    ws = WsCounter(page)
     t0 = time.perf_counter()
     page.goto(url)
     page.get_by_role("button", name="Simulate").wait_for()
     page.wait_for_function(PHASE_READY, arg=None, polling="raf")
-    return time.perf_counter() - t0, ctx, page
+    return time.perf_counter() - t0, ws.bytes, ctx, page, ws
 
 
-def simulate_latency(page, runs: int, gap_s: float) -> list[float]:
-    from app.presets import PAPER_PRESET, load_preset
+def omega_p_of(T_m: float) -> float:
+    from app.presets import load_preset
     from control.derivations import derive
 
-    params = load_preset(PAPER_PRESET)
-    out = []
-    for i in range(runs):
-        T_m = 1.0 + 0.05 * ((i % 2) + 1)
-        p = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=T_m))
-        omega_p = derive(p).profile.omega_p
-        field = page.get_by_label("T_m manoeuvre time [s]", exact=True)
-        field.fill(str(T_m))
-        field.press("Tab")
-        page.wait_for_timeout(150)
-        t0 = time.perf_counter()
-        page.get_by_role("button", name="Simulate").click()
-        page.wait_for_function(PHASE_READY, arg=omega_p, polling="raf")
-        out.append(time.perf_counter() - t0)
-        page.wait_for_timeout(1e3 * gap_s)
-    return out
+    params = load_preset(PRESET)
+    return derive(dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=T_m))).profile.omega_p
+
+
+def type_T_m(page, T_m: float) -> None:
+    box = field(page, "T_m manoeuvre time [s]")
+    box.fill(f"{T_m:g}")
+    box.press("Tab")
+    page.wait_for_timeout(200)
+
+
+def click_all(pages: list, k: int) -> list[float]:
+    """Every page types a new T_m, then all click Simulate at once; per-page round trip [s]."""
+    T_m = 1.0 + 0.05 * (k % 2 + 1)
+    w = omega_p_of(T_m)
+    for page in pages:
+        type_T_m(page, T_m)
+    handles, starts = [], []
+    for page in pages:
+        handles.append(page.evaluate_handle(WATCH_READY, w))  # watcher installed before the click
+    for page in pages:
+        starts.append(time.time() * 1e3)
+        page.get_by_role("button", name="Simulate").click(no_wait_after=True)
+    return [(h.json_value() - t0) / 1e3 for h, t0 in zip(handles, starts, strict=True)]
+
+
+def med(xs: list[float], scale: float = 1e3) -> str:
+    return f"median {scale * statistics.median(xs):.0f}, max {scale * max(xs):.0f}"
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=10)
-    ap.add_argument("--gap", type=float, default=0.3,
-                    help="wait between clicks [s] (< 6 s: the next click interrupts the replay)")
+    ap.add_argument("--runs", type=int, default=6, help="rounds per figure (median)")
+    ap.add_argument("--clients", default="1,5,10", help="numbers of pages clicking at once")
+    ap.add_argument("--replay-wait", type=float, default=8.0, help="time allowed for a full replay [s]")
     args = ap.parse_args()
+    counts = [int(c) for c in args.clients.split(",")]
     port = free_port()
     server = start_server(port)
     url = f"http://127.0.0.1:{port}"
     try:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=LAUNCH_ARGS)
-            print(f"server RSS idle, no client:           {rss_mb(server.pid):7.1f} MB")
-            loads, pages = [], []
-            for _ in range(5):
-                dt, ctx, page = page_load(browser, url)
-                loads.append(dt)
-                pages.append((ctx, page))
-            print(f"page load → usable (5 clients):       first {loads[0]:.2f} s, "
-                  f"median {statistics.median(loads):.2f} s, max {max(loads):.2f} s")
-            time.sleep(1.0)
-            print(f"server RSS with 5 clients connected:  {rss_mb(server.pid):7.1f} MB")
-            for ctx, _ in pages[1:]:
-                ctx.close()
-            page = pages[0][1]
-            lat = simulate_latency(page, args.runs, args.gap)
-            print(f"Simulate click → both trajectories drawn (paper preset, 20 kHz, {args.runs} runs, "
-                  f"{args.gap:g} s apart): "
-                  f"median {1e3 * statistics.median(lat):.0f} ms, min {1e3 * min(lat):.0f} ms, "
-                  f"max {1e3 * max(lat):.0f} ms")
-            page.get_by_role("button", name="Replay", exact=True).click()
-            frames = page.evaluate(COUNT_FRAMES)
-            print(f"replay: phase-plane redraws in the browser: {frames / 2.0:.1f} per second "
-                  "(server pushes 20/s)")
+            print(f"server RSS idle, no client: {rss_mb(server.pid):.1f} MB")
+            opened = [open_page(browser, url) for _ in range(max(counts))]
+            print(f"page open → usable ({len(opened)} pages): median {statistics.median(o[0] for o in opened):.2f} s, "
+                  f"first {opened[0][0]:.2f} s; websocket bytes median "
+                  f"{statistics.median(o[1] for o in opened) / 1e6:.2f} MB   [target ≤ 1 MB]")
+            print(f"server RSS with {len(opened)} pages: {rss_mb(server.pid):.1f} MB")
+            page, ws = opened[0][3], opened[0][4]
+            cpus, sizes, msgs, lat = [], [], [], []
+            for k in range(args.runs):
+                b0, m0, c0 = ws.bytes, ws.messages, cpu_s(server.pid)
+                lat += click_all([page], k)
+                page.wait_for_timeout(1e3 * args.replay_wait)  # the full replay, if the server pushes it
+                cpus.append(cpu_s(server.pid) - c0)
+                sizes.append(ws.bytes - b0)
+                msgs.append(ws.messages - m0)
+            print(f"per Simulate, 1 page ({args.runs} runs, incl. {args.replay_wait:g} s of replay): server CPU "
+                  f"{med(cpus)} ms [target ≤ 60]; websocket {statistics.median(sizes) / 1e3:.0f} kB in "
+                  f"{statistics.median(msgs):.0f} messages [target ≤ 500 kB]; round trip {med(lat)} ms")
+            for n in counts:
+                pages = [o[3] for o in opened[:n]]
+                rts = [t for k in range(args.runs) for t in (click_all(pages, k), pages[0].wait_for_timeout(500))[0]]
+                print(f"Simulate → drawn, {n:2d} pages clicking at once ({args.runs} rounds): {med(rts)} ms"
+                      f"   [target: 1 page ≤ 150, 10 pages median ≤ 600]")
+            b0 = ws.bytes
+            if page.evaluate(PLAY_IN_PLOT, "▶ 0.25×"):
+                frames = page.evaluate(COUNT_FRAMES, 2000)
+                where = "client-side animation"
+            else:
+                page.get_by_role("button", name="Replay", exact=True).click()
+                frames = page.evaluate(COUNT_FRAMES, 2000)
+                where = "server-pushed figures"
+            print(f"replay ({where}): {frames / 2.0:.1f} phase-plane frames/s drawn, "
+                  f"{(ws.bytes - b0) / 2.0 / 1e3:.1f} kB/s from the server   [target ≥ 30 frames/s, ≤ 1 kB/frame]")
             browser.close()
     finally:
         server.terminate()

@@ -2,18 +2,24 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
+from app.figure_json import figure_json
 from app.figures import (
     MAX_POINTS,
     cursor_index,
     decimate_index,
+    layer_entry_index,
     make_phase_plane_figure,
     make_time_plots_figure,
+    phase_plane_spec,
 )
 from app.figures_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
-from app.ui_replay import PhaseTemplate, time_template
+from app.figures_replay import MAX_FRAMES, SPEEDS
+from app.ui_replay import phase_plane_json
 from sim.engine import PAPER_TABLE1, Comparison, Table1Row, compare
 
 
@@ -44,25 +50,58 @@ def test_phase_plane_has_boundary_band_and_both_trajectories(comparison):
     assert fig.layout.meta["omega_p"] == pytest.approx(prof.omega_p)
 
 
-def test_phase_plane_replay_time_draws_part_of_the_trajectory(comparison):
-    fig = make_phase_plane_figure(comparison, t_now=0.3)
-    traces = _by_name(fig)
-    so_far, whole = traces["FDSMC so far"], traces["FDSMC trajectory"]
-    assert 1 < len(so_far.x) < len(whole.x)
-    assert len(traces["FDSMC now"].x) == 1
-    assert traces["FDSMC now"].x[0] == so_far.x[-1]
+def test_replay_frames_put_the_markers_on_the_trajectories(comparison):
+    """Each speed's in-browser frames move the "now" markers along θ_r(t), ω_r(t) at the frame times."""
+    spec = json.loads(phase_plane_json(comparison))
+    names = [t["name"] for t in spec["data"]]
+    now = [names.index("FDSMC now"), names.index("Conventional now")]
+    buttons = spec["layout"]["updatemenus"][0]["buttons"]
+    assert [b["label"] for b in buttons] == [f"▶ {k}" for k in SPEEDS] + ["Pause"]
+    t_end = float(comparison.fdsmc.trace.t[-1])
+    th = comparison.derived.params.manoeuvre.theta_dem
+    for button, speed in zip(buttons, SPEEDS.values(), strict=False):
+        frames, opts = button["args"]
+        assert all(f["traces"] == now for f in frames)
+        n = len(frames)
+        assert 2 <= n <= MAX_FRAMES
+        # wall time of the whole replay = simulated time / speed
+        assert opts["frame"]["duration"] * (n - 1) == pytest.approx(1e3 * t_end / speed, rel=1e-9)
+        k = n // 3
+        t_k = t_end * k / (n - 1)
+        tr = comparison.conventional.trace
+        assert frames[k]["data"][1]["x"][0] == pytest.approx(np.interp(t_k, tr.t, tr.theta_r) - th, rel=1e-4, abs=1e-6)
+        assert frames[k]["data"][1]["y"][0] == pytest.approx(np.interp(t_k, tr.t, tr.omega_r), rel=1e-4, abs=1e-6)
+        assert frames[-1]["data"][0]["text"] == [f"t = {t_end:.3f} s"]
+    # at 0.25× the frames come at least 30 per second unless capped
+    frames, opts = buttons[1]["args"]
+    assert opts["frame"]["duration"] <= 1e3 / 30 + 1e-9 or len(frames) == MAX_FRAMES
 
 
-def test_phase_template_frame_matches_figure(comparison):
-    import json
-    tpl = PhaseTemplate(comparison)
-    data = json.loads(tpl.frame(0.3))
-    names = {t["name"]: t for t in data["data"]}
-    expected = _by_name(make_phase_plane_figure(comparison, t_now=0.3))
-    assert len(names["FDSMC so far"]["x"]) == len(expected["FDSMC so far"].x)
-    assert names["Conventional now"]["y"][0] == pytest.approx(float(expected["Conventional now"].y[0]), rel=1e-5)
-    cursor = json.loads(time_template(comparison).replace('"__cursor__"', "0.25"))
-    assert cursor["layout"]["shapes"][0]["x0"] == 0.25
+def test_dict_figure_json_matches_plotly(comparison):
+    """The plain-dict encoder gives the same figure as Plotly's validated go.Figure."""
+    spec = phase_plane_spec(comparison)
+    ours = json.loads(figure_json(spec))
+    theirs = json.loads(make_phase_plane_figure(comparison).to_json())
+    assert [t["name"] for t in ours["data"]] == [t["name"] for t in theirs["data"]]
+    for a, b in zip(ours["data"], theirs["data"], strict=True):
+        for key in ("x", "y"):
+            if isinstance(a[key], dict):
+                assert a[key] == b[key]  # identical base64 typed arrays
+    assert ours["layout"]["template"] == theirs["layout"]["template"]
+
+
+def test_phase_plane_marks_boundary_layer_entry(comparison):
+    """The FDSMC marker of the boundary-layer entry lies within ±1/K of the switching boundary, eq. (45)."""
+    from control.sliding_mode import boundary_speed
+
+    k = layer_entry_index(comparison, comparison.fdsmc)
+    assert k is not None and 0 < k < len(comparison.fdsmc.trace.t) - 1
+    tr, d = comparison.fdsmc.trace, comparison.derived
+    th_re = tr.theta_r - d.params.manoeuvre.theta_dem
+    gap = np.abs(tr.omega_r - boundary_speed(th_re, d.profile.omega_p, d.profile.T_c))
+    assert gap[k] <= 1.0 / d.params.controller.K < gap[k - 1]
+    names = {t.name for t in make_phase_plane_figure(comparison).data}
+    assert "FDSMC enters boundary layer" in names
 
 
 def test_time_plots_have_all_signals_of_both_controllers(comparison):
@@ -71,7 +110,6 @@ def test_time_plots_have_all_signals_of_both_controllers(comparison):
     for label in ("θ_r", "ω_r", "i_d", "i_q", "u_d", "u_q", "α", "α_dem", "Γ_L", "Γ̂_L"):
         assert f"{label} FDSMC" in names and f"{label} Conventional" in names
     assert {"θ_dem", "ω_p, eq. (60)"} <= names
-    assert fig.layout.shapes[0].x0 == 0.0
 
 
 def test_energy_figures_show_totals_and_saving(comparison):

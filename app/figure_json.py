@@ -1,0 +1,63 @@
+"""Figure JSON without Plotly's per-trace validation: plain-dict figures, encoded once.
+
+Building a ``go.Figure`` validates every property of every trace and deep-copies the template;
+for the page's figures that is most of the server's CPU per Simulate. The figure functions
+therefore describe a figure as a plain dict (``{"data": [...], "layout": {...}}``, numpy arrays
+allowed) and :func:`figure_json` encodes it directly: float arrays as Plotly's base64 typed arrays
+(``{"dtype": "f4", "bdata": …}``, as ``plotly.io.to_json`` writes them) and ``layout.template``
+names replaced by the template's JSON, rendered once per process.
+"""
+
+from __future__ import annotations
+
+import base64
+import functools
+import json
+from typing import Any
+
+import numpy as np
+import plotly.graph_objects as go
+import plotly.io as pio
+
+
+@functools.cache
+def template_json(name: str) -> str:
+    """JSON of a named Plotly template (e.g. ``"plotly_white"``), rendered once."""
+    return json.dumps(pio.templates[name].to_plotly_json(), separators=(",", ":"))
+
+
+def _default(obj: Any) -> Any:
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind == "f":
+            a = np.ascontiguousarray(obj, dtype=np.float32 if obj.dtype.itemsize <= 4 else np.float64)
+            return {"dtype": "f4" if a.itemsize == 4 else "f8", "bdata": base64.b64encode(a).decode("ascii")}
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+_TEMPLATE_MARK = '"__template__"'
+
+
+def figure_json(spec: dict[str, Any], raw: dict[str, str] | None = None) -> str:
+    """The Plotly JSON of a plain-dict figure ``spec`` (not modified).
+
+    ``raw`` maps placeholder strings used as values in ``spec`` to ready-made JSON put in their place.
+    """
+    layout = dict(spec.get("layout", {}))
+    name = layout.get("template")
+    if isinstance(name, str):
+        layout["template"] = "__template__"
+    text = json.dumps({**spec, "layout": layout}, default=_default, separators=(",", ":"))
+    for mark, value in (raw or {}).items():
+        text = text.replace(f'"{mark}"', value, 1)
+    return text.replace(_TEMPLATE_MARK, template_json(name), 1) if isinstance(name, str) else text
+
+
+def to_figure(spec: dict[str, Any]) -> go.Figure:
+    """A validated ``go.Figure`` of a plain-dict figure (for exports and tests; slower)."""
+    return go.Figure(spec)
+
+
+__all__ = ["figure_json", "template_json", "to_figure"]
