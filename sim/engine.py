@@ -28,6 +28,9 @@ from sim import kernel as kn
 from sim.metrics import WindowSamples, chatter_window_steps, chatter_windows, run_metrics
 
 CONTROLLERS = ("fdsmc", "conventional")
+#: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
+#: (:mod:`control.optimum`); the kernel's P_CTRL is the index in this tuple.
+COMPARATORS = CONTROLLERS + ("optimum",)
 #: Simulated horizon beyond T_m, as a fraction of T_m [-].
 TAIL_FRACTION = 0.3
 #: RK4 step of continuous mode [s]; friction energies converged to < 0.05 % (see tests).
@@ -95,6 +98,7 @@ class Comparison:
 
     ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
     ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
+    ``optimum`` is the tracked minimum-energy move, when asked for.
     """
 
     derived: Derived
@@ -102,6 +106,7 @@ class Comparison:
     conventional: RunResult | None
     saving_friction_pct: float | None
     saving_electrical_pct: float | None
+    optimum: RunResult | None = None
 
 
 @dataclass(frozen=True)
@@ -181,7 +186,7 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str) -> np.ndar
     prm[[kn.P_RS, kn.P_LD, kn.P_LQ, kn.P_PSI, kn.P_P, kn.P_JR]] = (
         m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, m.J_r)
     prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (params.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
-    prm[kn.P_CTRL] = CONTROLLERS.index(controller)
+    prm[kn.P_CTRL] = COMPARATORS.index(controller)
     pr, o = d.profile, d.observer
     prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
@@ -209,8 +214,18 @@ def _load_steps(params: DriveParams) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _check_controller(controller: str) -> None:
-    if controller not in CONTROLLERS:
-        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(CONTROLLERS)}")
+    if controller not in COMPARATORS:
+        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(COMPARATORS)}")
+
+
+def _reference(d: Derived, controller: str) -> np.ndarray:
+    """The kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
+    if controller != "optimum":
+        return np.zeros((3, 2))
+    from control.optimum import tracked_move  # imports cvxpy only when limits are active
+
+    mv = tracked_move(d)
+    return np.ascontiguousarray(np.vstack((mv.theta, mv.omega, mv.alpha)))
 
 
 def _check_feasible(d: Derived) -> None:
@@ -237,7 +252,8 @@ def simulate(
     params : DriveParams
         The commissioning case.
     controller : str
-        ``"fdsmc"`` (eqs. 41–46 in [1]) or ``"conventional"`` (eq. 62 sign-corrected).
+        ``"fdsmc"`` (eqs. 41–46 in [1]), ``"conventional"`` (eq. 62 sign-corrected) or
+        ``"optimum"`` (the minimum-energy move of :mod:`control.optimum`, tracked).
     derived : Derived or None
         ``derive(params)`` if already computed.
     n_sub : int
@@ -272,7 +288,7 @@ def simulate(
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
     win = np.zeros((2 * len(steps), max(n for _, n in steps)))
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
-                  params.controller.delay_samples, g.decim, out, info, k_win, win)
+                  params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller))
     trace = _trace(out[:, : int(info[kn.I_NOUT])])
     samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, win[2 * j, :n], win[2 * j + 1, :n])
                for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
@@ -303,7 +319,7 @@ def run_steps(
     info = np.zeros(kn.N_INFO)
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
                   params.controller.delay_samples, int(n_steps) + 1, out, info,
-                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)))
+                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller))
     return info[kn.I_END: kn.I_END + kn.N_X].copy()
 
 
@@ -334,7 +350,7 @@ def compare(
     ----------
     params : DriveParams
     controllers : tuple of str
-        Any of ``"fdsmc"``, ``"conventional"``.
+        Any of ``"fdsmc"``, ``"conventional"``, ``"optimum"``.
     derived : Derived or None
         ``derive(params)`` if already computed.
     **options
@@ -357,7 +373,8 @@ def compare(
     else:
         runs = {c: simulate(params, c, d, **options) for c in controllers}
     f, c = runs.get("fdsmc"), runs.get("conventional")
-    return Comparison(d, f, c, _saving(f, c, "friction_J"), _saving(f, c, "electrical_in_total_J"))
+    return Comparison(d, f, c, _saving(f, c, "friction_J"), _saving(f, c, "electrical_in_total_J"),
+                      runs.get("optimum"))
 
 
 def table1_sweep(

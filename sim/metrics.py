@@ -172,7 +172,7 @@ def chatter_windows(
     t_end : float  End of the simulated horizon [s].
     """
     T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
-    if controller == "conventional":
+    if controller != "fdsmc":  # the conventional law and the tracked optimum: no cruise segment
         t0, t1 = 0.2 * T_m, T_m
     else:
         cruise = T_m - 4.0 * T_a
