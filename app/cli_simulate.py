@@ -10,7 +10,7 @@ from typing import Any
 
 from app.cli import add_preset_arguments
 from app.derived_view import derived_json
-from app.presets import load_preset
+from app.plant import load_model_and_plant
 from sim.engine import Comparison, RunResult, compare
 from sim.verdicts import comparator_notes, run_warnings
 
@@ -156,10 +156,10 @@ def print_summary(cmp: Comparison) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Simulate and print (table or JSON); optionally write the CSV."""
-    params = load_preset(args.preset, args.overrides)
+    params, plant = load_model_and_plant(args.preset, args.overrides)
     ctrls = {"both": ("fdsmc", "conventional"), "all": ("fdsmc", "conventional", "optimum")}.get(
         args.controller, (args.controller,))
-    cmp = compare(params, ctrls)
+    cmp = compare(params, ctrls, plant=plant)
     if args.csv:
         write_csv(args.csv, [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None])
     if args.json:

@@ -26,7 +26,10 @@ from numba import njit
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
  P_FV, P_TSI, P_TSA, P_CTRL, P_THDEM, P_OMP, P_TC, P_KB, P_AMAX, P_G1, P_G2, P_K1, P_K2, P_K3,
  P_K4, P_UMAX, P_IMAX, P_TM, P_GLE0, P_GRAMP, P_WLIM, P_ILIM) = range(39)
-N_PRM = 39
+# The plant's own coefficients A…G of eqs. (1)–(2) (its true R_s, L_d, L_q, Ψ_PM): P_A…P_G are the
+# controller's model of them. P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT, P_FV are the plant's.
+(P_PA, P_PB, P_PC, P_PD, P_PE, P_PF, P_PG) = range(39, 46)
+N_PRM = 46
 
 # ---- state indices -----------------------------------------------------------------------
 (X_ID, X_IQ, X_TH, X_W, X_EF, X_ECU, X_EEL, X_EMOT, X_ELOAD, X_THH, X_WH, X_L0, X_L1) = range(13)
@@ -156,8 +159,8 @@ def plant_rhs(t: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray, step_
     g_le = gamma_le(t, prm, step_t, step_v)
     T_em = electromagnetic_torque(i_d, i_q, prm)
     p_el = 1.5 * (u_d * i_d + u_q * i_q)
-    return (-prm[P_A] * i_d + prm[P_B] * w * i_q + prm[P_F] * u_d,
-            -(prm[P_C] * i_d + prm[P_E]) * w - prm[P_D] * i_q + prm[P_G] * u_q,
+    return (-prm[P_PA] * i_d + prm[P_PB] * w * i_q + prm[P_PF] * u_d,
+            -(prm[P_PC] * i_d + prm[P_PE]) * w - prm[P_PD] * i_q + prm[P_PG] * u_q,
             w,
             (T_em - prm[P_FV] * w - g_le) / prm[P_JT],
             prm[P_FV] * w * w,
