@@ -19,6 +19,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "bench": ("app.bench", "print speed figures of the simulation engine"),
     "serve": ("app.serve", "start the commissioning web UI"),
     "bldc": ("app.cli_bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
+    "multiaxis": ("app.cli_multiaxis", "axes that must finish together: common T_m, designs, energies"),
     "robustness": ("app.cli_robustness", "Monte-Carlo robustness to plant values the controller does not know"),
 }
 

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from control.derivations import Derived, derive
 from control.feasibility import LIMIT_TOLERANCE, torque_limit
 from control.params import DriveParams, ParameterError
 from sim.engine import CONTROLLERS, compare
@@ -87,10 +88,10 @@ def plant_for(params: DriveParams, values: dict[str, float]) -> DriveParams:
                                load=dataclasses.replace(params.load, **changes["load"]))
 
 
-def sample_metrics(params: DriveParams, plant: DriveParams) -> dict[str, dict[str, Any]]:
+def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None) -> dict[str, dict[str, Any]]:
     """Both controllers' metrics on one plant, plus ``infeasible`` (unstable, or the peak torque
-    beyond the plant's torque limit) and ``saving_friction_pct``."""
-    cmp = compare(params, CONTROLLERS, plant=plant, max_points=TRACE_POINTS)
+    beyond the plant's torque limit) and ``saving_friction_pct``; ``d`` = derive(params)."""
+    cmp = compare(params, CONTROLLERS, d, plant=plant, max_points=TRACE_POINTS)
     lim = torque_limit(plant)
     out: dict[str, dict[str, Any]] = {}
     for run in (cmp.fdsmc, cmp.conventional):
@@ -107,7 +108,8 @@ def sample_metrics(params: DriveParams, plant: DriveParams) -> dict[str, dict[st
 
 def simulate_chunk(params: DriveParams, rows: list[dict[str, float]]) -> list[dict[str, dict[str, Any]]]:
     """Metrics of several samples (one task); module-level so that it pickles."""
-    return [sample_metrics(params, plant_for(params, r)) for r in rows]
+    d = derive(params)  # the controller's design: the same for every sample
+    return [sample_metrics(params, plant_for(params, r), d) for r in rows]
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
