@@ -106,9 +106,11 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
     return out
 
 
-def simulate_chunk(params: DriveParams, rows: list[dict[str, float]]) -> list[dict[str, dict[str, Any]]]:
-    """Metrics of several samples (one task); module-level so that it pickles."""
-    d = derive(params)  # the controller's design: the same for every sample
+def simulate_chunk(params: DriveParams, rows: list[dict[str, float]],
+                   d: Derived | None = None) -> list[dict[str, dict[str, Any]]]:
+    """Metrics of several samples (one task); module-level so that it pickles. ``d`` =
+    derive(params), the controller's design (the same for every sample; computed if None)."""
+    d = derive(params) if d is None else d
     return [sample_metrics(params, plant_for(params, r), d) for r in rows]
 
 
@@ -169,21 +171,22 @@ def robustness(
     t0 = time.perf_counter()
     values = draw(params, spreads, samples, seed)
     rows = [{k: float(v[i]) for k, v in values.items()} for i in range(samples)]
-    runs = simulate_chunk(params, rows[:1])  # warm-up (compiled kernel loaded) …
+    d = derive(params)
+    runs = simulate_chunk(params, rows[:1], d)  # warm-up (compiled kernel loaded) …
     t1 = time.perf_counter()
-    runs += simulate_chunk(params, rows[1:2])  # … and one timed sample
+    runs += simulate_chunk(params, rows[1:2], d)  # … and one timed sample
     done = len(runs)
     size = chunk_size(time.perf_counter() - t1, samples - done, workers)
     chunks = [rows[i: i + size] for i in range(done, samples, size)]
     if progress is not None:
         progress(done, samples)
-    futures = [executor.submit(simulate_chunk, params, c) for c in chunks] if executor is not None else None
+    futures = [executor.submit(simulate_chunk, params, c, d) for c in chunks] if executor is not None else None
     for j, c in enumerate(chunks):
         if cancelled is not None and cancelled():
             for f in futures or []:
                 f.cancel()
             raise ParameterError(f"robustness run cancelled after {len(runs)} of {samples} samples")
-        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c))
+        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d))
         if progress is not None:
             progress(len(runs), samples)
     return RobustnessResult(values, runs, summarise(runs, time.perf_counter() - t0))
