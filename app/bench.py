@@ -13,6 +13,7 @@ import time
 
 from app.cli import add_preset_arguments
 from app.cli_bldc import bench_figure
+from app.preset_modes import load_mode_preset
 from app.presets import load_preset
 from control.derivations import derive
 from sim.engine import CONTINUOUS_STEP_S, compare, run_steps, table1_sweep
@@ -36,7 +37,7 @@ def _timed(fn: object, *args: object, **kw: object) -> float:
 def run(args: argparse.Namespace) -> int:
     """Print the speed figures."""
     base = args.overrides
-    p = load_preset(args.preset, [*base, "manoeuvre.T_m=2.6", "controller.f_s=20000"])
+    p = load_mode_preset(args.preset, [*base, "manoeuvre.T_m=2.6", "controller.f_s=20000"], mode="position")
     first = _timed(compare, p)
     times = [_timed(compare, p) for _ in range(max(1, args.repeat))]
     print(f"comparison T_m = 2.6 s (+30 % tail), f_s = 20 kHz: first call {first * 1e3:.0f} ms "

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from app.numbers import NumberFormatError, parse_number
 from app.presets import loads_raw
 from app.units import rpm_to_rad_s
 from control.bldc_params import EMF_SAMPLES_MAX, BldcParams
@@ -34,8 +35,8 @@ _SPLIT = re.compile(r"[,;\t ]+")
 
 def _number(text: str, row: int, col: int) -> float:
     try:
-        return float(text)
-    except ValueError:
+        return parse_number(text, "cell")
+    except NumberFormatError:
         raise ParameterError(
             f"emf waveform row {row}, column {col}: {text!r} is not a number: allowed numeric rows "
             "θ_e [deg], Φ'_a[, Φ'_b, Φ'_c] [Wb] (one optional header row)") from None
@@ -66,8 +67,8 @@ def _first_content_line(text: str) -> int:
 
 def _is_number(text: str) -> bool:
     try:
-        float(text)
-    except ValueError:
+        parse_number(text, "cell")
+    except NumberFormatError:
         return False
     return True
 
@@ -107,6 +108,8 @@ def parse_yaml(text: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _yaml_number(v: Any, row: int, col: int) -> float:
+    if isinstance(v, str):  # YAML scalars arrive as text: decimal or scientific notation only
+        return parse_number(v, f"emf waveform row {row}, column {col}")
     if isinstance(v, bool) or not isinstance(v, int | float):
         raise ParameterError(f"emf waveform row {row}, column {col}: {v!r} is not a number: allowed numbers only")
     return float(v)

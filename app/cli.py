@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
+from pathlib import Path
 
 #: sub-command → (module, help)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -56,6 +58,22 @@ def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None)
         p.add_argument("preset", metavar="PRESET", nargs="?", default=default, help="preset name or YAML path")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.FIELD=VALUE",
                    help="override a preset value, e.g. --set manoeuvre.T_m=1.4 or motor.L_d_mH=5.4")
+
+
+def check_writable(path: str, option: str) -> None:
+    """Raise ValueError unless ``path`` can be written (checked before any simulation runs)."""
+    target = Path(path)
+    try:
+        parent = target.parent if str(target.parent) else Path(".")
+        ok_dir = parent.is_dir() and os.access(parent, os.W_OK)
+        ok_file = not target.exists() or (target.is_file() and os.access(target, os.W_OK))
+    except (OSError, ValueError) as exc:  # name too long, NUL byte …
+        raise ValueError(f"{option} {path!r} cannot be written: {exc}") from None
+    if not ok_dir:
+        raise ValueError(f"{option} {path!r}: the folder {str(parent)!r} does not exist or is not writable: "
+                         "allowed a file in an existing, writable folder")
+    if not ok_file:
+        raise ValueError(f"{option} {path!r} is not a writable file: allowed a new or writable file")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -13,6 +13,7 @@ import time
 from typing import Any
 
 from app.cli import add_preset_arguments
+from app.preset_modes import load_mode_preset
 from app.presets import load_preset
 from control.bldc_design import BldcDesign
 from control.bldc_params import BldcParams
@@ -125,7 +126,7 @@ def bench_figure(params: BldcParams | None = None, repeat: int = 5) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Print the comparison (table or JSON)."""
-    params = load_preset(args.preset, args.overrides)
+    params = load_mode_preset(args.preset, args.overrides, mode="bldc")
     if args.bench:
         names = [c.name for c in params.scenario.cases]
         fast = [*args.overrides, "scenario.active=2000rpm"]

@@ -6,8 +6,9 @@ import argparse
 import json
 
 from app.cli import add_preset_arguments
+from app.cli_simulate import finite_or_none
 from app.derived_view import derived_json, derived_rows, format_table
-from app.presets import load_preset
+from app.preset_modes import load_mode_preset
 from control.derivations import derive
 
 
@@ -19,10 +20,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print the derived values (table or JSON) and warnings."""
-    params = load_preset(args.preset, args.overrides)
+    params = load_mode_preset(args.preset, args.overrides, mode="position")
     d = derive(params)
     if args.json:
-        print(json.dumps(derived_json(d), indent=2, ensure_ascii=False))
+        print(json.dumps(finite_or_none(derived_json(d)), indent=2, ensure_ascii=False, allow_nan=False))
         return 0
     print(f"Preset: {params.name}  ({params.source})\n")
     print(format_table(derived_rows(d)))

@@ -41,6 +41,7 @@ def design_json(dd: DriveDesign) -> dict[str, Any]:
         "limiting": [{"name": x.name, "value": _finite(x.value), "limit": _finite(x.limit), "unit": x.unit,
                       "violated": x.violated, "text": x.text} for x in dd.limiting],
         "notes": list(dd.notes),
+        "comparator_notes": list(dd.comparator),
         "design": {"alpha_max": dd.derived.alpha.alpha_max, "T_m": dd.params.manoeuvre.T_m, "K": c.K,
                    "T_c": dd.derived.profile.T_c, "T_c_rule": "T_a" if c.T_c == "T_a" else "given",
                    "f_s": c.f_s, "overshoot_eta": dd.derived.alpha.overshoot},
@@ -70,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
           f"T_c = {d['T_c']:.4g} s  f_s = {d['f_s']}  (η = {d['overshoot_eta']:.3g})")
     for x in dd.limiting:
         print(f"  {'✗' if x.violated else '·'} {x.text}")
-    for n in dd.notes:
+    for n in dd.notes + dd.comparator:
         print(f"  note: {n}")
     for name, v in out["verified"].items():
         print(f"  {name}: peak {v['torque_peak_Nm']:.4g} N·m, {v['i_q_peak_A']:.4g} A, {v['u_peak_V']:.4g} V; "

@@ -8,7 +8,7 @@ import json
 import math
 from typing import Any
 
-from app.cli import add_preset_arguments
+from app.cli import add_preset_arguments, check_writable
 from app.derived_view import derived_json
 from app.plant import load_model_and_plant
 from sim.engine import Comparison, RunResult, compare
@@ -156,6 +156,8 @@ def print_summary(cmp: Comparison) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Simulate and print (table or JSON); optionally write the CSV."""
+    if args.csv:
+        check_writable(args.csv, "--csv")
     params, plant = load_model_and_plant(args.preset, args.overrides)
     ctrls = {"both": ("fdsmc", "conventional"), "all": ("fdsmc", "conventional", "optimum")}.get(
         args.controller, (args.controller,))
@@ -163,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         write_csv(args.csv, [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None])
     if args.json:
-        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False))
+        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False, allow_nan=False))
     else:
         print_summary(cmp)
     return 0

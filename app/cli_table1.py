@@ -17,7 +17,8 @@ import sys
 
 from app.cli import add_preset_arguments
 from app.cli_simulate import finite_or_none
-from app.presets import load_preset
+from app.numbers import NumberFormatError, parse_number
+from app.preset_modes import load_mode_preset
 from control.params import ParameterError
 from sim.engine import PAPER_TABLE1, Table1Row, table1_sweep
 
@@ -37,8 +38,8 @@ def parse_tm(text: str) -> list[float]:
     out: list[float] = []
     for item in text.split(","):
         try:
-            v = float(item)
-        except ValueError:
+            v = parse_number(item, "--tm entry")
+        except NumberFormatError:
             raise ParameterError(f"--tm entry {item.strip()!r} is not a number: allowed a time > 0 s") from None
         if not 0.0 < v <= 1e4:
             raise ParameterError(f"--tm entry {v:g} s is out of range: allowed 0 < T_m ≤ 10000 s")
@@ -65,7 +66,7 @@ def _fmt(v: float | None) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep and print the table (or JSON)."""
-    params = load_preset(args.preset, args.overrides)
+    params = load_mode_preset(args.preset, args.overrides, mode="position")
     tms = parse_tm(args.tm)
 
     def progress(done: int, total: int) -> None:

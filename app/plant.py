@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable
 
-from app.presets import load_preset
+from app.preset_modes import load_mode_preset
 from control.params import DriveParams, Load, Motor, ParameterError
 
 PREFIX = "plant."
@@ -47,9 +47,7 @@ def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
 def load_model_and_plant(preset: str, overrides: Iterable[str]) -> tuple[DriveParams, DriveParams | None]:
     """The controller's model and the plant (None when no ``plant.`` override is given)."""
     model_ov, plant_ov = split_overrides(overrides)
-    params = load_preset(preset, model_ov)
+    params = load_mode_preset(preset, model_ov, mode="position")
     if not plant_ov:
         return params, None
-    if not isinstance(params, DriveParams):
-        raise ParameterError(f"plant.* overrides are allowed for position presets only, not {preset!r}")
-    return params, load_preset(preset, model_ov + plant_ov)
+    return params, load_mode_preset(preset, model_ov + plant_ov, mode="position")

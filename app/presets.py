@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import math
 import re
 import types
 import typing
@@ -21,6 +22,7 @@ from typing import Any
 import yaml
 
 from app import units
+from app.numbers import NumberFormatError, parse_integer, parse_number
 from control.bldc_params import BldcParams
 from control.params import DriveParams, ParameterError
 
@@ -62,24 +64,35 @@ def _describe(tp: Any) -> str:
     return "a list of mappings"
 
 
-#: A decimal number in exponent form without a dot, e.g. ``2e-4``: YAML 1.1 (PyYAML) reads it as
-#: text, but engineers write it so; it is accepted as a number.
-_EXPONENT_NUMBER = re.compile(r"^[+-]?\d+[eE][+-]?\d+$")
+def _number(name: str, value: Any, tp: type) -> Any:
+    """A number field's value: text is parsed by :mod:`app.numbers` (decimal or scientific notation
+    only; an integer field takes whole numbers only), a number from JSON/Python data is kept."""
+    try:
+        if isinstance(value, str):
+            return parse_integer(value, name) if tp is int else parse_number(value, name)
+    except NumberFormatError as exc:
+        raise PresetError(str(exc)) from None
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
+    if tp is int:  # 4.0 → 4; 2.5, nan … go to the dataclass, which names the allowed range
+        return int(value) if math.isfinite(value) and float(value).is_integer() else value
+    return float(value)
 
 
 def _coerce(name: str, value: Any, tp: Any) -> Any:
     """Check ``value`` against the annotation ``tp``; parse nested dataclasses."""
-    if isinstance(value, str) and _EXPONENT_NUMBER.match(value.strip()):
-        value = float(value)
-    number = isinstance(value, int | float) and not isinstance(value, bool)
-    if tp is float and number:
-        return float(value)
-    if tp is int and number:
-        return value
+    if tp in (float, int):
+        return _number(name, value, tp)
     if tp is str and isinstance(value, str):
         return value
-    if isinstance(tp, types.UnionType):
-        for arg in typing.get_args(tp):
+    if isinstance(tp, types.UnionType):  # e.g. float | str: a number, else the keyword text
+        args = typing.get_args(tp)
+        if float in args and isinstance(value, str) and str in args:
+            try:
+                return _number(name, value, float)
+            except PresetError:
+                return value
+        for arg in args:
             try:
                 return _coerce(name, value, arg)
             except PresetError:
@@ -89,7 +102,7 @@ def _coerce(name: str, value: Any, tp: Any) -> Any:
         if item is float:  # a list of numbers, e.g. a sampled back-EMF period
             return tuple(_coerce(f"{name}[{i}]", v, float) for i, v in enumerate(value))
         return tuple(_parse_section(item, v, f"{name}[{i}]") for i, v in enumerate(value))
-    raise PresetError(f"{name} = {value!r} has the wrong type: expected {_describe(tp)}")
+    raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
 
 
 def _parse_section(cls: type, raw: Any, section: str) -> Any:
@@ -115,8 +128,11 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
         elif key in extra:
             target = "psi_pm"
             ke = _coerce(f"{section}.{key}", value, float)
-            p = raw.get("p")
-            if not isinstance(p, int) or isinstance(p, bool) or p < 1:
+            try:
+                p = _number(f"{section}.p", raw.get("p"), int)
+            except PresetError:
+                p = 0
+            if p < 1:
                 raise PresetError(f"{section}.{key} needs a valid {section}.p (pole pairs) beside it")
             values[target] = units.ke_vrms_krpm_to_psi_pm(ke, p)
         else:
@@ -149,7 +165,7 @@ def parse_preset(raw: Any) -> Any:
     """
     if not isinstance(raw, dict):
         raise PresetError("a preset must be a YAML mapping with schema, name, source and sections")
-    if raw.get("schema") != SCHEMA:
+    if _schema(raw.get("schema")) != SCHEMA:
         raise PresetError(f"schema = {raw.get('schema')!r} is not supported: allowed schema: {SCHEMA}")
     mode = raw.get("mode", "position")
     if mode not in MODES:
@@ -173,26 +189,111 @@ def parse_preset(raw: Any) -> Any:
     return cls(**kwargs)
 
 
+# ---- YAML front-end: text → raw mapping of texts, lists and mappings -------------------------
+#: Deepest nesting of brackets / block indentation levels a preset may have (presets need 4).
+MAX_DEPTH = 32
+#: Widest indentation of a line [columns] (bounds block nesting the same way).
+MAX_INDENT = 128
+
+
+class _TextLoader(yaml.SafeLoader):
+    """Safe YAML loader that keeps every scalar as text: no YAML 1.1 implicit typing (``1:30`` →
+    90, ``017`` → 15, ``0x10``, ``1_000``, ``yes`` → True …). Numbers are parsed afterwards by
+    :mod:`app.numbers` against the field types; duplicate keys and explicit tags are errors."""
+
+
+_TextLoader.yaml_implicit_resolvers = {}
+
+
+def _mark(node: yaml.Node) -> str:
+    return f"line {node.start_mark.line + 1}, column {node.start_mark.column + 1}"
+
+
+def _refuse_tag(loader: _TextLoader, node: yaml.Node) -> Any:
+    raise PresetError(f"YAML tag {node.tag!r} at {_mark(node)} is not allowed: write plain values")
+
+
+def _unique_mapping(loader: _TextLoader, node: yaml.MappingNode) -> dict[Any, Any]:
+    out: dict[Any, Any] = {}
+    first: dict[Any, str] = {}
+    for key_node, value_node in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        if not isinstance(key, str):
+            raise PresetError(f"key at {_mark(key_node)} is not a name: allowed text keys only")
+        if key in out:
+            raise PresetError(f"duplicate key {key!r} at {_mark(key_node)} (first at {first[key]}): "
+                              "allowed each key once per mapping")
+        first[key] = _mark(key_node)
+        out[key] = loader.construct_object(value_node, deep=True)
+    return out
+
+
+for _tag in ("null", "bool", "int", "float", "binary", "timestamp", "omap", "pairs", "set", "merge", "value"):
+    _TextLoader.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
+_TextLoader.add_constructor(None, _refuse_tag)
+_TextLoader.add_constructor("tag:yaml.org,2002:map", _unique_mapping)
+
+
+def check_structure(text: str, origin: str) -> None:
+    """Cheap pre-scan before parsing: bracket nesting ≤ MAX_DEPTH, indentation ≤ MAX_INDENT.
+
+    Deeply nested flow collections (``[[[[…]]]]``) make a YAML parser's time grow faster than
+    the text; this linear scan refuses them first. Quotes and comments are skipped.
+    """
+    depth = 0
+    for number, line in enumerate(text.splitlines(), 1):
+        indent = len(line) - len(line.lstrip(" -"))
+        if indent > MAX_INDENT:
+            raise PresetError(f"{origin} line {number} is indented {indent} columns: allowed ≤ {MAX_INDENT}")
+        quote = ""
+        for ch in line:
+            if quote:
+                quote = "" if ch == quote else quote
+            elif ch in "'\"":
+                quote = ch
+            elif ch == "#":
+                break
+            elif ch in "[{":
+                depth += 1
+                if depth > MAX_DEPTH:
+                    raise PresetError(f"{origin} is nested too deeply at line {number}: allowed ≤ {MAX_DEPTH} "
+                                      "levels of brackets")
+            elif ch in "]}":
+                depth = max(0, depth - 1)
+
+
 def _check_no_aliases(text: str) -> None:
-    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+    for event in yaml.parse(text, Loader=_TextLoader):
         if isinstance(event, yaml.AliasEvent):
             raise PresetError("YAML anchors/aliases (*name) are not allowed in presets")
 
 
 def loads_raw(text: str, origin: str = "<text>") -> Any:
-    """Parse YAML text safely (size-limited, no aliases) into plain Python data."""
-    if len(text.encode("utf-8", "replace")) > MAX_BYTES:
+    """Parse YAML text safely (size-limited, shallow, no aliases, no duplicate keys) into plain data
+    whose scalars are all text (see :class:`_TextLoader`)."""
+    if len(text) > MAX_BYTES or len(text.encode("utf-8", "replace")) > MAX_BYTES:
         raise PresetError(f"{origin} is too large: allowed ≤ {MAX_BYTES // 1024} KiB")
+    check_structure(text, origin)
     try:
         _check_no_aliases(text)
-        return yaml.safe_load(text)
+        return yaml.load(text, Loader=_TextLoader)  # noqa: S506 - a SafeLoader subclass
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise PresetError(f"{origin} is not valid YAML{where}: {problem}") from None
+        raise PresetError(f"{origin} is not valid YAML{where}: {problem}: allowed plain YAML text") from None
     except RecursionError:
-        raise PresetError(f"{origin} is nested too deeply") from None
+        raise PresetError(f"{origin} is nested too deeply: allowed ≤ {MAX_DEPTH} levels") from None
+    except PresetError as exc:  # duplicate key, tag: say where
+        raise PresetError(f"{origin}: {exc}") from None
+
+
+def _schema(value: Any) -> int | None:
+    """The schema number of a preset (text or int), None if it is not a whole number."""
+    try:
+        return _number("schema", value, int)
+    except PresetError:
+        return None
 
 
 def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
@@ -209,7 +310,7 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
             raise PresetError(f"--set {item!r}: unknown section {section!r}{_hint(section, known)}")
         value = loads_raw(text, f"--set {key}") if text.strip() else None
         if value is None:
-            raise PresetError(f"--set {item!r} has no value")
+            raise PresetError(f"--set {item!r} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
         aliases = units.ALIASES.get(section, {})
         target = _field_of(name, aliases, [units.KE_KEY])
         for other in [k for k in raw[section] if _field_of(str(k), aliases, [units.KE_KEY]) == target]:
@@ -218,14 +319,24 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
     return raw
 
 
+#: Longest preset name or path accepted [characters].
+MAX_NAME = 1024
+
+
 def resolve(name_or_path: str) -> Path:
     """Preset name (file stem in ``presets/``) or path → path; a clear error if absent."""
+    if len(name_or_path) > MAX_NAME:
+        raise PresetError(f"preset name {name_or_path[:40]!r}… has {len(name_or_path)} characters: "
+                          f"allowed ≤ {MAX_NAME}")
     path = Path(name_or_path)
-    if path.suffix in (".yaml", ".yml") and path.exists():
-        return path
-    candidate = PRESET_DIR / f"{name_or_path}.yaml"
-    if candidate.exists():
-        return candidate
+    try:
+        if path.suffix in (".yaml", ".yml") and path.is_file():
+            return path
+        candidate = PRESET_DIR / f"{name_or_path}.yaml"
+        if "/" not in name_or_path and "\\" not in name_or_path and candidate.is_file():
+            return candidate
+    except (OSError, ValueError):  # name too long for the file system, NUL byte …
+        pass
     raise PresetError(f"preset {name_or_path!r} not found{_hint(str(name_or_path), list_presets())}")
 
 
@@ -238,6 +349,9 @@ def load_raw(name_or_path: str) -> Any:
     """Read a preset file (by name or path) into raw data, without validating sections."""
     path = resolve(name_or_path)
     try:
+        if path.stat().st_size > MAX_BYTES:  # before reading it
+            raise PresetError(f"{path.name} is too large ({path.stat().st_size // 1024} KiB): "
+                              f"allowed ≤ {MAX_BYTES // 1024} KiB")
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise PresetError(f"cannot read preset {str(path)!r}: {exc}") from None

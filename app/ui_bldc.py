@@ -26,11 +26,14 @@ from app.figures_bldc import (
     make_torque_figure,
 )
 from app.numbers import NumberFormatError
-from app.presets import dumps_preset, load_preset, loads_preset
+from app.preset_modes import load_mode_preset
+from app.presets import dumps_preset, loads_preset
 from app.ui_numbers import NumberInput
+from app.ui_text import checked_choice, md_text
+from app.ui_worker import Cancelled, Worker
 from app.units import kHz_to_Hz, mH_to_H, rad_s_to_rpm, rpm_to_rad_s
 from control.bldc_design import bldc_design
-from control.bldc_params import BldcParams
+from control.bldc_params import EMF_SHAPES, BldcParams
 from control.params import ParameterError
 from sim.bldc_emf import machine_table
 from sim.bldc_engine import CONTROLLERS, LABELS, BldcComparison, compare_bldc
@@ -76,10 +79,10 @@ class BldcTab:
     """Widgets and actions of the BLDC tab of one client."""
 
     def __init__(self, client: viser.ClientHandle, submit: Callable[[Callable[[], None]], Any],
-                 figures_container: Any = None) -> None:
-        self.client, self.gui, self._submit = client, client.gui, submit
+                 figures_container: Any = None, worker: Worker | None = None) -> None:
+        self.client, self.gui, self._submit, self._worker = client, client.gui, submit, worker
         self._figures_container = figures_container
-        self.params: BldcParams = load_preset(PRESET)
+        self.params: BldcParams = load_mode_preset(PRESET, mode="bldc")
         self.comparison: BldcComparison | None = None
         self._build()
         self._show_design()
@@ -100,6 +103,9 @@ class BldcTab:
         self.upload.on_upload(self._uploaded)
         self.run_button = gui.add_button("Simulate BLDC", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.run_button.on_click(lambda _: self.simulate())
+        self.cancel_button = gui.add_button("Cancel BLDC run", icon=viser.Icon.PLAYER_STOP, color="red",
+                                            visible=False)
+        self.cancel_button.on_click(lambda _: self._cancel())
         self.status = gui.add_markdown("Ready — press **Simulate BLDC**; the metrics and figures are in "
                                        "the results panel's **BLDC figures** tab.")
         self.warnings = gui.add_markdown("")
@@ -144,9 +150,10 @@ class BldcTab:
             t_end = self.t_end.read("scenario t_end [s]")
         except NumberFormatError as exc:
             raise ParameterError(str(exc)) from None
-        sections["machine"]["emf"] = self.emf.value
+        sections["machine"]["emf"] = checked_choice(self.emf.value, EMF_SHAPES, "Machine back-EMF")
         new = {sec: dataclasses.replace(getattr(p, sec), **vals) for sec, vals in sections.items()}
-        case = next(c for c in p.scenario.cases if c.name == self.scenario.value)
+        names = tuple(c.name for c in p.scenario.cases)
+        case = p.scenario.cases[names.index(checked_choice(self.scenario.value, names, "Scenario"))]
         case = dataclasses.replace(case, omega_ref=omega_ref, t_end=t_end)
         cases = tuple(case if c.name == case.name else c for c in p.scenario.cases)
         scen = dataclasses.replace(p.scenario, active=case.name, cases=cases)
@@ -159,7 +166,7 @@ class BldcTab:
         self.fig_dqx.figure = make_dqx_figure(table, p.machine.Phi_m)
         design = bldc_design(p)
         self.fig_reach.figure = make_reachability_figure(design)
-        self.warnings.content = "\n".join(f"⚠ {w}  " for w in design.warnings)
+        self.warnings.content = "\n".join(f"⚠ {md_text(w)}  " for w in design.warnings)
 
     # ---- actions ------------------------------------------------------------------------------
     def simulate(self) -> bool:
@@ -167,20 +174,25 @@ class BldcTab:
         try:
             params = self.collect()
         except (ParameterError, ValueError, TypeError) as exc:
-            self.status.content = f"**Rejected — nothing simulated:** {exc}"
+            self.status.content = f"**Rejected — nothing simulated:** {md_text(exc)}"
             return False
         return bool(self._submit(lambda: self._run(params)))
 
     def _run(self, params: BldcParams) -> None:
         self.status.content = f"Simulating… ({len(CONTROLLERS)} drives)"
-        self.run_button.disabled = True
+        self.run_button.disabled, self.cancel_button.visible = True, self._worker is not None
         try:
             comp = compare_bldc(params)
+            if self._worker is not None:
+                self._worker.checkpoint()
         except (ParameterError, ValueError) as exc:
-            self.status.content = f"**Rejected:** {exc}"
+            self.status.content = f"**Rejected:** {md_text(exc)}"
+            return
+        except Cancelled:
+            self.status.content = "Cancelled — the previous results are kept."
             return
         finally:
-            self.run_button.disabled = False
+            self.run_button.disabled, self.cancel_button.visible = False, False
         self.params, self.comparison = params, comp
         self._show_design()
         self.fig_speed.figure = make_speed_figure(comp)
@@ -189,8 +201,12 @@ class BldcTab:
         self.fig_currents.figure = make_currents_figure(comp)
         self.metrics.content = metrics_markdown(comp)
         sim_s = params.case.t_end * len(comp.runs)
-        self.status.content = (f"Done: scenario **{params.case.name}**, back-EMF **{params.machine.emf}**, "
+        self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**, "
                                f"{sim_s:g} s simulated in {comp.wall_s * 1e3:.0f} ms.")
+
+    def _cancel(self) -> None:
+        if self._worker is not None and self._worker.cancel():
+            self.status.content = "Cancelling…"
 
     def _scenario_chosen(self) -> None:
         """Show the chosen scenario's reference speed and duration."""
@@ -202,6 +218,11 @@ class BldcTab:
     def _emf_chosen(self, event: viser.GuiEvent) -> None:
         if event.client is None:
             return
+        if self.emf.value not in EMF_SHAPES:  # never offered: a hostile or stale client
+            self.status.content = (f"**Rejected:** Machine back-EMF = {md_text(repr(self.emf.value))} is not one "
+                                   f"of the offered options: allowed {', '.join(EMF_SHAPES)}")
+            self.emf.value = self.params.machine.emf
+            return
         if self.emf.value == "measured" and not self.params.machine.emf_samples:
             self.status.content = ("**Rejected:** machine back-EMF = 'measured' needs a waveform: "
                                    "upload a CSV/YAML file first")
@@ -211,7 +232,7 @@ class BldcTab:
             self.params = dataclasses.replace(
                 self.params, machine=dataclasses.replace(self.params.machine, emf=self.emf.value))
         except ParameterError as exc:
-            self.status.content = f"**Rejected:** {exc}"
+            self.status.content = f"**Rejected:** {md_text(exc)}"
             return
         self._show_design()
 
@@ -222,14 +243,14 @@ class BldcTab:
             measured = read_measured(text, f.name)
             self.params = with_measured(self.params, measured)
         except UnicodeDecodeError:
-            self.status.content = f"**Upload rejected:** {f.name} is not UTF-8 text: allowed CSV or YAML"
+            self.status.content = f"**Upload rejected:** {md_text(f.name)} is not UTF-8 text: allowed CSV or YAML"
             return
         except (ParameterError, ValueError) as exc:
-            self.status.content = f"**Upload rejected — nothing changed:** {exc}"
+            self.status.content = f"**Upload rejected — nothing changed:** {md_text(exc)}"
             return
         self.emf.value = "measured"
         shifts = ", ".join(f"{s:.1f}°" for s in measured.shifts_deg) or "one phase given"
-        note = (f"Loaded **{f.name}**: phase shifts {shifts}; fundamental offset vs the ideal trapezoid "
+        note = (f"Loaded **{md_text(f.name)}**: phase shifts {shifts}; fundamental offset vs the ideal trapezoid "
                 f"{measured.offset_deg:+.1f}° (the controller assumes 0°).")
         self.status.content = note
         self._show_design()
@@ -239,17 +260,18 @@ class BldcTab:
         try:
             params = loads_preset(f.content.decode("utf-8"), f.name)
         except UnicodeDecodeError:
-            self.status.content = f"**Import rejected — nothing changed:** {f.name} is not UTF-8 text"
+            self.status.content = f"**Import rejected — nothing changed:** {md_text(f.name)} is not UTF-8 text"
             return
         except (ParameterError, ValueError) as exc:
-            self.status.content = f"**Import rejected — nothing changed:** {exc}"
+            self.status.content = f"**Import rejected — nothing changed:** {md_text(exc)}"
             return
         if not isinstance(params, BldcParams):
-            self.status.content = (f"**Import rejected — nothing changed:** {f.name} is a position-drive "
+            self.status.content = (f"**Import rejected — nothing changed:** {md_text(f.name)} is a position-drive "
                                    "preset: import it in the *Position drive (FDSMC)* tab")
             return
         self.apply(params)
-        self.status.content = f"Imported **{params.name}** ({f.name}) — press **Simulate BLDC**."
+        self.status.content = (f"Imported **{md_text(params.name)}** ({md_text(f.name)}) — press "
+                               "**Simulate BLDC**.")
 
     def apply(self, params: BldcParams) -> None:
         """Show ``params`` in every widget of the tab and make them the tab's parameters."""
@@ -267,17 +289,17 @@ class BldcTab:
         try:
             params = self.collect()
         except (ParameterError, ValueError, TypeError) as exc:
-            self.status.content = f"**Rejected:** {exc}"
+            self.status.content = f"**Rejected:** {md_text(exc)}"
             return
         self.client.send_file_download(f"{params.name}.yaml", dumps_preset(params).encode("utf-8"),
                                        save_immediately=True)
 
 
 def build_bldc_tab(client: viser.ClientHandle, submit: Callable[[Callable[[], None]], Any],
-                   figures_container: Any = None) -> BldcTab:
+                   figures_container: Any = None, worker: Worker | None = None) -> BldcTab:
     """Build the BLDC tab in the current GUI container of ``client``; returns its handle object.
 
     ``figures_container`` (e.g. a tab of the wide results panel) receives the figures; without
     it they go into a folder of the current container.
     """
-    return BldcTab(client, submit, figures_container)
+    return BldcTab(client, submit, figures_container, worker)

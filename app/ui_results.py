@@ -13,6 +13,7 @@ import viser
 
 from app.figures import make_phase_plane_figure, make_time_plots_figure
 from app.figures_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
+from app.numbers import NumberFormatError, parse_number
 from app.ui_replay import Replay, set_figure_json
 from app.ui_scene import RotorScene
 from app.ui_text import annual_savings, savings_markdown
@@ -28,8 +29,8 @@ def parse_T_m_list(text: str) -> list[float]:
     values: list[float] = []
     for item in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):
         try:
-            value = float(item)
-        except ValueError:
+            value = parse_number(item, "Table 1 › T_m list")
+        except NumberFormatError:
             raise ValueError(f"Table 1 › T_m list: {item!r} is not a number: allowed a comma-separated "
                              "list of times > 0 s, e.g. 1.0, 1.4, 1.8") from None
         if not 0.0 < value <= 1e4:

@@ -17,13 +17,14 @@ from typing import Any
 
 import viser
 
-from app.presets import list_presets, load_preset
+from app.preset_modes import list_presets_of, load_mode_preset, require_mode
 from app.ui_files import FilesPanel
 from app.ui_inputs import InputError, InputsPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
-from app.ui_text import derived_markdown, design_markdown, warnings_html
-from app.ui_worker import Worker
+from app.ui_text import checked_choice, derived_markdown, design_markdown, md_text, warnings_html
+from app.ui_worker import Cancelled, Worker
+from app.web_guard import Guard, guarded
 from control.derivations import derive
 from control.nameplate import nameplate_consistency
 from control.params import DriveParams
@@ -53,6 +54,7 @@ class AppConfig:
     _initial: Comparison | None = None
     _lock: threading.Lock = field(default_factory=threading.Lock)
     sessions: dict[int, Session] = field(default_factory=dict)
+    guard: Guard | None = None
 
     def initial(self) -> Comparison:
         """The comparison of the start-up preset (computed on first use)."""
@@ -87,16 +89,17 @@ class Session:
         with tabs.add_tab("Position drive (FDSMC)"):
             self._controls()
         self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep)
-        _add_bldc_tab(self.client, tabs, self.submit, self.results.panel)
+        _add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
         self.results.panel.dock_right()
         self.results.panel.set_width(RESULTS_WIDTH)
 
     def _controls(self) -> None:
         gui = self.gui
-        names = list_presets()
+        names = self._preset_names = tuple(list_presets_of("position"))
         self.preset = gui.add_dropdown("Preset", names, initial_value=self.origin if self.origin in names
                                        else names[0])
         self.preset.on_update(self._preset_chosen)
+        self._preset_shown = self.preset.value
         self.files = FilesPanel(self.client, self._export_state, self._imported)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.simulate_button.on_click(lambda _: self.simulate())
@@ -105,6 +108,8 @@ class Session:
                                                  "verified by simulation")
         self.design_button.on_click(lambda _: self.design())
         self.design_note = gui.add_markdown("")
+        self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
+        self.cancel_button.on_click(lambda _: self.cancel())
         self.status = gui.add_markdown("Ready.")
         self.warnings = gui.add_html("")
         self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
@@ -160,10 +165,19 @@ class Session:
             return False
         return True
 
+    def cancel(self) -> bool:
+        """Cancel the running job (its result is discarded); False if nothing runs."""
+        if not self.worker.cancel():
+            return False
+        self.status.content = "Cancelling…"
+        return True
+
     def _run(self, params: DriveParams) -> None:
         self.status.content = "Simulating…"
         self.design_note.content = ""
+        self.worker.checkpoint()
         comparison = comparison_or_derived(params)  # ParameterError from derive → _job_failed
+        self.worker.checkpoint()
         self.params, self.comparison, self.error = params, comparison, None
         self.runs += 1
         if comparison.fdsmc is not None:
@@ -176,9 +190,13 @@ class Session:
         """Run the Table-1 sweep over ``T_m_values`` [s] on the worker with a progress bar."""
         params = self.params
 
+        def progress(done: int, total: int) -> None:
+            self.worker.checkpoint()
+            self.results.set_progress(done, total)
+
         def job() -> None:
-            self.results.set_progress(0, len(T_m_values))
-            rows = table1_sweep(params, T_m_values, progress=self.results.set_progress)
+            progress(0, len(T_m_values))
+            rows = table1_sweep(params, T_m_values, progress=progress)
             self.results.show_table1(rows, PAPER_TABLE1)
 
         self.submit(job)
@@ -187,13 +205,21 @@ class Session:
         if event.client is None:
             return
         try:
-            params = load_preset(self.preset.value)
+            name = checked_choice(self.preset.value, self._preset_names, "Preset")
+            params = load_mode_preset(name, mode="position")
+        except ValueError as exc:
+            self.preset.value = self._preset_shown  # back to the preset whose values are shown
+            self._reject(str(exc))
+            return
+        self._preset_shown = name
+        self._imported(params, name)
+
+    def _imported(self, params: DriveParams, origin: str) -> None:
+        try:
+            require_mode(params, "position", origin)
         except ValueError as exc:
             self._reject(str(exc))
             return
-        self._imported(params, self.preset.value)
-
-    def _imported(self, params: DriveParams, origin: str) -> None:
         self.origin = origin
         self.inputs.populate(params)
         self.params = params
@@ -230,7 +256,7 @@ class Session:
         self.use_tc.visible = T_c is not None
         if T_c is not None:
             self.use_tc.label = f"Use T_c = {T_c * 1e3:.4g} ms (damps the approach to θ_dem)"
-        self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: `{self.origin}`."
+        self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: {md_text(self.origin)}."
 
     def _nameplate_warnings(self) -> list[str]:
         """Disagreements with the optional datasheet Kt / rated torque typed on the page."""
@@ -251,6 +277,10 @@ class Session:
                                      auto_close_seconds=12.0)
 
     def _job_failed(self, exc: Exception) -> None:
+        if isinstance(exc, Cancelled):
+            with contextlib.suppress(Exception):
+                self.status.content = "Cancelled — the previous results are kept."
+            return
         if isinstance(exc, ValueError):
             self._reject(str(exc))
         else:
@@ -265,6 +295,7 @@ class Session:
     def _set_busy(self, busy: bool) -> None:
         self.simulate_button.disabled = busy
         self.design_button.disabled = busy
+        self.cancel_button.visible = busy
         self.results.sweep_button.disabled = busy
         if busy:
             self.status.content = "Working…"
@@ -281,7 +312,7 @@ class Session:
 
 
 def _add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,
-                  submit: Callable[[Callable[[], None]], Any], results: Any) -> None:
+                  submit: Callable[[Callable[[], None]], Any], results: Any, worker: Worker) -> None:
     """Second mode: the BLDC tab (inputs left, figures in a "BLDC figures" tab of ``results``)."""
     try:
         from app.ui_bldc import build_bldc_tab
@@ -289,12 +320,12 @@ def _add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,
         return
     figures_tab = results.add_tab("BLDC figures", viser.Icon.ENGINE)
     with tabs.add_tab("BLDC speed SMC", viser.Icon.ENGINE):
-        build_bldc_tab(client, submit, figures_tab)
+        build_bldc_tab(client, submit, figures_tab, worker)
 
 
 def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", port: int = 8080,
                   scene_3d: bool = True, environment_map: bool = False,
-                  ) -> tuple[viser.ViserServer, AppConfig]:
+                  guard: Guard | None = None) -> tuple[viser.ViserServer, AppConfig]:
     """Start the viser server with one :class:`Session` per connecting client.
 
     Parameters
@@ -304,17 +335,20 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     host, port            Bind address; viser moves to the next free port if taken (see ``get_port``).
     scene_3d : bool       Show the 3D rotors (tests switch it off).
     environment_map : bool  viser's HDRI background (off by default: it stalls software WebGL).
+    guard : Guard or None   Origin/Host/token rules (default: same-host origins on ``host``, no token).
 
     Returns
     -------
     (viser.ViserServer, AppConfig)
         The running server and its settings (``config.sessions`` maps client id → Session).
     """
-    server = viser.ViserServer(host=host, port=port, verbose=False)
+    guard = guard or Guard.for_host(host)
+    with guarded(guard):
+        server = viser.ViserServer(host=host, port=port, verbose=False)
     server.gui.set_panel_label("PMSM commissioning (FDSMC)")
     if not environment_map:  # the HDRI stalls software WebGL for seconds
         server.scene.configure_environment_map(hdri=None)
-    config = AppConfig(params, origin, scene_3d)
+    config = AppConfig(params, origin, scene_3d, guard=guard)
 
     @server.on_client_connect
     def _(client: viser.ClientHandle) -> None:

@@ -7,14 +7,44 @@ new rows appear on the page without changes here.
 from __future__ import annotations
 
 import html
+import re
 from dataclasses import dataclass
 from typing import Any
 
 from app.derived_view import derived_rows
 from control.derivations import Derived
+from control.params import ParameterError
 
 #: Joules per kilowatt-hour [J/kWh].
 J_PER_KWH = 3.6e6
+
+
+_MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
+
+
+def md_text(text: object) -> str:
+    """User-provided text (preset name/source, file names, messages quoting them) made safe to put
+    in Markdown or HTML: shown literally, never as markup, links, images or code.
+
+    HTML special characters become entities, Markdown punctuation is backslash-escaped and line
+    breaks become spaces (a name cannot start a heading or a table row).
+    """
+    flat = " ".join(str(text).split())
+    return _MARKDOWN_SPECIAL.sub(r"\\\1", html.escape(flat, quote=False))
+
+
+def checked_choice(value: object, options: tuple[str, ...] | list[str], label: str) -> str:
+    """A dropdown value the server received, checked against the options it offered.
+
+    Raises
+    ------
+    ParameterError
+        When a (hostile or stale) client sent a value that was never offered.
+    """
+    if not isinstance(value, str) or value not in options:
+        shown = repr(value) if len(repr(value)) <= 80 else repr(value)[:80] + "…"
+        raise ParameterError(f"{label} = {shown} is not one of the offered options: allowed {', '.join(options)}")
+    return value
 
 
 def derived_markdown(derived: Derived) -> str:
@@ -69,14 +99,9 @@ def design_markdown(dd: Any) -> str:
             if dd.clean else "**Design: not clean** — see the constraints below.")
     lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "
                    f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms"]
-    lines += [f"- {'✗' if x.violated else '·'} {_md_text(x.text)}" for x in dd.limiting]
-    lines += [f"- note: {_md_text(n)}" for n in dd.notes]
+    lines += [f"- {'✗' if x.violated else '·'} {md_text(x.text)}" for x in dd.limiting]
+    lines += [f"- note: {md_text(n)}" for n in dd.notes]
     return "\n\n".join(lines[:2]) + "\n\n" + "\n".join(lines[2:])
-
-
-def _md_text(text: str) -> str:
-    """Escape Markdown/HTML control characters of a message for a Markdown element."""
-    return "".join("\\" + ch if ch in "\\`*_{}[]<>#|" else ch for ch in text)
 
 
 def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
@@ -111,5 +136,5 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
             "(negative = the conventional controller is cheaper).")
 
 
-__all__ = ["design_markdown", "AnnualSavings", "annual_savings", "derived_markdown",
+__all__ = ["AnnualSavings", "design_markdown", "annual_savings", "checked_choice", "derived_markdown", "md_text",
            "savings_markdown", "warnings_html"]

@@ -3,6 +3,13 @@
 A second submission while a job runs is refused (a double-click never starts two overlapping
 runs). Errors a job raises are handed to ``on_error`` so the page can show them instead of a
 traceback.
+
+Cancel is cooperative: :meth:`Worker.cancel` sets a flag that jobs test with
+:meth:`Worker.checkpoint` between kernel calls (after a comparison, between Table-1 points), and
+the result of a cancelled job is discarded. The cost budget (:mod:`sim.budget`) bounds every
+kernel call to a few seconds of CPU, so a cancel takes effect within that; killing a subprocess
+instead would need the JIT-compiled kernels warmed in each process and the traces (up to the
+budget's bytes) pickled back, for a gain of at most those seconds.
 """
 
 from __future__ import annotations
@@ -10,6 +17,10 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
+
+
+class Cancelled(Exception):  # noqa: N818 - an outcome, not an error
+    """Raised at a checkpoint of a job whose Cancel was pressed; its result is discarded."""
 
 
 class Worker:
@@ -31,6 +42,7 @@ class Worker:
         self._lock = threading.Lock()
         self._busy = False
         self._closed = False
+        self._cancel = threading.Event()
         self._on_busy = on_busy
         self._on_error = on_error
 
@@ -45,8 +57,22 @@ class Worker:
             if self._busy or self._closed:
                 return None
             self._busy = True
+            self._cancel.clear()
         self._safe_busy(True)
         return self._pool.submit(self._run, fn)
+
+    def cancel(self) -> bool:
+        """Ask the running job to stop at its next checkpoint; False if nothing runs."""
+        with self._lock:
+            if not self._busy:
+                return False
+            self._cancel.set()
+            return True
+
+    def checkpoint(self) -> None:
+        """Called by jobs between pieces of work: raises :class:`Cancelled` after :meth:`cancel`."""
+        if self._cancel.is_set():
+            raise Cancelled("cancelled by the user")
 
     def _run(self, fn: Callable[[], None]) -> None:
         try:

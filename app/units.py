@@ -76,6 +76,11 @@ def ke_vrms_krpm_to_psi_pm(Ke_Vrms_krpm: float, p: int) -> float:
     return Ke_Vrms_krpm * math.sqrt(2.0 / 3.0) / (p * rpm_to_rad_s(1000.0))
 
 
+def kgcm2_to_kgm2(J_kgcm2: float) -> float:
+    """Inertia [kg·cm²] → [kg·m²]."""
+    return J_kgcm2 * 1e-4
+
+
 @dataclass(frozen=True)
 class Alias:
     """A unit-suffixed input key that maps onto an SI field."""
@@ -92,7 +97,9 @@ ALIASES: dict[str, dict[str, Alias]] = {
         "P_r_kW": Alias("P_r", kW_to_W, "kW"),
         "L_d_mH": Alias("L_d", mH_to_H, "mH"),
         "L_q_mH": Alias("L_q", mH_to_H, "mH"),
+        "J_r_kgcm2": Alias("J_r", kgcm2_to_kgm2, "kg·cm²"),
     },
+    "load": {"J_L_kgcm2": Alias("J_L", kgcm2_to_kgm2, "kg·cm²")},
     "controller": {
         "T_si_ms": Alias("T_si", ms_to_s, "ms"),
         "T_salpha_ms": Alias("T_salpha", ms_to_s, "ms"),
@@ -136,8 +143,3 @@ def psi_pm_to_kt_nm_per_arms(psi_pm: float, p: int) -> float:
 def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
     """Ψ_PM [Wb] → Ke [V_rms line-to-line per krpm]; inverse of :func:`ke_vrms_krpm_to_psi_pm`."""
     return psi_pm * p * rpm_to_rad_s(1000.0) / math.sqrt(2.0 / 3.0)
-
-
-def kgcm2_to_kgm2(J_kgcm2: float) -> float:
-    """Inertia [kg·cm²] → [kg·m²]."""
-    return J_kgcm2 * 1e-4

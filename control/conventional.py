@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from control._jit import jitable
+
 
 @dataclass(frozen=True)
 class ConventionalGains:
@@ -52,7 +54,24 @@ def conventional_law(
     float
         Demanded acceleration α_dem [rad/s²].
     """
-    return gains.g1 * (theta_dem - theta_hat) - gains.g2 * omega_hat
+    return conventional_demand(theta_dem, theta_hat, omega_hat, gains.g1, gains.g2)
+
+
+@jitable
+def conventional_demand(theta_dem: float, theta_hat: float, omega_hat: float, g1: float, g2: float) -> float:
+    """g1·(θ_rdem − θ̂_r) − g2·ω̂_r [rad/s²]: :func:`conventional_law` on scalars (numba-compilable)."""
+    return g1 * (theta_dem - theta_hat) - g2 * omega_hat
+
+
+@jitable
+def tracking_demand(theta_ref: float, omega_ref: float, alpha_ref: float, theta_hat: float, omega_hat: float,
+                    g1: float, g2: float) -> float:
+    """α_ref + g1·(θ_ref − θ̂_r) + g2·(ω_ref − ω̂_r) [rad/s²]: eq. (62) sign-corrected acting on the
+    error from a time-varying reference move, its acceleration fed forward (numba-compilable).
+
+    With θ_ref = θ_rdem constant and ω_ref = α_ref = 0 it is :func:`conventional_demand`.
+    """
+    return alpha_ref + g1 * (theta_ref - theta_hat) + g2 * (omega_ref - omega_hat)
 
 
 def friction_energy_conventional(F_v: float, delta_theta: float, T_m: float) -> float:

@@ -113,7 +113,21 @@ def derive(params: DriveParams) -> Derived:
     )
     # Recommended K and sample-rate verdict of the linearised loop (control.loop_analysis).
     gain, rate = recommend_K(d), sample_rate_check(d)
-    return replace(d, gain=gain, sample_rate=rate, warnings=d.warnings + loop_warnings(gain, rate))
+    extra = loop_warnings(gain, rate) + _layer_warning(ctrl.K, gain, prof)
+    return replace(d, gain=gain, sample_rate=rate, warnings=d.warnings + extra)
+
+
+def _layer_warning(K: float, gain: GainRecommendation, prof: VelocityProfile) -> tuple[str, ...]:
+    """The boundary layer |S| < 1/K of eq. (45) in [1] wider than ω_p: the outer loop never slides.
+
+    Warned only when a K within the chatter limit would slide (K_recommended·ω_p > 1); otherwise the
+    linear outer loop is the best this sample rate allows, which the design reports as a note.
+    """
+    if not prof.feasible or K * prof.omega_p > 1.0 or gain.K_recommended * prof.omega_p <= 1.0:
+        return ()
+    return (f"Boundary layer ±1/K = ±{1.0 / K:.4g} rad/s is wider than ω_p = {prof.omega_p:.4g} rad/s: the outer "
+            f"loop is linear, never sliding, on this manoeuvre. K = {gain.K_recommended:.4g} s/rad (recommended) "
+            "would slide.",)
 
 
 def _warnings(

@@ -257,6 +257,8 @@ def stability_measure(
     M = continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
     if law == "cruise":
         M = reduce_shift_mode(M)
+    if not np.all(np.isfinite(M)):  # a gain so large (or a model so extreme) that the loop overflows
+        return math.inf
     ev = np.linalg.eigvals(M)
     return float(np.max(ev.real)) if f_s is None else float(np.max(np.abs(ev)) - 1.0)
 
@@ -411,9 +413,13 @@ def geometric_bisect(flips: Callable[[float], bool], lo: float, hi: float, ratio
     """Smallest x in (lo, hi] with ``flips(x)`` true, given flips(lo) false and flips(hi) true.
 
     Bisection on a log scale until hi/lo ≤ ``ratio``; returns the upper end (where it flips).
+    The midpoint √lo·√hi never overflows, and at most 200 halvings are made (enough for any
+    bracket of doubles).
     """
-    while hi / lo > ratio:
-        mid = math.sqrt(lo * hi)
+    for _ in range(200):
+        if not hi / lo > ratio:
+            break
+        mid = math.sqrt(lo) * math.sqrt(hi)
         if flips(mid):
             hi = mid
         else:

@@ -81,7 +81,15 @@ def _check_fields(obj: Any, section: str, spec: dict[str, tuple[float | None, fl
             check_range(f"{section}.{f.name}", getattr(obj, f.name), low, high, low_open=low_open, unit=unit)
 
 
-_POS = (0.0, None, True)
+#: Shortest settling time of the inner loops and the observer [s]. With T_so ≥ 1 µs the observer
+#: pole q = 15/(2·T_so) ≤ 7.5e6 1/s, so q⁴·J_r (eq. (18) in [1], J_r ≤ 1e4 kg·m²) ≤ 3.2e31 and
+#: q·T_s ≤ 7.5e4 at f_s ≥ 100 Hz: exp(−q·T_s) is representable (it may round to 0, a dead-beat
+#: pole, which is harmless). The range bounds of every field below keep the derivations finite
+#: (e.g. α_max = H·P_r/V_0 ≤ 1.5e13·1e8/1 and T_m,min > 0).
+T_MIN_S = 1e-6
+#: Smallest demanded angle [rad]: about 3 counts of a 24-bit encoder (2π/2²⁴ = 3.7e-7 rad); far
+#: below it Δθ/T_m, the 2 % band and the profile's divisions underflow.
+THETA_DEM_MIN = 1e-6
 
 
 @dataclass(frozen=True)
@@ -123,9 +131,10 @@ class Motor:
 
     def __post_init__(self) -> None:
         spec = {
-            "V_0": (*_POS, "V"), "P_r": (*_POS, "W"), "omega_b": (*_POS, "rad/s"),
-            "Gamma_max": (*_POS, "N·m"), "psi_pm": (*_POS, "Wb"), "L_d": (*_POS, "H"),
-            "L_q": (*_POS, "H"), "R_s": (*_POS, "Ω"), "J_r": (*_POS, "kg·m²"),
+            "V_0": (1.0, 1e5, False, "V"), "P_r": (1e-3, 1e8, False, "W"), "omega_b": (0.0, 1e5, True, "rad/s"),
+            "Gamma_max": (1e-6, 1e6, False, "N·m"), "psi_pm": (1e-6, 100.0, False, "Wb"),
+            "L_d": (1e-9, 10.0, False, "H"), "L_q": (1e-9, 10.0, False, "H"), "R_s": (0.0, 1e4, True, "Ω"),
+            "J_r": (1e-9, 1e4, False, "kg·m²"),
         }
         _check_fields(self, "motor", spec)
         if isinstance(self.p, bool) or not isinstance(self.p, int | float) or not (
@@ -173,7 +182,7 @@ class Load:
 
     def __post_init__(self) -> None:
         _check_fields(self, "load", {
-            "J_L": (0.0, None, False, "kg·m²"), "F_v": (0.0, None, False, "N·m·s/rad"),
+            "J_L": (0.0, 1e4, False, "kg·m²"), "F_v": (0.0, 1e4, False, "N·m·s/rad"),
             "Gamma_Le": (-1e6, 1e6, True, "N·m"), "Gamma_Le_ramp": (-1e6, 1e6, True, "N·m/s"),
         })
         steps = tuple(s if isinstance(s, LoadStep) else LoadStep(**s) for s in self.steps)
@@ -226,8 +235,8 @@ class Controller:
 
     def __post_init__(self) -> None:
         _check_fields(self, "controller", {
-            "T_si": (0.0, 10.0, True, "s"), "T_salpha": (0.0, 10.0, True, "s"),
-            "T_so": (0.0, 10.0, True, "s"), "K": (0.0, 1e9, True, "s/rad"),
+            "T_si": (T_MIN_S, 10.0, False, "s"), "T_salpha": (T_MIN_S, 10.0, False, "s"),
+            "T_so": (T_MIN_S, 10.0, False, "s"), "K": (0.0, 1e9, True, "s/rad"),
             "V_dc": (0.0, 1e5, False, "V"), "i_max": (0.0, 1e6, False, "A"),
         })
         if self.T_c != "T_a":
@@ -245,6 +254,7 @@ class Controller:
             check_range("controller.f_s", self.f_s, 100.0, 1e7, low_open=False, unit="Hz")
         if self.delay_samples not in (0, 1) or isinstance(self.delay_samples, bool):
             raise ParameterError(f"controller.delay_samples = {self.delay_samples!r} is out of range: allowed 0 or 1")
+        object.__setattr__(self, "delay_samples", int(self.delay_samples))  # 1.0 → 1: the kernel needs an int
 
     @property
     def is_continuous(self) -> bool:
@@ -269,9 +279,10 @@ class Manoeuvre:
 
     def __post_init__(self) -> None:
         check_range("manoeuvre.theta_dem", self.theta_dem, -1e6, 1e6, unit="rad")
-        if self.theta_dem == 0.0:
-            raise ParameterError("manoeuvre.theta_dem = 0 rad is out of range: a non-zero angle is needed")
-        check_range("manoeuvre.T_m", self.T_m, 0.0, 1e4, unit="s")
+        if abs(self.theta_dem) < THETA_DEM_MIN:
+            raise ParameterError(f"manoeuvre.theta_dem = {self.theta_dem!r} rad is out of range: allowed "
+                                 f"{THETA_DEM_MIN:g} ≤ |value| ≤ 1e+06 rad")
+        check_range("manoeuvre.T_m", self.T_m, 1e-4, 1e4, low_open=False, unit="s")
 
 
 @dataclass(frozen=True)

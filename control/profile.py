@@ -91,7 +91,7 @@ def peak_speed(delta_theta: float, alpha_max: float, T_m: float) -> float:
         If T_m < T_m,min (no real root), naming T_m,min.
     """
     disc = (alpha_max * T_m) ** 2 - 2.0 * C_57 * alpha_max * abs(delta_theta)
-    if disc < 0.0 and -disc <= 1e-12 * (alpha_max * T_m) ** 2:
+    if -1e-12 * (alpha_max * T_m) ** 2 <= disc < 0.0:
         disc = 0.0  # T_m = T_m,min up to rounding: the double root
     if disc < 0.0:
         t_min = shortest_manoeuvre_time(delta_theta, alpha_max)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from control._jit import jitable
+
 
 def boundary_speed(theta_re: np.ndarray | float, omega_p: float, T_c: float) -> np.ndarray:
     """Speed on the switching boundary of eq. (41) in [1] at position error θ_re [rad/s].
@@ -27,20 +29,35 @@ def boundary_speed(theta_re: np.ndarray | float, omega_p: float, T_c: float) -> 
     )
 
 
+@jitable
 def switching_function(theta_re: float, omega_r: float, omega_p: float, T_c: float) -> float:
     """Switching function S(θ_re, ω_r) of eq. (44) in [1] [rad/s].
 
-    Written as ω_r minus the boundary speed of eq. (41), which equals eq. (44).
+    Written as ω_r minus the boundary speed of eq. (41), which equals eq. (44). Scalar and
+    numba-compilable: the compiled kernel (:mod:`sim.kernel`) inlines this very function.
     """
     if abs(theta_re) >= T_c * omega_p:
-        return omega_r + omega_p * float(np.sign(theta_re))
+        return omega_r + omega_p * (1.0 if theta_re > 0.0 else (-1.0 if theta_re < 0.0 else 0.0))
     return omega_r + theta_re / T_c
 
 
+@jitable
 def sat(S: float, K: float) -> float:
     """Boundary-layer saturation sat(S, K) of eq. (45) in [1] [-]."""
     x = K * S
     return 1.0 if x >= 1.0 else (-1.0 if x <= -1.0 else x)
+
+
+@jitable
+def smc_demand(
+    theta_re: float, omega_r: float, omega_p: float, T_c: float, K: float, alpha_max: float
+) -> tuple[float, float]:
+    """(u, S): demanded acceleration u = −α_max·sat(S, K) of eq. (46) and S of eq. (44) in [1].
+
+    Scalar and numba-compilable; the kernel, the reference and :func:`smc_law` all call it.
+    """
+    S = switching_function(theta_re, omega_r, omega_p, T_c)
+    return -alpha_max * sat(S, K), S
 
 
 def smc_law(
@@ -57,4 +74,4 @@ def smc_law(
     K : float          Boundary-layer gain [s/rad].
     alpha_max : float  Acceleration limit [rad/s²].
     """
-    return -alpha_max * sat(switching_function(theta_re, omega_r, omega_p, T_c), K)
+    return smc_demand(theta_re, omega_r, omega_p, T_c, K, alpha_max)[0]

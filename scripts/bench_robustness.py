@@ -15,7 +15,7 @@ from multiprocessing import get_context
 
 from app.cli_robustness import parse_spreads
 from app.presets import load_preset
-from sim.robustness import robustness
+from sim.robustness import robustness, simulate_chunk
 
 
 def timed(label: str, params, spreads, n: int, executor, workers: int) -> float:
@@ -42,12 +42,14 @@ def main() -> None:
     rates = {}
     for w in (1, 2):
         with ProcessPoolExecutor(w, mp_context=get_context("spawn")) as pool:
+            list(pool.map(simulate_chunk, [params] * 2 * w, [[{}]] * 2 * w))  # start + load the kernel
             rates[w] = timed(f"process pool, {w} worker(s)", params, spreads, a.samples, pool, w)
     print(f"scaling 2 vs 1 worker: {rates[2] / rates[1]:.2f}× (efficiency {50 * rates[2] / rates[1]:.0f} %)")
     from dask.distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
             Client(cl) as client:
+        client.gather(client.map(simulate_chunk, [params] * 4, [[{}]] * 4, pure=False))
         timed("Dask LocalCluster, 2 workers", params, spreads, a.samples, client, 2)
 
 

@@ -1,0 +1,36 @@
+"""Closed-loop simulation: plant models, compiled kernels, energies, metrics, verdicts.
+
+The compiled kernels inline the control laws of :mod:`control` (one implementation of each law).
+numba's on-disk cache keys an entry on the kernel's own source file only, so an edited law in
+``control/`` would leave a stale compiled kernel in use. Before any kernel is compiled, this package
+therefore points numba's cache at a folder named after a hash of every ``control/`` and ``sim/``
+source file: any edit selects a fresh folder and recompiles.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+
+_ROOT = Path(__file__).resolve().parent.parent
+
+
+def source_hash() -> str:
+    """SHA-256 (16 hex digits) of every Python source of ``control/`` and ``sim/`` (path and bytes)."""
+    h = hashlib.sha256()
+    for pkg in ("control", "sim"):
+        for path in sorted((_ROOT / pkg).rglob("*.py")):
+            h.update(str(path.relative_to(_ROOT)).encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _keyed_cache_dir() -> str:
+    base = os.environ.get("NUMBA_CACHE_DIR") or str(_ROOT / ".numba_cache")
+    return str(Path(base) / f"src-{source_hash()}")
+
+
+numba.config.CACHE_DIR = _keyed_cache_dir()

@@ -29,6 +29,7 @@ from control.bldc_design import BldcDesign, bldc_design
 from control.bldc_params import BldcParams
 from control.params import ParameterError
 from sim import bldc_kernel as kn
+from sim import budget
 from sim.bldc_emf import machine_table
 from sim.bldc_metrics import run_metrics
 
@@ -136,6 +137,40 @@ def _check_controller(controller: str) -> None:
         raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(CONTROLLERS)}")
 
 
+#: Bytes of trace memory per recorded sample and controller: the kernel's record row (N_CH
+#: doubles), the trace's contiguous copies of it and the derived rows (ω*, i_abc, v_phase and
+#: its temporary, E_kin, E_mag) [B].
+TRACE_BYTES_PER_SAMPLE = 8 * (2 * kn.N_CH + 12)
+
+
+def run_cost(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> budget.Cost:
+    """Cost of ``n_runs`` runs of the active scenario: RK4 steps and trace bytes (parameters only)."""
+    n_ticks = int(math.ceil(params.case.t_end * params.inverter.f_s - 1e-9))
+    return budget.Cost(n_runs * n_ticks * int(n_sub), n_runs * (n_ticks + 1) * TRACE_BYTES_PER_SAMPLE)
+
+
+def check_budget(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> budget.Cost:
+    """Raise :class:`~sim.budget.BudgetError` unless ``n_runs`` runs fit the budget (before any work)."""
+    cost = run_cost(params, n_runs, n_sub)
+    if cost.fits:
+        return cost
+    case, f_s = params.case, params.inverter.f_s
+    i = next(k for k, c in enumerate(params.scenario.cases) if c.name == case.name)
+
+    def with_t_end(t_end: float) -> budget.Cost:
+        ticks = int(math.ceil(t_end * f_s - 1e-9))
+        return budget.Cost(n_runs * ticks * n_sub, n_runs * (ticks + 1) * TRACE_BYTES_PER_SAMPLE)
+
+    def with_f_s(rate: float) -> budget.Cost:
+        ticks = int(math.ceil(case.t_end * rate - 1e-9))
+        return budget.Cost(n_runs * ticks * n_sub, n_runs * (ticks + 1) * TRACE_BYTES_PER_SAMPLE)
+
+    drivers = [budget.Driver(f"scenario.cases[{i}].t_end", case.t_end, "s", with_t_end, 1e-6),
+               budget.Driver("inverter.f_s", f_s, "Hz", with_f_s, 1e3)]
+    what = f"{n_runs} controller(s) × {case.t_end:g} s at f_s = {f_s:g} Hz, scenario {case.name!r}"
+    return budget.check(cost, what, drivers)
+
+
 def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
                   design: BldcDesign | None = None, table: np.ndarray | None = None,
                   n_sub: int = N_SUB) -> BldcRunResult:
@@ -155,6 +190,7 @@ def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
         Never raises for a diverging run: ``metrics["stable"]`` is False with a ``reason``.
     """
     _check_controller(controller)
+    check_budget(params, 1, n_sub)
     d = bldc_design(params) if design is None else design
     tab = machine_table(params.machine) if table is None else np.ascontiguousarray(table, dtype=float)
     case = params.case
@@ -197,6 +233,7 @@ def compare_bldc(params: BldcParams, controllers: tuple[str, ...] = CONTROLLERS,
     """
     for c in controllers:
         _check_controller(c)
+    check_budget(params, len(controllers))
     d = bldc_design(params)
     tab = machine_table(params.machine) if table is None else np.asarray(table, dtype=float)
     t0 = time.perf_counter()

@@ -74,6 +74,7 @@ class DriveDesign:
     clean : bool                    True when the FDSMC run passed every check.
     limiting : tuple of Constraint  Binding and violated constraints.
     notes : tuple of str            Statements that do not make the design unclean.
+    comparator : tuple of str       Where the conventional comparator exceeds the drive's limits.
     """
 
     params: DriveParams
@@ -82,6 +83,7 @@ class DriveDesign:
     clean: bool
     limiting: tuple[Constraint, ...]
     notes: tuple[str, ...]
+    comparator: tuple[str, ...] = ()
 
 
 def _with(params: DriveParams, section: str, **changes: object) -> DriveParams:
@@ -200,7 +202,7 @@ def _verify(p: DriveParams, limiting: list[Constraint]) -> DriveDesign:
                                                   "The manoeuvre is infeasible at the designed α_max.")])
     limiting = limiting + [_torque_binding(p, cmp.fdsmc)] + run_checks(p, cmp.fdsmc)
     clean = not any(c.violated for c in limiting)
-    return DriveDesign(p, d, cmp, clean, tuple(limiting), _notes(d, cmp))
+    return DriveDesign(p, d, cmp, clean, tuple(limiting), _notes(d), tuple(comparator_notes(cmp)))
 
 
 def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
@@ -243,11 +245,11 @@ def run_checks(p: DriveParams, run: RunResult) -> list[Constraint]:
     return out
 
 
-def _notes(d: Derived, cmp: Comparison) -> tuple[str, ...]:
+def _notes(d: Derived) -> tuple[str, ...]:
     notes: list[str] = []
     K, w_p = d.params.controller.K, d.profile.omega_p
     if w_p <= 1.0 / K:
         notes.append(f"Boundary layer ±1/K = ±{1.0 / K:.4g} rad/s is wider than ω_p = {w_p:.4g} rad/s: the "
                      "outer loop is linear (never sliding) on this manoeuvre; the K limit of the sampled "
                      "loop allows no larger K.")
-    return tuple(notes + comparator_notes(cmp))
+    return tuple(notes)

@@ -24,8 +24,9 @@ import numpy as np
 from control.derivations import Derived, derive
 from control.model import model_coefficients, torque_constant
 from control.params import DriveParams, ParameterError
+from sim import budget
 from sim import kernel as kn
-from sim.metrics import WindowSamples, chatter_window_steps, chatter_windows, run_metrics
+from sim.metrics import CHATTER_MAX_WINDOW_S, WindowSamples, chatter_window_steps, chatter_windows, run_metrics
 
 CONTROLLERS = ("fdsmc", "conventional")
 #: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
@@ -41,8 +42,6 @@ CONTINUOUS_STEP_RATIO = 0.1875
 PLANT_STEP_MAX_S = 5e-5
 #: Most trace points kept per run (energies and peaks use every step).
 MAX_POINTS = 20000
-#: Most kernel steps per run (≈ 5 s of computing); longer runs are refused, not hung.
-MAX_STEPS = 20_000_000
 #: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
 PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
 
@@ -165,15 +164,60 @@ def _grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: int)
         T_s = 1.0 / float(ctrl.f_s)
         sub = max(n_sub, plant_substeps(params))
         n_steps, h = int(math.ceil(t_end / T_s)), T_s / sub
-    if n_steps > MAX_STEPS:
-        rate = (f"RK4 steps of {h_continuous:g} s (continuous mode: the step follows the fastest of "
-                "T_so, T_sα, T_si)" if ctrl.is_continuous else f"samples at f_s = {ctrl.f_s:g} Hz")
-        t_max = MAX_STEPS / n_steps * params.manoeuvre.T_m
-        raise ParameterError(
-            f"manoeuvre.T_m = {params.manoeuvre.T_m:g} s needs {n_steps:.3g} {rate}: allowed "
-            f"T_m ≤ {t_max:.4g} s (at most {MAX_STEPS:.0e} steps per run)")
     decim = max(1, int(math.ceil(n_steps / max_points)))
     return _Grid(ctrl.is_continuous, h, n_steps, sub, decim, n_steps // decim + 1)
+
+
+def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUOUS_STEP_S,
+             max_points: int = MAX_POINTS) -> budget.Cost:
+    """Cost of one controller's run (integration steps, trace bytes), from the parameters alone.
+
+    Trace bytes: the kernel's output (N_CH channels × kept points) and the two full-resolution
+    chatter windows (≤ CHATTER_MAX_WINDOW_S each, θ_r and α_dem), 8 bytes per value.
+    """
+    g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
+    window = min(g.n_steps, int(CHATTER_MAX_WINDOW_S / (g.h * g.n_sub)) + 2)
+    return budget.Cost(g.n_steps * g.n_sub, 8 * (kn.N_CH * g.n_out + 4 * window))
+
+
+def _with(params: DriveParams, field: str, value: float) -> DriveParams:
+    section, name = field.split(".")
+    part = dataclasses.replace(getattr(params, section), **{name: value})
+    return dataclasses.replace(params, **{section: part})
+
+
+def _cost_drivers(params: DriveParams, request: Callable[[DriveParams], budget.Cost]) -> list[budget.Driver]:
+    """The fields that set the step count and trace size, with the end of their range that is cheapest."""
+    ctrl, m = params.controller, params.motor
+    fields: list[tuple[str, float, str, float, bool]] = [("manoeuvre.T_m", params.manoeuvre.T_m, "s", 1e-4, False)]
+    if ctrl.is_continuous:
+        fields.append(("controller.T_so", ctrl.T_so, "s", 10.0, False))
+    else:
+        fields.append(("controller.f_s", float(ctrl.f_s), "Hz", 100.0, False))
+        if plant_substeps(params) > 1:
+            fields += [("motor.omega_b", m.omega_b, "rad/s", 1e-3, False), ("motor.p", m.p, "", 1, True)]
+    return [budget.Driver(name, value, unit, lambda v, n=name: request(_with(params, n, v)), limit, integer)
+            for name, value, unit, limit, integer in fields]
+
+
+def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budget.Cost:
+    """Raise :class:`~sim.budget.BudgetError` unless ``n_runs`` runs of ``params`` fit the budget.
+
+    Called before any derivation or allocation by :func:`simulate`, :func:`compare` and
+    :func:`table1_sweep` (which checks the whole sweep).
+    """
+    def request(p: DriveParams) -> budget.Cost:
+        one = run_cost(p, **options)
+        return budget.Cost(n_runs * one.steps, n_runs * one.trace_bytes)
+
+    cost = request(params)
+    if cost.fits:
+        return cost
+    g = _grid(params, int(options.get("n_sub", 1)), float(options.get("h_continuous", CONTINUOUS_STEP_S)),
+              int(options.get("max_points", MAX_POINTS)))
+    what = (f"{n_runs} run(s) × {g.n_steps:.3g} RK4 steps of {g.h:.3g} s" if g.continuous else
+            f"{n_runs} run(s) × {g.n_steps:.3g} samples × {g.n_sub} RK4 sub-steps")
+    return budget.check(cost, what, _cost_drivers(params, request))
 
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
@@ -289,6 +333,7 @@ def simulate(
         For an unknown controller or an infeasible manoeuvre (T_m < T_m,min).
     """
     _check_controller(controller)
+    check_budget(params, 1, n_sub=n_sub, h_continuous=h_continuous, max_points=max_points)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
     g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
@@ -299,7 +344,7 @@ def simulate(
     info = np.zeros(kn.N_INFO)
     T_step = g.h * g.n_sub
     windows = chatter_windows(params, d, controller, g.n_steps * T_step)
-    steps = [chatter_window_steps(w, T_step) for w in windows.values()]
+    steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
     win = np.zeros((2 * len(steps), max(n for _, n in steps)))
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
@@ -346,8 +391,14 @@ def _trace(chans: np.ndarray) -> Trace:
     return Trace(**{name: chans[i] for i, name in enumerate(kn.CHANNELS)})
 
 
+def reached_target(run: RunResult) -> bool:
+    """True when the run is stable and θ_r entered the 2 % band around θ_dem (a run that never
+    gets there — e.g. a rotor that never moves — has no energy figure worth comparing)."""
+    return bool(run.metrics["stable"]) and run.metrics.get("t_2pct_first_s") is not None
+
+
 def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:
-    if a is None or b is None or not (a.metrics["stable"] and b.metrics["stable"]):
+    if a is None or b is None or not (reached_target(a) and reached_target(b)):
         return None
     va, vb = a.metrics[key], b.metrics[key]
     if not isinstance(va, float) or not isinstance(vb, float) or vb == 0.0:
@@ -376,10 +427,11 @@ def compare(
     Returns
     -------
     Comparison
-        Savings are None unless both runs exist and are stable.
+        Savings are None unless both runs exist, are stable and reached the 2 % band.
     """
     for c in controllers:
         _check_controller(c)
+    check_budget(params, len(controllers), **options)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
     runs: dict[str, RunResult] = {}
@@ -421,15 +473,21 @@ def table1_sweep(
         For an infeasible T_m, or when a run is unstable (naming T_m and the reason), so that
         no row is ever computed from a diverged run.
     """
+    points = [_with(params, "manoeuvre.T_m", float(T_m)) for T_m in T_m_values]
+    total = sum((run_cost(p, **options) for p in points), budget.Cost(0, 0))
+    if points and not budget.Cost(2 * total.steps, 2 * total.trace_bytes).fits:
+        check_budget(max(points, key=lambda p: p.manoeuvre.T_m), 2 * len(points), **options)
     rows: list[Table1Row] = []
-    for i, T_m in enumerate(T_m_values):
-        p = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=float(T_m)))
+    for i, (T_m, p) in enumerate(zip(T_m_values, points, strict=True)):
         cmp = compare(p, **options)
         assert cmp.fdsmc is not None and cmp.conventional is not None
         for run in (cmp.fdsmc, cmp.conventional):
             if not run.metrics["stable"]:
                 raise ParameterError(
                     f"manoeuvre.T_m = {T_m:g} s: {run.controller} run unstable — {run.metrics['reason']}")
+            if not reached_target(run):
+                raise ParameterError(f"manoeuvre.T_m = {T_m:g} s: the {run.controller} run never reached the "
+                                     "2 % band around θ_dem, so its energy is not comparable")
         wf, wc = float(cmp.fdsmc.metrics["friction_J"]), float(cmp.conventional.metrics["friction_J"])  # type: ignore[arg-type]
         e = cmp.derived.energy
         rows.append(Table1Row(float(T_m), wf, wc, 100.0 * (1.0 - wf / wc),

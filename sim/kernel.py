@@ -22,6 +22,8 @@ import math
 import numpy as np
 from numba import njit
 
+from control import conventional, fdc, inverter, sliding_mode
+
 # ---- prm indices -------------------------------------------------------------------------
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
  P_FV, P_TSI, P_TSA, P_CTRL, P_THDEM, P_OMP, P_TC, P_KB, P_AMAX, P_G1, P_G2, P_K1, P_K2, P_K3,
@@ -83,56 +85,30 @@ def reference_at(t: float, ref: np.ndarray, T_m: float) -> tuple[float, float, f
 @_helper
 def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
               ref: np.ndarray) -> tuple[float, float]:
-    """Demanded acceleration [rad/s²] and switching function S [rad/s] (eqs. 44–46, 62, or the
-    reference tracking law α_ref + g1·(θ_ref − θ̂) + g2·(ω_ref − ω̂))."""
+    """Demanded acceleration [rad/s²] and S [rad/s]: eqs. (44)–(46), (62), or the reference tracking
+    law :func:`control.conventional.tracking_demand` (``P_CTRL`` = 2), all of :mod:`control`."""
     if prm[P_CTRL] == 2.0:
         th_r, w_r, a_r = reference_at(t, ref, prm[P_TM])
-        return a_r + prm[P_G1] * (th_r - theta_hat) + prm[P_G2] * (w_r - omega_hat), 0.0
+        return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
     if prm[P_CTRL] == 1.0:
-        return prm[P_G1] * (prm[P_THDEM] - theta_hat) - prm[P_G2] * omega_hat, 0.0
-    th_re = theta_hat - prm[P_THDEM]
-    w_p, T_c = prm[P_OMP], prm[P_TC]
-    on_slope = abs(th_re) < T_c * w_p
-    S = omega_hat + th_re / T_c if on_slope else omega_hat + w_p * np.sign(th_re)
-    x = prm[P_KB] * S
-    x = min(1.0, max(-1.0, x))
-    return -prm[P_AMAX] * x, S
+        return conventional.conventional_demand(prm[P_THDEM], theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
+    return sliding_mode.smc_demand(theta_hat - prm[P_THDEM], omega_hat, prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
 
 
 @_helper
 def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0: float,
                  L1: float, prm: np.ndarray) -> tuple[float, float, float]:
-    """u_d of eq. (9), u_q of eq. (14) [V] and α of eq. (7) [rad/s²]."""
-    A, B, C, D, E = prm[P_A], prm[P_B], prm[P_C], prm[P_D], prm[P_E]
-    F, G, H, K, M = prm[P_F], prm[P_G], prm[P_H], prm[P_K], prm[P_M]
-    alpha = (H + K * i_d) * i_q - M * L0
-    u_d = (-3.0 / prm[P_TSI] * i_d + A * i_d - B * omega_hat * i_q) / F
-    forced = 3.0 / prm[P_TSA] * (alpha_dem - alpha)
-    coupling = K * i_q * (A * i_d - B * omega_hat * i_q - F * u_d)
-    u_q = ((forced + coupling + M * L1) / (H + K * i_d)
-           + C * omega_hat * i_d + D * i_q + E * omega_hat) / G
-    return u_d, u_q, alpha
+    """u_d of eq. (9), u_q of eq. (14) [V] and α of eq. (7) [rad/s²]: :func:`control.fdc.fdc_voltages`."""
+    return fdc.fdc_voltages(alpha_dem, i_d, i_q, omega_hat, L0, L1, prm[P_A], prm[P_B], prm[P_C], prm[P_D],
+                            prm[P_E], prm[P_F], prm[P_G], prm[P_H], prm[P_K], prm[P_M], prm[P_TSI], prm[P_TSA])
 
 
 @_helper
 def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
                   prm: np.ndarray) -> tuple[float, float, bool]:
-    """Optional inverter limits: current limit on i_q, then |u_dq| ≤ u_max. Returns flag."""
-    sat = False
-    i_max = prm[P_IMAX]
-    if i_max > 0.0 and abs(i_q) >= i_max:
-        # u_q that holds di_q/dt = 0 (eq. 2); do not push |i_q| further.
-        u_hold = (prm[P_C] * omega_hat * i_d + prm[P_D] * i_q + prm[P_E] * omega_hat) / prm[P_G]
-        if (u_q - u_hold) * i_q > 0.0:
-            u_q = u_hold
-            sat = True
-    u_max = prm[P_UMAX]
-    mag = math.sqrt(u_d * u_d + u_q * u_q)
-    if u_max > 0.0 and mag > u_max:
-        u_d *= u_max / mag
-        u_q *= u_max / mag
-        sat = True
-    return u_d, u_q, sat
+    """Optional inverter limits of :func:`control.inverter.limit_voltage`. Returns the flag."""
+    return inverter.limit_voltage(u_d, u_q, i_d, i_q, omega_hat, prm[P_IMAX], prm[P_UMAX], prm[P_C], prm[P_D],
+                                  prm[P_E], prm[P_G])
 
 
 @_helper

@@ -184,13 +184,19 @@ def chatter_windows(
     return {"cruise": (t0, t1), "hold": (h0, t_end)}
 
 
-def chatter_window_steps(window: tuple[float, float], T_step: float) -> tuple[int, int]:
-    """First step index and number of steps [-] of ``window`` [s] for steps of T_step [s]."""
+def chatter_window_steps(window: tuple[float, float], T_step: float, n_steps: int) -> tuple[int, int]:
+    """First step index and number of steps [-] of ``window`` [s] for steps of T_step [s].
+
+    Only steps 0 … n_steps − 1 are recorded by the kernel: a window ending at the horizon
+    n_steps·T_step must not count the step at the horizon itself (it would stay 0.0 and inflate the
+    peak-to-peak figures).
+    """
     t0, t1 = window
     if t1 <= t0:
         return 0, 0
     k0 = int(np.ceil(t0 / T_step))
-    return k0, max(0, int(np.floor(t1 / T_step)) - k0 + 1)
+    k1 = min(int(np.floor(t1 / T_step)), n_steps - 1)
+    return k0, max(0, k1 - k0 + 1)
 
 
 def run_metrics(

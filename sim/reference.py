@@ -10,6 +10,7 @@ observer (15) corrected (continuous) or its ZOH-exact discrete form; outer law (
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +18,7 @@ import numpy as np
 from control import fdc
 from control.conventional import conventional_law
 from control.derivations import Derived
+from control.inverter import limit_voltage
 from control.params import DriveParams
 from control.sliding_mode import smc_law
 
@@ -81,6 +83,8 @@ class ReferenceDrive:
         alpha = fdc.acceleration_estimate(i_d, i_q, L0, c)
         u_d = fdc.direct_axis_voltage(i_d, i_q, w_h, c, ctrl.T_si)
         u_q = fdc.quadrature_axis_voltage(a_dem, alpha, i_d, i_q, w_h, u_d, L1, c, ctrl.T_salpha)
+        u_max = ctrl.V_dc / math.sqrt(3.0)
+        u_d, u_q, _ = limit_voltage(u_d, u_q, i_d, i_q, w_h, ctrl.i_max, u_max, c.C, c.D, c.E, c.G)
         return u_d, u_q
 
     def plant(self, t: float, x: np.ndarray, u_d: float, u_q: float) -> np.ndarray:

@@ -145,7 +145,7 @@ def comparator_notes(comparison: Comparison) -> list[str]:
     issues = _saturation(run) + limit_warnings(run, comparison.derived)
     if not issues:
         return []
-    return [f"Comparator: {w} Its energy is not a fair baseline for the saving." for w in issues]
+    return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."]
 
 
 def _saving_verdicts(comparison: Comparison) -> list[str]:

@@ -92,7 +92,7 @@ def test_nan_row_is_rejected():
     th, vals = _three_phase()
     vals = vals.copy()
     vals[17, 1] = np.nan
-    with pytest.raises(ParameterError, match=r"row 18 is not a finite number"):
+    with pytest.raises(ParameterError, match=r"row 19, column 3: 'nan' is not a number"):  # line 1: header
         read_measured(_csv(th, vals))
 
 

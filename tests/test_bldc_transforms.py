@@ -135,8 +135,19 @@ def test_eq12_typo_theta_r_instead_of_theta_e():
     fa, fb = dqx.alpha_beta(*f)
     phi = np.arctan2(-fa, fb)
     assert np.allclose(phi - th, 0.0, atol=1e-12)  # eq. (8)
-    eq12 = phi - th / NPP
-    assert np.allclose(eq12, th * (1 - 1 / NPP), atol=1e-12) and np.all(np.abs(eq12) > 0.06)
+    # Physics of the two frames: steady sinusoidal currents in phase with the back-EMF must be a
+    # constant i_qx (and i_dx = 0) in a frame that is right. With φ of eq. (8) (θ_e) they are; with
+    # the printed eq. (12) (θ_r = θ_e/n_pp in place of θ_e) the frame rotates and i_qx oscillates.
+    i_abc = np.array([10.0 * np.sin(th - k * 2 * np.pi / 3) for k in range(3)])
+    ia, ib = dqx.alpha_beta(*i_abc)
+
+    def currents(angle):
+        return np.array([dqx.to_dqx(a, b, 1.0, x) for a, b, x in zip(ia, ib, angle, strict=True)])
+
+    right = currents(phi)
+    wrong = currents(phi - th + th / NPP)  # θ_x + θ_r instead of θ_x + θ_e
+    assert np.ptp(right[:, 1]) < 1e-9 and np.allclose(right[:, 0], 0.0, atol=1e-9)
+    assert np.ptp(wrong[:, 1]) > 1.0 and np.max(np.abs(wrong[:, 0])) > 1.0
 
 
 def test_single_argument_arctan_of_eq8_flips_the_axes():

@@ -40,7 +40,7 @@ def test_bad_input_exit_2_single_line_subprocess():
     )
     assert r.returncode == 2
     assert r.stderr.strip().count("\n") == 0
-    assert "motor.J_r = -1.0" in r.stderr and "allowed > 0" in r.stderr
+    assert "motor.J_r = -1.0" in r.stderr and "allowed 1e-09 ≤ value ≤ 10000" in r.stderr
     assert "Traceback" not in r.stderr
 
 

@@ -17,6 +17,9 @@ CASES = [
     ("fdsmc", ["controller.K=1000", "controller.delay_samples=1", "load.Gamma_Le=5", "load.Gamma_Le_ramp=20"]),
     ("fdsmc", ["controller.f_s=continuous", "controller.K=0.45"]),
     ("conventional", ["controller.f_s=continuous", "load.Gamma_Le=-8"]),
+    # inverter limits active: the conventional law's start hits i_max, the FDSMC's the voltage limit
+    ("conventional", ["controller.K=0.3", "controller.i_max=40", "controller.V_dc=600"]),
+    ("fdsmc", ["controller.K=0.3", "controller.V_dc=120", "controller.i_max=500"]),
 ]
 
 

@@ -25,7 +25,7 @@ def _wait_phase_omega_p(page, omega_p: float) -> None:
 def test_derived_alpha_max_of_default_preset(page):
     d = derive(load_preset(PAPER_PRESET))
     text = f"{d.alpha.alpha_max:.5g}"  # derived_rows format: 2651.2 rad/s²
-    assert page.get_by_text(text, exact=True).count() >= 1
+    page.get_by_text(text, exact=True).first.wait_for()  # the derived-values panel is drawn
     assert "α_max" in page.content()
 
 
@@ -56,9 +56,11 @@ def test_invalid_value_shows_message_and_simulates_nothing(page, ui_server):
     error.wait_for()
     message = error.inner_text()
     assert "J_r" in message and "-0.1" in message and "allowed" in message
-    page.wait_for_timeout(300)
-    assert {cid: s.runs for cid, s in ui_server.config.sessions.items()
-            if cid in runs_before} == runs_before
+    # The rejection happens in the click's callback, before any job is submitted: once the message
+    # is shown, no session is running a job and none has counted a run.
+    sessions = ui_server.config.sessions
+    assert not any(s.worker.busy for s in sessions.values())
+    assert {cid: s.runs for cid, s in sessions.items() if cid in runs_before} == runs_before
     assert _phase_omega_p(page) == before
 
 
@@ -97,7 +99,10 @@ def test_two_browser_contexts_keep_separate_values(browser, ui_server):
         set_number(page_a, "T_m manoeuvre time [s]", 2.2)
         page_a.get_by_role("button", name="Simulate").click()
         _wait_phase_omega_p(page_a, derive(new).profile.omega_p)
-        page_b.wait_for_timeout(300)
+        # A's run has finished; B's own session never ran and still holds the preset's T_m.
+        session_a, session_b = sorted(ui_server.config.sessions.values(), key=lambda s: s.client.client_id)[-2:]
+        assert session_a.params.manoeuvre.T_m == 2.2 and session_a.runs >= 1
+        assert session_b.runs == 0 and session_b.params.manoeuvre.T_m == params.manoeuvre.T_m
         assert field(page_b, "T_m manoeuvre time [s]").input_value() == "1"
         assert abs(_phase_omega_p(page_b) - derive(params).profile.omega_p) < 1e-9
     finally:

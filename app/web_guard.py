@@ -1,0 +1,139 @@
+"""Who may use the page: Origin/Host checks on every request and an access token off loopback.
+
+viser 1.1 serves its page and websocket with ``websockets.asyncio.server.serve`` and offers no
+hook for the handshake, so :func:`guarded` wraps that call while a server is being built and
+puts :meth:`Guard.check` in front of viser's own ``process_request``:
+
+* **Host** (every HTTP request and the websocket handshake): the host name must be one the tool
+  is served as — loopback names by default, the bound address, ``--allow-origin`` hosts. This
+  stops DNS-rebinding pages.
+* **Origin** (the websocket handshake): must be an allowed origin, so a web page from another
+  site open in the engineer's browser cannot drive the tool. A missing Origin (not a browser) is
+  refused too.
+* **Token** (only when bound to a non-loopback address): the start-up URL carries
+  ``?token=…``; the first page load sets an HttpOnly, SameSite=Strict cookie, and every later
+  request (assets, websocket) must carry the token in the cookie or the query.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hmac
+import http
+import secrets
+import threading
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from typing import Any
+from urllib.parse import parse_qs, urlsplit
+
+import websockets.asyncio.server as ws_server
+
+LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
+COOKIE = "pmsm_token"
+_patch_lock = threading.Lock()
+
+
+def new_token() -> str:
+    """A random URL-safe access token (128 bits)."""
+    return secrets.token_urlsafe(16)
+
+
+def _host_of(text: str) -> str:
+    """Host name of a ``Host`` header or an origin URL, lower case, without port or brackets."""
+    netloc = urlsplit(text if "//" in text else f"//{text}").hostname
+    return (netloc or "").lower()
+
+
+@dataclass
+class Guard:
+    """The access rules of one server.
+
+    Attributes
+    ----------
+    hosts : set of str     Host names the page may be served as.
+    origins : set of str   Extra allowed origins (scheme://host[:port]) besides same-host ones.
+    token : str or None    Required access token (None on loopback).
+    refused : list of str  Reasons of refused requests (most recent last; for logs and tests).
+    """
+
+    hosts: set[str]
+    origins: set[str] = field(default_factory=set)
+    token: str | None = None
+    refused: list[str] = field(default_factory=list)
+
+    @classmethod
+    def for_host(cls, host: str, allow_origins: list[str] | tuple[str, ...] = (),
+                 token: str | None = None) -> Guard:
+        """Rules for a server bound to ``host`` with extra allowed origins."""
+        hosts = set(LOOPBACK_HOSTS)
+        if host not in ("0.0.0.0", "::", ""):
+            hosts.add(host.strip("[]").lower())
+        origins = {o.rstrip("/").lower() for o in allow_origins}
+        hosts |= {_host_of(o) for o in origins}
+        return cls(hosts, origins, token)
+
+    def _token_ok(self, request: Any) -> bool:
+        if self.token is None:
+            return True
+        query = parse_qs(urlsplit(request.path).query).get("token", [""])[0]
+        cookies = request.headers.get("Cookie", "")
+        jar = dict(c.strip().split("=", 1) for c in cookies.split(";") if "=" in c)
+        given = query or jar.get(COOKIE, "")
+        return hmac.compare_digest(given.encode(), self.token.encode())
+
+    def reason(self, request: Any) -> str | None:
+        """Why ``request`` is refused, or None if it may proceed."""
+        host_header = request.headers.get("Host", "").lower()
+        host = _host_of(host_header)
+        if self.token is None and host not in self.hosts:
+            return f"Host {host!r} is not one this tool is served as ({', '.join(sorted(self.hosts))})"
+        if request.headers.get("Upgrade", "").lower() == "websocket":
+            origin = request.headers.get("Origin", "").rstrip("/").lower()
+            same = bool(origin) and urlsplit(origin).netloc == host_header
+            if not origin or not (same or origin in self.origins):
+                return f"websocket Origin {origin or '(none)'!r} is not allowed (allowed: this page's own host)"
+        if not self._token_ok(request):
+            return "missing or wrong access token: open the URL printed at start-up (…?token=…)"
+        return None
+
+    def check(self, connection: Any, request: Any) -> Any:
+        """``process_request`` hook: a 403 response for a refused request, else None."""
+        why = self.reason(request)
+        if why is None:
+            return None
+        self.refused.append(why)
+        return connection.respond(http.HTTPStatus.FORBIDDEN, f"Forbidden: {why}\n")
+
+    def wrap(self, inner: Callable[[Any, Any], Any] | None) -> Callable[[Any, Any], Any]:
+        """``inner`` (viser's file server) behind :meth:`check`; sets the token cookie on pages."""
+        def process_request(connection: Any, request: Any) -> Any:
+            refused = self.check(connection, request)
+            if refused is not None:
+                return refused
+            response = inner(connection, request) if inner is not None else None
+            if response is not None and self.token is not None:
+                response.headers["Set-Cookie"] = f"{COOKIE}={self.token}; HttpOnly; SameSite=Strict; Path=/"
+            return response
+
+        return process_request
+
+
+@contextlib.contextmanager
+def guarded(guard: Guard) -> Iterator[None]:
+    """While active, every ``websockets`` server started gets ``guard`` in front of its requests."""
+    with _patch_lock:
+        original = ws_server.serve
+
+        def serve(*args: Any, **kwargs: Any) -> Any:
+            kwargs["process_request"] = guard.wrap(kwargs.get("process_request"))
+            return original(*args, **kwargs)
+
+        ws_server.serve = serve  # type: ignore[assignment]
+        try:
+            yield
+        finally:
+            ws_server.serve = original  # type: ignore[assignment]
+
+
+__all__ = ["COOKIE", "LOOPBACK_HOSTS", "Guard", "guarded", "new_token"]

@@ -1,0 +1,201 @@
+"""The page against hostile clients (no browser): a raw websocket client, foreign origins and hosts,
+the access token, dropdown values never offered, markup in user text, cancel."""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+
+import msgspec
+import pytest
+import viser
+import websockets
+
+from app.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
+from app.ui_session import create_server
+from app.ui_text import checked_choice, md_text
+from app.ui_worker import Cancelled, Worker
+from app.web_guard import COOKIE, Guard
+from control.params import ParameterError
+
+PROTOCOL = f"viser-v{viser.__version__}"
+
+
+def free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@pytest.fixture(scope="module")
+def served() -> Iterator[tuple[str, object, object]]:
+    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(), scene_3d=False)
+    try:
+        yield f"127.0.0.1:{server.get_port()}", server, config
+    finally:
+        server.stop()
+
+
+def _ws_status(hostport: str, origin: str | None, headers: dict[str, str] | None = None,
+               path: str = "/") -> str:
+    async def go() -> str:
+        try:
+            async with websockets.connect(f"ws://{hostport}{path}", origin=origin, subprotocols=[PROTOCOL],
+                                          additional_headers=headers or {}):
+                return "open"
+        except websockets.exceptions.InvalidStatus as exc:
+            return str(exc.response.status_code)
+
+    return asyncio.run(go())
+
+
+def _http_status(url: str, headers: dict[str, str] | None = None) -> tuple[int, str]:
+    try:
+        with urllib.request.urlopen(urllib.request.Request(url, headers=headers or {})) as r:
+            return r.status, r.headers.get("Set-Cookie", "")
+    except urllib.error.HTTPError as exc:
+        return exc.code, ""
+
+
+def test_foreign_origin_and_missing_origin_refused(served):
+    hostport, _, config = served
+    assert _ws_status(hostport, "http://evil.example") == "403"
+    assert _ws_status(hostport, "http://localhost:1") == "403"  # another port is another origin
+    assert _ws_status(hostport, None) == "403"
+    assert any("evil.example" in r for r in config.guard.refused)
+    assert _ws_status(hostport, f"http://{hostport}") == "open"
+
+
+def test_dns_rebinding_host_refused(served):
+    hostport, _, _ = served
+    assert _http_status(f"http://{hostport}/")[0] == 200
+    assert _http_status(f"http://{hostport}/", {"Host": "evil.example:80"})[0] == 403
+
+
+def test_allow_list_admits_a_configured_origin():
+    guard = Guard.for_host("127.0.0.1", ["https://hmi.plant.local"])
+    server, _ = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(), scene_3d=False,
+                              guard=guard)
+    try:
+        hostport = f"127.0.0.1:{server.get_port()}"
+        assert _ws_status(hostport, "https://hmi.plant.local") == "open"
+        assert _ws_status(hostport, "https://other.plant.local") == "403"
+    finally:
+        server.stop()
+
+
+def test_token_required_when_not_on_loopback():
+    guard = Guard.for_host("0.0.0.0", token="s3cret-token")
+    server, _ = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, host="127.0.0.1", port=free_port(),
+                              scene_3d=False, guard=guard)
+    try:
+        hostport = f"127.0.0.1:{server.get_port()}"
+        assert _http_status(f"http://{hostport}/")[0] == 403
+        assert _http_status(f"http://{hostport}/?token=wrong")[0] == 403
+        status, cookie = _http_status(f"http://{hostport}/?token=s3cret-token")
+        assert status == 200 and f"{COOKIE}=s3cret-token" in cookie and "HttpOnly" in cookie
+        origin = f"http://{hostport}"
+        assert _ws_status(hostport, origin) == "403"
+        assert _ws_status(hostport, origin, {"Cookie": f"{COOKIE}=s3cret-token"}) == "open"
+        assert _ws_status(hostport, origin, path="/?token=s3cret-token") == "open"
+        assert _ws_status(hostport, "http://evil.example", {"Cookie": f"{COOKIE}=s3cret-token"}) == "403"
+    finally:
+        server.stop()
+
+
+CAMERA = {"type": "ViewerCameraMessage", "wxyz": [1.0, 0.0, 0.0, 0.0], "position": [0.0, 0.0, 1.0],
+          "fov": 1.0, "near": 0.01, "far": 100.0, "image_height": 600, "image_width": 800,
+          "look_at": [0.0, 0.0, 0.0], "up_direction": [0.0, 0.0, 1.0]}
+
+
+def _send_update(hostport: str, config: object, handle_of: str, value: str) -> object:
+    """Connect as a hand-written client, set a GUI value by uuid, return the session."""
+    known = set(config.sessions)
+    done = threading.Event()
+    session_box: list[object] = []
+
+    async def go() -> None:
+        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
+                                      subprotocols=[PROTOCOL], max_size=None) as ws:
+            await ws.send(msgspec.msgpack.encode(CAMERA))  # viser counts a client after its first camera
+            for _ in range(600):
+                new = set(config.sessions) - known
+                if new:
+                    session_box.append(config.sessions[new.pop()])
+                    break
+                await asyncio.sleep(0.05)
+            handle = getattr(session_box[0], handle_of)
+            msg = {"type": "GuiUpdateMessage", "uuid": handle._impl.uuid, "updates": {"value": value}}
+            await ws.send(msgspec.msgpack.encode(msg))
+            for _ in range(600):
+                if session_box[0].error is not None:
+                    break
+                await asyncio.sleep(0.05)
+            done.set()
+
+    asyncio.run(go())
+    assert done.is_set()
+    return session_box[0]
+
+
+def test_hostile_client_cannot_load_a_file_through_the_preset_dropdown(served, tmp_path):
+    hostport, _, config = served
+    target = tmp_path / "x.yaml"
+    target.write_text((PRESET_DIR / "paper_12kw_pmsm.yaml").read_text().replace(
+        "name: paper_12kw_pmsm", "name: HACKED"), encoding="utf-8")
+    rel = Path("..") / Path(*([".."] * len(PRESET_DIR.parts))) / str(target.with_suffix(""))[1:]
+    session = _send_update(hostport, config, "preset", str(rel))
+    assert "is not one of the offered options" in session.error
+    assert session.params.name != "HACKED" and session.origin != str(rel)
+
+
+def test_fdsmc_preset_dropdown_offers_position_presets_only(served):
+    hostport, _, config = served
+    session = _send_update(hostport, config, "preset", "bldc_smc_paper")
+    assert "bldc_smc_paper" not in session.preset.options
+    assert "paper_12kw_pmsm" in session.preset.options
+    assert "is not one of the offered options" in session.error
+
+
+def test_md_text_shows_markup_as_text():
+    shown = md_text("# GAINS VERIFIED <b>USE K=50</b> `x` ![i](http://e/i.png) a|b\n## h")
+    assert "<" not in shown and ">" not in shown and "&lt;b&gt;" in shown
+    for ch in "#`![]()|":
+        assert f"\\{ch}" in shown
+    assert "\n" not in shown
+
+
+def test_checked_choice():
+    assert checked_choice("a", ("a", "b"), "Preset") == "a"
+    with pytest.raises(ParameterError, match=r"Preset = '\.\./x' is not one of the offered options: allowed a, b"):
+        checked_choice("../x", ("a", "b"), "Preset")
+    with pytest.raises(ParameterError, match="allowed a, b"):
+        checked_choice(3, ("a", "b"), "Preset")
+
+
+def test_worker_cancel_stops_at_the_next_checkpoint():
+    errors: list[Exception] = []
+    worker = Worker(lambda _: None, errors.append)
+    reached = []
+
+    def job() -> None:
+        for i in range(1000):
+            worker.checkpoint()
+            reached.append(i)
+            time.sleep(0.005)
+
+    future = worker.submit(job)
+    while not reached:
+        time.sleep(0.005)
+    assert worker.cancel()
+    future.result(timeout=10)
+    assert len(reached) < 1000 and isinstance(errors[0], Cancelled)
+    assert not worker.busy and not worker.cancel()
+    worker.close()
