@@ -14,6 +14,7 @@ from typing import Any
 
 from app.cli import add_preset_arguments
 from app.cli_simulate import finite_or_none
+from app.numbers import parse_number
 from app.presets import load_preset, loads_raw
 from control.params import DriveParams, ParameterError
 from sim.duty import Move, duty_cycle
@@ -33,6 +34,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def _field(item: dict[str, Any], key: str, where: str, default: float | None = None) -> float:
     v = item.get(key, default)
+    if isinstance(v, str):  # the strict loader keeps scalars as text: parse them exactly
+        return parse_number(v, f"{where}: {key}")
     if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
         raise ParameterError(f"{where}: {key} = {v!r} is not allowed: a finite number")
     return float(v)
