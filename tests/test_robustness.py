@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -16,6 +19,7 @@ from sim.engine import compare
 from sim.robustness import METRICS, TRACE_POINTS, Spread, draw, robustness
 
 PRESET = "siemens_1ft7044_ak7"
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def test_plant_equal_to_model_changes_nothing():
@@ -83,20 +87,32 @@ def test_zero_spread_reproduces_the_nominal_run_exactly():
     assert res.summary["fdsmc"]["friction_J"]["p05"] == res.summary["fdsmc"]["friction_J"]["p95"]
 
 
-def test_dask_cluster_gives_the_local_results():
-    from dask.distributed import Client, LocalCluster
+_DASK_SCRIPT = """
+import json
+from dask.distributed import Client, LocalCluster
+from app.cli_robustness import parse_spreads
+from app.presets import load_preset
+from sim.robustness import robustness
+params = load_preset("siemens_1ft7044_ak7")
+spreads = parse_spreads(["plant.J_L=0.001:0.004,plant.R_s=±20%"])
+local = robustness(params, spreads, 5, seed=3)
+done = []
+with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cl, \\
+        Client(cl) as client:
+    remote = robustness(params, spreads, 5, seed=3, executor=client, workers=2, progress=lambda d, n: done.append(d))
+print(json.dumps({"same": remote.runs == local.runs, "summary": remote.summary["fdsmc"] == local.summary["fdsmc"],
+                  "done": done}))
+"""
 
-    params = load_preset(PRESET)
-    spreads = parse_spreads(["plant.J_L=0.001:0.004,plant.R_s=±20%"])
-    local = robustness(params, spreads, 5, seed=3)
-    done: list[int] = []
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cl, \
-            Client(cl) as client:
-        remote = robustness(params, spreads, 5, seed=3, executor=client, workers=2,
-                            progress=lambda d, n: done.append(d))
-    assert remote.runs == local.runs
-    assert done == sorted(done) and done[-1] == 5
-    assert remote.summary["fdsmc"] == local.summary["fdsmc"]
+
+def test_dask_cluster_gives_the_local_results():
+    """Run in a fresh interpreter: the cluster's event loop must not outlive it in the test process."""
+    r = subprocess.run([sys.executable, "-c", _DASK_SCRIPT], capture_output=True, text=True, check=False,
+                       cwd=ROOT, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert out["same"] and out["summary"]
+    assert out["done"] == sorted(out["done"]) and out["done"][-1] == 5
 
 
 def test_robustness_cli_json(capsys):
