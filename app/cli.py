@@ -1,4 +1,4 @@
-"""Command-line interface: ``python -m app {derive,simulate,table1,bench,serve,bldc} …``.
+"""Command-line interface: ``python -m app {derive,simulate,export,table1,bench,serve,bldc} …``.
 
 Each sub-command lives in its own module exposing ``add_arguments(parser)`` and
 ``run(args) -> int``. Bad input exits with code 2 and one clear line on stderr, never a traceback.
@@ -17,10 +17,12 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "derive": ("app.cli_derive", "derive α_max, observer gains, profile, comparator gains, energies"),
     "design": ("app.cli_design", "design a clean setting for this drive and verify it by simulation"),
     "simulate": ("app.cli_simulate", "simulate the FDSMC and the conventional controller"),
+    "export": ("app.cli_export", "write the drive parameter file, C controller, CSV or HTML report"),
     "table1": ("app.cli_table1", "Table-1 sweep of the friction saving over manoeuvre times"),
     "bench": ("app.bench", "print speed figures of the simulation engine"),
     "serve": ("app.serve", "start the commissioning web UI"),
     "bldc": ("app.cli_bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
+    "log": ("app.cli_log", "import a drive log: overlay on the simulation, identify the motor and load"),
     "multiaxis": ("app.cli_multiaxis", "axes that must finish together: common T_m, designs, energies"),
     "dutycycle": ("app.cli_duty", "a duty cycle of moves with dwells: energy per cycle and per year"),
     "robustness": ("app.cli_robustness", "Monte-Carlo robustness to plant values the controller does not know"),
@@ -53,9 +55,9 @@ def build_parser() -> argparse.ArgumentParser:
 def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None) -> None:
     """The PRESET positional and repeatable ``--set section.field=value`` options."""
     if default is None:
-        p.add_argument("preset", metavar="PRESET", help="preset name (presets/NAME.yaml) or YAML path")
+        p.add_argument("preset", metavar="PRESET", help="preset name (presets/NAME.yaml) or a YAML/JSON file path")
     else:
-        p.add_argument("preset", metavar="PRESET", nargs="?", default=default, help="preset name or YAML path")
+        p.add_argument("preset", metavar="PRESET", nargs="?", default=default, help="preset name or YAML/JSON path")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.FIELD=VALUE",
                    help="override a preset value, e.g. --set manoeuvre.T_m=1.4 or motor.L_d_mH=5.4")
 

@@ -3,26 +3,18 @@
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 from typing import Any
 
 from app.cli import add_preset_arguments, check_writable
 from app.derived_view import derived_json
+from app.exports import trace_csv
 from app.plant import load_model_and_plant
+from control.params import ParameterError
 from sim.engine import Comparison, RunResult, compare
 from sim.verdicts import comparator_notes, run_warnings
 
-#: Trace columns written by ``--csv``: (Trace field, header, unit).
-CSV_COLUMNS = (
-    ("theta_r", "theta_r", "rad"), ("omega_r", "omega_r", "rad/s"), ("i_d", "i_d", "A"),
-    ("i_q", "i_q", "A"), ("u_d", "u_d", "V"), ("u_q", "u_q", "V"), ("alpha", "alpha", "rad/s^2"),
-    ("alpha_dem", "alpha_dem", "rad/s^2"), ("Gamma_L", "Gamma_L", "N*m"),
-    ("Gamma_L_hat", "Gamma_L_hat", "N*m"), ("S", "S", "rad/s"),
-    ("E_friction", "E_friction", "J"), ("E_copper", "E_copper", "J"),
-    ("E_electrical", "E_electrical", "J"),
-)
 #: Rows of the terminal summary: (metric key, label, unit).
 SUMMARY = (
     ("friction_J", "Friction loss over [0, T_m]", "J"),
@@ -54,7 +46,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="which run(s): both = FDSMC and conventional, all = both and the tracked "
                         "minimum-energy optimum (default all)")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
-    p.add_argument("--csv", metavar="FILE", help="write the time series with a units header row")
+    p.add_argument("--csv", metavar="FILE", help="write the time series (CSV: controller column, units in the headers)")
 
 
 def finite_or_none(value: Any) -> Any:
@@ -104,22 +96,13 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     return finite_or_none(out)
 
 
-def write_csv(path: str, runs: list[RunResult]) -> None:
-    """Write t and each run's channels (prefixed by controller when there are two)."""
-    prefix = len(runs) > 1
-    names, units, cols = ["t"], ["s"], [runs[0].trace.t]
-    for run in runs:
-        for field, head, unit in CSV_COLUMNS:
-            names.append(f"{run.controller}.{head}" if prefix else head)
-            units.append(unit)
-            cols.append(getattr(run.trace, field))
-    n = min(len(c) for c in cols)
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(names)
-        w.writerow(units)
-        for i in range(n):
-            w.writerow([f"{c[i]:.9g}" for c in cols])
+def write_csv(path: str, cmp: Comparison) -> None:
+    """Write the time series in the one CSV format of the exports (:func:`app.exports.trace_csv`)."""
+    try:
+        with open(path, "w", newline="", encoding="utf-8") as fh:
+            fh.write(trace_csv(cmp))
+    except OSError as exc:
+        raise ParameterError(f"cannot write --csv {path!r}: {exc.strerror or exc}") from None
 
 
 def _fmt(v: Any) -> str:
@@ -163,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
         args.controller, (args.controller,))
     cmp = compare(params, ctrls, plant=plant)
     if args.csv:
-        write_csv(args.csv, [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None])
+        write_csv(args.csv, cmp)
     if args.json:
         print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False, allow_nan=False))
     else:

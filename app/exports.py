@@ -1,31 +1,41 @@
-"""Exports: the drive parameter file (YAML / JSON / C header), CSV time series, an offline HTML report.
+"""The export model shared by the page's Export menu and ``python -m app export``.
 
-The YAML file is a valid preset (written by :func:`app.presets.dumps_preset`, so it re-imports
-to exactly the same inputs in the UI and the CLI) followed by ``exported_from`` and the derived
-``drive_gains`` as data, one ``NAME: value  # [unit] reference`` line each. The JSON file holds the same inputs and
-gains as data, plus the full ``derive --json`` object. The C header ``#define``s every gain in
-upper case with its unit in a comment.
+:func:`export_files` turns one simulated case (a :class:`sim.engine.Comparison`, whose
+``derived.params`` are the inputs) into the files of one format — the same bytes whoever asks:
+
+* ``yaml`` / ``json``: the drive parameter file (schema 2): an importable preset (inputs in SI)
+  plus ``units`` (the unit of every input), ``drive_gains`` (value, unit, reference), ``verdicts``
+  (feasibility, warnings, run warnings, savings) and ``results`` (each run's metrics, the unit in
+  each key's suffix). The loader ignores the informational sections and recomputes them, so
+  export → import → export gives identical bytes;
+* ``c``: the C99 controller module (:mod:`app.export_c`);
+* ``csv``: the time series of both runs (:func:`trace_csv`);
+* ``html``: the offline report (:mod:`app.export_html`).
+
+Files are named after the case's ``name``; no date is written, so exports are reproducible.
 """
 
 from __future__ import annotations
 
-import datetime as _dt
-import html
 import io
 import json
+import re
+import zipfile
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import plotly.graph_objects as go
-import plotly.io as pio
 
-from app.derived_view import derived_json, derived_rows
-from app.presets import SCHEMA, dumps_preset, to_raw
+from app.derived_view import derived_rows
+from app.export_c import TOOL, controller_files
+from app.presets import SCHEMA, dumps, to_raw
+from app.units import SI_UNITS
 from control.derivations import Derived
-from control.params import DriveParams
+from control.params import ParameterError
+from sim.engine import Comparison
+from sim.verdicts import comparator_notes, run_warnings
 
-TOOL = "pmsm-commissioning (FDSMC)"
+FORMATS = ("yaml", "json", "c", "csv", "html")
 
 
 @dataclass(frozen=True)
@@ -47,12 +57,12 @@ def drive_gains(d: Derived) -> list[Gain]:
     p, pr, o = d.params, d.profile, d.observer
     units = {r.symbol: r.unit for r in derived_rows(d)}
     gains = [
-        Gain("ALPHA_MAX", d.alpha.alpha_max, "rad/s^2", f"alpha_max, {d.alpha.rule} rule"),
+        Gain("ALPHA_MAX", d.alpha.alpha_max, "rad/s²", f"alpha_max, {d.alpha.rule} rule"),
         Gain("OMEGA_P", pr.omega_p, "rad/s", "peak speed, eq. (60)"),
         Gain("T_A", pr.T_a, "s", "acceleration time, eq. (58)"),
         Gain("T_C", pr.T_c, "s", "sliding-mode time constant, eq. (59)"),
         Gain("K_BL", p.controller.K, "s/rad", "boundary-layer gain K, eq. (45)"),
-        Gain("G1", d.conventional.g1, "1/s^2", "conventional gain, eq. (61)"),
+        Gain("G1", d.conventional.g1, "1/s²", "conventional gain, eq. (61)"),
         Gain("G2", d.conventional.g2, "1/s", "conventional gain, eq. (61)"),
         Gain("T_SI", p.controller.T_si, "s", "d-current settling time, eq. (8)"),
         Gain("T_SALPHA", p.controller.T_salpha, "s", "acceleration settling time, eq. (13)"),
@@ -71,104 +81,125 @@ def drive_gains(d: Derived) -> list[Gain]:
     return gains
 
 
-def _num(x: float) -> str:
-    return repr(float(x))
+def _finite(value: Any) -> Any:
+    """JSON/YAML-safe data: non-finite floats → None, numpy scalars → Python, recursively."""
+    if isinstance(value, dict):
+        return {str(k): _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
 
 
-def parameter_yaml(params: DriveParams, d: Derived, origin: str) -> str:
-    """Drive parameter file as YAML: an importable preset + ``exported_from`` + ``drive_gains`` data.
-
-    ``drive_gains`` maps each upper-case gain name to its SI value, with the unit and equation in
-    a comment on the same line. On import the gains are recomputed from the inputs (the preset
-    loader ignores ``drive_gains`` and ``exported_from``), so export → import is exact.
-    """
-    head = [f"# Drive parameter file — {TOOL}, {_dt.date.today().isoformat()}",
-            "# All values SI (see docs/nomenclature.md). Re-import: upload this file in the web UI, or",
-            "# `python -m app derive <file>`; drive_gains are then recomputed from the inputs."]
-    tail = [f"exported_from: {json.dumps(origin)}", "drive_gains:"]
-    tail += [f"  {g.name}: {_num(g.value)}  # [{g.unit}] {g.ref}" for g in drive_gains(d)]
-    tail += [f"# warning: {w}" for w in d.warnings]
-    return "\n".join(head) + "\n" + dumps_preset(params) + "\n".join(tail) + "\n"
+def verdicts(cmp: Comparison) -> dict[str, Any]:
+    """Feasibility, design warnings, run warnings and savings of one case."""
+    d = cmp.derived
+    return {"feasible": bool(d.profile.feasible), "warnings": list(d.warnings),
+            "run_warnings": run_warnings(cmp), "comparator_notes": comparator_notes(cmp),
+            "saving_friction_pct": cmp.saving_friction_pct,
+            "saving_electrical_pct": cmp.saving_electrical_pct}
 
 
-def parameter_data(params: DriveParams, d: Derived, origin: str) -> dict[str, Any]:
-    """Drive parameter file as plain data: schema, origin, inputs (SI), gains, derived values."""
-    return {
-        "schema": SCHEMA,
-        "tool": TOOL,
-        "preset": origin,
-        "inputs": to_raw(params),
-        "gains": {g.name: {"value": g.value, "unit": g.unit, "ref": g.ref} for g in drive_gains(d)},
-        "derived": derived_json(d),
-    }
+def parameter_data(cmp: Comparison) -> dict[str, Any]:
+    """The drive parameter file as plain data (schema 2): preset + units, gains, verdicts, results."""
+    params = cmp.derived.params
+    raw = to_raw(params)
+    raw["units"] = {sec: dict(SI_UNITS[sec]) for sec in ("motor", "load", "controller", "manoeuvre")}
+    raw["drive_gains"] = {g.name: {"value": g.value, "unit": g.unit, "ref": g.ref} for g in drive_gains(cmp.derived)}
+    raw["verdicts"] = verdicts(cmp)
+    raw["results"] = {r.controller: dict(r.metrics) for r in (cmp.fdsmc, cmp.conventional) if r is not None}
+    raw["exported_by"] = TOOL
+    return _finite(raw)
 
 
-def parameter_json(params: DriveParams, d: Derived, origin: str) -> str:
-    """Drive parameter file as JSON text."""
-    return json.dumps(parameter_data(params, d, origin), indent=2, ensure_ascii=False) + "\n"
+def parameter_yaml(cmp: Comparison) -> str:
+    """Drive parameter file as YAML (written by :func:`app.presets.dumps`)."""
+    head = (f"# Drive parameter file (schema {SCHEMA}) — {TOOL}. SI units; the unit of each input is in\n"
+            "# `units`. Re-import: the page's Import button or any command taking PRESET, e.g.\n"
+            "# `python -m app derive FILE`; drive_gains, verdicts and results are then recomputed.\n")
+    return head + dumps(parameter_data(cmp))
 
 
-def parameter_c_header(params: DriveParams, d: Derived, origin: str) -> str:
-    """Drive parameter file as a C header: ``#define FDSMC_<NAME> <value> /* [unit] ref */``."""
-    guard = "FDSMC_DRIVE_PARAMETERS_H"
-    lines = ["/* Drive parameter file generated by " + TOOL + f" on {_dt.date.today().isoformat()}.",
-             f" * Inputs from: {origin.replace('*/', '* /')}. All values in SI units. */",
-             f"#ifndef {guard}", f"#define {guard}", ""]
-    for g in drive_gains(d):
-        lines.append(f"#define FDSMC_{g.name:<12} ({_num(g.value)}) /* [{g.unit}] {g.ref} */")
-    lines += ["", f"#endif /* {guard} */", ""]
-    return "\n".join(lines)
+def parameter_json(cmp: Comparison) -> str:
+    """Drive parameter file as JSON text (same data as the YAML file)."""
+    return json.dumps(parameter_data(cmp), indent=2, ensure_ascii=False, allow_nan=False) + "\n"
 
 
-#: CSV columns: (trace attribute, header with unit).
+#: CSV columns: (Trace attribute, unit).
 CSV_COLUMNS = (
-    ("t", "t_s"), ("theta_r", "theta_r_rad"), ("omega_r", "omega_r_rad_s"), ("i_d", "i_d_A"),
-    ("i_q", "i_q_A"), ("u_d", "u_d_V"), ("u_q", "u_q_V"), ("alpha", "alpha_rad_s2"),
-    ("alpha_dem", "alpha_dem_rad_s2"), ("Gamma_L", "Gamma_L_Nm"), ("Gamma_L_hat", "Gamma_L_hat_Nm"),
-    ("theta_hat", "theta_hat_rad"), ("omega_hat", "omega_hat_rad_s"), ("S", "S_rad_s"),
-    ("E_friction", "E_friction_J"), ("E_copper", "E_copper_J"), ("E_electrical", "E_electrical_J"),
+    ("t", "s"), ("theta_r", "rad"), ("omega_r", "rad/s"), ("i_d", "A"), ("i_q", "A"), ("u_d", "V"),
+    ("u_q", "V"), ("alpha", "rad/s^2"), ("alpha_dem", "rad/s^2"), ("alpha_hat", "rad/s^2"),
+    ("Gamma_L", "N*m"), ("Gamma_L_hat", "N*m"), ("theta_hat", "rad"), ("omega_hat", "rad/s"),
+    ("S", "rad/s"), ("E_friction", "J"), ("E_copper", "J"), ("E_electrical", "J"), ("E_motoring", "J"),
+    ("E_load", "J"),
 )
 
 
-def trace_csv(comparison: Any) -> str:
-    """Time series of both runs as CSV (one row per controller and sample, SI units in headers)."""
+def trace_csv(cmp: Comparison) -> str:
+    """Time series of both runs as one CSV table (the format of the page and ``simulate --csv``).
+
+    One column per signal with its unit in the header (``theta_r [rad]``), a first ``controller``
+    column, one row per controller and sample (SI units, ``%.9g``): ``pandas.read_csv`` gives typed
+    columns directly (``df.groupby("controller")``), Excel filters on the first column.
+
+    Raises
+    ------
+    ParameterError
+        When there is no run (an infeasible manoeuvre).
+    """
+    runs = [r for r in (cmp.fdsmc, cmp.conventional) if r is not None]
+    if not runs:
+        raise ParameterError("nothing to export as CSV: there is no simulated run "
+                             f"(manoeuvre.T_m = {cmp.derived.params.manoeuvre.T_m:g} s is infeasible)")
     out = io.StringIO()
-    out.write("controller," + ",".join(h for _, h in CSV_COLUMNS) + "\n")
-    for run in (comparison.fdsmc, comparison.conventional):
-        if run is None:
-            continue
+    out.write("controller," + ",".join(f"{a} [{u}]" for a, u in CSV_COLUMNS) + "\n")
+    for run in runs:
         block = io.StringIO()
-        table = np.column_stack([getattr(run.trace, a) for a, _ in CSV_COLUMNS])
-        np.savetxt(block, table, fmt="%.9g", delimiter=",")
-        prefix = f"{run.controller},"
-        out.writelines(prefix + line + "\n" for line in block.getvalue().splitlines())
+        np.savetxt(block, np.column_stack([getattr(run.trace, a) for a, _ in CSV_COLUMNS]), fmt="%.9g",
+                   delimiter=",")
+        out.writelines(f"{run.controller},{line}\n" for line in block.getvalue().splitlines())
     return out.getvalue()
 
 
-def _table(rows: list[tuple[str, ...]], head: tuple[str, ...]) -> str:
-    th = "".join(f"<th>{html.escape(h)}</th>" for h in head)
-    trs = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows)
-    return f"<table><thead><tr>{th}</tr></thead><tbody>{trs}</tbody></table>"
+def safe_stem(name: str) -> str:
+    """A file-name stem from a preset/motor name (letters, digits, ``_-.`` only)."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "drive"
 
 
-def html_report(params: DriveParams, d: Derived, origin: str, warnings: list[str],
-                figures: list[go.Figure]) -> str:
-    """Self-contained HTML report (Plotly inlined, opens offline): inputs, derived values, warnings, figures."""
-    raw = to_raw(params)
-    inputs = [(sec, k, str(v)) for sec in ("motor", "load", "controller", "manoeuvre")
-              for k, v in raw[sec].items()]
-    derived = [(r.label, r.symbol, r.text(), r.unit, r.ref) for r in derived_rows(d)]
-    warn = "".join(f"<li>{html.escape(w)}</li>" for w in warnings) or "<li>none</li>"
-    plots = [pio.to_html(fig, full_html=False, include_plotlyjs=(i == 0), default_height="560px")
-             for i, fig in enumerate(figures)]
-    style = ("body{font-family:sans-serif;margin:24px;max-width:1200px}table{border-collapse:collapse;"
-             "margin-bottom:16px}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}"
-             ".warn{color:#c92a2a;font-weight:600}")
-    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>FDSMC commissioning report — "
-            f"{html.escape(params.name)}</title><style>{style}</style></head><body>"
-            f"<h1>FDSMC commissioning report</h1><p>Preset: {html.escape(origin)} — "
-            f"{html.escape(params.source)}<br>Generated {_dt.datetime.now().isoformat(timespec='seconds')} "
-            f"by {TOOL}.</p><h2>Warnings</h2><ul class='warn'>{warn}</ul>"
-            f"<h2>Inputs (SI)</h2>{_table(inputs, ('section', 'field', 'value'))}"
-            f"<h2>Derived values</h2>{_table(derived, ('quantity', 'symbol', 'value', 'unit', 'ref.'))}"
-            f"<h2>Figures</h2>{''.join(plots)}</body></html>")
+def export_files(fmt: str, cmp: Comparison) -> dict[str, bytes]:
+    """File name → content of one export format for the case ``cmp`` (see the module doc).
+
+    Raises
+    ------
+    ParameterError
+        For an unknown format, a C export in continuous mode, or a CSV without a run.
+    """
+    stem = safe_stem(cmp.derived.params.name)
+    if fmt == "c":
+        files = controller_files(cmp.derived.params, cmp.derived, SCHEMA)
+        return {name: text.encode("utf-8") for name, text in files.items()}
+    if fmt == "html":
+        from app.export_html import html_report  # plotly: imported only when a report is made
+
+        return {f"{stem}.html": html_report(cmp).encode("utf-8")}
+    writers = {"yaml": parameter_yaml, "json": parameter_json, "csv": trace_csv}
+    if fmt not in writers:
+        raise ParameterError(f"format = {fmt!r} is not allowed: one of {', '.join(FORMATS)}")
+    return {f"{stem}.{fmt}": writers[fmt](cmp).encode("utf-8")}
+
+
+def export_download(fmt: str, cmp: Comparison) -> tuple[str, bytes]:
+    """One downloadable file: the single export file, or a zip (``<name>_fdsmc_controller.zip``)
+    holding the C module's header and source."""
+    files = export_files(fmt, cmp)
+    if len(files) == 1:
+        return next(iter(files.items()))
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
+        for name, content in files.items():
+            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))  # reproducible bytes
+            zf.writestr(info, content, zipfile.ZIP_DEFLATED)
+    return f"{safe_stem(cmp.derived.params.name)}_fdsmc_controller.zip", buf.getvalue()

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import json
 import math
 import re
 import types
@@ -26,7 +27,9 @@ from app.numbers import NumberFormatError, parse_integer, parse_number
 from control.bldc_params import BldcParams
 from control.params import DriveParams, ParameterError
 
-SCHEMA = 1
+SCHEMA = 2
+#: Schemas read: 1 (inputs only) is migrated to 2 (adds the informational export sections).
+SCHEMAS_READ = (1, 2)
 PRESET_DIR = Path(__file__).resolve().parent.parent / "presets"
 MAX_BYTES = 256 * 1024
 #: The page's start-up preset: a real catalogue servo with a verified clean design.
@@ -36,7 +39,7 @@ PAPER_PRESET = "paper_12kw_pmsm"
 _TOP_KEYS = ("schema", "name", "source", "mode")
 #: Top-level keys an exported drive parameter file adds; informational, ignored on import (the
 #: gains are recomputed from the inputs).
-_EXPORT_KEYS = ("exported_from", "drive_gains")
+_EXPORT_KEYS = ("exported_by", "units", "drive_gains", "verdicts", "results")
 
 #: Parameter dataclass per preset mode. Other modes register themselves here.
 MODES: dict[str, type] = {"position": DriveParams}
@@ -164,9 +167,9 @@ def parse_preset(raw: Any) -> Any:
         With a message naming the field, the value and the allowed range or type.
     """
     if not isinstance(raw, dict):
-        raise PresetError("a preset must be a YAML mapping with schema, name, source and sections")
-    if _schema(raw.get("schema")) != SCHEMA:
-        raise PresetError(f"schema = {raw.get('schema')!r} is not supported: allowed schema: {SCHEMA}")
+        raise PresetError("a preset must be a mapping: allowed a YAML or JSON mapping with schema, name, "
+                          "source and sections")
+    raw = migrate(raw)
     mode = raw.get("mode", "position")
     if mode not in MODES:
         raise PresetError(f"mode = {mode!r} is not known{_hint(str(mode), list(MODES))}")
@@ -186,7 +189,44 @@ def parse_preset(raw: Any) -> Any:
         if key not in raw:
             raise PresetError(f"missing key {key!r}: every preset names itself and its source")
         kwargs[key] = _coerce(key, raw[key], str)
+    _check_units(raw.get("units"), sections)
     return cls(**kwargs)
+
+
+def migrate(raw: dict[str, Any]) -> dict[str, Any]:
+    """A schema-1 mapping → schema 2 (a copy); schema 2 unchanged; other schemas refused.
+
+    Schema 1 holds the inputs only; its drive parameter exports added ``exported_from`` and a flat
+    ``drive_gains`` (YAML) or wrapped the inputs as ``{"tool", "preset", "inputs", "gains",
+    "derived"}`` (JSON). Their informational parts are dropped (the gains are recomputed).
+    """
+    schema = _schema(raw.get("schema"))
+    if schema not in SCHEMAS_READ:
+        raise PresetError(f"schema = {raw.get('schema')!r} is not supported: allowed schema: "
+                          f"{' or '.join(map(str, SCHEMAS_READ))}")
+    if schema == SCHEMA:
+        return raw
+    if isinstance(raw.get("inputs"), dict) and "tool" in raw:  # schema-1 JSON export
+        raw = raw["inputs"]
+    out = {k: v for k, v in raw.items() if k not in ("exported_from", "drive_gains")}
+    out["schema"] = SCHEMA
+    return out
+
+
+def _check_units(table: Any, sections: list[str]) -> None:
+    """An exported file's ``units`` section must state the SI unit of each value it names."""
+    if table is None:
+        return
+    if not isinstance(table, dict):
+        raise PresetError(f"units must be a mapping of section: {{field: unit}}, got {table!r}")
+    for section, fields in table.items():
+        expected = units.SI_UNITS.get(str(section))
+        if section not in sections or expected is None or not isinstance(fields, dict):
+            raise PresetError(f"units.{section} is not a section of this preset{_hint(str(section), sections)}")
+        for name, unit in fields.items():
+            if name in expected and unit != expected[name]:
+                raise PresetError(f"units.{section}.{name} = {unit!r} is not allowed: values in this file are SI "
+                                  f"({expected[name]!r}); write a unit-suffixed key (e.g. L_d_mH) for other units")
 
 
 # ---- YAML front-end: text → raw mapping of texts, lists and mappings -------------------------
@@ -324,13 +364,13 @@ MAX_NAME = 1024
 
 
 def resolve(name_or_path: str) -> Path:
-    """Preset name (file stem in ``presets/``) or path → path; a clear error if absent."""
+    """Preset name (file stem in ``presets/``) or path (YAML or JSON) → path; a clear error if absent."""
     if len(name_or_path) > MAX_NAME:
         raise PresetError(f"preset name {name_or_path[:40]!r}… has {len(name_or_path)} characters: "
                           f"allowed ≤ {MAX_NAME}")
     path = Path(name_or_path)
     try:
-        if path.suffix in (".yaml", ".yml") and path.is_file():
+        if path.suffix in (".yaml", ".yml", ".json") and path.is_file():
             return path
         candidate = PRESET_DIR / f"{name_or_path}.yaml"
         if "/" not in name_or_path and "\\" not in name_or_path and candidate.is_file():
@@ -355,7 +395,7 @@ def load_raw(name_or_path: str) -> Any:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise PresetError(f"cannot read preset {str(path)!r}: {exc}") from None
-    return loads_raw(text, path.name)
+    return loads_any_raw(text, path.name)
 
 
 def load_preset(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()) -> Any:
@@ -364,8 +404,45 @@ def load_preset(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[s
 
 
 def loads_preset(text: str, origin: str = "<upload>") -> Any:
-    """Validate preset YAML text (e.g. an upload) and return its parameter object."""
-    return parse_preset(loads_raw(text, origin))
+    """Validate preset YAML or JSON text (e.g. an upload) and return its parameter object."""
+    return parse_preset(loads_any_raw(text, origin))
+
+
+def loads_json_raw(text: str, origin: str = "<text>") -> Any:
+    """Parse a JSON preset or drive parameter file (size-limited) into plain Python data."""
+    if len(text.encode("utf-8", "replace")) > MAX_BYTES:
+        raise PresetError(f"{origin} is too large: allowed ≤ {MAX_BYTES // 1024} KiB")
+    check_structure(text, origin)
+    try:
+        return json.loads(text, parse_constant=_no_constant, object_pairs_hook=_unique_keys)
+    except json.JSONDecodeError as exc:
+        raise PresetError(f"{origin} is not valid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}") from None
+    except RecursionError:
+        raise PresetError(f"{origin} is nested too deeply") from None
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    keys = [k for k, _ in pairs]
+    dup = next((k for k in keys if keys.count(k) > 1), None)
+    if dup is not None:
+        raise PresetError(f"key {dup!r} is given more than once in a JSON object: allowed once")
+    return dict(pairs)
+
+
+def _no_constant(name: str) -> Any:
+    raise PresetError(f"{name} is not allowed in a preset: allowed finite numbers")
+
+
+def loads_any_raw(text: str, origin: str = "<text>") -> Any:
+    """JSON (``*.json``, or text starting with ``{``) or YAML text → plain Python data."""
+    if origin.lower().endswith(".json"):
+        return loads_json_raw(text, origin)
+    if text.lstrip().startswith("{"):  # JSON text; a YAML flow mapping falls back to YAML
+        try:
+            return loads_json_raw(text, origin)
+        except PresetError:
+            pass
+    return loads_raw(text, origin)
 
 
 def _plain(value: Any) -> Any:
@@ -407,3 +484,14 @@ __all__ = [
     "dumps_preset", "list_presets", "load_preset", "loads_preset", "parse_preset", "save_preset",
     "to_raw",
 ]
+
+
+def loads_log_mapping(text: str, origin: str = "<mapping>") -> dict[str, str]:
+    """A drive-log column mapping (YAML ``column: signal [unit]``) as a dict of strings."""
+    raw = loads_raw(text, origin)
+    if not isinstance(raw, dict) or not raw:
+        raise PresetError(f"{origin}: a mapping file needs lines 'column: signal [unit]', e.g. 'Iq: i_q [A]'")
+    bad = [k for k, v in raw.items() if not isinstance(v, str)]
+    if bad:
+        raise PresetError(f"{origin}: column {str(bad[0])!r} maps to {raw[bad[0]]!r}: allowed 'signal [unit]'")
+    return {str(k): v for k, v in raw.items()}

@@ -1,56 +1,55 @@
-"""Export buttons and preset upload of the position-drive tab.
+"""Export menu and preset upload of the position-drive tab.
 
-Downloads go to the one client that asked (``client.send_file_download``). An upload is
-validated by the same loader as the CLI (:func:`app.presets.loads_preset`); a bad file gets a
-notification naming the problem and changes nothing.
+Downloads go to the one client that asked (``client.send_file_download``) and are produced by the
+export model shared with the CLI (:func:`app.exports.export_download`), so the page and
+``python -m app export`` write the same bytes. An export describes the simulated case; when the
+inputs shown differ from it (edited but not simulated) the export is refused with a message naming
+the uncommitted fields. An upload (YAML or JSON) is validated by the same loader as the CLI
+(:func:`app.presets.loads_preset`); a bad file gets a notification naming the problem and
+changes nothing.
 """
 
 from __future__ import annotations
 
-import re
+import dataclasses
 from collections.abc import Callable
 from typing import Any
 
 import viser
 
-from app import exports
-from app.figures import make_phase_plane_figure, make_time_plots_figure
-from app.figures_energy import make_energy_bars_figure, make_energy_figure
-from app.presets import MAX_BYTES, PresetError, loads_preset
+from app.exports import export_download, safe_stem
+from app.presets import MAX_BYTES, PresetError, loads_preset, to_raw
 from control.params import DriveParams, ParameterError
+from sim.engine import Comparison
 
-#: Export label → (file suffix, needs a simulation).
+#: Export label → format of :func:`app.exports.export_files`.
 EXPORTS = {
-    "Drive parameters (YAML)": (".yaml", False),
-    "Drive parameters (JSON)": (".json", False),
-    "C header for firmware": (".h", False),
-    "Time series (CSV)": (".csv", True),
-    "HTML report (offline)": (".html", False),
+    "Drive parameters (YAML)": "yaml",
+    "Drive parameters (JSON)": "json",
+    "C controller module (.h + .c, zip)": "c",
+    "Time series (CSV)": "csv",
+    "HTML report (offline)": "html",
 }
 
 
-def safe_stem(name: str) -> str:
-    """A file-name stem from a preset name (letters, digits, ``_-.`` only)."""
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "drive"
+class ExportRefusedError(ValueError):
+    """An export that would not describe the inputs shown; the message says why."""
 
 
-def export_text(kind: str, params: DriveParams, comparison: Any, origin: str,
-                warnings: list[str]) -> str:
-    """Text of one export kind (a key of :data:`EXPORTS`)."""
-    d = comparison.derived
-    if kind.endswith("(YAML)"):
-        return exports.parameter_yaml(params, d, origin)
-    if kind.endswith("(JSON)"):
-        return exports.parameter_json(params, d, origin)
-    if kind.startswith("C header"):
-        return exports.parameter_c_header(params, d, origin)
-    if kind.startswith("Time series"):
-        return exports.trace_csv(comparison)
-    figures = [make_phase_plane_figure(comparison)]
-    if comparison.fdsmc is not None:
-        figures += [make_time_plots_figure(comparison), make_energy_figure(comparison),
-                    make_energy_bars_figure(comparison)]
-    return exports.html_report(params, d, origin, warnings, figures)
+def _flat(params: DriveParams) -> dict[str, Any]:
+    raw = to_raw(params)
+    out: dict[str, Any] = {}
+    for section, fields in raw.items():
+        if isinstance(fields, dict):
+            out.update({f"{section}.{k}": v for k, v in fields.items()})
+    return out
+
+
+def uncommitted(shown: DriveParams, committed: DriveParams) -> list[str]:
+    """``field = shown (simulated: value)`` for every input that differs (SI units); name and
+    source are not simulated inputs (the Export folder sets them)."""
+    a, b = _flat(shown), _flat(committed)
+    return [f"{k} = {a[k]!r} (simulated: {b.get(k)!r})" for k in a if a[k] != b.get(k)]
 
 
 def parse_upload(name: str, content: bytes) -> DriveParams:
@@ -60,40 +59,53 @@ def parse_upload(name: str, content: bytes) -> DriveParams:
     try:
         text = content.decode("utf-8")
     except UnicodeDecodeError:
-        raise PresetError(f"{name} is not UTF-8 text: allowed a YAML preset file") from None
+        raise PresetError(f"{name} is not UTF-8 text: allowed a YAML or JSON preset file") from None
     params = loads_preset(text, name or "<upload>")
     if not isinstance(params, DriveParams):
         raise PresetError(f"{name} is a preset for another mode: allowed a position-drive (FDSMC) preset")
     return params
 
 
-class FilesPanel:
-    """"Export" folder with one button per export kind, and the upload button."""
+def renamed(cmp: Comparison, name: str, source: str) -> Comparison:
+    """The case with the name and source written into the exports (both must be non-blank)."""
+    for field, text in (("name", name), ("source", source)):
+        if not text.strip():
+            raise ExportRefusedError(f"Export › {field} = {text!r} is empty: allowed any non-blank text "
+                                     "(the file name and the file's header come from it)")
+    params = dataclasses.replace(cmp.derived.params, name=name.strip(), source=source.strip())
+    return dataclasses.replace(cmp, derived=dataclasses.replace(cmp.derived, params=params))
 
-    def __init__(self, client: viser.ClientHandle, state: Callable[[], tuple[DriveParams, Any, str, list[str]]],
-                 on_import: Callable[[DriveParams, str], None]) -> None:
+
+class FilesPanel:
+    """"Export" folder (name, source and one button per export format), and the upload button.
+
+    ``state`` returns the simulated case to export or raises :class:`ExportRefusedError`; the
+    name and source typed in the folder replace the case's in every file (and the file name).
+    """
+
+    def __init__(self, client: viser.ClientHandle, state: Callable[[], Comparison],
+                 on_import: Callable[[DriveParams, str], None], params: DriveParams) -> None:
         self._client, self._state, self._on_import = client, state, on_import
         gui = client.gui
-        self.upload = gui.add_upload_button("Import preset (YAML)", icon=viser.Icon.UPLOAD,
-                                            mime_type=".yaml,.yml,text/yaml,text/plain")
+        self.upload = gui.add_upload_button("Import preset (YAML/JSON)", icon=viser.Icon.UPLOAD,
+                                            mime_type=".yaml,.yml,.json,text/yaml,application/json,text/plain")
         self.upload.on_upload(self._uploaded)
         with gui.add_folder("Export", expand_by_default=False):
+            self.name = gui.add_text("Name (file name)", params.name)
+            self.source = gui.add_text("Source", params.source)
             self.buttons = {}
-            for label in EXPORTS:
+            for label, fmt in EXPORTS.items():
                 button = gui.add_button(label, icon=viser.Icon.DOWNLOAD)
-                button.on_click(lambda _, label=label: self._export(label))
+                button.on_click(lambda _, fmt=fmt: self._export(fmt))
                 self.buttons[label] = button
 
-    def _export(self, kind: str) -> None:
-        params, comparison, origin, warnings = self._state()
-        suffix, needs_run = EXPORTS[kind]
-        if needs_run and comparison.fdsmc is None:
-            self._client.add_notification("Nothing to export", "Simulate first: there is no time series yet.",
-                                          color="yellow", auto_close_seconds=6.0)
+    def _export(self, fmt: str) -> None:
+        try:
+            name, content = export_download(fmt, renamed(self._state(), self.name.value, self.source.value))
+        except (ExportRefusedError, ParameterError) as exc:
+            self._client.add_notification("Not exported", str(exc), color="yellow", auto_close_seconds=12.0)
             return
-        text = export_text(kind, params, comparison, origin, warnings)
-        self._client.send_file_download(f"{safe_stem(params.name)}{suffix}", text.encode("utf-8"),
-                                        save_immediately=True)
+        self._client.send_file_download(name, content, save_immediately=True)
 
     def _uploaded(self, _: viser.GuiEvent) -> None:
         f = self.upload.value
@@ -104,3 +116,10 @@ class FilesPanel:
                                           auto_close_seconds=15.0)
             return
         self._on_import(params, f.name)
+
+    def show_names(self, params: DriveParams) -> None:
+        """Show the name and source of newly loaded inputs (a preset chosen or a file imported)."""
+        self.name.value, self.source.value = params.name, params.source
+
+
+__all__ = ["EXPORTS", "ExportRefusedError", "FilesPanel", "parse_upload", "renamed", "safe_stem", "uncommitted"]

@@ -18,8 +18,9 @@ from typing import Any
 import viser
 
 from app.preset_modes import list_presets_of, load_mode_preset, require_mode
-from app.ui_files import FilesPanel
+from app.ui_files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui_inputs import InputError, InputsPanel
+from app.ui_log import LogPanel
 from app.ui_results import ResultsPanel
 from app.ui_scene import RotorScene
 from app.ui_text import checked_choice, derived_markdown, design_markdown, md_text, warnings_html
@@ -100,7 +101,8 @@ class Session:
                                        else names[0])
         self.preset.on_update(self._preset_chosen)
         self._preset_shown = self.preset.value
-        self.files = FilesPanel(self.client, self._export_state, self._imported)
+        self.files = FilesPanel(self.client, self._export_state, self._imported, self.params)
+        self.log_panel = LogPanel(self)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.simulate_button.on_click(lambda _: self.simulate())
         self.design_button = gui.add_button("Design for this drive", icon=viser.Icon.WAND, color="blue",
@@ -220,6 +222,7 @@ class Session:
         except ValueError as exc:
             self._reject(str(exc))
             return
+        self.files.show_names(params)
         self.origin = origin
         self.inputs.populate(params)
         self.params = params
@@ -300,10 +303,17 @@ class Session:
         if busy:
             self.status.content = "Working…"
 
-    def _export_state(self) -> tuple[DriveParams, Comparison, str, list[str]]:
-        d = self.comparison.derived
-        return (self.params, self.comparison, self.origin,
-                list(d.warnings) + run_warnings(self.comparison) + comparator_notes(self.comparison))
+    def _export_state(self) -> Comparison:
+        """The simulated case, if it is what the page shows; else ExportRefusedError saying what differs."""
+        try:
+            shown = self.inputs.collect()
+        except ValueError as exc:
+            raise ExportRefusedError(f"The inputs shown are not valid, so nothing was exported: {exc}") from None
+        changed = uncommitted(shown, self.comparison.derived.params)
+        if changed:
+            raise ExportRefusedError("Inputs edited but not simulated — press Simulate (or wait for the run in "
+                                     "progress), then export. Not committed: " + "; ".join(changed))
+        return self.comparison
 
     def close(self) -> None:
         """Stop the worker and the replay (client disconnected)."""

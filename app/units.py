@@ -125,7 +125,6 @@ ALIASES: dict[str, dict[str, Alias]] = {
 #: Keys needing more than one field to convert (Ke needs the pole pairs).
 KE_KEY = "Ke_Vrms_krpm"
 
-
 def kt_nm_per_arms_to_psi_pm(Kt_Nm_Arms: float, p: int) -> float:
     """Torque constant Kt [N·m per A_rms] → Ψ_PM [Wb] (amplitude-invariant dq, i_d = 0).
 
@@ -143,3 +142,17 @@ def psi_pm_to_kt_nm_per_arms(psi_pm: float, p: int) -> float:
 def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
     """Ψ_PM [Wb] → Ke [V_rms line-to-line per krpm]; inverse of :func:`ke_vrms_krpm_to_psi_pm`."""
     return psi_pm * p * rpm_to_rad_s(1000.0) / math.sqrt(2.0 / 3.0)
+
+
+#: SI unit of every input field of the position-drive parameter model (control/params.py), as
+#: written in exported parameter files (``units`` section).
+SI_UNITS: dict[str, dict[str, str]] = {
+    "motor": {"V_0": "V", "P_r": "W", "omega_b": "rad/s", "Gamma_max": "N·m", "psi_pm": "Wb", "L_d": "H",
+              "L_q": "H", "R_s": "Ω", "p": "-", "J_r": "kg·m²"},
+    "load": {"J_L": "kg·m²", "F_v": "N·m·s/rad", "Gamma_Le": "N·m", "steps": "t: s, Gamma_Le: N·m",
+             "Gamma_Le_ramp": "N·m/s"},
+    "controller": {"T_si": "s", "T_salpha": "s", "T_so": "s", "K": "s/rad", "T_c": "s or 'T_a'",
+                   "alpha_max_rule": "-", "f_s": "Hz or 'continuous'", "delay_samples": "samples",
+                   "V_dc": "V", "i_max": "A"},
+    "manoeuvre": {"theta_dem": "rad", "T_m": "s"},
+}

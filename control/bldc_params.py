@@ -214,7 +214,8 @@ class BldcScenario:
         times = [s.t for s in steps]
         if times != sorted(times) or any(t >= self.t_end for t in times):
             raise ParameterError(
-                f"scenario.cases.T_L_steps times = {times} must increase and stay below t_end = {self.t_end} s"
+                f"scenario.cases.T_L_steps times = {times} s are out of order or too late: allowed increasing "
+                f"times below t_end = {self.t_end} s"
             )
         object.__setattr__(self, "T_L_steps", steps)
 

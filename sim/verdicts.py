@@ -12,7 +12,7 @@ import math
 from control.derivations import Derived
 from control.loop_analysis import ZETA_SLOPE_MIN
 from control.model import available_voltage
-from sim.engine import Comparison, RunResult
+from sim.engine import Comparison, RunResult, reached_target
 
 NAMES = {"fdsmc": "FDSMC", "conventional": "Conventional"}
 
@@ -153,6 +153,11 @@ def _saving_verdicts(comparison: Comparison) -> list[str]:
     its target, is not a saving: say so."""
     saving, bound = comparison.saving_friction_pct, comparison.derived.energy.bound_pct
     if saving is None:
+        never = [r for r in (comparison.fdsmc, comparison.conventional)
+                 if r is not None and r.metrics["stable"] and not reached_target(r)]
+        if never:
+            return [f"Saving not comparable: {', '.join(NAMES[r.controller] for r in never)} never reached the "
+                    "2 % band around θ_dem, so no saving is given."]
         return []
     out: list[str] = []
     missed = [r for r in (comparison.fdsmc, comparison.conventional) if r is not None and _target_missed(r)]

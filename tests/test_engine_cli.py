@@ -50,16 +50,19 @@ def test_simulate_unstable_reports_reason_not_numbers(capsys):
     assert "conventional" not in out
 
 
-def test_simulate_csv_has_units_row(tmp_path, capsys):
+def test_simulate_csv_is_the_export_format(tmp_path, capsys):
+    """One CSV format: a controller column, one column per signal, units in the header names,
+    numbers from the second row on (no units row, so pandas/Excel read typed columns)."""
     path = tmp_path / "run.csv"
     assert main(["simulate", "paper_12kw_pmsm", "--controller", "fdsmc", "--csv", str(path)]) == 0
     text = capsys.readouterr().out
     assert "chatter" in text  # the paper's K = 1000 is flagged in the summary
     with path.open() as fh:
         rows = list(csv.reader(fh))
-    assert rows[0][:3] == ["t", "theta_r", "omega_r"] and rows[1][:3] == ["s", "rad", "rad/s"]
+    assert rows[0][:4] == ["controller", "t [s]", "theta_r [rad]", "omega_r [rad/s]"]
+    assert rows[1][0] == "fdsmc" and float(rows[1][1]) == 0.0
     assert len(rows) > 1000
-    assert float(rows[-1][1]) == pytest.approx(60.0, rel=0.02)
+    assert float(rows[-1][2]) == pytest.approx(60.0, rel=0.02)
 
 
 def test_table1_json_rows(capsys):

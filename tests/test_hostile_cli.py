@@ -34,7 +34,7 @@ def _fails(argv: list[str], capsys: pytest.CaptureFixture[str], *needles: str) -
 
 @pytest.mark.parametrize(("override", "needles"), [
     ("controller.T_so=1e-200", ("controller.T_so = 1e-200", "allowed 1e-06 ≤ value ≤ 10")),
-    ("motor.P_r=1e171", ("motor.P_r = 1e+171", "allowed 0 < value ≤ 1e+08")),
+    ("motor.P_r=1e171", ("motor.P_r = 1e+171", "allowed 0.001 ≤ value ≤ 1e+08")),
     ("motor.J_r=1e-300", ("motor.J_r = 1e-300", "allowed 1e-09 ≤ value")),
     ("manoeuvre.theta_dem=5e-324", ("manoeuvre.theta_dem = 5e-324", "allowed 1e-06 ≤ |value|")),
     ("motor.omega_b=1e300", ("motor.omega_b = 1e+300", "allowed 0 < value ≤ 100000")),

@@ -138,7 +138,7 @@ def test_yaml_safety_and_size():
     with pytest.raises(PresetError):
         loads_preset("!!python/object/apply:os.system ['true']")
     with pytest.raises(PresetError, match="schema"):
-        loads_preset("schema: 2\n")
+        loads_preset("schema: 3\n")
 
 
 def test_load_steps_parse():

@@ -43,6 +43,15 @@ def served() -> Iterator[tuple[str, object, object]]:
         server.stop()
 
 
+def _run(coro_fn) -> object:
+    """Run a coroutine on its own thread (the browser tests leave an event loop on the main one)."""
+    box: list[object] = []
+    t = threading.Thread(target=lambda: box.append(asyncio.run(coro_fn())))
+    t.start()
+    t.join(120)
+    return box[0] if box else None
+
+
 def _ws_status(hostport: str, origin: str | None, headers: dict[str, str] | None = None,
                path: str = "/") -> str:
     async def go() -> str:
@@ -53,7 +62,7 @@ def _ws_status(hostport: str, origin: str | None, headers: dict[str, str] | None
         except websockets.exceptions.InvalidStatus as exc:
             return str(exc.response.status_code)
 
-    return asyncio.run(go())
+    return _run(go)
 
 
 def _http_status(url: str, headers: dict[str, str] | None = None) -> tuple[int, str]:
@@ -140,7 +149,7 @@ def _send_update(hostport: str, config: object, handle_of: str, value: str) -> o
                 await asyncio.sleep(0.05)
             done.set()
 
-    asyncio.run(go())
+    _run(go)
     assert done.is_set()
     return session_box[0]
 

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import io
 import re
+import zipfile
 from pathlib import Path
+
+from playwright.sync_api import expect
 
 from app.presets import PAPER_PRESET, dumps_preset, load_preset, loads_preset
 from control.derivations import derive
@@ -64,10 +68,20 @@ def test_invalid_value_shows_message_and_simulates_nothing(page, ui_server):
     assert _phase_omega_p(page) == before
 
 
-def _download(page, label: str) -> str:
+def _download(page, label: str) -> tuple[str, bytes]:
     with page.expect_download() as info:
         page.get_by_role("button", name=label).click()
-    return Path(info.value.path()).read_text(encoding="utf-8")
+    return info.value.suggested_filename, Path(info.value.path()).read_bytes()
+
+
+def _set_text(page, label: str, value: str) -> None:
+    """Type into the text field labelled ``label`` and wait until it shows the text."""
+    box = page.locator(f'xpath=//label[normalize-space(.)="{label}"]/ancestor::*[.//input or .//textarea][1]'
+                       '//*[self::input or self::textarea]').first
+    box.fill(value)
+    box.press("Tab")
+    expect(box).to_have_value(value)
+    page.wait_for_timeout(120)  # viser throttles GUI messages to one per 50 ms
 
 
 def test_import_export_round_trip_and_c_header(page, tmp_path):
@@ -78,16 +92,40 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
         load=dataclasses.replace(params.load, F_v=0.3333333333333333))
     path = tmp_path / "imported_case.yaml"
     path.write_text(dumps_preset(uploaded), encoding="utf-8")
-    page.locator("input[type=file]").set_input_files(str(path))
+    page.locator("input[type=file][accept*='.yaml']").set_input_files(str(path))
     _wait_phase_omega_p(page, derive(uploaded).profile.omega_p)
     assert field(page, "T_m manoeuvre time [s]").input_value() == "1.8"
     page.get_by_text("Export", exact=True).click()
-    exported = _download(page, "Drive parameters (YAML)")
-    assert loads_preset(exported, "export.yaml") == uploaded
-    header = _download(page, "C header for firmware")
-    match = re.search(r"#define FDSMC_OMEGA_P\s+\(([^)]+)\)", header)
+    name, exported = _download(page, "Drive parameters (YAML)")
+    assert name == "imported_case.yaml" and loads_preset(exported.decode(), "export.yaml") == uploaded
+    name, archive = _download(page, "C controller module (.h + .c, zip)")
+    assert name == "imported_case_fdsmc_controller.zip"
+    with zipfile.ZipFile(io.BytesIO(archive)) as zf:
+        assert sorted(zf.namelist()) == ["fdsmc_controller.c", "fdsmc_controller.h"]
+        header = zf.read("fdsmc_controller.h").decode()
+    assert "Drive: imported_case" in header and "Source: browser test" in header
+    match = re.search(r"#define FDSMC_OMEGA_P\s+\(\(fdsmc_real\)([^)]+)\)", header)
     assert match is not None
     assert abs(float(match.group(1)) - derive(uploaded).profile.omega_p) <= 1e-12 * float(match.group(1))
+    _set_text(page, "Name (file name)", "acme servo axis 2")  # name and source say what the motor is
+    _set_text(page, "Source", "ACME data sheet")
+    name, exported = _download(page, "Drive parameters (JSON)")
+    assert name == "acme_servo_axis_2.json"
+    assert loads_preset(exported.decode(), name) == dataclasses.replace(
+        uploaded, name="acme servo axis 2", source="ACME data sheet")
+
+
+def test_export_of_edited_but_unsimulated_inputs_is_refused(page):
+    """An export describes the inputs shown: after an edit without Simulate it is refused with a
+    message naming the uncommitted field, and nothing is downloaded."""
+    set_number(page, "T_m manoeuvre time [s]", 1.4)
+    page.get_by_text("Export", exact=True).click()
+    downloads: list[object] = []
+    page.on("download", lambda d: downloads.append(d))
+    page.get_by_role("button", name="Drive parameters (YAML)").click()
+    note = page.get_by_text(re.compile(r"Not committed: manoeuvre\.T_m = 1\.4 \(simulated: 1\.0\)"))
+    note.wait_for(timeout=10000)
+    assert downloads == []
 
 
 def test_two_browser_contexts_keep_separate_values(browser, ui_server):
