@@ -23,6 +23,9 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "serve": ("app.serve", "start the commissioning web UI"),
     "bldc": ("app.cli_bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
     "log": ("app.cli_log", "import a drive log: overlay on the simulation, identify the motor and load"),
+    "multiaxis": ("app.cli_multiaxis", "axes that must finish together: common T_m, designs, energies"),
+    "dutycycle": ("app.cli_duty", "a duty cycle of moves with dwells: energy per cycle and per year"),
+    "robustness": ("app.cli_robustness", "Monte-Carlo robustness to plant values the controller does not know"),
 }
 
 

@@ -10,9 +10,9 @@ from typing import Any
 from app.cli import add_preset_arguments, check_writable
 from app.derived_view import derived_json
 from app.exports import trace_csv
-from app.preset_modes import load_mode_preset
+from app.plant import load_model_and_plant
 from control.params import ParameterError
-from sim.engine import Comparison, compare
+from sim.engine import Comparison, RunResult, compare
 from sim.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
@@ -42,8 +42,9 @@ SUMMARY = (
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``simulate``."""
     add_preset_arguments(p)
-    p.add_argument("--controller", choices=("fdsmc", "conventional", "both"), default="both",
-                   help="which controller(s) to simulate (default both)")
+    p.add_argument("--controller", choices=("fdsmc", "conventional", "optimum", "both", "all"), default="all",
+                   help="which run(s): both = FDSMC and conventional, all = both and the tracked "
+                        "minimum-energy optimum (default all)")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
     p.add_argument("--csv", metavar="FILE", help="write the time series (CSV: controller column, units in the headers)")
 
@@ -59,12 +60,35 @@ def finite_or_none(value: Any) -> Any:
     return value
 
 
+#: Energy compared with the optimum: the net electrical input over the whole simulated horizon.
+OPTIMUM_BASIS = "electrical_in_total_J"
+
+
+def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float | None:
+    """100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save
+    (W = net electrical input over the whole horizon); None unless both runs are stable."""
+    if run is None or optimum is None or not (run.metrics["stable"] and optimum.metrics["stable"]):
+        return None
+    w, w_opt = run.metrics[OPTIMUM_BASIS], optimum.metrics[OPTIMUM_BASIS]
+    if not isinstance(w, float) or not isinstance(w_opt, float) or w <= 0.0:
+        return None
+    return 100.0 * (1.0 - w_opt / w)
+
+
 def comparison_json(cmp: Comparison) -> dict[str, Any]:
-    """The stable JSON contract of ``simulate --json``."""
+    """The stable JSON contract of ``simulate --json``.
+
+    Each run's entry holds its metrics; with the optimum run, the ``fdsmc`` and ``conventional``
+    entries gain ``saving_vs_optimum_pct`` (see :func:`saving_vs_optimum`).
+    """
     out: dict[str, Any] = {"derived": derived_json(cmp.derived)}
-    for run in (cmp.fdsmc, cmp.conventional):
+    for run in (cmp.fdsmc, cmp.conventional, cmp.optimum):
         if run is not None:
             out[run.controller] = dict(run.metrics)
+    if cmp.optimum is not None:
+        for run in (cmp.fdsmc, cmp.conventional):
+            if run is not None:
+                out[run.controller]["saving_vs_optimum_pct"] = saving_vs_optimum(run, cmp.optimum)
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["run_warnings"] = run_warnings(cmp)
@@ -91,7 +115,7 @@ def _fmt(v: Any) -> str:
 
 def print_summary(cmp: Comparison) -> None:
     """Side-by-side table of the runs, savings, warnings and explanations."""
-    runs = [r for r in (cmp.fdsmc, cmp.conventional) if r is not None]
+    runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None]
     p = cmp.derived.params
     print(f"Preset: {p.name}  T_m = {p.manoeuvre.T_m:g} s, θ_dem = {p.manoeuvre.theta_dem:g} rad, "
           f"f_s = {p.controller.f_s}, K = {p.controller.K:g} s/rad\n")
@@ -104,6 +128,11 @@ def print_summary(cmp: Comparison) -> None:
         print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
               f"(eq. (52) predicts {_fmt(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
         print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
+    for run in (cmp.fdsmc, cmp.conventional):
+        gap = saving_vs_optimum(run, cmp.optimum)
+        if run is not None and gap is not None:
+            print(f"The tracked minimum-energy optimum would save {gap:.2f} % of the {run.controller}'s "
+                  "net electrical input (whole run)")
     for w in run_warnings(cmp) + list(cmp.derived.warnings) + comparator_notes(cmp):
         print(f"  ! {w}")
 
@@ -112,9 +141,10 @@ def run(args: argparse.Namespace) -> int:
     """Simulate and print (table or JSON); optionally write the CSV."""
     if args.csv:
         check_writable(args.csv, "--csv")
-    params = load_mode_preset(args.preset, args.overrides, mode="position")
-    ctrls = ("fdsmc", "conventional") if args.controller == "both" else (args.controller,)
-    cmp = compare(params, ctrls)
+    params, plant = load_model_and_plant(args.preset, args.overrides)
+    ctrls = {"both": ("fdsmc", "conventional"), "all": ("fdsmc", "conventional", "optimum")}.get(
+        args.controller, (args.controller,))
+    cmp = compare(params, ctrls, plant=plant)
     if args.csv:
         write_csv(args.csv, cmp)
     if args.json:

@@ -63,6 +63,17 @@ def conventional_demand(theta_dem: float, theta_hat: float, omega_hat: float, g1
     return g1 * (theta_dem - theta_hat) - g2 * omega_hat
 
 
+@jitable
+def tracking_demand(theta_ref: float, omega_ref: float, alpha_ref: float, theta_hat: float, omega_hat: float,
+                    g1: float, g2: float) -> float:
+    """α_ref + g1·(θ_ref − θ̂_r) + g2·(ω_ref − ω̂_r) [rad/s²]: eq. (62) sign-corrected acting on the
+    error from a time-varying reference move, its acceleration fed forward (numba-compilable).
+
+    With θ_ref = θ_rdem constant and ω_ref = α_ref = 0 it is :func:`conventional_demand`.
+    """
+    return alpha_ref + g1 * (theta_ref - theta_hat) + g2 * (omega_ref - omega_hat)
+
+
 def friction_energy_conventional(F_v: float, delta_theta: float, T_m: float) -> float:
     """Frictional energy of the ideal critically damped step response, F_v·Δθ²·a/4 [J].
 

@@ -22,13 +22,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.derivations import Derived, derive
-from control.model import torque_constant
+from control.model import model_coefficients, torque_constant
 from control.params import DriveParams, ParameterError
 from sim import budget
 from sim import kernel as kn
 from sim.metrics import CHATTER_MAX_WINDOW_S, WindowSamples, chatter_window_steps, chatter_windows, run_metrics
 
 CONTROLLERS = ("fdsmc", "conventional")
+#: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
+#: (:mod:`control.optimum`); the kernel's P_CTRL is the index in this tuple.
+COMPARATORS = CONTROLLERS + ("optimum",)
 #: Simulated horizon beyond T_m, as a fraction of T_m [-].
 TAIL_FRACTION = 0.3
 #: RK4 step of continuous mode [s]; friction energies converged to < 0.05 % (see tests).
@@ -94,6 +97,7 @@ class Comparison:
 
     ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
     ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
+    ``optimum`` is the tracked minimum-energy move, when asked for.
     """
 
     derived: Derived
@@ -101,6 +105,7 @@ class Comparison:
     conventional: RunResult | None
     saving_friction_pct: float | None
     saving_electrical_pct: float | None
+    optimum: RunResult | None = None
 
 
 @dataclass(frozen=True)
@@ -215,17 +220,27 @@ def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budg
     return budget.check(cost, what, _cost_drivers(params, request))
 
 
-def pack_parameters(params: DriveParams, d: Derived, controller: str) -> np.ndarray:
-    """The kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.kernel`)."""
-    c, m, ld, ctrl = d.coefficients, params.motor, params.load, params.controller
+def pack_parameters(params: DriveParams, d: Derived, controller: str,
+                    plant: DriveParams | None = None) -> np.ndarray:
+    """The kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.kernel`).
+
+    ``params``/``d`` are the controller's model; ``plant`` (default: the same) gives the true
+    motor and load values the simulated drive has (R_s, L_d, L_q, Ψ_PM, p, J_r, J_L, F_v, Γ_Le).
+    """
+    c, ctrl = d.coefficients, params.controller
+    pl = params if plant is None else plant
+    m, ld, cp = pl.motor, pl.load, c if plant is None else model_coefficients(pl.motor)
     prm = np.zeros(kn.N_PRM)
     for name, idx in zip("ABCDEFGHKM", (kn.P_A, kn.P_B, kn.P_C, kn.P_D, kn.P_E, kn.P_F, kn.P_G,
                                          kn.P_H, kn.P_K, kn.P_M), strict=True):
         prm[idx] = getattr(c, name)
+    for name, idx in zip("ABCDEFG", (kn.P_PA, kn.P_PB, kn.P_PC, kn.P_PD, kn.P_PE, kn.P_PF, kn.P_PG),
+                         strict=True):
+        prm[idx] = getattr(cp, name)
     prm[[kn.P_RS, kn.P_LD, kn.P_LQ, kn.P_PSI, kn.P_P, kn.P_JR]] = (
         m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, m.J_r)
-    prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (params.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
-    prm[kn.P_CTRL] = CONTROLLERS.index(controller)
+    prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (pl.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
+    prm[kn.P_CTRL] = COMPARATORS.index(controller)
     pr, o = d.profile, d.observer
     prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
@@ -233,6 +248,7 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str) -> np.ndar
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
     prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), ctrl.i_max)  # 0 = no limit
     prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
+    m = params.motor
     w_scale = max(m.omega_b, pr.omega_p, abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
     i_scale = max(m.Gamma_max, d.alpha.torque_needed) / torque_constant(m)
     prm[[kn.P_WLIM, kn.P_ILIM]] = (20.0 * w_scale, 100.0 * i_scale)
@@ -253,8 +269,18 @@ def _load_steps(params: DriveParams) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _check_controller(controller: str) -> None:
-    if controller not in CONTROLLERS:
-        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(CONTROLLERS)}")
+    if controller not in COMPARATORS:
+        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(COMPARATORS)}")
+
+
+def _reference(d: Derived, controller: str) -> np.ndarray:
+    """The kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
+    if controller != "optimum":
+        return np.zeros((3, 2))
+    from control.optimum import tracked_move  # imports cvxpy only when limits are active
+
+    mv = tracked_move(d)
+    return np.ascontiguousarray(np.vstack((mv.theta, mv.omega, mv.alpha)))
 
 
 def _check_feasible(d: Derived) -> None:
@@ -273,6 +299,7 @@ def simulate(
     n_sub: int = 1,
     h_continuous: float = CONTINUOUS_STEP_S,
     max_points: int = MAX_POINTS,
+    plant: DriveParams | None = None,
 ) -> RunResult:
     """Simulate one rest-to-rest manoeuvre with the FDC inner loops and the chosen outer loop.
 
@@ -281,7 +308,8 @@ def simulate(
     params : DriveParams
         The commissioning case.
     controller : str
-        ``"fdsmc"`` (eqs. 41–46 in [1]) or ``"conventional"`` (eq. 62 sign-corrected).
+        ``"fdsmc"`` (eqs. 41–46 in [1]), ``"conventional"`` (eq. 62 sign-corrected) or
+        ``"optimum"`` (the minimum-energy move of :mod:`control.optimum`, tracked).
     derived : Derived or None
         ``derive(params)`` if already computed.
     n_sub : int
@@ -290,6 +318,9 @@ def simulate(
         Largest RK4 step in continuous mode [s] (see :func:`continuous_step`).
     max_points : int
         Most trace points kept [-].
+    plant : DriveParams or None
+        The drive's true motor and load values when they differ from the controller's model
+        ``params`` (see :func:`pack_parameters`); None: the plant is the model.
 
     Returns
     -------
@@ -306,8 +337,8 @@ def simulate(
     d = derive(params) if derived is None else derived
     _check_feasible(d)
     g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
-    prm = pack_parameters(params, d, controller)
-    step_t, step_v = _load_steps(params)
+    prm = pack_parameters(params, d, controller, plant)
+    step_t, step_v = _load_steps(params if plant is None else plant)
     Phi, Gam, Lo = _observer_arrays(d)
     out = np.zeros((kn.N_CH, g.n_out))
     info = np.zeros(kn.N_INFO)
@@ -317,11 +348,11 @@ def simulate(
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
     win = np.zeros((2 * len(steps), max(n for _, n in steps)))
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
-                  params.controller.delay_samples, g.decim, out, info, k_win, win)
+                  params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller))
     trace = _trace(out[:, : int(info[kn.I_NOUT])])
     samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, win[2 * j, :n], win[2 * j + 1, :n])
                for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
-    met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, info)
+    met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, info, plant)
     return RunResult(controller, trace, met)
 
 
@@ -348,7 +379,7 @@ def run_steps(
     info = np.zeros(kn.N_INFO)
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
                   params.controller.delay_samples, int(n_steps) + 1, out, info,
-                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)))
+                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller))
     return info[kn.I_END: kn.I_END + kn.N_X].copy()
 
 
@@ -377,7 +408,7 @@ def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:
 
 def compare(
     params: DriveParams, controllers: tuple[str, ...] = CONTROLLERS, derived: Derived | None = None,
-    **options: float,
+    plant: DriveParams | None = None, **options: float,
 ) -> Comparison:
     """Simulate both controllers on the same case (thread-safe; the kernel releases the GIL).
 
@@ -385,9 +416,11 @@ def compare(
     ----------
     params : DriveParams
     controllers : tuple of str
-        Any of ``"fdsmc"``, ``"conventional"``.
+        Any of ``"fdsmc"``, ``"conventional"``, ``"optimum"``.
     derived : Derived or None
         ``derive(params)`` if already computed.
+    plant : DriveParams or None
+        The drive's true values (see :func:`simulate`); None: the controller's model.
     **options
         Passed to :func:`simulate` (``n_sub``, ``h_continuous``, ``max_points``).
 
@@ -404,12 +437,13 @@ def compare(
     runs: dict[str, RunResult] = {}
     if len(controllers) > 1:
         with ThreadPoolExecutor(max_workers=len(controllers)) as pool:
-            futures = {c: pool.submit(simulate, params, c, d, **options) for c in controllers}
+            futures = {c: pool.submit(simulate, params, c, d, plant=plant, **options) for c in controllers}
             runs = {c: f.result() for c, f in futures.items()}
     else:
-        runs = {c: simulate(params, c, d, **options) for c in controllers}
+        runs = {c: simulate(params, c, d, plant=plant, **options) for c in controllers}
     f, c = runs.get("fdsmc"), runs.get("conventional")
-    return Comparison(d, f, c, _saving(f, c, "friction_J"), _saving(f, c, "electrical_in_total_J"))
+    return Comparison(d, f, c, _saving(f, c, "friction_J"), _saving(f, c, "electrical_in_total_J"),
+                      runs.get("optimum"))
 
 
 def table1_sweep(

@@ -9,7 +9,9 @@ agree. Formulas (see [1], the FDSMC paper):
 * FDC: eqs. (7), (9), (10), (14) with ω̂_r, L̂0, L̂1 from the observer;
 * observer: eq. (15) corrected (e_o = θ_r − θ̂_r, dθ̂/dt = ω̂ + K1·e_o); digital mode uses the
   ZOH-exact prediction form x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·e_o[k];
-* outer loop: eqs. (41)–(46) (FDSMC) or eq. (62) sign-corrected (conventional);
+* outer loop: eqs. (41)–(46) (FDSMC), eq. (62) sign-corrected (conventional), or tracking of a
+  reference move (θ_ref, ω_ref, α_ref) — the minimum-energy optimum — by α_ref fed forward plus
+  the gains of eq. (61) on the tracking error;
 * energies as extra states of the same RK4 integration, so that the balance closes.
 """
 
@@ -26,7 +28,10 @@ from control import conventional, fdc, inverter, sliding_mode
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
  P_FV, P_TSI, P_TSA, P_CTRL, P_THDEM, P_OMP, P_TC, P_KB, P_AMAX, P_G1, P_G2, P_K1, P_K2, P_K3,
  P_K4, P_UMAX, P_IMAX, P_TM, P_GLE0, P_GRAMP, P_WLIM, P_ILIM) = range(39)
-N_PRM = 39
+# The plant's own coefficients A…G of eqs. (1)–(2) (its true R_s, L_d, L_q, Ψ_PM): P_A…P_G are the
+# controller's model of them. P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT, P_FV are the plant's.
+(P_PA, P_PB, P_PC, P_PD, P_PE, P_PF, P_PG) = range(39, 46)
+N_PRM = 46
 
 # ---- state indices -----------------------------------------------------------------------
 (X_ID, X_IQ, X_TH, X_W, X_EF, X_ECU, X_EEL, X_EMOT, X_ELOAD, X_THH, X_WH, X_L0, X_L1) = range(13)
@@ -64,8 +69,27 @@ def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) 
 
 
 @_helper
-def outer_law(theta_hat: float, omega_hat: float, prm: np.ndarray) -> tuple[float, float]:
-    """Demanded acceleration [rad/s²] and S [rad/s]: eqs. (44)–(46) or (62) of :mod:`control`."""
+def reference_at(t: float, ref: np.ndarray, T_m: float) -> tuple[float, float, float]:
+    """θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] at t [s], linear between the rows of ``ref``
+    (equally spaced nodes over [0, T_m]); the final node's θ at rest after T_m."""
+    n = ref.shape[1]
+    if t >= T_m:
+        return ref[0, n - 1], 0.0, 0.0
+    x = max(t, 0.0) / T_m * (n - 1)
+    j = min(int(x), n - 2)
+    f = x - j
+    return ((1.0 - f) * ref[0, j] + f * ref[0, j + 1], (1.0 - f) * ref[1, j] + f * ref[1, j + 1],
+            (1.0 - f) * ref[2, j] + f * ref[2, j + 1])
+
+
+@_helper
+def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
+              ref: np.ndarray) -> tuple[float, float]:
+    """Demanded acceleration [rad/s²] and S [rad/s]: eqs. (44)–(46), (62), or the reference tracking
+    law :func:`control.conventional.tracking_demand` (``P_CTRL`` = 2), all of :mod:`control`."""
+    if prm[P_CTRL] == 2.0:
+        th_r, w_r, a_r = reference_at(t, ref, prm[P_TM])
+        return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
     if prm[P_CTRL] == 1.0:
         return conventional.conventional_demand(prm[P_THDEM], theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
     return sliding_mode.smc_demand(theta_hat - prm[P_THDEM], omega_hat, prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
@@ -88,9 +112,10 @@ def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: flo
 
 
 @_helper
-def control_output(p: tuple, o: tuple, prm: np.ndarray) -> tuple[float, float, float, float, float, bool]:
+def control_output(t: float, p: tuple, o: tuple, prm: np.ndarray,
+                   ref: np.ndarray) -> tuple[float, float, float, float, float, bool]:
     """u_d, u_q [V], α_dem, α [rad/s²], S [rad/s], saturated, from measured i and estimates."""
-    alpha_dem, S = outer_law(o[0], o[1], prm)
+    alpha_dem, S = outer_law(t, o[0], o[1], prm, ref)
     u_d, u_q, alpha = fdc_voltages(alpha_dem, p[X_ID], p[X_IQ], o[1], o[2], o[3], prm)
     u_d, u_q, sat = limit_voltage(u_d, u_q, p[X_ID], p[X_IQ], o[1], prm)
     return u_d, u_q, alpha_dem, alpha, S, sat
@@ -110,8 +135,8 @@ def plant_rhs(t: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray, step_
     g_le = gamma_le(t, prm, step_t, step_v)
     T_em = electromagnetic_torque(i_d, i_q, prm)
     p_el = 1.5 * (u_d * i_d + u_q * i_q)
-    return (-prm[P_A] * i_d + prm[P_B] * w * i_q + prm[P_F] * u_d,
-            -(prm[P_C] * i_d + prm[P_E]) * w - prm[P_D] * i_q + prm[P_G] * u_q,
+    return (-prm[P_PA] * i_d + prm[P_PB] * w * i_q + prm[P_PF] * u_d,
+            -(prm[P_PC] * i_d + prm[P_PE]) * w - prm[P_PD] * i_q + prm[P_PG] * u_q,
             w,
             (T_em - prm[P_FV] * w - g_le) / prm[P_JT],
             prm[P_FV] * w * w,
@@ -168,20 +193,20 @@ def rk4_plant(t: float, h: float, p: tuple, u_d: float, u_q: float, prm: np.ndar
 
 @_helper
 def full_rhs(t: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
-             step_v: np.ndarray) -> tuple:
+             step_v: np.ndarray, ref: np.ndarray) -> tuple:
     """Continuous mode: plant and observer derivatives with the controller inside."""
-    u_d, u_q, _, _, _, _ = control_output(p, o, prm)
+    u_d, u_q, _, _, _, _ = control_output(t, p, o, prm, ref)
     return plant_rhs(t, p, u_d, u_q, prm, step_t, step_v), observer_rhs(p, o, prm)
 
 
 @_helper
 def rk4_continuous(t: float, h: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
-                   step_v: np.ndarray) -> tuple:
+                   step_v: np.ndarray, ref: np.ndarray) -> tuple:
     """One RK4 step [s] of plant + observer with the controller evaluated in every stage."""
-    a1, b1 = full_rhs(t, p, o, prm, step_t, step_v)
-    a2, b2 = full_rhs(t + 0.5 * h, axpy9(p, 0.5 * h, a1), axpy4(o, 0.5 * h, b1), prm, step_t, step_v)
-    a3, b3 = full_rhs(t + 0.5 * h, axpy9(p, 0.5 * h, a2), axpy4(o, 0.5 * h, b2), prm, step_t, step_v)
-    a4, b4 = full_rhs(t + h, axpy9(p, h, a3), axpy4(o, h, b3), prm, step_t, step_v)
+    a1, b1 = full_rhs(t, p, o, prm, step_t, step_v, ref)
+    a2, b2 = full_rhs(t + 0.5 * h, axpy9(p, 0.5 * h, a1), axpy4(o, 0.5 * h, b1), prm, step_t, step_v, ref)
+    a3, b3 = full_rhs(t + 0.5 * h, axpy9(p, 0.5 * h, a2), axpy4(o, 0.5 * h, b2), prm, step_t, step_v, ref)
+    a4, b4 = full_rhs(t + h, axpy9(p, h, a3), axpy4(o, h, b3), prm, step_t, step_v, ref)
     return rk4_sum9(p, h, a1, a2, a3, a4), rk4_sum4(o, h, b1, b2, b3, b4)
 
 
@@ -248,14 +273,14 @@ def store_state(info: np.ndarray, at: int, p: tuple, o: tuple, w: float, p0: tup
 
 
 @_helper
-def step_sample(p: tuple, o: tuple, hold: tuple, continuous: bool,
-                delay: int, prm: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray):
+def step_sample(t: float, p: tuple, o: tuple, hold: tuple, continuous: bool, delay: int,
+                prm: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray, ref: np.ndarray):
     """Controller (and, digital, the observer update) at one sample or continuous step.
 
     Returns (voltages applied over the step, new observer state, new held voltages, the
     recorded outputs (u_d, u_q, α_dem, α̂, S), saturated flag).
     """
-    u_d, u_q, a_dem, a_hat, S, sat = control_output(p, o, prm)
+    u_d, u_q, a_dem, a_hat, S, sat = control_output(t, p, o, prm, ref)
     if continuous:
         return (u_d, u_q), o, hold, (u_d, u_q, a_dem, a_hat, S), sat
     if delay == 1:
@@ -268,8 +293,11 @@ def step_sample(p: tuple, o: tuple, hold: tuple, continuous: bool,
 def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray,
                Gam: np.ndarray, Lo: np.ndarray, continuous: bool, h: float, n_steps: int,
                n_sub: int, delay: int, decim: int, out: np.ndarray, info: np.ndarray,
-               k_win: np.ndarray, win: np.ndarray) -> None:
+               k_win: np.ndarray, win: np.ndarray, ref: np.ndarray) -> None:
     """Integrate one run from rest; fills ``out`` (N_CH × samples) and ``info`` (I_* indices).
+
+    ``ref`` (3 × n: θ_ref, ω_ref, α_ref on equally spaced nodes over [0, T_m]) is read only by the
+    reference-tracking outer law (``prm[P_CTRL]`` = 2); pass a 3 × 2 array of zeros otherwise.
 
     For each window j, rows 2j and 2j + 1 of ``win`` receive α_dem and ω_r of every step
     k_win[j] … k_win[j] + n − 1 at full resolution (the chatter test's windows, independent of
@@ -284,7 +312,7 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
     n_out, t, t_sat, T_m, hit = 0, 0.0, 0.0, prm[P_TM], False
     info[:] = 0.0
     for k in range(n_steps):
-        u, o_next, hold, rec, sat = step_sample(p, o, hold, continuous, delay, prm, Phi, Gam, Lo)
+        u, o_next, hold, rec, sat = step_sample(t, p, o, hold, continuous, delay, prm, Phi, Gam, Lo, ref)
         if k % decim == 0 and n_out < out.shape[1]:
             record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
             n_out += 1
@@ -296,7 +324,7 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
         p0, o, t0 = p, o_next, t
         for _ in range(n_sub):
             if continuous:
-                p, o = rk4_continuous(t, h, p, o, prm, step_t, step_v)
+                p, o = rk4_continuous(t, h, p, o, prm, step_t, step_v, ref)
             else:
                 p = rk4_plant(t, h, p, u[0], u[1], prm, step_t, step_v)
             t += h

@@ -172,7 +172,7 @@ def chatter_windows(
     t_end : float  End of the simulated horizon [s].
     """
     T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
-    if controller == "conventional":
+    if controller != "fdsmc":  # the conventional law and the tracked optimum: no cruise segment
         t0, t1 = 0.2 * T_m, T_m
     else:
         cruise = T_m - 4.0 * T_a
@@ -201,17 +201,18 @@ def chatter_window_steps(window: tuple[float, float], T_step: float, n_steps: in
 
 def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
-    samples: dict[str, WindowSamples], info: np.ndarray,
+    samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None,
 ) -> dict[str, float | bool | str | None]:
     """All metrics of one run from the (decimated) trace, the full-resolution chatter-window
     ``samples`` and the kernel's ``info`` vector.
 
     Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
-    every number becomes None, ``stable`` False and ``reason`` says why.
+    every number becomes None, ``stable`` False and ``reason`` says why. Stored energies use the
+    ``plant``'s true values when given.
     """
     failed = bool(info[kn.I_FAILED])
     met: dict[str, float | bool | str | None] = {}
-    energies = energy_metrics(params, info)
+    energies = energy_metrics(params if plant is None else plant, info)
     theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
     resp = response_metrics(t, theta_r, params.manoeuvre.theta_dem, theta_Tm)
     verdicts = {name: detect_chatter(s.t, s.alpha_dem, s.omega_r, s.window, d.alpha.alpha_max)

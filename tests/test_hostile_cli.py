@@ -131,10 +131,11 @@ def test_substeps_count_in_the_budget_and_are_refused_before_work(monkeypatch, c
                  "motor.p = 100 → largest accepted")
     p = load_preset("paper_12kw_pmsm", ["motor.omega_b=1e5", "motor.p=100"])
     best = float(err.split("motor.omega_b = 100000 rad/s → largest accepted ")[1].split()[0])
-    assert engine.check_budget(dataclasses.replace(p, motor=dataclasses.replace(p.motor, omega_b=best)), 2).fits
+    runs = len(engine.COMPARATORS)  # simulate runs the FDSMC, the conventional law and the optimum
+    assert engine.check_budget(dataclasses.replace(p, motor=dataclasses.replace(p.motor, omega_b=best)), runs).fits
     over = dataclasses.replace(p, motor=dataclasses.replace(p.motor, omega_b=best * 1.01))
     with pytest.raises(budget.BudgetError):
-        engine.check_budget(over, 2)
+        engine.check_budget(over, runs)
 
 
 def test_budget_counts_every_substep_exactly():
