@@ -22,7 +22,8 @@ from app import units
 from app.numbers import NumberFormatError
 from app.presets import parse_preset, to_raw
 from app.ui_numbers import NumberInput
-from control.params import DriveParams
+from app.ui_text import checked_choice
+from control.params import DriveParams, ParameterError
 
 Conv = Callable[[float, int], float]  # (value, pole pairs) → value
 
@@ -121,6 +122,8 @@ FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("controller", "Inver
            ("manoeuvre", "Manoeuvre"))
 TC_RULES = ("T_c = T_a, eq. (59)", "T_c given below")
 FS_MODES = ("digital, sampled at f_s", "continuous")
+ALPHA_RULES = ("torque_limit", "paper")
+DELAYS = ("0", "1")
 #: Optional datasheet values used only to cross-check the nameplate (label → key).
 CHECKS = (("Kt datasheet [N·m/A_rms] (optional check)", "Kt"), ("T_N rated torque [N·m] (optional check)", "T_N"))
 
@@ -188,12 +191,12 @@ class InputsPanel:
         elif section == "controller":
             self.tc_rule = gui.add_dropdown("T_c rule", TC_RULES)
             self.tc_ms = NumberInput(gui, "T_c sliding time const. [ms]")
-            self.alpha_rule = gui.add_dropdown("α_max rule", ("torque_limit", "paper"),
+            self.alpha_rule = gui.add_dropdown("α_max rule", ALPHA_RULES,
                                                hint="torque_limit: largest α within Γ_max/i_max incl. friction, "
                                                     "load and inner-loop overshoot; paper: α_max = H·P_r/V_0")
             self.fs_mode = gui.add_dropdown("Controller", FS_MODES)
             self.fs_khz = NumberInput(gui, "f_s sample rate [kHz]")
-            self.delay = gui.add_dropdown("Computation delay [samples]", ("0", "1"))
+            self.delay = gui.add_dropdown("Computation delay [samples]", DELAYS)
 
     # ---- units --------------------------------------------------------------------------------
     def _unit(self, f: Field) -> Unit | None:
@@ -217,9 +220,11 @@ class InputsPanel:
             values = {f.key: self._read(f) for f in fields}
         except InputError:
             values = {}  # unparsable text stays as typed; it is reported on Simulate
-        label = self.selectors[group].value
+        label, offered = self.selectors[group].value, [u.label for u in UNIT_GROUPS[group]]
+        if label not in offered:  # never offered: refused on Simulate by collect()
+            return
         for g in groups:
-            idx = [u.label for u in UNIT_GROUPS[group]].index(label)
+            idx = offered.index(label)
             self._choice[g] = UNIT_GROUPS[g][idx]
         for f in fields:
             self.numbers[f.key].label = f.text(self._unit(f))
@@ -294,15 +299,18 @@ class InputsPanel:
             raw[f.section][f.name] = self._read(f)
         raw["load"]["steps"] = parse_steps(self.steps.value)
         c = raw["controller"]
-        try:
-            c["T_c"] = "T_a" if self.tc_rule.value == TC_RULES[0] else self.tc_ms.read(
-                "Controller › T_c [ms]", units.ms_to_s)
-            c["f_s"] = "continuous" if self.fs_mode.value == FS_MODES[1] else self.fs_khz.read(
+        try:  # dropdown values are checked against the options offered (a client may send anything)
+            tc_rule = checked_choice(self.tc_rule.value, TC_RULES, "T_c rule")
+            fs_mode = checked_choice(self.fs_mode.value, FS_MODES, "Controller")
+            c["alpha_max_rule"] = checked_choice(self.alpha_rule.value, ALPHA_RULES, "α_max rule")
+            c["delay_samples"] = int(checked_choice(self.delay.value, DELAYS, "Computation delay"))
+            for group, _title in SELECTORS:
+                checked_choice(self.selectors[group].value, [u.label for u in UNIT_GROUPS[group]], _title)
+            c["T_c"] = "T_a" if tc_rule == TC_RULES[0] else self.tc_ms.read("Controller › T_c [ms]", units.ms_to_s)
+            c["f_s"] = "continuous" if fs_mode == FS_MODES[1] else self.fs_khz.read(
                 "Controller › f_s [kHz]", units.kHz_to_Hz)
-        except NumberFormatError as exc:
+        except (NumberFormatError, ParameterError) as exc:
             raise InputError(str(exc)) from None
-        c["alpha_max_rule"] = self.alpha_rule.value
-        c["delay_samples"] = int(self.delay.value)
         self.nameplate_checks()
         try:
             return parse_preset(raw)
