@@ -124,8 +124,9 @@ CAMERA = {"type": "ViewerCameraMessage", "wxyz": [1.0, 0.0, 0.0, 0.0], "position
           "look_at": [0.0, 0.0, 0.0], "up_direction": [0.0, 0.0, 1.0]}
 
 
-def _send_update(hostport: str, config: object, handle_of: str, value: str) -> object:
-    """Connect as a hand-written client, set a GUI value by uuid, return the session."""
+def _send_update(hostport: str, config: object, handle_of: str, value: str, wait_error: bool = True) -> object:
+    """Connect as a hand-written client, set a GUI value by uuid (``handle_of`` a dotted attribute path of
+    the session), return the session."""
     known = set(config.sessions)
     done = threading.Event()
     session_box: list[object] = []
@@ -140,13 +141,20 @@ def _send_update(hostport: str, config: object, handle_of: str, value: str) -> o
                     session_box.append(config.sessions[new.pop()])
                     break
                 await asyncio.sleep(0.05)
-            handle = getattr(session_box[0], handle_of)
+            handle = session_box[0]
+            for attr in handle_of.split("."):
+                handle = getattr(handle, attr)
             msg = {"type": "GuiUpdateMessage", "uuid": handle._impl.uuid, "updates": {"value": value}}
             await ws.send(msgspec.msgpack.encode(msg))
-            for _ in range(600):
+            for _ in range(600 if wait_error else 0):
                 if session_box[0].error is not None:
                     break
                 await asyncio.sleep(0.05)
+            if not wait_error:  # let the server apply the update before the socket closes
+                for _ in range(200):
+                    if handle.value == value:
+                        break
+                    await asyncio.sleep(0.05)
             done.set()
 
     _run(go)
@@ -163,6 +171,15 @@ def test_hostile_client_cannot_load_a_file_through_the_preset_dropdown(served, t
     session = _send_update(hostport, config, "preset", str(rel))
     assert "is not one of the offered options" in session.error
     assert session.params.name != "HACKED" and session.origin != str(rel)
+
+
+def test_input_dropdowns_refuse_values_never_offered(served):
+    hostport, _, config = served
+    session = _send_update(hostport, config, "inputs.alpha_rule", "fast", wait_error=False)
+    params, runs = session.params, session.runs
+    assert session.simulate() is False
+    assert "α_max rule = 'fast' is not one of the offered options" in session.error
+    assert session.params is params and session.runs == runs
 
 
 def test_fdsmc_preset_dropdown_offers_position_presets_only(served):
