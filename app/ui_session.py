@@ -132,6 +132,14 @@ class Session:
     # ---- actions ------------------------------------------------------------------------------
     def simulate(self) -> bool:
         """Commit the inputs and simulate both controllers on the worker; False if not started."""
+        return self._commit_and_submit(self._run)
+
+    def design(self) -> bool:
+        """Commit the inputs, design for this drive on the worker and show the verified design."""
+        return self._commit_and_submit(self._run_design)
+
+    def _commit_and_submit(self, job: Callable[[DriveParams], None]) -> bool:
+        """Validate the inputs (nothing runs on an error) and hand ``job(params)`` to the worker."""
         try:
             params = self.inputs.collect()
         except InputError as exc:
@@ -140,17 +148,7 @@ class Session:
         if self.worker.busy:
             return self.submit(lambda: None)  # refused, with the "busy" note
         self.results.replay.pause()  # frees the browser for the new result
-        return self.submit(lambda: self._run(params))
-
-    def design(self) -> bool:
-        """Commit the inputs, design for this drive on the worker and show the verified design."""
-        try:
-            params = self.inputs.collect()
-        except InputError as exc:
-            self._reject(str(exc))
-            return False
-        self.results.replay.pause()
-        return self.submit(lambda: self._run_design(params))
+        return self.submit(lambda: job(params))
 
     def _run_design(self, params: DriveParams) -> None:
         self.status.content = "Designing and verifying…"
