@@ -54,6 +54,8 @@ class ReferenceDrive:
     def __init__(self, params: DriveParams, d: Derived, controller: str) -> None:
         self.p, self.d, self.controller = params, d, controller
         self.c = d.coefficients
+        #: Coefficients of the simulated plant: the controller's model unless a subclass simulates another drive.
+        self.plant_c = d.coefficients
         # x = [i_d, i_q, θ, ω, E_f, E_cu, E_el]; xh = [θ̂, ω̂, L̂0, L̂1]
         self.x = np.zeros(7)
         self.xh = np.zeros(4)
@@ -89,7 +91,7 @@ class ReferenceDrive:
 
     def plant(self, t: float, x: np.ndarray, u_d: float, u_q: float) -> np.ndarray:
         """Derivatives of [i_d, i_q, θ, ω, E_f, E_cu, E_el], eqs. (1)–(3), (4b), (5)."""
-        c, m, ld = self.c, self.p.motor, self.p.load
+        c, m, ld = self.plant_c, self.p.motor, self.p.load
         i_d, i_q, _, w = x[:4]
         T_em = 1.5 * m.p * (m.psi_pm + (m.L_d - m.L_q) * i_d) * i_q
         return np.array([

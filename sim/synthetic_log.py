@@ -82,7 +82,7 @@ class _InjectingDrive(ReferenceDrive):
 
     def __init__(self, true: DriveParams, d_nominal: Derived, injection: Injection) -> None:
         super().__init__(true, d_nominal, "fdsmc")
-        self.c_true = model_coefficients(true.motor)
+        self.plant_c = model_coefficients(true.motor)  # the true plant; the controller keeps d_nominal's
         self.inj = injection
         self.t_move = injection.dwell * len(injection.levels)
 
@@ -101,18 +101,6 @@ class _InjectingDrive(ReferenceDrive):
         u_d = fdc.direct_axis_voltage(i_d, i_q, w_h, c, ctrl.T_si, i_d_dem)
         u_q = fdc.quadrature_axis_voltage(a_dem, alpha, i_d, i_q, w_h, u_d, L1, c, ctrl.T_salpha)
         return u_d, u_q
-
-    def plant(self, t: float, x: np.ndarray, u_d: float, u_q: float) -> np.ndarray:
-        c, m, ld = self.c_true, self.p.motor, self.p.load
-        i_d, i_q, _, w = x[:4]
-        T_em = 1.5 * m.p * (m.psi_pm + (m.L_d - m.L_q) * i_d) * i_q
-        return np.array([
-            -c.A * i_d + c.B * w * i_q + c.F * u_d,
-            -(c.C * i_d + c.E) * w - c.D * i_q + c.G * u_q,
-            w,
-            (T_em - ld.F_v * w - self.gamma_le(t)) / self.p.J_total,
-            0.0, 0.0, 0.0,
-        ])
 
 
 def clean_log(true: DriveParams, d_nominal: Derived, t_end: float, injection: Injection = Injection(),
