@@ -13,9 +13,9 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 
-from app.cli_robustness import parse_spreads
-from app.presets import load_preset
-from sim.robustness import robustness, simulate_chunk
+from app.cli.robustness import parse_spreads
+from app.io.presets import load_preset
+from sim.studies.robustness import robustness, simulate_chunk
 
 
 def timed(label: str, params, spreads, n: int, executor, workers: int) -> float:

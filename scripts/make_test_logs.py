@@ -1,6 +1,6 @@
 """Write the two example drive logs of tests/data/ reproducibly (seeded).
 
-Both come from :mod:`sim.synthetic_log`: a drive tuned for the paper's 12 kW motor
+Both come from :mod:`sim.drivelog.synthetic`: a drive tuned for the paper's 12 kW motor
 (``presets/paper_12kw_pmsm.yaml`` with ``LOG_OVERRIDES``) controls a plant with other
 parameters (``TRUE_MOTOR``, ``TRUE_LOAD``): 120 ms of motor-ID d-axis current injection at
 standstill (i_d,dem steps of 15 ms: ±10 A three times, 5 A, 0 A), then a 3 rad move in 0.45 s
@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from app.presets import load_preset
-from control.derivations import derive
-from sim.synthetic_log import LOG_DURATION, LOG_OVERRIDES, LogNoise, add_noise, clean_log, perturbed
+from app.io.presets import load_preset
+from control.fdsmc.derivations import derive
+from sim.drivelog.synthetic import LOG_DURATION, LOG_OVERRIDES, LogNoise, add_noise, clean_log, perturbed
 
 HEADER = "# Synthetic drive log made by scripts/make_test_logs.py from the project's plant (seed {seed}).\n"
 

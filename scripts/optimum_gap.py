@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli_simulate import saving_vs_optimum
-from app.presets import load_preset
-from sim.engine import compare
+from app.cli.simulate import saving_vs_optimum
+from app.io.presets import load_preset
+from sim.fdsmc.engine import compare
 
 TABLE1_TM = (1.0, 1.4, 1.8, 2.2, 2.6)
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a")

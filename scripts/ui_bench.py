@@ -109,8 +109,8 @@ def open_page(browser, url: str) -> tuple[float, int, object, object, WsCounter]
 
 
 def omega_p_of(T_m: float) -> float:
-    from app.presets import load_preset
-    from control.derivations import derive
+    from app.io.presets import load_preset
+    from control.fdsmc.derivations import derive
 
     params = load_preset(PRESET)
     return derive(dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=T_m))).profile.omega_p

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from app.presets import load_preset
-from control.params import DriveParams
+from app.io.presets import load_preset
+from control.fdsmc.params import DriveParams
 
 
 @pytest.fixture(scope="session")

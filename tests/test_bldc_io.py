@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from app.bldc_emf_io import read_measured, with_measured
-from app.presets import PresetError, dumps_preset, load_preset, loads_preset
-from control.params import ParameterError
-from sim import bldc_emf
-from sim.bldc_engine import simulate_bldc
+from app.io.bldc_emf import read_measured, with_measured
+from app.io.presets import PresetError, dumps_preset, load_preset, loads_preset
+from control.fdsmc.params import ParameterError
+from sim.bldc import emf as bldc_emf
+from sim.bldc.engine import simulate_bldc
 
 
 def _csv(theta_deg, cols, header="theta_e_deg,phi_a,phi_b,phi_c"):

@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from app.presets import load_preset
-from control.bldc_design import bldc_design
-from control.bldc_speed_smc import reachability_bound, reachability_check
-from control.dqx import trapezoid_unit
-from sim import bldc_emf
-from sim import bldc_kernel as kn
-from sim.bldc_engine import CONTROLLERS, pack_parameters, simulate_bldc
+from app.io.presets import load_preset
+from control.bldc.design import bldc_design
+from control.bldc.dqx import trapezoid_unit
+from control.bldc.speed_smc import reachability_bound, reachability_check
+from sim.bldc import emf as bldc_emf
+from sim.bldc import kernel as kn
+from sim.bldc.engine import CONTROLLERS, pack_parameters, simulate_bldc
 
 
 @pytest.fixture(scope="module")

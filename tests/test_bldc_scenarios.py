@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.presets import load_preset
-from control.bldc_plain_smc import steady_state_error
-from sim.bldc_engine import compare_bldc
-from sim.bldc_metrics import steady_windows
+from app.cli.main import main
+from app.io.presets import load_preset
+from control.bldc.plain_smc import steady_state_error
+from sim.bldc.engine import compare_bldc
+from sim.bldc.metrics import steady_windows
 
 RPM = 60.0 / (2.0 * math.pi)
 

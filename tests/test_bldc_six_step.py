@@ -14,10 +14,10 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from app.presets import load_preset
-from control import bldc_six_step as six
-from control.dqx import torque_constant_fig7, trapezoid_unit, trapezoid_unit_slope
-from sim.bldc_engine import simulate_bldc
+from app.io.presets import load_preset
+from control.bldc import six_step as six
+from control.bldc.dqx import torque_constant_fig7, trapezoid_unit, trapezoid_unit_slope
+from sim.bldc.engine import simulate_bldc
 
 PHI_M, NPP = 0.12, 3
 SHIFTS = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)

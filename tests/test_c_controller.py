@@ -3,11 +3,11 @@ the simulator's digital mode: what the drive will run is what was simulated.
 
 The module is compiled with the system C compiler and loaded with :mod:`ctypes` (standard
 library, no build step or extra package: the shared object is called directly from Python,
-sample by sample, between RK4 steps of :class:`sim.plant.PlantInTheLoop`; see app/c_verify.py).
+sample by sample, between RK4 steps of :class:`sim.fdsmc.plant.PlantInTheLoop`; see app/exports/c_verify.py).
 
 Agreement = max |C − simulator| / max |simulator| over the run (error relative to the signal's
 peak), for θ_r, ω_r, i_q and the energies, at every controller sample of the 1.3 s horizon
-(``python -m app.c_verify`` prints the figures).
+(``python -m app.exports.c_verify`` prints the figures).
 Measured (paper preset, 20 kHz): double ≤ 7e-9 at the paper's K = 1000 (limit-cycling loop),
 ≤ 2e-7 with delay and inverter limits; float32 at the recommended K: θ_r 1.6e-8, ω_r 1.1e-6,
 i_q 2.5e-5, energies ≤ 2e-6.
@@ -24,12 +24,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.c_verify import CFLAGS, agreement, build, closed_loop, compiler, write_module
-from app.export_c import controller_files
-from app.presets import SCHEMA, list_presets, load_preset
-from control.derivations import derive
-from control.params import DriveParams, ParameterError
-from sim.engine import simulate
+from app.exports.c_module import controller_files
+from app.exports.c_verify import CFLAGS, agreement, build, closed_loop, compiler, write_module
+from app.io.presets import SCHEMA, list_presets, load_preset
+from control.fdsmc.derivations import derive
+from control.fdsmc.params import DriveParams, ParameterError
+from sim.fdsmc.engine import simulate
 
 ROOT = Path(__file__).resolve().parent.parent
 #: float32 tolerance: ε(float32) = 6e-8 per operation; the observer (pole at 37 500 rad/s) and the
@@ -153,7 +153,7 @@ def test_every_real_motor_preset_runs_as_simulated(tmp_path, preset):
 def test_a_new_position_demand_leaves_the_estimates_unchanged(tmp_path):
     """The observer does not depend on θ_dem (eq. (15)); its z0 = θ̂ − θ_dem is shifted exactly
     when the demand changes, so θ̂ and ω̂ are the same whatever demand sequence the drive sends."""
-    from app.c_verify import _types
+    from app.exports.c_verify import _types
 
     params = load_preset("paper_12kw_pmsm", PAPER_K_REC)
     _write(tmp_path, params)

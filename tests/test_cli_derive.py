@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from app.cli import main
+from app.cli.main import main
 
 
 def test_derive_json_keys_and_values(capsys):

@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numba import njit
 
-from control import conventional, fdc, sliding_mode
+from control.fdsmc import conventional, fdc, sliding_mode
 
 finite = st.floats(-1e3, 1e3, allow_nan=False)
 positive = st.floats(1e-3, 1e3, allow_nan=False)
@@ -51,7 +51,7 @@ def test_kernel_source_holds_no_copy_of_the_laws():
     # The kernel calls the control/ laws; it must not spell their formulas out again.
     from pathlib import Path
 
-    src = (Path(__file__).resolve().parents[1] / "sim" / "kernel.py").read_text()
+    src = (Path(__file__).resolve().parents[1] / "sim" / "fdsmc" / "kernel.py").read_text()
     for formula in ("3.0 / prm[P_TSA]", "prm[P_G1] * (prm[P_THDEM]", "min(1.0, max(-1.0"):
         assert formula not in src
     for call in ("sliding_mode.smc_demand(", "conventional.conventional_demand(", "fdc.fdc_voltages("):

@@ -9,11 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from control.conventional import conventional_gains, friction_energy_conventional
-from control.derivations import derive
-from control.model import model_coefficients
-from control.params import ParameterError
-from control.profile import (
+from control.fdsmc.conventional import conventional_gains, friction_energy_conventional
+from control.fdsmc.derivations import derive
+from control.fdsmc.model import model_coefficients
+from control.fdsmc.params import ParameterError
+from control.fdsmc.profile import (
     C_52,
     C_57,
     friction_energy_eq52,
@@ -39,7 +39,7 @@ def test_alpha_max_paper_rule_and_torque(paper_params):
     # α_max = H·P_r/V_0 = 95·12000/430 (section 5)
     assert d.alpha.alpha_max == pytest.approx(2651.16, abs=0.01)
     # torque on the total inertia J_r + 4·J_r = 0.15 kg·m²: 397.67 N·m ≫ Γ_max = 40 N·m, times the
-    # inner loops' overshoot η (about 1.2 at 20 kHz, control.transient)
+    # inner loops' overshoot η (about 1.2 at 20 kHz, control.fdsmc.transient)
     assert 1.1 < d.alpha.overshoot < 1.4
     assert d.alpha.torque_needed == pytest.approx(397.67 * d.alpha.overshoot, abs=0.01)
     assert not d.alpha.torque_ok

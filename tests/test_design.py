@@ -9,11 +9,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from app.presets import load_preset
-from control.feasibility import torque_limit, voltage_limit
-from control.params import Controller, DriveParams, Load, Manoeuvre, Motor
-from sim.design import design_drive, run_checks
-from sim.verdicts import comparator_notes, run_warnings
+from app.io.presets import load_preset
+from control.fdsmc.feasibility import torque_limit, voltage_limit
+from control.fdsmc.params import Controller, DriveParams, Load, Manoeuvre, Motor
+from sim.fdsmc.design import design_drive, run_checks
+from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a")
 
@@ -109,8 +109,8 @@ def test_design_keeps_the_users_nameplate():
 def test_design_cli_json_contract_and_loadable_preset(capsys, tmp_path):
     import json
 
-    from app.cli import main
-    from app.presets import load_preset as load
+    from app.cli.main import main
+    from app.io.presets import load_preset as load
 
     out_file = tmp_path / "designed.yaml"
     assert main(["design", "yaskawa_sgm7j_04a", "--set", "controller.K=1000", "--json", "-o", str(out_file)]) == 0

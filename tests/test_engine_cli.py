@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from app.cli import main
+from app.cli.main import main
 
 RUN_KEYS = {
     "friction_J", "copper_J", "electrical_in_J", "regenerated_J", "friction_total_J",

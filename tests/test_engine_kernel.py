@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.presets import load_preset
-from control.derivations import derive
-from sim import kernel as kn
-from sim.engine import run_steps
-from sim.reference import run_reference
+from app.io.presets import load_preset
+from control.fdsmc.derivations import derive
+from sim.fdsmc import kernel as kn
+from sim.fdsmc.engine import run_steps
+from sim.fdsmc.reference import run_reference
 
 CASES = [
     ("fdsmc", ["controller.K=0.3"]),

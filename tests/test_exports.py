@@ -13,9 +13,9 @@ import zipfile
 import pytest
 import yaml
 
-from app.cli import main
-from app.export_html import ROW_HEIGHT_PX, html_report
-from app.exports import (
+from app.cli.main import main
+from app.exports.html import ROW_HEIGHT_PX, html_report
+from app.exports.model import (
     FORMATS,
     drive_gains,
     export_download,
@@ -24,12 +24,12 @@ from app.exports import (
     parameter_yaml,
     trace_csv,
 )
-from app.presets import SCHEMA, load_preset, loads_preset, loads_raw
-from app.ui_files import parse_upload, safe_stem, uncommitted
-from app.units import SI_UNITS
-from control.derivations import derive
-from control.params import ParameterError
-from sim.engine import Comparison, compare
+from app.io.presets import SCHEMA, load_preset, loads_preset, loads_raw
+from app.io.units import SI_UNITS
+from app.ui.files import parse_upload, safe_stem, uncommitted
+from control.fdsmc.derivations import derive
+from control.fdsmc.params import ParameterError
+from sim.fdsmc.engine import Comparison, compare
 
 
 @pytest.fixture(scope="module")
@@ -197,7 +197,7 @@ def test_upload_rejects_bad_files_with_clear_messages(paper_params, case):
 
 
 def test_page_rename_sets_file_name_and_refuses_blank(case):
-    from app.ui_files import ExportRefusedError, renamed
+    from app.ui.files import ExportRefusedError, renamed
 
     name, content = export_download("yaml", renamed(case, " line 3 axis ", "nameplate"))
     assert name == "line_3_axis.yaml" and loads_raw(content.decode())["source"] == "nameplate"
@@ -221,7 +221,7 @@ def test_round_trip_in_continuous_mode(tmp_path, paper_params, fmt):
 
 
 def test_bldc_mode_presets_load_from_yaml_and_json():
-    from app.presets import dumps_preset, to_raw
+    from app.io.presets import dumps_preset, to_raw
 
     bldc = load_preset("bldc_smc_paper")
     assert loads_preset(dumps_preset(bldc), "b.yaml") == bldc

@@ -7,8 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from app.figure_json import figure_json
-from app.figures import (
+from app.figures.comparison import (
     MAX_POINTS,
     cursor_index,
     decimate_index,
@@ -17,10 +16,11 @@ from app.figures import (
     make_time_plots_figure,
     phase_plane_spec,
 )
-from app.figures_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
-from app.figures_replay import MAX_FRAMES, SPEEDS
-from app.ui_replay import phase_plane_json
-from sim.engine import PAPER_TABLE1, Comparison, Table1Row, compare
+from app.figures.energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
+from app.figures.plain import figure_json
+from app.figures.replay import MAX_FRAMES, SPEEDS
+from app.ui.replay import phase_plane_json
+from sim.fdsmc.engine import PAPER_TABLE1, Comparison, Table1Row, compare
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +92,7 @@ def test_dict_figure_json_matches_plotly(comparison):
 
 def test_phase_plane_marks_boundary_layer_entry(comparison):
     """The FDSMC marker of the boundary-layer entry lies within ±1/K of the switching boundary, eq. (45)."""
-    from control.sliding_mode import boundary_speed
+    from control.fdsmc.sliding_mode import boundary_speed
 
     k = layer_entry_index(comparison, comparison.fdsmc)
     assert k is not None and 0 < k < len(comparison.fdsmc.trace.t) - 1

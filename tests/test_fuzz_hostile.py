@@ -23,21 +23,22 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from app import units
-from app.bldc_emf_io import read_measured
-from app.cli_table1 import parse_tm
-from app.numbers import NumberFormatError, parse_integer, parse_number
-from app.presets import PRESET_DIR, PresetError, load_preset, loads_preset
-from app.ui_results import parse_T_m_list
-from app.ui_text import checked_choice
-from control.derivations import derive, predicted_energy
-from control.feasibility import alpha_max, feasibility
-from control.model import model_coefficients
-from control.observer import discrete_observer, observer_gains
-from control.params import ParameterError
-from control.profile import velocity_profile
-from sim import budget, engine
-from sim.bldc_engine import check_budget as bldc_check_budget
+from app.cli.table1 import parse_tm
+from app.io import units
+from app.io.bldc_emf import read_measured
+from app.io.numbers import NumberFormatError, parse_integer, parse_number
+from app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
+from app.ui.results import parse_T_m_list
+from app.ui.text import checked_choice
+from control.fdsmc.derivations import derive, predicted_energy
+from control.fdsmc.feasibility import alpha_max, feasibility
+from control.fdsmc.model import model_coefficients
+from control.fdsmc.observer import discrete_observer, observer_gains
+from control.fdsmc.params import ParameterError
+from control.fdsmc.profile import velocity_profile
+from sim.bldc.engine import check_budget as bldc_check_budget
+from sim.common import budget
+from sim.fdsmc import engine
 
 PAPER = (PRESET_DIR / "paper_12kw_pmsm.yaml").read_text(encoding="utf-8")
 BLDC = (PRESET_DIR / "bldc_smc_paper.yaml").read_text(encoding="utf-8")
@@ -279,7 +280,7 @@ def test_fuzz_bldc_budget(t_end, f_s, n):
 
 def test_accepted_runs_take_no_more_steps_than_the_budget_counted(monkeypatch):
     """The kernel is called with exactly the steps the budget counted (sub-steps included)."""
-    import sim.kernel as kn
+    import sim.fdsmc.kernel as kn
 
     real, seen = kn.run_kernel, []
 

@@ -11,13 +11,14 @@ from pathlib import Path
 
 import pytest
 
-from app.cli import main
-from app.presets import MAX_BYTES, PRESET_DIR, PresetError, load_preset, loads_preset
-from control.derivations import derive
-from control.params import ParameterError
-from sim import budget, engine
-from sim.bldc_engine import check_budget as bldc_check_budget
-from sim.bldc_engine import compare_bldc
+from app.cli.main import main
+from app.io.presets import MAX_BYTES, PRESET_DIR, PresetError, load_preset, loads_preset
+from control.fdsmc.derivations import derive
+from control.fdsmc.params import ParameterError
+from sim.bldc.engine import check_budget as bldc_check_budget
+from sim.bldc.engine import compare_bldc
+from sim.common import budget
+from sim.fdsmc import engine
 
 PAPER = (PRESET_DIR / "paper_12kw_pmsm.yaml").read_text(encoding="utf-8")
 BLDC = (PRESET_DIR / "bldc_smc_paper.yaml").read_text(encoding="utf-8")
@@ -119,13 +120,13 @@ def test_csv_path_checked_before_the_simulation(capsys, monkeypatch):
     def boom(*_a, **_k):
         raise AssertionError("the simulation must not run")
 
-    monkeypatch.setattr("app.cli_simulate.compare", boom)
+    monkeypatch.setattr("app.cli.simulate.compare", boom)
     _fails(["simulate", "paper_12kw_pmsm", "--csv", "/nonexistent/x.csv"], capsys, "--csv", "/nonexistent")
 
 
 def test_substeps_count_in_the_budget_and_are_refused_before_work(monkeypatch, capsys):
     """ω_b = 1e5 rad/s at p = 100 asks for 2500 RK4 sub-steps per sample: over budget, no kernel call."""
-    monkeypatch.setattr("sim.kernel.run_kernel", lambda *a: (_ for _ in ()).throw(AssertionError("ran")))
+    monkeypatch.setattr("sim.fdsmc.kernel.run_kernel", lambda *a: (_ for _ in ()).throw(AssertionError("ran")))
     err = _fails(["simulate", "paper_12kw_pmsm", "--set", "motor.omega_b=1e5", "--set", "motor.p=100"],
                  capsys, "integration steps", "motor.omega_b = 100000 rad/s → largest accepted",
                  "motor.p = 100 → largest accepted")

@@ -1,6 +1,6 @@
 """Identification of R_s, L_d, L_q, Ψ_PM, J_total, F_v, Γ_Le from logs of the project's own plant.
 
-The logs come from :mod:`sim.synthetic_log`: a drive tuned for the paper's motor controls a
+The logs come from :mod:`sim.drivelog.synthetic`: a drive tuned for the paper's motor controls a
 plant with different parameters (motor-ID d-axis injection, then a move), sampled at 10 kHz
 with current noise, 12-bit ADC, 14-bit encoder, quantised voltages and a one-sample delay.
 """
@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.presets import load_preset
-from control.derivations import derive
-from control.identification import identify
-from sim.synthetic_log import (
+from app.io.presets import load_preset
+from control.fdsmc.derivations import derive
+from control.fdsmc.identification import identify
+from sim.drivelog.synthetic import (
     LOG_DURATION,
     LOG_OVERRIDES,
     TRUE_LOAD,

@@ -11,9 +11,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.presets import load_preset
-from control.derivations import derive
-from control.loop_analysis import (
+from app.io.presets import load_preset
+from control.fdsmc.derivations import derive
+from control.fdsmc.loop_analysis import (
     continuous_loop,
     gain_limit,
     minimum_sample_rate,
@@ -22,7 +22,7 @@ from control.loop_analysis import (
     sample_rate_check,
     stability_measure,
 )
-from sim.engine import simulate
+from sim.fdsmc.engine import simulate
 
 
 def _params(*overrides: str):
@@ -117,7 +117,7 @@ def test_derived_carries_verdicts_and_warning():
 
 def test_slope_damping_matches_ideal_loop_eigenvalues():
     """ζ of s² + α_max·K·s + α_max·K/T_c (eqs. 41, 46 with the plant θ̈ = u of eq. (15))."""
-    from control.loop_analysis import slope_damping
+    from control.fdsmc.loop_analysis import slope_damping
 
     for a_max, K, T_c in ((2651.0, 0.3, 0.024), (2651.0, 0.3, 3.8e-4), (100.0, 2.0, 0.05)):
         s = np.roots([1.0, a_max * K, a_max * K / T_c])

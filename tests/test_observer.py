@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from control.observer import (
+from control.fdsmc.observer import (
     discrete_observer,
     error_matrix,
     observer_gains,

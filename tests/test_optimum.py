@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from app.cli import main
-from app.presets import load_preset
-from control.feasibility import LIMIT_TOLERANCE, torque_limit
-from control.optimum import MoveModel, closed_form, hamiltonian_matrix, move_model, numerical_optimum
-from sim.engine import compare
+from app.cli.main import main
+from app.io.presets import load_preset
+from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
+from control.fdsmc.optimum import MoveModel, closed_form, hamiltonian_matrix, move_model, numerical_optimum
+from sim.fdsmc.engine import compare
 
 PAPER_TM = (1.0, 1.4, 1.8, 2.2, 2.6)  # Table 1 of the FDSMC paper
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a")

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from app import presets
-from app.presets import PresetError, dumps_preset, load_preset, loads_preset, to_raw
-from control.params import ParameterError
+from app.io import presets
+from app.io.presets import PresetError, dumps_preset, load_preset, loads_preset, to_raw
+from control.fdsmc.params import ParameterError
 
 RAW_OK = dict  # alias for readability
 

@@ -7,15 +7,15 @@ import math
 
 import pytest
 
-from app.presets import load_preset
-from app.units import kt_nm_per_arms_to_psi_pm, psi_pm_to_ke_vrms_krpm, psi_pm_to_kt_nm_per_arms
-from control.derivations import derive
-from control.feasibility import LIMIT_TOLERANCE, exceeds
-from control.loop_analysis import loop_model
-from control.nameplate import nameplate_consistency
-from control.transient import acceleration_overshoot
-from sim.engine import compare
-from sim.verdicts import comparator_notes, run_warnings
+from app.io.presets import load_preset
+from app.io.units import kt_nm_per_arms_to_psi_pm, psi_pm_to_ke_vrms_krpm, psi_pm_to_kt_nm_per_arms
+from control.fdsmc.derivations import derive
+from control.fdsmc.feasibility import LIMIT_TOLERANCE, exceeds
+from control.fdsmc.loop_analysis import loop_model
+from control.fdsmc.nameplate import nameplate_consistency
+from control.fdsmc.transient import acceleration_overshoot
+from sim.fdsmc.engine import compare
+from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 
 def _replace(p, section, **kw):
@@ -46,7 +46,7 @@ def test_overshoot_predicts_the_simulated_start_of_acceleration(paper_params):
 
 
 def test_kt_ke_psi_round_trip():
-    # Kt = (3/2)·√2·p·Ψ_PM [N·m/A_rms] (eq. (5), i_q = √2·I_rms); Ke ↔ Ψ_PM of app.units
+    # Kt = (3/2)·√2·p·Ψ_PM [N·m/A_rms] (eq. (5), i_q = √2·I_rms); Ke ↔ Ψ_PM of app.io.units
     assert psi_pm_to_kt_nm_per_arms(kt_nm_per_arms_to_psi_pm(0.544, 5), 5) == pytest.approx(0.544, rel=1e-15)
     psi = kt_nm_per_arms_to_psi_pm(0.544, 5)
     # For a sinusoidal PMSM Kt [N·m/A_rms] = √3·Ke [V/(rad/s)] (LL rms): both routes agree

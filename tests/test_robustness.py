@@ -10,13 +10,13 @@ import sys
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.cli_robustness import parse_spread, parse_spreads
-from app.plant import load_model_and_plant
-from app.presets import load_preset
-from control.params import ParameterError
-from sim.engine import compare
-from sim.robustness import METRICS, TRACE_POINTS, Spread, draw, robustness
+from app.cli.main import main
+from app.cli.robustness import parse_spread, parse_spreads
+from app.io.plant_overrides import load_model_and_plant
+from app.io.presets import load_preset
+from control.fdsmc.params import ParameterError
+from sim.fdsmc.engine import compare
+from sim.studies.robustness import METRICS, TRACE_POINTS, Spread, draw, robustness
 
 PRESET = "siemens_1ft7044_ak7"
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -90,9 +90,9 @@ def test_zero_spread_reproduces_the_nominal_run_exactly():
 _DASK_SCRIPT = """
 import json
 from dask.distributed import Client, LocalCluster
-from app.cli_robustness import parse_spreads
-from app.presets import load_preset
-from sim.robustness import robustness
+from app.cli.robustness import parse_spreads
+from app.io.presets import load_preset
+from sim.studies.robustness import robustness
 params = load_preset("siemens_1ft7044_ak7")
 spreads = parse_spreads(["plant.J_L=0.001:0.004,plant.R_s=±20%"])
 local = robustness(params, spreads, 5, seed=3)

@@ -16,12 +16,12 @@ import pytest
 import viser
 import websockets
 
-from app.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
-from app.ui_session import create_server
-from app.ui_text import checked_choice, md_text
-from app.ui_worker import Cancelled, Worker
-from app.web_guard import COOKIE, Guard
-from control.params import ParameterError
+from app.io.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
+from app.ui.session import create_server
+from app.ui.text import checked_choice, md_text
+from app.ui.web_guard import COOKIE, Guard
+from app.ui.worker import Cancelled, Worker
+from control.fdsmc.params import ParameterError
 
 PROTOCOL = f"viser-v{viser.__version__}"
 

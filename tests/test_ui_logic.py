@@ -8,14 +8,14 @@ import time
 
 import pytest
 
-from app.serve import is_loopback
-from app.ui_inputs import InputError, parse_steps
-from app.ui_results import parse_T_m_list
-from app.ui_text import annual_savings, derived_markdown, warnings_html
-from app.ui_worker import Worker
-from control.derivations import derive
-from sim.engine import compare
-from sim.verdicts import recommended_K, run_warnings
+from app.cli.serve import is_loopback
+from app.ui.inputs import InputError, parse_steps
+from app.ui.results import parse_T_m_list
+from app.ui.text import annual_savings, derived_markdown, warnings_html
+from app.ui.worker import Worker
+from control.fdsmc.derivations import derive
+from sim.fdsmc.engine import compare
+from sim.fdsmc.verdicts import recommended_K, run_warnings
 
 
 def test_worker_refuses_a_second_job_while_one_runs():

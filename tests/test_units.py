@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from app import units
+from app.io import units
 
 
 def test_rpm():
@@ -33,7 +33,7 @@ def test_ke_to_psi_pm_hand_calculation():
 
 
 def test_ke_in_preset(paper_params):
-    from app.presets import parse_preset, to_raw
+    from app.io.presets import parse_preset, to_raw
 
     raw = to_raw(paper_params)
     del raw["motor"]["psi_pm"]

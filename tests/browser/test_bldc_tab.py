@@ -56,7 +56,7 @@ def test_bldc_import_scenario_switch_and_export_round_trip(page, tmp_path):
     import dataclasses
     from pathlib import Path
 
-    from app.presets import dumps_preset, load_preset, loads_preset
+    from app.io.presets import dumps_preset, load_preset, loads_preset
 
     params = load_preset("bldc_smc_paper")
     uploaded = dataclasses.replace(params, name="bldc_imported", source="browser test",
@@ -80,7 +80,7 @@ def test_bldc_import_scenario_switch_and_export_round_trip(page, tmp_path):
 
 
 def test_bldc_import_of_a_position_preset_is_rejected_and_changes_nothing(page, tmp_path):
-    from app.presets import DEFAULT_PRESET, PRESET_DIR
+    from app.io.presets import DEFAULT_PRESET, PRESET_DIR
 
     _open_tab(page)
     page.get_by_text("Machine, load, inverter, gains", exact=True).click()

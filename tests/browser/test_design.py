@@ -17,8 +17,8 @@ from tests.browser.conftest import UiServer, field, free_port, open_page, set_nu
 
 @pytest.fixture(scope="module")
 def default_server() -> Iterator[UiServer]:
-    from app.presets import DEFAULT_PRESET, load_preset
-    from app.ui_session import create_server
+    from app.io.presets import DEFAULT_PRESET, load_preset
+    from app.ui.session import create_server
 
     server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(),
                                    scene_3d=False)

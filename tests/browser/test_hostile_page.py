@@ -10,7 +10,7 @@ from collections.abc import Iterator
 import pytest
 import viser
 
-from app.presets import PRESET_DIR, loads_preset
+from app.io.presets import PRESET_DIR, loads_preset
 
 OPEN_WS_JS = """async ([url, protocol]) => await new Promise((resolve) => {
   const ws = new WebSocket(url, [protocol]);

@@ -5,8 +5,8 @@ from __future__ import annotations
 import re
 import shutil
 
-from app.ui_log import EXAMPLE_LOG
-from sim.synthetic_log import TRUE_MOTOR
+from app.ui.log import EXAMPLE_LOG
+from sim.drivelog.synthetic import TRUE_MOTOR
 from tests.browser.conftest import figure
 
 

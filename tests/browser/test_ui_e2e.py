@@ -10,8 +10,8 @@ from pathlib import Path
 
 from playwright.sync_api import expect
 
-from app.presets import PAPER_PRESET, dumps_preset, load_preset, loads_preset
-from control.derivations import derive
+from app.io.presets import PAPER_PRESET, dumps_preset, load_preset, loads_preset
+from control.fdsmc.derivations import derive
 from tests.browser.conftest import ARTIFACTS, field, figure, open_page, set_number
 
 
@@ -177,7 +177,7 @@ def _click_and_wait_for_run(page, button) -> None:
 def test_recommended_K_then_T_c_min_one_click_fixes(page):
     """Slow manoeuvre (T_m = 60 s): K = 1000 chatters → "Use recommended K"; the approach to θ_dem
     is then poorly damped with T_c = T_a → "Use T_c = …" selects T_c,min and the chatter is gone."""
-    from sim.verdicts import T_c_advice
+    from sim.fdsmc.verdicts import T_c_advice
 
     params = load_preset(PAPER_PRESET)
     slow = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=60.0))

@@ -1,0 +1,77 @@
+"""``python -m app bench``: speed figures of the simulation engine (prints, never asserts).
+
+1. one FDSMC-vs-conventional comparison, paper preset, T_m = 2.6 s + tail, f_s = 20 kHz (warm);
+2. the five-point Table-1 sweep in digital mode (20 kHz) and in continuous mode;
+3. the compiled kernel's throughput in steps/s against the plain-Python reference step.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+from app.cli.bldc import bench_figure
+from app.cli.main import add_preset_arguments
+from app.io.preset_modes import load_mode_preset
+from app.io.presets import load_preset
+from control.fdsmc.derivations import derive
+from sim.fdsmc.engine import CONTINUOUS_STEP_S, compare, run_steps, table1_sweep
+from sim.fdsmc.reference import run_reference
+
+TM_SWEEP = (1.0, 1.4, 1.8, 2.2, 2.6)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``bench``."""
+    add_preset_arguments(p, default="paper_12kw_pmsm")
+    p.add_argument("--repeat", type=int, default=7, help="repetitions of each figure (median; at least 5)")
+
+
+def _timed(fn: object, *args: object, **kw: object) -> float:
+    t0 = time.perf_counter()
+    fn(*args, **kw)  # type: ignore[operator]
+    return time.perf_counter() - t0
+
+
+def _medians(repeat: int, fn: object, *args: object, **kw: object) -> tuple[float, float]:
+    """Median wall time and median process CPU time (all threads) [s] of ``repeat`` calls."""
+    walls, cpus = [], []
+    for _ in range(max(5, repeat)):
+        w0, c0 = time.perf_counter(), time.process_time()
+        fn(*args, **kw)  # type: ignore[operator]
+        walls.append(time.perf_counter() - w0)
+        cpus.append(time.process_time() - c0)
+    return statistics.median(walls), statistics.median(cpus)
+
+
+def _ms(wall_cpu: tuple[float, float]) -> str:
+    return f"median {wall_cpu[0] * 1e3:.1f} ms wall, {wall_cpu[1] * 1e3:.1f} ms CPU"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print the speed figures."""
+    base = args.overrides
+    p = load_mode_preset(args.preset, [*base, "manoeuvre.T_m=2.6", "controller.f_s=20000"], mode="position")
+    rep = max(5, args.repeat)
+    first = _timed(compare, p)
+    print(f"comparison T_m = 2.6 s (+30 % tail), f_s = 20 kHz, derive included ({rep} runs): first call "
+          f"{first * 1e3:.0f} ms (cache load), warm {_ms(_medians(rep, compare, p))}   [target ≤ 15 ms CPU]")
+    pd = load_preset(args.preset, [*base, "controller.f_s=20000"])
+    table1_sweep(pd, TM_SWEEP[:1])
+    print(f"Table-1 sweep, 5 points, digital 20 kHz: {_ms(_medians(rep, table1_sweep, pd, TM_SWEEP))}   "
+          "[target ≤ 0.5 s]")
+    pc = load_preset(args.preset, [*base, "controller.f_s=continuous"])
+    table1_sweep(pc, TM_SWEEP[:1])
+    print(f"Table-1 sweep, 5 points, continuous (RK4 h = {CONTINUOUS_STEP_S * 1e6:g} µs): "
+          f"{_ms(_medians(rep, table1_sweep, pc, TM_SWEEP))}   [target ≤ 3 s]")
+    d = derive(pd)
+    n_k, n_r = 200_000, 4_000
+    run_steps(pd, "fdsmc", 10, derived=d)
+    tk = statistics.median(_timed(run_steps, pd, "fdsmc", n_k, derived=d) for _ in range(rep))
+    tr = _timed(run_reference, pd, d, "fdsmc", n_r)
+    sk, sr = n_k / tk, n_r / tr
+    print(f"kernel throughput (digital, 1 RK4 substep/sample): compiled {sk:,.0f} samples/s, "
+          f"plain-Python reference {sr:,.0f} samples/s, speed-up ×{sk / sr:,.0f}")
+    print(bench_figure())  # BLDC mode: 2000 rpm scenario, simulated s per wall s
+    return 0

@@ -1,0 +1,79 @@
+"""``python -m app design PRESET [--set …] [--json] [-o FILE]``: a clean design for this drive."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from app.cli.main import add_preset_arguments
+from app.io.presets import dumps, load_preset, to_raw
+from sim.fdsmc.design import DriveDesign, design_drive
+
+_VERIFIED_KEYS = ("torque_peak_Nm", "i_q_peak_A", "u_peak_V", "omega_peak_rad_s", "theta_error_at_Tm_rad",
+                  "chatter", "saturated_s", "stable", "friction_J", "electrical_in_J")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``design``."""
+    add_preset_arguments(p)
+    p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the designed preset (YAML) to FILE")
+
+
+def _finite(x: Any) -> Any:
+    return None if isinstance(x, float) and not math.isfinite(x) else x
+
+
+def design_json(dd: DriveDesign) -> dict[str, Any]:
+    """The JSON contract of ``design --json``."""
+    c, cmp = dd.params.controller, dd.comparison
+    verified: dict[str, Any] = {}
+    for name in ("fdsmc", "conventional"):
+        run = getattr(cmp, name) if cmp is not None else None
+        if run is not None:
+            verified[name] = {k: _finite(run.metrics.get(k)) for k in _VERIFIED_KEYS}
+            verified[name]["i_peak_A"] = verified[name]["i_q_peak_A"]
+    return {
+        "clean": dd.clean,
+        "limiting": [{"name": x.name, "value": _finite(x.value), "limit": _finite(x.limit), "unit": x.unit,
+                      "violated": x.violated, "text": x.text} for x in dd.limiting],
+        "notes": list(dd.notes),
+        "comparator_notes": list(dd.comparator),
+        "design": {"alpha_max": dd.derived.alpha.alpha_max, "T_m": dd.params.manoeuvre.T_m, "K": c.K,
+                   "T_c": dd.derived.profile.T_c, "T_c_rule": "T_a" if c.T_c == "T_a" else "given",
+                   "f_s": c.f_s, "overshoot_eta": dd.derived.alpha.overshoot},
+        "verified": verified,
+        "saving_friction_pct": _finite(cmp.saving_friction_pct) if cmp else None,
+        "saving_electrical_pct": _finite(cmp.saving_electrical_pct) if cmp else None,
+        "preset": to_raw(dd.params),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    """Design, verify and print (table or JSON); optionally write the designed preset."""
+    params = load_preset(args.preset, args.overrides)
+    if args.output and not Path(args.output).resolve().parent.is_dir():  # checked before the work
+        raise ValueError(f"-o {args.output}: the folder does not exist")
+    dd = design_drive(params)
+    out = design_json(dd)
+    if args.output:
+        with open(args.output, "w", encoding="utf-8") as fh:
+            fh.write(dumps(out["preset"]))
+    if args.json:
+        print(json.dumps(out, indent=2, ensure_ascii=False))
+        return 0
+    d = out["design"]
+    print(f"Design for {params.name}: {'CLEAN' if dd.clean else 'NOT CLEAN'}")
+    print(f"  α_max = {d['alpha_max']:.5g} rad/s²  T_m = {d['T_m']:g} s  K = {d['K']:.4g} s/rad  "
+          f"T_c = {d['T_c']:.4g} s  f_s = {d['f_s']}  (η = {d['overshoot_eta']:.3g})")
+    for x in dd.limiting:
+        print(f"  {'✗' if x.violated else '·'} {x.text}")
+    for n in dd.notes + dd.comparator:
+        print(f"  note: {n}")
+    for name, v in out["verified"].items():
+        print(f"  {name}: peak {v['torque_peak_Nm']:.4g} N·m, {v['i_q_peak_A']:.4g} A, {v['u_peak_V']:.4g} V; "
+              f"error at T_m {v['theta_error_at_Tm_rad']:.3g} rad; chatter {v['chatter']}")
+    return 0

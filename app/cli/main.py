@@ -1,0 +1,93 @@
+"""Command-line interface: ``python -m app {derive,simulate,export,table1,bench,serve,bldc} …``.
+
+Each sub-command lives in its own module exposing ``add_arguments(parser)`` and
+``run(args) -> int``. Bad input exits with code 2 and one clear line on stderr, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+from pathlib import Path
+
+#: sub-command → (module, help)
+COMMANDS: dict[str, tuple[str, str]] = {
+    "derive": ("app.cli.derive", "derive α_max, observer gains, profile, comparator gains, energies"),
+    "design": ("app.cli.design", "design a clean setting for this drive and verify it by simulation"),
+    "simulate": ("app.cli.simulate", "simulate the FDSMC and the conventional controller"),
+    "export": ("app.cli.export", "write the drive parameter file, C controller, CSV or HTML report"),
+    "table1": ("app.cli.table1", "Table-1 sweep of the friction saving over manoeuvre times"),
+    "bench": ("app.cli.bench", "print speed figures of the simulation engine"),
+    "serve": ("app.cli.serve", "start the commissioning web UI"),
+    "bldc": ("app.cli.bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
+    "log": ("app.cli.log", "import a drive log: overlay on the simulation, identify the motor and load"),
+    "multiaxis": ("app.cli.multiaxis", "axes that must finish together: common T_m, designs, energies"),
+    "dutycycle": ("app.cli.duty", "a duty cycle of moves with dwells: energy per cycle and per year"),
+    "robustness": ("app.cli.robustness", "Monte-Carlo robustness to plant values the controller does not know"),
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, exit 2
+        sys.stderr.write(f"error: {message}\n")
+        raise SystemExit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every available sub-command."""
+    parser = _Parser(prog="python -m app", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for name, (module, help_text) in COMMANDS.items():
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name != module:
+                raise
+            continue
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        mod.add_arguments(p)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None) -> None:
+    """The PRESET positional and repeatable ``--set section.field=value`` options."""
+    if default is None:
+        p.add_argument("preset", metavar="PRESET", help="preset name (presets/NAME.yaml) or a YAML/JSON file path")
+    else:
+        p.add_argument("preset", metavar="PRESET", nargs="?", default=default, help="preset name or YAML/JSON path")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.FIELD=VALUE",
+                   help="override a preset value, e.g. --set manoeuvre.T_m=1.4 or motor.L_d_mH=5.4")
+
+
+def check_writable(path: str, option: str) -> None:
+    """Raise ValueError unless ``path`` can be written (checked before any simulation runs)."""
+    target = Path(path)
+    try:
+        parent = target.parent if str(target.parent) else Path(".")
+        ok_dir = parent.is_dir() and os.access(parent, os.W_OK)
+        ok_file = not target.exists() or (target.is_file() and os.access(target, os.W_OK))
+    except (OSError, ValueError) as exc:  # name too long, NUL byte …
+        raise ValueError(f"{option} {path!r} cannot be written: {exc}") from None
+    if not ok_dir:
+        raise ValueError(f"{option} {path!r}: the folder {str(parent)!r} does not exist or is not writable: "
+                         "allowed a file in an existing, writable folder")
+    if not ok_file:
+        raise ValueError(f"{option} {path!r} is not a writable file: allowed a new or writable file")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; returns the process exit code."""
+    from app.threads import limit_blas_threads
+
+    limit_blas_threads()
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args._run(args) or 0)
+    except ValueError as exc:  # ParameterError, PresetError: bad input
+        sys.stderr.write(f"error: {exc}\n")
+        return 2
+    except KeyboardInterrupt:
+        return 130

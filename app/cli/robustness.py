@@ -1,0 +1,145 @@
+"""``python -m app robustness PRESET --samples N [--seed S] [--spread …] [--json] [--scheduler …]``.
+
+Spreads (comma-separated or repeated), each on a plant value (see :mod:`app.io.plant_overrides`), in SI:
+``plant.J_L=0:0.3`` uniform between 0 and 0.3; ``plant.R_s=±20%`` (or ``+-20%``) uniform within
+±20 % of the preset's value; ``plant.psi_pm=~5%`` normal with σ = 5 % of it (truncated at ±3σ).
+Runs on a local process pool (all cores) or, with ``--scheduler tcp://HOST:PORT`` or the
+environment variable ``PMSM_DASK_SCHEDULER``, on a Dask distributed cluster.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
+from typing import Any
+
+from app.cli.main import add_preset_arguments
+from app.cli.simulate import finite_or_none
+from app.io.plant_overrides import load_model_and_plant, plant_section
+from control.fdsmc.params import ParameterError
+from sim.studies.robustness import MAX_NORMAL_SIGMA, METRICS, RobustnessResult, Spread, robustness
+
+SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
+MAX_SAMPLES = 1_000_000
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``robustness``."""
+    add_preset_arguments(p)
+    p.add_argument("--samples", type=int, default=100, help="number of sampled plants (default 100)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the sampling (default 0)")
+    p.add_argument("--spread", action="append", default=[], metavar="plant.FIELD=DIST[,…]",
+                   help="plant.J_L=0:0.3 (uniform), plant.R_s=±20%% (uniform relative), "
+                        "plant.psi_pm=~5%% (normal, relative σ)")
+    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                   help="local worker processes (default: all cores)")
+    p.add_argument("--scheduler", default=os.environ.get(SCHEDULER_ENV),
+                   help=f"Dask scheduler address tcp://HOST:PORT (or ${SCHEDULER_ENV})")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--csv", metavar="FILE", help="write one row per sample (drawn values and metrics)")
+
+
+def _number(text: str, item: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise ParameterError(f"--spread {item!r}: {text!r} is not a number") from None
+    if v != v or v in (float("inf"), float("-inf")):
+        raise ParameterError(f"--spread {item!r}: {text!r} is not a finite number")
+    return v
+
+
+def parse_spread(item: str) -> Spread:
+    """One ``plant.FIELD=DIST`` item → :class:`Spread` (see the module docstring)."""
+    key, sep, dist = item.strip().partition("=")
+    if not sep or not key.startswith("plant."):
+        raise ParameterError(f"--spread {item!r} is not allowed: the form is plant.FIELD=DIST")
+    field, dist = key[len("plant."):], dist.strip()
+    section = plant_section(field)
+    if dist.startswith(("±", "+-", "~")) and dist.endswith("%"):
+        x = _number(dist.lstrip("±+-~")[:-1], item) / 100.0
+        if dist.startswith("~"):
+            if not 0.0 <= x <= MAX_NORMAL_SIGMA:
+                raise ParameterError(f"--spread {item!r}: σ = {100 * x:g} % is not allowed: 0 … "
+                                     f"{100 * MAX_NORMAL_SIGMA:g} %")
+            return Spread(section, field, "normal", 0.0, x)
+        if not 0.0 <= x < 1.0:
+            raise ParameterError(f"--spread {item!r}: ±{100 * x:g} % is not allowed: 0 … <100 %")
+        return Spread(section, field, "relative", -x, x)
+    lo, colon, hi = dist.partition(":")
+    if not colon:
+        raise ParameterError(f"--spread {item!r}: {dist!r} is not allowed: LO:HI, ±X% or ~X%")
+    a, b = _number(lo, item), _number(hi, item)
+    if b < a:
+        raise ParameterError(f"--spread {item!r}: the range {a:g}:{b:g} is not allowed: LO ≤ HI")
+    return Spread(section, field, "uniform", a, b)
+
+
+def parse_spreads(items: list[str]) -> list[Spread]:
+    """All ``--spread`` options (each may hold a comma-separated list)."""
+    return [parse_spread(x) for item in items for x in item.split(",") if x.strip()]
+
+
+def _progress(done: int, total: int) -> None:
+    sys.stderr.write(f"\rsamples {done}/{total} ({100 * done // total} %)")
+    if done == total:
+        sys.stderr.write("\n")
+    sys.stderr.flush()
+
+
+def write_csv(path: str, res: RobustnessResult) -> None:
+    """One row per sample: the drawn plant values, then each controller's metrics."""
+    keys = list(res.values)
+    cols = [(c, m) for c in ("fdsmc", "conventional") for m in (*METRICS, "chatter", "infeasible")]
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(keys + [f"{c}.{m}" for c, m in cols])
+        for i, r in enumerate(res.runs):
+            w.writerow([f"{res.values[k][i]:.9g}" for k in keys] + [r[c][m] for c, m in cols])
+
+
+def _print_table(summary: dict[str, Any]) -> None:
+    print(f"{summary['samples']} samples in {summary['seconds']:.1f} s")
+    for ctrl in ("fdsmc", "conventional"):
+        e = summary[ctrl]
+        print(f"\n{ctrl}: chatter probability {e['chatter_probability']:.3f}, "
+              f"infeasible probability {e['infeasible_probability']:.3f}")
+        print(f"  {'metric':28s}{'mean':>12s}{'p05':>12s}{'p50':>12s}{'p95':>12s}{'worst':>12s}")
+        for key in METRICS:
+            row = e[key]
+            print(f"  {key:28s}" + "".join(f"{row[s]:12.5g}" if row[s] is not None else f"{'—':>12s}"
+                                          for s in ("mean", "p05", "p50", "p95", "worst")))
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the Monte-Carlo analysis and print the summary."""
+    if not 1 <= args.samples <= MAX_SAMPLES:
+        raise ParameterError(f"--samples = {args.samples} is not allowed: 1 … {MAX_SAMPLES}")
+    if args.workers < 1:
+        raise ParameterError(f"--workers = {args.workers} is not allowed: ≥ 1")
+    params, plant = load_model_and_plant(args.preset, args.overrides)
+    if plant is not None:
+        raise ParameterError("plant.* --set overrides are not allowed here: give the plant's "
+                             "distribution with --spread (the preset is the nominal plant)")
+    spreads = parse_spreads(args.spread)
+    if args.scheduler:
+        from dask.distributed import Client
+
+        with Client(args.scheduler) as client:
+            workers = max(1, len(client.scheduler_info().get("workers", {})))
+            res = robustness(params, spreads, args.samples, args.seed, client, workers, _progress)
+    else:
+        with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
+            res = robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress)
+    if args.csv:
+        write_csv(args.csv, res)
+    if args.json:
+        print(json.dumps(finite_or_none(res.summary), indent=2, ensure_ascii=False))
+    else:
+        _print_table(res.summary)
+    return 0

@@ -1,0 +1,154 @@
+"""``python -m app simulate PRESET [--set …] [--controller …] [--json] [--csv FILE]``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import Any
+
+from app.cli.main import add_preset_arguments, check_writable
+from app.exports.model import trace_csv
+from app.io.derived_view import derived_json
+from app.io.plant_overrides import load_model_and_plant
+from control.fdsmc.params import ParameterError
+from sim.fdsmc.engine import Comparison, RunResult, compare
+from sim.fdsmc.verdicts import comparator_notes, run_warnings
+
+#: Rows of the terminal summary: (metric key, label, unit).
+SUMMARY = (
+    ("friction_J", "Friction loss over [0, T_m]", "J"),
+    ("copper_J", "Copper loss over [0, T_m]", "J"),
+    ("electrical_in_J", "Net electrical input over [0, T_m]", "J"),
+    ("regenerated_J", "Regenerated over [0, T_m]", "J"),
+    ("friction_total_J", "Friction loss, whole run", "J"),
+    ("copper_total_J", "Copper loss, whole run", "J"),
+    ("electrical_in_total_J", "Net electrical input, whole run", "J"),
+    ("energy_balance_residual_J", "Energy-balance residual", "J"),
+    ("t_2pct_first_s", "First entry into the 2 % band", "s"),
+    ("t_2pct_settle_s", "2 % settling time", "s"),
+    ("theta_error_at_Tm_rad", "Position error at T_m", "rad"),
+    ("overshoot_rad", "Overshoot", "rad"),
+    ("omega_peak_rad_s", "Peak speed", "rad/s"),
+    ("i_q_peak_A", "Peak i_q", "A"),
+    ("torque_peak_Nm", "Peak torque", "N·m"),
+    ("u_peak_V", "Peak |u_dq|", "V"),
+    ("saturated_s", "Time saturated", "s"),
+    ("chatter", "Chatter (limit cycle)", ""),
+    ("stable", "Stable", ""),
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``simulate``."""
+    add_preset_arguments(p)
+    p.add_argument("--controller", choices=("fdsmc", "conventional", "optimum", "both", "all"), default="all",
+                   help="which run(s): both = FDSMC and conventional, all = both and the tracked "
+                        "minimum-energy optimum (default all)")
+    p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
+    p.add_argument("--csv", metavar="FILE", help="write the time series (CSV: controller column, units in the headers)")
+
+
+def finite_or_none(value: Any) -> Any:
+    """JSON-safe value: non-finite floats become None, containers are converted recursively."""
+    if isinstance(value, dict):
+        return {k: finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [finite_or_none(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+#: Energy compared with the optimum: the net electrical input over the whole simulated horizon.
+OPTIMUM_BASIS = "electrical_in_total_J"
+
+
+def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float | None:
+    """100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save
+    (W = net electrical input over the whole horizon); None unless both runs are stable."""
+    if run is None or optimum is None or not (run.metrics["stable"] and optimum.metrics["stable"]):
+        return None
+    w, w_opt = run.metrics[OPTIMUM_BASIS], optimum.metrics[OPTIMUM_BASIS]
+    if not isinstance(w, float) or not isinstance(w_opt, float) or w <= 0.0:
+        return None
+    return 100.0 * (1.0 - w_opt / w)
+
+
+def comparison_json(cmp: Comparison) -> dict[str, Any]:
+    """The stable JSON contract of ``simulate --json``.
+
+    Each run's entry holds its metrics; with the optimum run, the ``fdsmc`` and ``conventional``
+    entries gain ``saving_vs_optimum_pct`` (see :func:`saving_vs_optimum`).
+    """
+    out: dict[str, Any] = {"derived": derived_json(cmp.derived)}
+    for run in (cmp.fdsmc, cmp.conventional, cmp.optimum):
+        if run is not None:
+            out[run.controller] = dict(run.metrics)
+    if cmp.optimum is not None:
+        for run in (cmp.fdsmc, cmp.conventional):
+            if run is not None:
+                out[run.controller]["saving_vs_optimum_pct"] = saving_vs_optimum(run, cmp.optimum)
+    out["saving_friction_pct"] = cmp.saving_friction_pct
+    out["saving_electrical_pct"] = cmp.saving_electrical_pct
+    out["run_warnings"] = run_warnings(cmp)
+    out["comparator_notes"] = comparator_notes(cmp)
+    return finite_or_none(out)
+
+
+def write_csv(path: str, cmp: Comparison) -> None:
+    """Write the time series in the one CSV format of the exports (:func:`app.exports.model.trace_csv`)."""
+    try:
+        with open(path, "w", newline="", encoding="utf-8") as fh:
+            fh.write(trace_csv(cmp))
+    except OSError as exc:
+        raise ParameterError(f"cannot write --csv {path!r}: {exc.strerror or exc}") from None
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    return f"{v:.5g}" if isinstance(v, float) else str(v)
+
+
+def print_summary(cmp: Comparison) -> None:
+    """Side-by-side table of the runs, savings, warnings and explanations."""
+    runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None]
+    p = cmp.derived.params
+    print(f"Preset: {p.name}  T_m = {p.manoeuvre.T_m:g} s, θ_dem = {p.manoeuvre.theta_dem:g} rad, "
+          f"f_s = {p.controller.f_s}, K = {p.controller.K:g} s/rad\n")
+    print(f"{'':40s}" + "".join(f"{r.controller:>16s}" for r in runs))
+    for key, label, unit in SUMMARY:
+        head = label + (f" [{unit}]" if unit else "")
+        print(f"{head:40s}" + "".join(f"{_fmt(r.metrics.get(key)):>16s}" for r in runs))
+    if cmp.saving_friction_pct is not None:
+        e = cmp.derived.energy
+        print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
+              f"(eq. (52) predicts {_fmt(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
+        print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
+    for run in (cmp.fdsmc, cmp.conventional):
+        gap = saving_vs_optimum(run, cmp.optimum)
+        if run is not None and gap is not None:
+            print(f"The tracked minimum-energy optimum would save {gap:.2f} % of the {run.controller}'s "
+                  "net electrical input (whole run)")
+    for w in run_warnings(cmp) + list(cmp.derived.warnings) + comparator_notes(cmp):
+        print(f"  ! {w}")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Simulate and print (table or JSON); optionally write the CSV."""
+    if args.csv:
+        check_writable(args.csv, "--csv")
+    params, plant = load_model_and_plant(args.preset, args.overrides)
+    ctrls = {"both": ("fdsmc", "conventional"), "all": ("fdsmc", "conventional", "optimum")}.get(
+        args.controller, (args.controller,))
+    cmp = compare(params, ctrls, plant=plant)
+    if args.csv:
+        write_csv(args.csv, cmp)
+    if args.json:
+        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False, allow_nan=False))
+    else:
+        print_summary(cmp)
+    return 0

@@ -1,0 +1,92 @@
+"""``python -m app table1 PRESET [--set …] [--tm 1.0,1.4,1.8,2.2,2.6] [--json]``.
+
+The Table-1 sweep of [1]: per manoeuvre time the simulated FDSMC and conventional friction
+energies over [0, T_m], the saving, eq. (52)'s prediction, the bound 1 − 4/5.6, and the paper's
+printed value beside them — both as printed and with the printed columns reversed (see
+``docs/paper_reproduction.md``).
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+
+from app.cli.main import add_preset_arguments
+from app.cli.simulate import finite_or_none
+from app.io.numbers import NumberFormatError, parse_number
+from app.io.preset_modes import load_mode_preset
+from control.fdsmc.params import ParameterError
+from sim.fdsmc.engine import PAPER_TABLE1, Table1Row, table1_sweep
+
+DEFAULT_TM = "1.0,1.4,1.8,2.2,2.6"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``table1``."""
+    add_preset_arguments(p)
+    p.add_argument("--tm", default=DEFAULT_TM, metavar="T1,T2,…",
+                   help=f"comma-separated manoeuvre times in s (default {DEFAULT_TM})")
+    p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
+
+
+def parse_tm(text: str) -> list[float]:
+    """Manoeuvre times from ``"1.0,1.4"``; ParameterError naming the bad entry."""
+    out: list[float] = []
+    for item in text.split(","):
+        try:
+            v = parse_number(item, "--tm entry")
+        except NumberFormatError:
+            raise ParameterError(f"--tm entry {item.strip()!r} is not a number: allowed a time > 0 s") from None
+        if not 0.0 < v <= 1e4:
+            raise ParameterError(f"--tm entry {v:g} s is out of range: allowed 0 < T_m ≤ 10000 s")
+        out.append(v)
+    return out
+
+
+def reversed_paper() -> dict[float, float]:
+    """Table 1's printed savings with the column order reversed (T_m ↦ value of the mirror column)."""
+    keys = sorted(PAPER_TABLE1)
+    return {k: PAPER_TABLE1[m] for k, m in zip(keys, reversed(keys), strict=True)}
+
+
+def row_json(r: Table1Row) -> dict[str, float | None]:
+    """One row of ``table1 --json``."""
+    out = dataclasses.asdict(r)
+    out["paper_reversed_pct"] = reversed_paper().get(round(r.T_m, 3))
+    return out
+
+
+def _fmt(v: float | None) -> str:
+    return "—" if v is None else f"{v:.2f}"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the sweep and print the table (or JSON)."""
+    params = load_mode_preset(args.preset, args.overrides, mode="position")
+    tms = parse_tm(args.tm)
+
+    def progress(done: int, total: int) -> None:
+        if not args.json:
+            sys.stderr.write(f"\r  simulated {done}/{total}")
+            sys.stderr.flush()
+
+    rows = table1_sweep(params, tms, progress)
+    if args.json:
+        print(json.dumps(finite_or_none({"rows": [row_json(r) for r in rows]}), indent=2))
+        return 0
+    sys.stderr.write("\n")
+    print(f"Preset: {params.name}, f_s = {params.controller.f_s}, K = {params.controller.K:g} s/rad\n")
+    print(f"{'T_m [s]':>8} {'W_FDSMC [J]':>12} {'W_conv [J]':>12} {'saving %':>9} {'eq.52 %':>8} "
+          f"{'bound %':>8} {'paper %':>8} {'reversed %':>10}")
+    rev = reversed_paper()
+    for r in rows:
+        print(f"{r.T_m:8.3g} {r.friction_fdsmc_J:12.2f} {r.friction_conventional_J:12.2f} "
+              f"{r.saving_pct:9.2f} {r.saving_eq52_pct:8.2f} {r.bound_pct:8.2f} {_fmt(r.paper_pct):>8} "
+              f"{_fmt(rev.get(round(r.T_m, 3))):>10}")
+    print("\nSaving = 1 − W_FDSMC/W_conv, friction over [0, T_m]. 'reversed' = the paper's printed "
+          "row read right-to-left (see docs/paper_reproduction.md).")
+    return 0

@@ -1,0 +1,205 @@
+"""The export model shared by the page's Export menu and ``python -m app export``.
+
+:func:`export_files` turns one simulated case (a :class:`sim.fdsmc.engine.Comparison`, whose
+``derived.params`` are the inputs) into the files of one format — the same bytes whoever asks:
+
+* ``yaml`` / ``json``: the drive parameter file (schema 2): an importable preset (inputs in SI)
+  plus ``units`` (the unit of every input), ``drive_gains`` (value, unit, reference), ``verdicts``
+  (feasibility, warnings, run warnings, savings) and ``results`` (each run's metrics, the unit in
+  each key's suffix). The loader ignores the informational sections and recomputes them, so
+  export → import → export gives identical bytes;
+* ``c``: the C99 controller module (:mod:`app.exports.c_module`);
+* ``csv``: the time series of both runs (:func:`trace_csv`);
+* ``html``: the offline report (:mod:`app.exports.html`).
+
+Files are named after the case's ``name``; no date is written, so exports are reproducible.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import re
+import zipfile
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from app.exports.c_module import TOOL, controller_files
+from app.io.derived_view import derived_rows
+from app.io.presets import SCHEMA, dumps, to_raw
+from app.io.units import SI_UNITS
+from control.fdsmc.derivations import Derived
+from control.fdsmc.params import ParameterError
+from sim.fdsmc.engine import Comparison
+from sim.fdsmc.verdicts import comparator_notes, run_warnings
+
+FORMATS = ("yaml", "json", "c", "csv", "html")
+
+
+@dataclass(frozen=True)
+class Gain:
+    """One value the drive firmware needs: name (C identifier), value, unit, reference."""
+
+    name: str
+    value: float
+    unit: str
+    ref: str
+
+
+def drive_gains(d: Derived) -> list[Gain]:
+    """Every derived gain and setting the drive needs, in SI units.
+
+    K1…K4 (continuous, eq. (18)), L1…L4 and the pole for f_s (discrete observer), α_max, ω_p,
+    T_a, T_c, K, g1, g2, T_si, T_sα, θ_dem, T_m.
+    """
+    p, pr, o = d.params, d.profile, d.observer
+    units = {r.symbol: r.unit for r in derived_rows(d)}
+    gains = [
+        Gain("ALPHA_MAX", d.alpha.alpha_max, "rad/s²", f"alpha_max, {d.alpha.rule} rule"),
+        Gain("OMEGA_P", pr.omega_p, "rad/s", "peak speed, eq. (60)"),
+        Gain("T_A", pr.T_a, "s", "acceleration time, eq. (58)"),
+        Gain("T_C", pr.T_c, "s", "sliding-mode time constant, eq. (59)"),
+        Gain("K_BL", p.controller.K, "s/rad", "boundary-layer gain K, eq. (45)"),
+        Gain("G1", d.conventional.g1, "1/s²", "conventional gain, eq. (61)"),
+        Gain("G2", d.conventional.g2, "1/s", "conventional gain, eq. (61)"),
+        Gain("T_SI", p.controller.T_si, "s", "d-current settling time, eq. (8)"),
+        Gain("T_SALPHA", p.controller.T_salpha, "s", "acceleration settling time, eq. (13)"),
+        Gain("THETA_DEM", p.manoeuvre.theta_dem, "rad", "demanded angle"),
+        Gain("T_M", p.manoeuvre.T_m, "s", "manoeuvre time"),
+        Gain("OBS_Q", o.q, "1/s", "observer pole magnitude, eq. (17)"),
+    ]
+    gains += [Gain(f"OBS_K{i}", getattr(o, f"K{i}"), units.get(f"K{i}", "-"), "observer gain, eq. (18)")
+              for i in range(1, 5)]
+    od = d.observer_discrete
+    if od is not None:
+        gains += [Gain("F_S", 1.0 / od.T_s, "Hz", "controller sample rate"),
+                  Gain("OBS_Z_POLE", od.z_pole, "-", "discrete observer pole exp(-q/f_s)")]
+        gains += [Gain(f"OBS_L{i + 1}", float(v), units.get(f"L{i + 1}", "-"),
+                       "discrete observer gain (Ackermann)") for i, v in enumerate(od.L)]
+    return gains
+
+
+def _finite(value: Any) -> Any:
+    """JSON/YAML-safe data: non-finite floats → None, numpy scalars → Python, recursively."""
+    if isinstance(value, dict):
+        return {str(k): _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def verdicts(cmp: Comparison) -> dict[str, Any]:
+    """Feasibility, design warnings, run warnings and savings of one case."""
+    d = cmp.derived
+    return {"feasible": bool(d.profile.feasible), "warnings": list(d.warnings),
+            "run_warnings": run_warnings(cmp), "comparator_notes": comparator_notes(cmp),
+            "saving_friction_pct": cmp.saving_friction_pct,
+            "saving_electrical_pct": cmp.saving_electrical_pct}
+
+
+def parameter_data(cmp: Comparison) -> dict[str, Any]:
+    """The drive parameter file as plain data (schema 2): preset + units, gains, verdicts, results."""
+    params = cmp.derived.params
+    raw = to_raw(params)
+    raw["units"] = {sec: dict(SI_UNITS[sec]) for sec in ("motor", "load", "controller", "manoeuvre")}
+    raw["drive_gains"] = {g.name: {"value": g.value, "unit": g.unit, "ref": g.ref} for g in drive_gains(cmp.derived)}
+    raw["verdicts"] = verdicts(cmp)
+    raw["results"] = {r.controller: dict(r.metrics) for r in (cmp.fdsmc, cmp.conventional) if r is not None}
+    raw["exported_by"] = TOOL
+    return _finite(raw)
+
+
+def parameter_yaml(cmp: Comparison) -> str:
+    """Drive parameter file as YAML (written by :func:`app.io.presets.dumps`)."""
+    head = (f"# Drive parameter file (schema {SCHEMA}) — {TOOL}. SI units; the unit of each input is in\n"
+            "# `units`. Re-import: the page's Import button or any command taking PRESET, e.g.\n"
+            "# `python -m app derive FILE`; drive_gains, verdicts and results are then recomputed.\n")
+    return head + dumps(parameter_data(cmp))
+
+
+def parameter_json(cmp: Comparison) -> str:
+    """Drive parameter file as JSON text (same data as the YAML file)."""
+    return json.dumps(parameter_data(cmp), indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+
+
+#: CSV columns: (Trace attribute, unit).
+CSV_COLUMNS = (
+    ("t", "s"), ("theta_r", "rad"), ("omega_r", "rad/s"), ("i_d", "A"), ("i_q", "A"), ("u_d", "V"),
+    ("u_q", "V"), ("alpha", "rad/s^2"), ("alpha_dem", "rad/s^2"), ("alpha_hat", "rad/s^2"),
+    ("Gamma_L", "N*m"), ("Gamma_L_hat", "N*m"), ("theta_hat", "rad"), ("omega_hat", "rad/s"),
+    ("S", "rad/s"), ("E_friction", "J"), ("E_copper", "J"), ("E_electrical", "J"), ("E_motoring", "J"),
+    ("E_load", "J"),
+)
+
+
+def trace_csv(cmp: Comparison) -> str:
+    """Time series of both runs as one CSV table (the format of the page and ``simulate --csv``).
+
+    One column per signal with its unit in the header (``theta_r [rad]``), a first ``controller``
+    column, one row per controller and sample (SI units, ``%.9g``): ``pandas.read_csv`` gives typed
+    columns directly (``df.groupby("controller")``), Excel filters on the first column.
+
+    Raises
+    ------
+    ParameterError
+        When there is no run (an infeasible manoeuvre).
+    """
+    runs = [r for r in (cmp.fdsmc, cmp.conventional) if r is not None]
+    if not runs:
+        raise ParameterError("nothing to export as CSV: there is no simulated run "
+                             f"(manoeuvre.T_m = {cmp.derived.params.manoeuvre.T_m:g} s is infeasible)")
+    out = io.StringIO()
+    out.write("controller," + ",".join(f"{a} [{u}]" for a, u in CSV_COLUMNS) + "\n")
+    for run in runs:
+        block = io.StringIO()
+        np.savetxt(block, np.column_stack([getattr(run.trace, a) for a, _ in CSV_COLUMNS]), fmt="%.9g",
+                   delimiter=",")
+        out.writelines(f"{run.controller},{line}\n" for line in block.getvalue().splitlines())
+    return out.getvalue()
+
+
+def safe_stem(name: str) -> str:
+    """A file-name stem from a preset/motor name (letters, digits, ``_-.`` only)."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "drive"
+
+
+def export_files(fmt: str, cmp: Comparison) -> dict[str, bytes]:
+    """File name → content of one export format for the case ``cmp`` (see the module doc).
+
+    Raises
+    ------
+    ParameterError
+        For an unknown format, a C export in continuous mode, or a CSV without a run.
+    """
+    stem = safe_stem(cmp.derived.params.name)
+    if fmt == "c":
+        files = controller_files(cmp.derived.params, cmp.derived, SCHEMA)
+        return {name: text.encode("utf-8") for name, text in files.items()}
+    if fmt == "html":
+        from app.exports.html import html_report  # plotly: imported only when a report is made
+
+        return {f"{stem}.html": html_report(cmp).encode("utf-8")}
+    writers = {"yaml": parameter_yaml, "json": parameter_json, "csv": trace_csv}
+    if fmt not in writers:
+        raise ParameterError(f"format = {fmt!r} is not allowed: one of {', '.join(FORMATS)}")
+    return {f"{stem}.{fmt}": writers[fmt](cmp).encode("utf-8")}
+
+
+def export_download(fmt: str, cmp: Comparison) -> tuple[str, bytes]:
+    """One downloadable file: the single export file, or a zip (``<name>_fdsmc_controller.zip``)
+    holding the C module's header and source."""
+    files = export_files(fmt, cmp)
+    if len(files) == 1:
+        return next(iter(files.items()))
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
+        for name, content in files.items():
+            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))  # reproducible bytes
+            zf.writestr(info, content, zipfile.ZIP_DEFLATED)
+    return f"{safe_stem(cmp.derived.params.name)}_fdsmc_controller.zip", buf.getvalue()

@@ -1,0 +1,53 @@
+"""The controller's model vs the plant's true values: ``--set plant.FIELD=VALUE`` overrides.
+
+A ``plant.`` override changes the simulated drive only; the controller keeps designing with the
+preset's (and the other overrides') values. FIELD is a motor or load field of the preset, with the
+same unit suffixes as ``motor.`` / ``load.`` overrides (``plant.L_d_mH=6``, ``plant.J_L=0.3``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterable
+
+from app.io.preset_modes import load_mode_preset
+from control.fdsmc.params import DriveParams, Load, Motor, ParameterError
+
+PREFIX = "plant."
+MOTOR_FIELDS = tuple(f.name for f in dataclasses.fields(Motor))
+LOAD_FIELDS = tuple(f.name for f in dataclasses.fields(Load) if f.name != "steps")
+
+
+def plant_section(field: str) -> str:
+    """``motor`` or ``load`` for a plant field (a unit suffix such as ``_mH`` is allowed)."""
+    for name in (field, field.rsplit("_", 1)[0]):
+        if name in MOTOR_FIELDS:
+            return "motor"
+        if name in LOAD_FIELDS:
+            return "load"
+    raise ParameterError(
+        f"plant.{field} is not a plant value: allowed plant.FIELD with FIELD one of "
+        f"{', '.join(MOTOR_FIELDS + LOAD_FIELDS)} (optionally with a unit suffix)")
+
+
+def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
+    """(the model's overrides, the plant's overrides mapped to ``motor.``/``load.`` fields)."""
+    model, plant = [], []
+    for item in overrides:
+        if not item.startswith(PREFIX):
+            model.append(item)
+            continue
+        key, sep, value = item[len(PREFIX):].partition("=")
+        if not sep:
+            raise ParameterError(f"--set {item!r} is not allowed: the form is plant.FIELD=VALUE")
+        plant.append(f"{plant_section(key.strip())}.{key.strip()}={value}")
+    return model, plant
+
+
+def load_model_and_plant(preset: str, overrides: Iterable[str]) -> tuple[DriveParams, DriveParams | None]:
+    """The controller's model and the plant (None when no ``plant.`` override is given)."""
+    model_ov, plant_ov = split_overrides(overrides)
+    params = load_mode_preset(preset, model_ov, mode="position")
+    if not plant_ov:
+        return params, None
+    return params, load_mode_preset(preset, model_ov + plant_ov, mode="position")

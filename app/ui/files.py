@@ -1,0 +1,125 @@
+"""Export menu and preset upload of the position-drive tab.
+
+Downloads go to the one client that asked (``client.send_file_download``) and are produced by the
+export model shared with the CLI (:func:`app.exports.model.export_download`), so the page and
+``python -m app export`` write the same bytes. An export describes the simulated case; when the
+inputs shown differ from it (edited but not simulated) the export is refused with a message naming
+the uncommitted fields. An upload (YAML or JSON) is validated by the same loader as the CLI
+(:func:`app.io.presets.loads_preset`); a bad file gets a notification naming the problem and
+changes nothing.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from typing import Any
+
+import viser
+
+from app.exports.model import export_download, safe_stem
+from app.io.presets import MAX_BYTES, PresetError, loads_preset, to_raw
+from control.fdsmc.params import DriveParams, ParameterError
+from sim.fdsmc.engine import Comparison
+
+#: Export label → format of :func:`app.exports.model.export_files`.
+EXPORTS = {
+    "Drive parameters (YAML)": "yaml",
+    "Drive parameters (JSON)": "json",
+    "C controller module (.h + .c, zip)": "c",
+    "Time series (CSV)": "csv",
+    "HTML report (offline)": "html",
+}
+
+
+class ExportRefusedError(ValueError):
+    """An export that would not describe the inputs shown; the message says why."""
+
+
+def _flat(params: DriveParams) -> dict[str, Any]:
+    raw = to_raw(params)
+    out: dict[str, Any] = {}
+    for section, fields in raw.items():
+        if isinstance(fields, dict):
+            out.update({f"{section}.{k}": v for k, v in fields.items()})
+    return out
+
+
+def uncommitted(shown: DriveParams, committed: DriveParams) -> list[str]:
+    """``field = shown (simulated: value)`` for every input that differs (SI units); name and
+    source are not simulated inputs (the Export folder sets them)."""
+    a, b = _flat(shown), _flat(committed)
+    return [f"{k} = {a[k]!r} (simulated: {b.get(k)!r})" for k in a if a[k] != b.get(k)]
+
+
+def parse_upload(name: str, content: bytes) -> DriveParams:
+    """Validate an uploaded preset file; PresetError/ParameterError with a clear message if bad."""
+    if len(content) > MAX_BYTES:
+        raise PresetError(f"{name} is too large ({len(content) // 1024} KiB): allowed ≤ {MAX_BYTES // 1024} KiB")
+    try:
+        text = content.decode("utf-8")
+    except UnicodeDecodeError:
+        raise PresetError(f"{name} is not UTF-8 text: allowed a YAML or JSON preset file") from None
+    params = loads_preset(text, name or "<upload>")
+    if not isinstance(params, DriveParams):
+        raise PresetError(f"{name} is a preset for another mode: allowed a position-drive (FDSMC) preset")
+    return params
+
+
+def renamed(cmp: Comparison, name: str, source: str) -> Comparison:
+    """The case with the name and source written into the exports (both must be non-blank)."""
+    for field, text in (("name", name), ("source", source)):
+        if not text.strip():
+            raise ExportRefusedError(f"Export › {field} = {text!r} is empty: allowed any non-blank text "
+                                     "(the file name and the file's header come from it)")
+    params = dataclasses.replace(cmp.derived.params, name=name.strip(), source=source.strip())
+    return dataclasses.replace(cmp, derived=dataclasses.replace(cmp.derived, params=params))
+
+
+class FilesPanel:
+    """"Export" folder (name, source and one button per export format), and the upload button.
+
+    ``state`` returns the simulated case to export or raises :class:`ExportRefusedError`; the
+    name and source typed in the folder replace the case's in every file (and the file name).
+    """
+
+    def __init__(self, client: viser.ClientHandle, state: Callable[[], Comparison],
+                 on_import: Callable[[DriveParams, str], None], params: DriveParams) -> None:
+        self._client, self._state, self._on_import = client, state, on_import
+        gui = client.gui
+        self.upload = gui.add_upload_button("Import preset (YAML/JSON)", icon=viser.Icon.UPLOAD,
+                                            mime_type=".yaml,.yml,.json,text/yaml,application/json,text/plain")
+        self.upload.on_upload(self._uploaded)
+        with gui.add_folder("Export", expand_by_default=False):
+            self.name = gui.add_text("Name (file name)", params.name)
+            self.source = gui.add_text("Source", params.source)
+            self.buttons = {}
+            for label, fmt in EXPORTS.items():
+                button = gui.add_button(label, icon=viser.Icon.DOWNLOAD)
+                button.on_click(lambda _, fmt=fmt: self._export(fmt))
+                self.buttons[label] = button
+
+    def _export(self, fmt: str) -> None:
+        try:
+            name, content = export_download(fmt, renamed(self._state(), self.name.value, self.source.value))
+        except (ExportRefusedError, ParameterError) as exc:
+            self._client.add_notification("Not exported", str(exc), color="yellow", auto_close_seconds=12.0)
+            return
+        self._client.send_file_download(name, content, save_immediately=True)
+
+    def _uploaded(self, _: viser.GuiEvent) -> None:
+        f = self.upload.value
+        try:
+            params = parse_upload(f.name, f.content)
+        except (PresetError, ParameterError) as exc:
+            self._client.add_notification("Import rejected — nothing changed", str(exc), color="red",
+                                          auto_close_seconds=15.0)
+            return
+        self._on_import(params, f.name)
+
+    def show_names(self, params: DriveParams) -> None:
+        """Show the name and source of newly loaded inputs (a preset chosen or a file imported)."""
+        self.name.value, self.source.value = params.name, params.source
+
+
+__all__ = ["EXPORTS", "ExportRefusedError", "FilesPanel", "parse_upload", "renamed", "safe_stem", "uncommitted"]

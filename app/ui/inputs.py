@@ -1,0 +1,329 @@
+"""Input folders of the position-drive tab: nameplate, load, inverter/controller, manoeuvre.
+
+Values are shown in nameplate units with the unit in every label and converted to SI here, at the
+edge. Every number is a text field parsed on the server (:mod:`app.ui.number_fields`): what reaches the
+physics is exactly what was typed, or nothing runs and the message names the field, the value and
+the allowed range. Unit selectors (inertia in kg·m² or kg·cm², move in rad/deg/rev, R_s and L per
+phase or line-to-line, Ψ_PM or Ke or Kt) convert the shown values; nothing is committed while
+typing: :meth:`InputsPanel.collect` reads the fields on Simulate (or Enter) and validates them with
+the same loader as the CLI and YAML files (:func:`app.io.presets.parse_preset`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import viser
+
+from app.io import units
+from app.io.numbers import NumberFormatError
+from app.io.presets import parse_preset, to_raw
+from app.ui.number_fields import NumberInput
+from app.ui.text import checked_choice
+from control.fdsmc.params import DriveParams, ParameterError
+
+Conv = Callable[[float, int], float]  # (value, pole pairs) → value
+
+
+def _same(x: float, _p: int) -> float:
+    return x
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A display unit: label and converters to/from SI (they may need the pole pairs p)."""
+
+    label: str
+    to_si: Conv = _same
+    from_si: Conv = _same
+
+
+def _scale(label: str, k: float) -> Unit:
+    return Unit(label, lambda x, _p: x * k, lambda x, _p: x / k)
+
+
+#: Unit choices per selector; the first is the default.
+UNIT_GROUPS: dict[str, tuple[Unit, ...]] = {
+    "inertia": (Unit("kg·m²"), _scale("kg·cm²", 1e-4)),
+    "angle": (Unit("rad"), _scale("deg", math.pi / 180.0), _scale("rev", 2.0 * math.pi)),
+    "flux": (Unit("Ψ_PM [Wb]"),
+             Unit("Ke [V_rms LL/krpm]", lambda x, p: units.ke_vrms_krpm_to_psi_pm(x, p),
+                  lambda x, p: units.psi_pm_to_ke_vrms_krpm(x, p)),
+             Unit("Kt [N·m/A_rms]", lambda x, p: units.kt_nm_per_arms_to_psi_pm(x, p),
+                  lambda x, p: units.psi_pm_to_kt_nm_per_arms(x, p))),
+    "resistance": (Unit("per phase"), _scale("line-to-line", 0.5)),
+    "inductance": (_scale("per phase", 1e-3), _scale("line-to-line", 0.5e-3)),
+}
+SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), ("inertia", "Inertia unit"),
+             ("angle", "Move unit"))
+
+
+@dataclass(frozen=True)
+class Field:
+    """One numeric input: SI field ``section.name`` shown as ``label [unit]``.
+
+    ``unit`` is the fixed display unit, or ``group`` names the selector whose choice applies.
+    """
+
+    section: str
+    name: str
+    label: str
+    unit: str = ""
+    scale: float = 1.0  # SI value = shown value · scale (fixed units)
+    group: str | None = None
+    integer: bool = False
+
+    @property
+    def key(self) -> str:
+        """``section.name``."""
+        return f"{self.section}.{self.name}"
+
+    def unit_of(self, choice: Unit | None) -> str:
+        """Display unit text for the selector's ``choice``."""
+        if self.group in ("resistance", "inductance") and choice is not None:
+            return f"{'Ω' if self.group == 'resistance' else 'mH'}, {choice.label}"
+        return choice.label if choice is not None else self.unit
+
+    def text(self, choice: Unit | None = None) -> str:
+        """Label with unit, as shown on the page."""
+        if self.group == "flux" and choice is not None:
+            return choice.label
+        return f"{self.label} [{self.unit_of(choice)}]"
+
+
+FIELDS: tuple[Field, ...] = (
+    Field("motor", "V_0", "V_0 rated (LL rms)", "V"),
+    Field("motor", "P_r", "P_r rated power", "kW", 1e3),
+    Field("motor", "omega_b", "n_b rated speed", "rpm", math.pi / 30.0),
+    Field("motor", "Gamma_max", "Γ_max peak torque", "N·m"),
+    Field("motor", "psi_pm", "Ψ_PM", group="flux"),
+    Field("motor", "p", "p pole pairs", "-", integer=True),
+    Field("motor", "R_s", "R_s", group="resistance"),
+    Field("motor", "L_d", "L_d", group="inductance"),
+    Field("motor", "L_q", "L_q", group="inductance"),
+    Field("motor", "J_r", "J_r rotor inertia", group="inertia"),
+    Field("load", "J_L", "J_L load inertia", group="inertia"),
+    Field("load", "F_v", "F_v viscous friction", "N·m·s/rad"),
+    Field("load", "Gamma_Le", "Γ_Le load torque at t=0", "N·m"),
+    Field("load", "Gamma_Le_ramp", "Γ_Le ramp", "N·m/s"),
+    Field("controller", "V_dc", "V_dc inverter DC link (0 = ideal)", "V"),
+    Field("controller", "i_max", "i_max inverter peak current (0 = none)", "A"),
+    Field("controller", "T_si", "T_si current settling", "ms", 1e-3),
+    Field("controller", "T_salpha", "T_sα accel. settling", "ms", 1e-3),
+    Field("controller", "T_so", "T_so observer settling", "ms", 1e-3),
+    Field("controller", "K", "K boundary-layer gain", "s/rad"),
+    Field("manoeuvre", "theta_dem", "θ_dem demanded angle", group="angle"),
+    Field("manoeuvre", "T_m", "T_m manoeuvre time", "s"),
+)
+FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("controller", "Inverter and controller"),
+           ("manoeuvre", "Manoeuvre"))
+TC_RULES = ("T_c = T_a, eq. (59)", "T_c given below")
+FS_MODES = ("digital, sampled at f_s", "continuous")
+ALPHA_RULES = ("torque_limit", "paper")
+DELAYS = ("0", "1")
+#: Optional datasheet values used only to cross-check the nameplate (label → key).
+CHECKS = (("Kt datasheet [N·m/A_rms] (optional check)", "Kt"), ("T_N rated torque [N·m] (optional check)", "T_N"))
+
+
+class InputError(ValueError):
+    """Invalid form input; the message names the field (with its page label) and the allowed range."""
+
+
+def format_steps(steps: tuple[Any, ...]) -> str:
+    """Load-torque steps → ``"t:Γ, t:Γ"`` text [s, N·m]."""
+    return ", ".join(f"{s.t:g}:{s.Gamma_Le:g}" for s in steps)
+
+
+def parse_steps(text: str) -> list[dict[str, float]]:
+    """``"t:Γ, t:Γ"`` [s, N·m] → list of step mappings; InputError on malformed text."""
+    from app.io.numbers import parse_number
+
+    out: list[dict[str, float]] = []
+    for item in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):
+        t_txt, sep, g_txt = item.partition(":")
+        try:
+            if not sep:
+                raise NumberFormatError(item)
+            out.append({"t": parse_number(t_txt, "t"), "Gamma_Le": parse_number(g_txt, "Γ_Le")})
+        except NumberFormatError:
+            raise InputError(
+                f"Load › torque steps: {item!r} is malformed: allowed 't:Γ_Le' pairs in s and N·m, "
+                "separated by commas, e.g. '0.5:10, 1.2:0'") from None
+    return out
+
+
+class InputsPanel:
+    """The input folders on one client's GUI; build inside the current container context."""
+
+    def __init__(self, gui: viser.GuiApi, params: DriveParams) -> None:
+        self._gui = gui
+        self._params = params
+        self.numbers: dict[str, NumberInput] = {}
+        self.selectors: dict[str, viser.GuiDropdownHandle] = {}
+        self._choice = {g: units_[0] for g, units_ in UNIT_GROUPS.items()}
+        for section, title in FOLDERS:
+            with gui.add_folder(title):
+                self._selectors(section)
+                for f in (f for f in FIELDS if f.section == section):
+                    self.numbers[f.key] = NumberInput(gui, f.text(self._unit(f)))
+                self._extra(section)
+        self.populate(params)
+
+    def _selectors(self, section: str) -> None:
+        wanted = {"motor": ("flux", "resistance", "inertia"), "manoeuvre": ("angle",)}.get(section, ())
+        for group, title in SELECTORS:
+            if group in wanted:
+                handle = self._gui.add_dropdown(title, tuple(u.label for u in UNIT_GROUPS[group]))
+                handle.on_update(lambda _e, g=group: self._unit_changed(g))
+                self.selectors[group] = handle
+
+    def _extra(self, section: str) -> None:
+        gui = self._gui
+        if section == "motor":
+            self.checks = {key: NumberInput(gui, label, hint="Leave empty to skip this cross-check")
+                           for label, key in CHECKS}
+        elif section == "load":
+            self.steps = gui.add_text("Γ_Le steps [t s : N·m, …]", "",
+                                      hint="Later steps of the external load torque, e.g. 0.5:10, 1.2:0")
+        elif section == "controller":
+            self.tc_rule = gui.add_dropdown("T_c rule", TC_RULES)
+            self.tc_ms = NumberInput(gui, "T_c sliding time const. [ms]")
+            self.alpha_rule = gui.add_dropdown("α_max rule", ALPHA_RULES,
+                                               hint="torque_limit: largest α within Γ_max/i_max incl. friction, "
+                                                    "load and inner-loop overshoot; paper: α_max = H·P_r/V_0")
+            self.fs_mode = gui.add_dropdown("Controller", FS_MODES)
+            self.fs_khz = NumberInput(gui, "f_s sample rate [kHz]")
+            self.delay = gui.add_dropdown("Computation delay [samples]", DELAYS)
+
+    # ---- units --------------------------------------------------------------------------------
+    def _unit(self, f: Field) -> Unit | None:
+        return self._choice[f.group] if f.group else None
+
+    def _p(self) -> int:
+        try:
+            return int(self.numbers["motor.p"].read("motor.p", integer=True))
+        except NumberFormatError:
+            return self._params.motor.p
+
+    def _show(self, f: Field, si: float) -> None:
+        u = self._unit(f)
+        shown = u.from_si(si, self._p()) if u is not None else (si if f.integer else si / f.scale)
+        self.numbers[f.key].show(int(shown) if f.integer else float(shown), exact=si)
+
+    def _unit_changed(self, group: str) -> None:
+        groups = ("resistance", "inductance") if group == "resistance" else (group,)
+        fields = [f for f in FIELDS if f.group in groups]
+        try:
+            values = {f.key: self._read(f) for f in fields}
+        except InputError:
+            values = {}  # unparsable text stays as typed; it is reported on Simulate
+        label, offered = self.selectors[group].value, [u.label for u in UNIT_GROUPS[group]]
+        if label not in offered:  # never offered: refused on Simulate by collect()
+            return
+        for g in groups:
+            idx = offered.index(label)
+            self._choice[g] = UNIT_GROUPS[g][idx]
+        for f in fields:
+            self.numbers[f.key].label = f.text(self._unit(f))
+            if f.key in values:
+                self._show(f, values[f.key])
+
+    # ---- values -------------------------------------------------------------------------------
+    def populate(self, params: DriveParams) -> None:
+        """Show ``params`` in the fields; remembers them as the unchanged reference."""
+        self._params = params
+        raw = to_raw(params)
+        self.numbers["motor.p"].show(params.motor.p)
+        for f in FIELDS:
+            self._show(f, raw[f.section][f.name])
+        c = params.controller
+        self.steps.value = format_steps(params.load.steps)
+        self.tc_rule.value = TC_RULES[0] if c.T_c == "T_a" else TC_RULES[1]
+        if c.T_c != "T_a":
+            self.tc_ms.show(float(c.T_c) * 1e3, exact=float(c.T_c))
+        self.alpha_rule.value = c.alpha_max_rule
+        self.fs_mode.value = FS_MODES[1] if c.is_continuous else FS_MODES[0]
+        if not c.is_continuous:
+            self.fs_khz.show(float(c.f_s) * 1e-3, exact=float(c.f_s))
+        self.delay.value = str(c.delay_samples)
+
+    def show_T_c_in_force(self, T_c: float) -> None:
+        """With the rule T_c = T_a, show the T_a in force [s] in the T_c field (read-only meaning)."""
+        if self.tc_rule.value == TC_RULES[0]:
+            self.tc_ms.show(T_c * 1e3, exact=T_c)
+
+    def set_T_c(self, T_c: float) -> None:
+        """Select "T_c given below" and show ``T_c`` [s] (e.g. "use T_c,min")."""
+        self.tc_rule.value = TC_RULES[1]
+        self.tc_ms.show(units.s_to_ms(T_c), exact=T_c)
+
+    def set_value(self, key: str, value_si: float) -> None:
+        """Set one numeric field from an SI value (e.g. "use recommended K")."""
+        self._show(next(f for f in FIELDS if f.key == key), value_si)
+
+    def _read(self, f: Field) -> float:
+        u, page = self._unit(f), f"{dict(FOLDERS)[f.section]} › {f.text(self._unit(f))}"
+        try:
+            if f.integer:
+                return self.numbers[f.key].read(page, integer=True)
+            conv = (lambda x: u.to_si(x, self._p())) if u is not None else (lambda x: x * f.scale)
+            return self.numbers[f.key].read(page, conv)
+        except NumberFormatError as exc:
+            raise InputError(str(exc)) from None
+
+    def nameplate_checks(self) -> dict[str, float]:
+        """The optional datasheet values typed for the cross-check (empty fields left out)."""
+        out: dict[str, float] = {}
+        for label, key in CHECKS:
+            field = self.checks[key]
+            if field.handle.value.strip():
+                try:
+                    out[key] = float(field.read(label))
+                except NumberFormatError as exc:
+                    raise InputError(str(exc)) from None
+        return out
+
+    def collect(self) -> DriveParams:
+        """Validate the fields and return the new parameters.
+
+        Raises
+        ------
+        InputError
+            Naming the page label, the SI field, the value and the allowed range.
+        """
+        raw = to_raw(self._params)
+        for f in FIELDS:
+            raw[f.section][f.name] = self._read(f)
+        raw["load"]["steps"] = parse_steps(self.steps.value)
+        c = raw["controller"]
+        try:  # dropdown values are checked against the options offered (a client may send anything)
+            tc_rule = checked_choice(self.tc_rule.value, TC_RULES, "T_c rule")
+            fs_mode = checked_choice(self.fs_mode.value, FS_MODES, "Controller")
+            c["alpha_max_rule"] = checked_choice(self.alpha_rule.value, ALPHA_RULES, "α_max rule")
+            c["delay_samples"] = int(checked_choice(self.delay.value, DELAYS, "Computation delay"))
+            for group, _title in SELECTORS:
+                checked_choice(self.selectors[group].value, [u.label for u in UNIT_GROUPS[group]], _title)
+            c["T_c"] = "T_a" if tc_rule == TC_RULES[0] else self.tc_ms.read("Controller › T_c [ms]", units.ms_to_s)
+            c["f_s"] = "continuous" if fs_mode == FS_MODES[1] else self.fs_khz.read(
+                "Controller › f_s [kHz]", units.kHz_to_Hz)
+        except (NumberFormatError, ParameterError) as exc:
+            raise InputError(str(exc)) from None
+        self.nameplate_checks()
+        try:
+            return parse_preset(raw)
+        except ValueError as exc:
+            raise InputError(_with_label(str(exc))) from None
+
+
+def _with_label(message: str) -> str:
+    """Prefix a loader message with the page label of the field it names (SI values stay in it)."""
+    for f in FIELDS:
+        if message.startswith(f"{f.key} "):
+            return f"{dict(FOLDERS)[f.section]} › {f.label}: {message}"
+    return message
+
+
+__all__ = ["FIELDS", "FOLDERS", "Field", "InputError", "InputsPanel", "format_steps", "parse_steps"]

@@ -1,0 +1,142 @@
+"""Replay of a comparison: the browser animates the phase plane, the server turns the 3D rotors.
+
+The phase-plane figure carries its own play buttons (one per speed), pause and time slider
+(:mod:`app.figures.replay`): it is sent once per Simulate and animated by Plotly in the browser,
+with no server traffic per frame. The 3D rotors are scene nodes; their replay (Play/Pause and
+a time slider in the "3D replay" folder) sends one small orientation update per rotor per tick
+and runs only while playing.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+import numpy as np
+import viser
+
+from app.figures.comparison import phase_plane_spec, runs, time_plots_spec
+from app.figures.plain import figure_json
+from app.figures.replay import SPEEDS, replay_layout
+from app.ui.scene import RotorScene
+
+FRAME_HZ = 25.0
+
+
+def set_figure_json(handle: viser.GuiPlotlyHandle, json_str: str) -> None:
+    """Send a ready-made Plotly JSON string to a plot widget (skips re-encoding a go.Figure).
+
+    ``_plotly_json_str`` is the widget property that ``GuiPlotlyHandle.figure`` itself sets.
+    """
+    handle._plotly_json_str = json_str
+
+
+def phase_plane_json(comparison: Any) -> str:
+    """JSON of the phase plane with its in-browser replay (buttons per speed, slider)."""
+    spec = phase_plane_spec(comparison)
+    layout, raw = replay_layout(comparison, [t["name"] for t in spec["data"]])
+    spec["layout"].update(layout)
+    return figure_json(spec, raw)
+
+
+def time_plots_json(comparison: Any) -> str:
+    """JSON of the time plots."""
+    return figure_json(time_plots_spec(comparison))
+
+
+class Replay:
+    """Sends the figures of a comparison; Play/Pause and a time slider for the 3D rotors."""
+
+    def __init__(self, gui: viser.GuiApi, phase: viser.GuiPlotlyHandle,
+                 time_plots: viser.GuiPlotlyHandle | None, scene: RotorScene | None,
+                 flush: Any = lambda: None) -> None:
+        self._phase, self._time_plots, self._scene, self._flush = phase, time_plots, scene, flush
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._comparison: Any = None
+        self._t_end = 1.0
+        self._t_now = 0.0
+        self.folder = gui.add_folder("3D replay", expand_by_default=False, visible=scene is not None)
+        with self.folder:
+            self.buttons = gui.add_button_group("3D rotors", ("Play", "Pause", "Replay"))
+            self.slider = gui.add_slider("t [s]", min=0.0, max=1.0, step=0.001, initial_value=0.0)
+            self.speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.25×")
+        self.buttons.on_click(self._on_button)
+        self.slider.on_update(self._on_slider)
+
+    def load(self, comparison: Any, autoplay: bool = True) -> None:
+        """Show a new comparison: the phase plane first, then the time plots; rotors to the end."""
+        self.pause()
+        set_figure_json(self._phase, phase_plane_json(comparison))
+        self._flush()  # the phase plane goes out before the larger figure is even built
+        if self._time_plots is not None:
+            set_figure_json(self._time_plots, time_plots_json(comparison))
+        with self._lock:
+            self._comparison = comparison
+            rs = runs(comparison)
+            self._t_end = max((float(run.trace.t[-1]) for _, run in rs), default=1.0)
+        self.slider.max = self._t_end
+        self.slider.step = self._t_end / 1000.0
+        if autoplay and self._scene is not None and rs:
+            self.play(restart=True)
+        else:
+            self.seek(self._t_end)
+
+    def seek(self, t_now: float) -> None:
+        """Turn the 3D rotors to their angles at ``t_now`` [s]."""
+        with self._lock:
+            comparison = self._comparison
+            self._t_now = t_now = min(max(t_now, 0.0), self._t_end)
+        if self._scene is not None and comparison is not None:
+            self._scene.show({key: float(np.interp(t_now, run.trace.t, run.trace.theta_r))
+                              for key, run in runs(comparison)})
+
+    def play(self, restart: bool = False) -> None:
+        """Start (or restart from t = 0) the 3D replay thread."""
+        self.pause()
+        if self._comparison is None or self._scene is None:
+            return
+        if restart or self._t_now >= self._t_end:
+            self._t_now = 0.0
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name="ui-replay-3d", daemon=True)
+        self._thread.start()
+
+    def pause(self) -> None:
+        """Stop the 3D replay thread (keeps the current time)."""
+        self._stop.set()
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout=2.0)
+        self._thread = None
+
+    def _run(self) -> None:
+        period = 1.0 / FRAME_HZ
+        t0, wall0, n = self._t_now, time.monotonic(), 0
+        while not self._stop.is_set():
+            t_now = t0 + (time.monotonic() - wall0) * SPEEDS.get(self.speed.value, 0.25)
+            self.seek(t_now)
+            self.slider.value = round(min(t_now, self._t_end), 6)
+            if t_now >= self._t_end:
+                return
+            n += 1
+            self._stop.wait(max(0.0, wall0 + n * period - time.monotonic()))
+
+    def _on_button(self, event: viser.GuiEvent) -> None:
+        label = self.buttons.value
+        if label.endswith("Pause"):
+            self.pause()
+        else:
+            self.play(restart=label.endswith("Replay"))
+
+    def _on_slider(self, event: viser.GuiEvent) -> None:
+        if event.client is None:  # our own update during play
+            return
+        self.pause()
+        self.seek(float(self.slider.value))
+
+    def close(self) -> None:
+        """Stop the replay for good (client left)."""
+        self.pause()

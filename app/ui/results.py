@@ -1,0 +1,114 @@
+"""The results panel (docked right, most of the window): phase plane, time plots, energy, Table 1.
+
+Only builds widgets and pushes figures made by the pure ``make_*_figure`` functions; the
+simulations themselves run on the session's worker.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import plotly.graph_objects as go
+import viser
+
+from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
+from app.figures.plain import figure_json
+from app.io.numbers import NumberFormatError, parse_number
+from app.ui.replay import Replay, set_figure_json
+from app.ui.scene import RotorScene
+from app.ui.text import annual_savings, savings_markdown
+
+#: Default T_m list of the Table-1 sweep [s] (the paper's columns).
+TABLE1_T_M = "1.0, 1.4, 1.8, 2.2, 2.6"
+#: Plot height / width per figure [-].
+ASPECT_PHASE, ASPECT_TIME, ASPECT_SMALL = 0.72, 1.45, 0.55
+
+
+def parse_T_m_list(text: str) -> list[float]:
+    """``"1.0, 1.4"`` → [1.0, 1.4] [s]; ValueError naming the bad item and the allowed form."""
+    values: list[float] = []
+    for item in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):
+        try:
+            value = parse_number(item, "Table 1 › T_m list")
+        except NumberFormatError:
+            raise ValueError(f"Table 1 › T_m list: {item!r} is not a number: allowed a comma-separated "
+                             "list of times > 0 s, e.g. 1.0, 1.4, 1.8") from None
+        if not 0.0 < value <= 1e4:
+            raise ValueError(f"Table 1 › T_m list: {value:g} s is out of range: allowed 0 < T_m ≤ 10000 s")
+        values.append(value)
+    if not 1 <= len(values) <= 40:
+        raise ValueError(f"Table 1 › T_m list has {len(values)} values: allowed 1 … 40")
+    return values
+
+
+class ResultsPanel:
+    """Right-hand panel with the result tabs of one client."""
+
+    def __init__(self, client: viser.ClientHandle, comparison: Any, scene: RotorScene | None,
+                 on_sweep: Callable[[list[float]], None]) -> None:
+        gui = client.gui
+        self._on_sweep = on_sweep
+        self._comparison = comparison
+        self.panel = gui.add_panel()
+        phase_tab = self.panel.add_tab("Phase plane", viser.Icon.CHART_DOTS)
+        time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
+        with phase_tab:
+            self.phase = gui.add_plotly(go.Figure(), aspect=ASPECT_PHASE)
+        with time_tab:
+            self.time_plots = gui.add_plotly(go.Figure(), aspect=ASPECT_TIME)
+        with phase_tab:
+            self.replay = Replay(gui, self.phase, self.time_plots, scene, flush=client.flush)
+        with self.panel.add_tab("Energy", viser.Icon.BOLT):
+            self.energy = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
+            self.bars = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
+            self._build_savings(gui)
+        with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
+            self.t_m_list = gui.add_text("T_m list [s]", TABLE1_T_M)
+            self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
+            self.progress = gui.add_progress_bar(0.0, animated=False)
+            self.table1 = gui.add_plotly(make_table1_figure([]), aspect=ASPECT_SMALL)
+        self.sweep_button.on_click(lambda _: self._sweep_clicked(client))
+
+    def _build_savings(self, gui: viser.GuiApi) -> None:
+        with gui.add_folder("Savings estimate (electrical input, per axis)"):
+            self.cycles = gui.add_number("Cycles per hour [1/h]", 600.0, step=1.0)
+            self.hours = gui.add_number("Hours per year [h]", 4000.0, step=10.0)
+            self.price = gui.add_number("Energy price [€/kWh]", 0.25, step=0.01)
+            for h in (self.cycles, self.hours, self.price):
+                h.precision = 4
+                h.on_update(lambda _: self._update_savings())
+            self.savings = gui.add_markdown("")
+        self._update_savings()
+
+    def _update_savings(self) -> None:
+        values = (self.cycles.value, self.hours.value, self.price.value)
+        if any(not isinstance(v, int | float) or v < 0 for v in values):
+            self.savings.content = "**Savings inputs must be numbers ≥ 0.**"
+            return
+        self.savings.content = savings_markdown(annual_savings(self._comparison, *values))
+
+    def show(self, comparison: Any, autoplay: bool = True) -> None:
+        """Draw a new comparison: phase plane first (it is what the user waits for), then the rest."""
+        self._comparison = comparison
+        self.replay.load(comparison, autoplay=autoplay)
+        set_figure_json(self.energy, figure_json(energy_spec(comparison)))
+        set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))
+        self._update_savings()
+
+    def _sweep_clicked(self, client: viser.ClientHandle) -> None:
+        try:
+            values = parse_T_m_list(self.t_m_list.value)
+        except ValueError as exc:
+            client.add_notification("Table-1 sweep not started", str(exc), color="red",
+                                    auto_close_seconds=10.0)
+            return
+        self._on_sweep(values)
+
+    def set_progress(self, done: int, total: int) -> None:
+        """Progress of the sweep [-]."""
+        self.progress.value = 100.0 * done / max(total, 1)
+
+    def show_table1(self, rows: list[Any], paper: dict[float, float]) -> None:
+        """Draw the sweep result."""
+        set_figure_json(self.table1, make_table1_figure(rows, paper).to_json())

@@ -1,0 +1,85 @@
+"""Live tuning: sliders for K, T_c, T_m and J_L that re-simulate while they are dragged.
+
+A slider never simulates by itself: it writes its value into the inputs panel (the same field,
+shown and kept exactly as if typed) and asks the session to simulate the panel's values. While
+a run is in progress further moves only mark the panel as changed; when the run ends, one new
+run of the latest values starts. Stale values are never queued, and what runs is what the
+inputs panel shows.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import viser
+
+from app.io import units
+from control.fdsmc.params import DriveParams
+
+#: Slider range around the value it is centred on: [value / SPAN, value · SPAN].
+SPAN = 5.0
+#: Positions per slider.
+STEPS = 200
+
+
+@dataclass(frozen=True)
+class Knob:
+    """One slider: page label, the inputs-panel key, and shown value ↔ SI [shown unit → SI unit]."""
+
+    label: str
+    key: str
+    to_si: Callable[[float], float]
+    from_si: Callable[[float], float]
+
+
+KNOBS = (
+    Knob("K [s/rad]", "controller.K", float, float),
+    Knob("T_c [ms]", "controller.T_c", units.ms_to_s, units.s_to_ms),
+    Knob("T_m [s]", "manoeuvre.T_m", float, float),
+    Knob("J_L [kg·cm²]", "load.J_L", units.kgcm2_to_kgm2, lambda J: J * 1e4),
+)
+
+
+def _si_values(params: DriveParams, T_c: float) -> dict[str, float]:
+    """Current SI values of the knobs (T_c [s] is the one in force)."""
+    return {"controller.K": params.controller.K, "controller.T_c": T_c,
+            "manoeuvre.T_m": params.manoeuvre.T_m, "load.J_L": params.load.J_L}
+
+
+def slider_range(value: float) -> tuple[float, float, float]:
+    """(min, max, step) of a slider centred on ``value`` (> 0) in the shown unit."""
+    lo, hi = value / SPAN, value * SPAN
+    return lo, hi, (hi - lo) / STEPS
+
+
+class LiveTuning:
+    """The "Live tuning" folder; ``apply(key, si)`` writes a value into the inputs panel."""
+
+    def __init__(self, gui: viser.GuiApi, apply: Callable[[str, float], None],
+                 request_run: Callable[[], None]) -> None:
+        self._apply, self._request_run = apply, request_run
+        self._sliders: dict[str, Any] = {}
+        with gui.add_folder("Live tuning (drag: re-simulates)", expand_by_default=True):
+            for knob in KNOBS:
+                slider = gui.add_slider(knob.label, min=0.0, max=1.0, step=0.01, initial_value=0.5)
+                slider.on_update(lambda event, k=knob: self._moved(event, k))
+                self._sliders[knob.key] = slider
+
+    def centre(self, params: DriveParams, T_c: float) -> None:
+        """Centre each slider's range on the current value (after a preset, file or design)."""
+        for knob in KNOBS:
+            shown = knob.from_si(_si_values(params, T_c)[knob.key])
+            if not shown > 0.0:
+                continue
+            lo, hi, step = slider_range(shown)
+            slider = self._sliders[knob.key]
+            slider.min, slider.max, slider.step = lo, hi, step
+            slider.value = shown
+
+    def _moved(self, event: viser.GuiEvent, knob: Knob) -> None:
+        if event.client is None:  # our own centring
+            return
+        self._apply(knob.key, knob.to_si(float(self._sliders[knob.key].value)))
+        self._request_run()

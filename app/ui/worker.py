@@ -1,0 +1,97 @@
+"""One background worker per browser client: runs jobs off the GUI event loop, one at a time.
+
+A second submission while a job runs is refused (a double-click never starts two overlapping
+runs). Errors a job raises are handed to ``on_error`` so the page can show them instead of a
+traceback.
+
+Cancel is cooperative: :meth:`Worker.cancel` sets a flag that jobs test with
+:meth:`Worker.checkpoint` between kernel calls (after a comparison, between Table-1 points), and
+the result of a cancelled job is discarded. The cost budget (:mod:`sim.common.budget`) bounds every
+kernel call to a few seconds of CPU, so a cancel takes effect within that; killing a subprocess
+instead would need the JIT-compiled kernels warmed in each process and the traces (up to the
+budget's bytes) pickled back, for a gain of at most those seconds.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+
+
+class Cancelled(Exception):  # noqa: N818 - an outcome, not an error
+    """Raised at a checkpoint of a job whose Cancel was pressed; its result is discarded."""
+
+
+class Worker:
+    """Single-thread job runner with a busy flag.
+
+    Parameters
+    ----------
+    on_busy : callable(bool)
+        Called with True when a job starts and False when it ends (e.g. to disable buttons).
+    on_error : callable(Exception)
+        Called (on the worker thread) with any exception a job raised.
+    name : str
+        Thread-name prefix, for debugging.
+    """
+
+    def __init__(self, on_busy: Callable[[bool], None], on_error: Callable[[Exception], None],
+                 name: str = "ui-worker") -> None:
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix=name)
+        self._lock = threading.Lock()
+        self._busy = False
+        self._closed = False
+        self._cancel = threading.Event()
+        self._on_busy = on_busy
+        self._on_error = on_error
+
+    @property
+    def busy(self) -> bool:
+        """True while a job runs."""
+        return self._busy
+
+    def submit(self, fn: Callable[[], None]) -> Future | None:
+        """Run ``fn`` on the worker unless a job is running; returns its future or None if refused."""
+        with self._lock:
+            if self._busy or self._closed:
+                return None
+            self._busy = True
+            self._cancel.clear()
+        self._safe_busy(True)
+        return self._pool.submit(self._run, fn)
+
+    def cancel(self) -> bool:
+        """Ask the running job to stop at its next checkpoint; False if nothing runs."""
+        with self._lock:
+            if not self._busy:
+                return False
+            self._cancel.set()
+            return True
+
+    def checkpoint(self) -> None:
+        """Called by jobs between pieces of work: raises :class:`Cancelled` after :meth:`cancel`."""
+        if self._cancel.is_set():
+            raise Cancelled("cancelled by the user")
+
+    def _run(self, fn: Callable[[], None]) -> None:
+        try:
+            fn()
+        except Exception as exc:  # shown to the user by on_error, never lost
+            self._on_error(exc)
+        finally:
+            with self._lock:
+                self._busy = False
+            self._safe_busy(False)
+
+    def _safe_busy(self, busy: bool) -> None:
+        try:
+            self._on_busy(busy)
+        except Exception as exc:  # a closed client must not break the worker
+            self._on_error(exc)
+
+    def close(self) -> None:
+        """Refuse new jobs and let the thread end after the current one."""
+        with self._lock:
+            self._closed = True
+        self._pool.shutdown(wait=False, cancel_futures=True)

@@ -1,0 +1,104 @@
+"""Transient of the inner loops: how far the true acceleration overshoots a step of α_dem.
+
+When the outer loop of [1] switches α_dem from 0 to ±α_max (start of acceleration, eq. (45)
+saturated), the FDC acceleration loop of eq. (13) and the load-torque observer of eq. (15) must
+also learn the load inertia J_L, which the controller does not know (it uses J_r only, eq. (7)):
+until L̂ has caught up, the delivered acceleration — and so the motor torque — overshoots the
+demand. The linearised loop of :mod:`control.fdsmc.loop_analysis` (continuous, or sampled with the
+drive's f_s and computation delay) gives the overshoot factor η ≥ 1 exactly, so the torque-limit
+rule for α_max can leave room for it instead of a fudge factor.
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.linalg import expm
+
+from control.fdsmc.loop_analysis import (
+    LoopModel,
+    continuous_matrix,
+    discrete_matrix,
+    fdc_input_gain,
+    fdc_row,
+    sampled_parts,
+)
+
+#: Samples per fastest designed time constant for the continuous step response [-].
+_STEPS_PER_TAU = 40
+#: Most steps of the continuous step response [-].
+_MAX_STEPS = 3000
+
+
+def _horizon(lm: LoopModel) -> float:
+    """Step-response horizon: 6 times the slowest of T_si, T_sα, T_so [s]."""
+    c = lm.params.controller
+    return 6.0 * max(c.T_si, c.T_salpha, c.T_so)
+
+
+def _step_system(lm: LoopModel, f_s: float | None, delay: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """(Φ, γ, h): z_{k+1} = Φ·z_k + γ·α_dem of the loop with the outer law open (α_dem input)."""
+    c, ctrl = lm.coefficients, lm.params.controller
+    row = fdc_row(c, ctrl.T_salpha, 0.0, 0.0)
+    g_in = fdc_input_gain(c, ctrl.T_salpha)
+    if f_s is not None:
+        sp = sampled_parts(lm, f_s)
+        Z = discrete_matrix(sp, c.H, row, delay)
+        gamma = np.zeros(Z.shape[0])
+        if delay:
+            gamma[-1] = g_in  # the demand reaches the held voltage one sample later
+        else:
+            gamma[:3] = sp.bd * g_in
+        return Z, gamma, 1.0 / f_s
+    A = continuous_matrix(lm, row)
+    b = np.zeros(A.shape[0])
+    b[0] = c.G * g_in
+    tau = min(ctrl.T_si, ctrl.T_salpha, ctrl.T_so) / 3.0
+    h = max(tau / _STEPS_PER_TAU, _horizon(lm) / _MAX_STEPS)
+    n = A.shape[0]
+    aug = np.zeros((n + 1, n + 1))
+    aug[:n, :n], aug[:n, n] = A * h, b * h
+    E = expm(aug)
+    return E[:n, :n], E[:n, n], h
+
+
+def acceleration_overshoot(lm: LoopModel, f_s: float | None, delay: int = 0) -> float:
+    """Peak of the true acceleration dω_r/dt after a unit step of α_dem [-] (η ≥ 1).
+
+    Parameters
+    ----------
+    lm : LoopModel
+        Model, parameters (J_r + J_L, F_v) and observer gains.
+    f_s : float or None
+        Controller sample rate [Hz]; None for the continuous implementation.
+    delay : int
+        Computation delay [samples].
+
+    Returns
+    -------
+    float
+        max_t α(t)/α_dem over 6 times the slowest of T_si, T_sα, T_so; 1 if it never overshoots.
+        ``inf`` if the loop is unstable (the sample-rate check reports that case).
+
+    Notes
+    -----
+    α = (J_r·H·i_q − F_v·ω_r)/(J_r + J_L), eq. (4b) in [1] at Γ_Le = 0. The torque the motor must
+    deliver at the start of an acceleration is then ≈ η·α_max·(J_r + J_L) plus friction and load.
+    """
+    Phi, gamma, h = _step_system(lm, f_s, delay)
+    if np.max(np.abs(np.linalg.eigvals(Phi))) >= 1.0 + 1e-6:  # θ, ω: marginal (open outer loop)
+        return math.inf
+    p, J_t = lm.params, lm.params.J_total
+    n = int(math.ceil(_horizon(lm) / h)) + delay + 2
+    z = np.zeros(Phi.shape[0])
+    peak = 0.0
+    for _ in range(n):
+        z = Phi @ z + gamma
+        peak = max(peak, (p.motor.J_r * lm.coefficients.H * z[0] - p.load.F_v * z[2]) / J_t)
+    return max(1.0, peak)
+
+
+__all__ = ["acceleration_overshoot"]

@@ -1,0 +1,498 @@
+"""Closed-loop simulation engine: one run, an FDSMC-vs-conventional comparison, the Table-1 sweep.
+
+The model (plant, FDC inner loops, observer, outer loop, energies) is integrated by the
+compiled kernel :func:`sim.fdsmc.kernel.run_kernel`; this module packs the parameters, chooses the
+time grid, and turns the raw arrays into frozen results with the metrics of issue 3.
+
+Rest-to-rest manoeuvre from θ_r = 0 to θ_dem, simulated over [0, (1 + TAIL_FRACTION)·T_m].
+Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) in [1]); the
+``_total`` ones are over the whole simulated horizon.
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.fdsmc.derivations import Derived, derive
+from control.fdsmc.model import model_coefficients, torque_constant
+from control.fdsmc.params import DriveParams, ParameterError
+from sim.common import budget
+from sim.fdsmc import kernel as kn
+from sim.fdsmc.metrics import CHATTER_MAX_WINDOW_S, WindowSamples, chatter_window_steps, chatter_windows, run_metrics
+
+CONTROLLERS = ("fdsmc", "conventional")
+#: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
+#: (:mod:`control.fdsmc.optimum`); the kernel's P_CTRL is the index in this tuple.
+COMPARATORS = CONTROLLERS + ("optimum",)
+#: Simulated horizon beyond T_m, as a fraction of T_m [-].
+TAIL_FRACTION = 0.3
+#: RK4 step of continuous mode [s]; friction energies converged to < 0.05 % (see tests).
+CONTINUOUS_STEP_S = 5e-6
+#: Largest h·λ_max of continuous mode (λ_max the fastest designed pole) [-]; 5 µs at T_so = 0.2 ms.
+CONTINUOUS_STEP_RATIO = 0.1875
+#: Largest RK4 plant substep between controller samples in digital mode [s].
+PLANT_STEP_MAX_S = 5e-5
+#: Most trace points kept per run (energies and peaks use every step).
+MAX_POINTS = 20000
+#: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
+PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
+
+
+@dataclass(frozen=True)
+class Trace:
+    """Time series of one run on a common grid (SI units; energies cumulative from t = 0).
+
+    Attributes
+    ----------
+    t [s]; theta_r [rad]; omega_r [rad/s]; i_d, i_q [A]; u_d, u_q [V] (applied);
+    alpha [rad/s²] true rotor acceleration dω_r/dt; alpha_dem [rad/s²] outer-loop demand;
+    alpha_hat [rad/s²] eq. (7) with Γ̂_L; Gamma_L [N·m] true total load torque, eq. (4a)/(6);
+    Gamma_L_hat [N·m] observer's L̂0; theta_hat [rad]; omega_hat [rad/s]; S [rad/s] switching
+    function (0 for the conventional law); E_friction, E_copper, E_electrical, E_motoring,
+    E_load [J].
+    """
+
+    t: np.ndarray
+    theta_r: np.ndarray
+    omega_r: np.ndarray
+    i_d: np.ndarray
+    i_q: np.ndarray
+    u_d: np.ndarray
+    u_q: np.ndarray
+    alpha: np.ndarray
+    alpha_dem: np.ndarray
+    Gamma_L: np.ndarray
+    Gamma_L_hat: np.ndarray
+    theta_hat: np.ndarray
+    omega_hat: np.ndarray
+    S: np.ndarray
+    E_friction: np.ndarray
+    E_copper: np.ndarray
+    E_electrical: np.ndarray
+    alpha_hat: np.ndarray
+    E_motoring: np.ndarray
+    E_load: np.ndarray
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """One controller's run: trace and the metrics of ``simulate --json`` (plus ``reason``)."""
+
+    controller: str
+    trace: Trace
+    metrics: dict[str, float | bool | str | None]
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """FDSMC and conventional runs of one case and the savings [%] (None if not both stable).
+
+    ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
+    ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
+    ``optimum`` is the tracked minimum-energy move, when asked for.
+    """
+
+    derived: Derived
+    fdsmc: RunResult | None
+    conventional: RunResult | None
+    saving_friction_pct: float | None
+    saving_electrical_pct: float | None
+    optimum: RunResult | None = None
+
+
+@dataclass(frozen=True)
+class Table1Row:
+    """One column of Table 1 in [1]: friction [J] over [0, T_m] and savings [%]."""
+
+    T_m: float
+    friction_fdsmc_J: float
+    friction_conventional_J: float
+    saving_pct: float
+    saving_eq52_pct: float
+    bound_pct: float
+    paper_pct: float | None
+
+
+@dataclass(frozen=True)
+class _Grid:
+    continuous: bool
+    h: float
+    n_steps: int
+    n_sub: int
+    decim: int
+    n_out: int
+
+
+def continuous_step(params: DriveParams, h_max: float = CONTINUOUS_STEP_S) -> float:
+    """RK4 step of continuous mode [s]: h_max, or less so that h·λ_max ≤ CONTINUOUS_STEP_RATIO.
+
+    λ_max [1/s] is the fastest designed pole: the observer's q = 15/(2·T_so) (eq. (17) in [1]),
+    3/T_sα (eq. (13)) or 3/T_si (eq. (8)). At the paper's T_so = 0.2 ms this gives 5 µs, where
+    halving the step changes the friction energy by < 0.05 % (tests); a faster observer or inner
+    loop gets a proportionally smaller step instead of a diverging integration.
+    """
+    c = params.controller
+    lam = max(15.0 / (2.0 * c.T_so), 3.0 / c.T_salpha, 3.0 / c.T_si)
+    return min(h_max, CONTINUOUS_STEP_RATIO / lam)
+
+
+def plant_substeps(params: DriveParams) -> int:
+    """RK4 substeps per sample [-] so that the plant step is ≤ PLANT_STEP_MAX_S and ≤ 0.2 rad
+    of the fastest electrical angle p·max(ω_b, 2.1·|θ_dem|/T_m) (the comparator peaks at
+    Δθ·5.6/(e·T_m)); 1 at 20 kHz for the paper's motor."""
+    m = params.motor
+    w_e = m.p * max(m.omega_b, 2.1 * abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
+    h_max = min(PLANT_STEP_MAX_S, 0.2 / w_e)
+    return max(1, int(math.ceil(1.0 / (float(params.controller.f_s) * h_max) - 1e-9)))
+
+
+def _grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: int) -> _Grid:
+    t_end = (1.0 + TAIL_FRACTION) * params.manoeuvre.T_m
+    ctrl = params.controller
+    if ctrl.is_continuous:
+        h_continuous = continuous_step(params, h_continuous)
+        n_steps, h, sub = int(math.ceil(t_end / h_continuous)), h_continuous, 1
+    else:
+        T_s = 1.0 / float(ctrl.f_s)
+        sub = max(n_sub, plant_substeps(params))
+        n_steps, h = int(math.ceil(t_end / T_s)), T_s / sub
+    decim = max(1, int(math.ceil(n_steps / max_points)))
+    return _Grid(ctrl.is_continuous, h, n_steps, sub, decim, n_steps // decim + 1)
+
+
+def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUOUS_STEP_S,
+             max_points: int = MAX_POINTS) -> budget.Cost:
+    """Cost of one controller's run (integration steps, trace bytes), from the parameters alone.
+
+    Trace bytes: the kernel's output (N_CH channels × kept points) and the two full-resolution
+    chatter windows (≤ CHATTER_MAX_WINDOW_S each, θ_r and α_dem), 8 bytes per value.
+    """
+    g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
+    window = min(g.n_steps, int(CHATTER_MAX_WINDOW_S / (g.h * g.n_sub)) + 2)
+    return budget.Cost(g.n_steps * g.n_sub, 8 * (kn.N_CH * g.n_out + 4 * window))
+
+
+def _with(params: DriveParams, field: str, value: float) -> DriveParams:
+    section, name = field.split(".")
+    part = dataclasses.replace(getattr(params, section), **{name: value})
+    return dataclasses.replace(params, **{section: part})
+
+
+def _cost_drivers(params: DriveParams, request: Callable[[DriveParams], budget.Cost]) -> list[budget.Driver]:
+    """The fields that set the step count and trace size, with the end of their range that is cheapest."""
+    ctrl, m = params.controller, params.motor
+    fields: list[tuple[str, float, str, float, bool]] = [("manoeuvre.T_m", params.manoeuvre.T_m, "s", 1e-4, False)]
+    if ctrl.is_continuous:
+        fields.append(("controller.T_so", ctrl.T_so, "s", 10.0, False))
+    else:
+        fields.append(("controller.f_s", float(ctrl.f_s), "Hz", 100.0, False))
+        if plant_substeps(params) > 1:
+            fields += [("motor.omega_b", m.omega_b, "rad/s", 1e-3, False), ("motor.p", m.p, "", 1, True)]
+    return [budget.Driver(name, value, unit, lambda v, n=name: request(_with(params, n, v)), limit, integer)
+            for name, value, unit, limit, integer in fields]
+
+
+def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budget.Cost:
+    """Raise :class:`~sim.common.budget.BudgetError` unless ``n_runs`` runs of ``params`` fit the budget.
+
+    Called before any derivation or allocation by :func:`simulate`, :func:`compare` and
+    :func:`table1_sweep` (which checks the whole sweep).
+    """
+    def request(p: DriveParams) -> budget.Cost:
+        one = run_cost(p, **options)
+        return budget.Cost(n_runs * one.steps, n_runs * one.trace_bytes)
+
+    cost = request(params)
+    if cost.fits:
+        return cost
+    g = _grid(params, int(options.get("n_sub", 1)), float(options.get("h_continuous", CONTINUOUS_STEP_S)),
+              int(options.get("max_points", MAX_POINTS)))
+    what = (f"{n_runs} run(s) × {g.n_steps:.3g} RK4 steps of {g.h:.3g} s" if g.continuous else
+            f"{n_runs} run(s) × {g.n_steps:.3g} samples × {g.n_sub} RK4 sub-steps")
+    return budget.check(cost, what, _cost_drivers(params, request))
+
+
+def pack_parameters(params: DriveParams, d: Derived, controller: str,
+                    plant: DriveParams | None = None) -> np.ndarray:
+    """The kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.kernel`).
+
+    ``params``/``d`` are the controller's model; ``plant`` (default: the same) gives the true
+    motor and load values the simulated drive has (R_s, L_d, L_q, Ψ_PM, p, J_r, J_L, F_v, Γ_Le).
+    """
+    c, ctrl = d.coefficients, params.controller
+    pl = params if plant is None else plant
+    m, ld, cp = pl.motor, pl.load, c if plant is None else model_coefficients(pl.motor)
+    prm = np.zeros(kn.N_PRM)
+    for name, idx in zip("ABCDEFGHKM", (kn.P_A, kn.P_B, kn.P_C, kn.P_D, kn.P_E, kn.P_F, kn.P_G,
+                                         kn.P_H, kn.P_K, kn.P_M), strict=True):
+        prm[idx] = getattr(c, name)
+    for name, idx in zip("ABCDEFG", (kn.P_PA, kn.P_PB, kn.P_PC, kn.P_PD, kn.P_PE, kn.P_PF, kn.P_PG),
+                         strict=True):
+        prm[idx] = getattr(cp, name)
+    prm[[kn.P_RS, kn.P_LD, kn.P_LQ, kn.P_PSI, kn.P_P, kn.P_JR]] = (
+        m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, m.J_r)
+    prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (pl.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
+    prm[kn.P_CTRL] = COMPARATORS.index(controller)
+    pr, o = d.profile, d.observer
+    prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
+        params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
+    prm[[kn.P_G1, kn.P_G2]] = (d.conventional.g1, d.conventional.g2)
+    prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
+    prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), ctrl.i_max)  # 0 = no limit
+    prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
+    m = params.motor
+    w_scale = max(m.omega_b, pr.omega_p, abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
+    i_scale = max(m.Gamma_max, d.alpha.torque_needed) / torque_constant(m)
+    prm[[kn.P_WLIM, kn.P_ILIM]] = (20.0 * w_scale, 100.0 * i_scale)
+    return prm
+
+
+def _observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    od = d.observer_discrete
+    if od is None:
+        return np.zeros((4, 4)), np.zeros(4), np.zeros(4)
+    return np.ascontiguousarray(od.Phi), np.ascontiguousarray(od.Gamma), np.ascontiguousarray(od.L)
+
+
+def _load_steps(params: DriveParams) -> tuple[np.ndarray, np.ndarray]:
+    steps = params.load.steps
+    return (np.array([s.t for s in steps], dtype=float),
+            np.array([s.Gamma_Le for s in steps], dtype=float))
+
+
+def _check_controller(controller: str) -> None:
+    if controller not in COMPARATORS:
+        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(COMPARATORS)}")
+
+
+def _reference(d: Derived, controller: str) -> np.ndarray:
+    """The kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
+    if controller != "optimum":
+        return np.zeros((3, 2))
+    from control.fdsmc.optimum import tracked_move  # imports cvxpy only when limits are active
+
+    mv = tracked_move(d)
+    return np.ascontiguousarray(np.vstack((mv.theta, mv.omega, mv.alpha)))
+
+
+def _check_feasible(d: Derived) -> None:
+    pr, T_m = d.profile, d.params.manoeuvre.T_m
+    if not pr.feasible:
+        raise ParameterError(
+            f"manoeuvre.T_m = {T_m:g} s is infeasible: allowed ≥ T_m,min = {pr.T_m_min:.4g} s "
+            f"for Δθ = {pr.delta_theta:g} rad at α_max = {d.alpha.alpha_max:.5g} rad/s²")
+
+
+def simulate(
+    params: DriveParams,
+    controller: str = "fdsmc",
+    derived: Derived | None = None,
+    *,
+    n_sub: int = 1,
+    h_continuous: float = CONTINUOUS_STEP_S,
+    max_points: int = MAX_POINTS,
+    plant: DriveParams | None = None,
+) -> RunResult:
+    """Simulate one rest-to-rest manoeuvre with the FDC inner loops and the chosen outer loop.
+
+    Parameters
+    ----------
+    params : DriveParams
+        The commissioning case.
+    controller : str
+        ``"fdsmc"`` (eqs. 41–46 in [1]), ``"conventional"`` (eq. 62 sign-corrected) or
+        ``"optimum"`` (the minimum-energy move of :mod:`control.fdsmc.optimum`, tracked).
+    derived : Derived or None
+        ``derive(params)`` if already computed.
+    n_sub : int
+        Least RK4 substeps per sample in digital mode [-] (more if :func:`plant_substeps` asks).
+    h_continuous : float
+        Largest RK4 step in continuous mode [s] (see :func:`continuous_step`).
+    max_points : int
+        Most trace points kept [-].
+    plant : DriveParams or None
+        The drive's true motor and load values when they differ from the controller's model
+        ``params`` (see :func:`pack_parameters`); None: the plant is the model.
+
+    Returns
+    -------
+    RunResult
+        Never raises for an unstable run: ``metrics["stable"]`` is False with a ``reason``.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown controller or an infeasible manoeuvre (T_m < T_m,min).
+    """
+    _check_controller(controller)
+    check_budget(params, 1, n_sub=n_sub, h_continuous=h_continuous, max_points=max_points)
+    d = derive(params) if derived is None else derived
+    _check_feasible(d)
+    g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
+    prm = pack_parameters(params, d, controller, plant)
+    step_t, step_v = _load_steps(params if plant is None else plant)
+    Phi, Gam, Lo = _observer_arrays(d)
+    out = np.zeros((kn.N_CH, g.n_out))
+    info = np.zeros(kn.N_INFO)
+    T_step = g.h * g.n_sub
+    windows = chatter_windows(params, d, controller, g.n_steps * T_step)
+    steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
+    k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
+    win = np.zeros((2 * len(steps), max(n for _, n in steps)))
+    kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
+                  params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller))
+    trace = _trace(out[:, : int(info[kn.I_NOUT])])
+    samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, win[2 * j, :n], win[2 * j + 1, :n])
+               for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
+    met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, info, plant)
+    return RunResult(controller, trace, met)
+
+
+def run_steps(
+    params: DriveParams, controller: str, n_steps: int, *, n_sub: int = 1,
+    h_continuous: float = CONTINUOUS_STEP_S, derived: Derived | None = None,
+) -> np.ndarray:
+    """Run the kernel for ``n_steps`` samples (digital) or RK4 steps (continuous) from rest.
+
+    Returns
+    -------
+    numpy.ndarray
+        Final kernel state [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, E_mot, E_load, θ̂, ω̂, L̂0, L̂1]
+        (indices ``X_*`` of :mod:`sim.fdsmc.kernel`; SI units).
+    """
+    _check_controller(controller)
+    d = derive(params) if derived is None else derived
+    prm = pack_parameters(params, d, controller)
+    step_t, step_v = _load_steps(params)
+    Phi, Gam, Lo = _observer_arrays(d)
+    cont = params.controller.is_continuous
+    h = h_continuous if cont else 1.0 / float(params.controller.f_s) / n_sub
+    out = np.zeros((kn.N_CH, 1))
+    info = np.zeros(kn.N_INFO)
+    kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
+                  params.controller.delay_samples, int(n_steps) + 1, out, info,
+                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller))
+    return info[kn.I_END: kn.I_END + kn.N_X].copy()
+
+
+def _trace(chans: np.ndarray) -> Trace:
+    """Trace from the kernel's channel-major output (each row is one contiguous channel)."""
+    finite = np.all(np.isfinite(chans), axis=0)
+    if not np.all(finite):
+        chans = chans[:, : int(np.argmin(finite))]
+    return Trace(**{name: chans[i] for i, name in enumerate(kn.CHANNELS)})
+
+
+def reached_target(run: RunResult) -> bool:
+    """True when the run is stable and θ_r entered the 2 % band around θ_dem (a run that never
+    gets there — e.g. a rotor that never moves — has no energy figure worth comparing)."""
+    return bool(run.metrics["stable"]) and run.metrics.get("t_2pct_first_s") is not None
+
+
+def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:
+    if a is None or b is None or not (reached_target(a) and reached_target(b)):
+        return None
+    va, vb = a.metrics[key], b.metrics[key]
+    if not isinstance(va, float) or not isinstance(vb, float) or vb == 0.0:
+        return None
+    return 100.0 * (1.0 - va / vb)
+
+
+def compare(
+    params: DriveParams, controllers: tuple[str, ...] = CONTROLLERS, derived: Derived | None = None,
+    plant: DriveParams | None = None, **options: float,
+) -> Comparison:
+    """Simulate both controllers on the same case (thread-safe; the kernel releases the GIL).
+
+    Parameters
+    ----------
+    params : DriveParams
+    controllers : tuple of str
+        Any of ``"fdsmc"``, ``"conventional"``, ``"optimum"``.
+    derived : Derived or None
+        ``derive(params)`` if already computed.
+    plant : DriveParams or None
+        The drive's true values (see :func:`simulate`); None: the controller's model.
+    **options
+        Passed to :func:`simulate` (``n_sub``, ``h_continuous``, ``max_points``).
+
+    Returns
+    -------
+    Comparison
+        Savings are None unless both runs exist, are stable and reached the 2 % band.
+    """
+    for c in controllers:
+        _check_controller(c)
+    check_budget(params, len(controllers), **options)
+    d = derive(params) if derived is None else derived
+    _check_feasible(d)
+    runs: dict[str, RunResult] = {}
+    if len(controllers) > 1:
+        with ThreadPoolExecutor(max_workers=len(controllers)) as pool:
+            futures = {c: pool.submit(simulate, params, c, d, plant=plant, **options) for c in controllers}
+            runs = {c: f.result() for c, f in futures.items()}
+    else:
+        runs = {c: simulate(params, c, d, plant=plant, **options) for c in controllers}
+    f, c = runs.get("fdsmc"), runs.get("conventional")
+    return Comparison(d, f, c, _saving(f, c, "friction_J"), _saving(f, c, "electrical_in_total_J"),
+                      runs.get("optimum"))
+
+
+def table1_sweep(
+    params: DriveParams,
+    T_m_values: Sequence[float],
+    progress: Callable[[int, int], None] | None = None,
+    **options: float,
+) -> list[Table1Row]:
+    """Friction energies and savings over manoeuvre times, as Table 1 of [1].
+
+    Parameters
+    ----------
+    params : DriveParams
+        The case; its T_m is replaced by each value.
+    T_m_values : sequence of float
+        Manoeuvre times [s].
+    progress : callable or None
+        Called as ``progress(done, total)`` after each point.
+
+    Returns
+    -------
+    list of Table1Row
+
+    Raises
+    ------
+    ParameterError
+        For an infeasible T_m, or when a run is unstable (naming T_m and the reason), so that
+        no row is ever computed from a diverged run.
+    """
+    points = [_with(params, "manoeuvre.T_m", float(T_m)) for T_m in T_m_values]
+    total = sum((run_cost(p, **options) for p in points), budget.Cost(0, 0))
+    if points and not budget.Cost(2 * total.steps, 2 * total.trace_bytes).fits:
+        check_budget(max(points, key=lambda p: p.manoeuvre.T_m), 2 * len(points), **options)
+    rows: list[Table1Row] = []
+    for i, (T_m, p) in enumerate(zip(T_m_values, points, strict=True)):
+        cmp = compare(p, **options)
+        assert cmp.fdsmc is not None and cmp.conventional is not None
+        for run in (cmp.fdsmc, cmp.conventional):
+            if not run.metrics["stable"]:
+                raise ParameterError(
+                    f"manoeuvre.T_m = {T_m:g} s: {run.controller} run unstable — {run.metrics['reason']}")
+            if not reached_target(run):
+                raise ParameterError(f"manoeuvre.T_m = {T_m:g} s: the {run.controller} run never reached the "
+                                     "2 % band around θ_dem, so its energy is not comparable")
+        wf, wc = float(cmp.fdsmc.metrics["friction_J"]), float(cmp.conventional.metrics["friction_J"])  # type: ignore[arg-type]
+        e = cmp.derived.energy
+        rows.append(Table1Row(float(T_m), wf, wc, 100.0 * (1.0 - wf / wc),
+                              float(e.saving_pct) if e.saving_pct is not None else math.nan,
+                              e.bound_pct, PAPER_TABLE1.get(round(float(T_m), 3))))
+        if progress is not None:
+            progress(i + 1, len(T_m_values))
+    return rows

@@ -1,0 +1,261 @@
+"""Run metrics of one closed-loop simulation: energies, response figures, chatter detection.
+
+Chatter criterion (documented in ``docs/paper_reproduction.md``), applied to two windows:
+``cruise`` — the middle 60 % of the planned cruise segment for the FDSMC, [0.2·T_m, T_m] for the
+conventional law (at most its central 0.25 s) — and ``hold`` — the second half of the tail after
+T_m (at most its last 0.25 s), where the drive should rest at θ_dem. Each window is sampled at
+every controller step (not the decimated trace, so that a limit cycle is never aliased away).
+Take the high-pass part r = α_dem − (moving average of α_dem over 5 ms). The loop chatters when
+r swings by more than 20 % of α_max peak-to-peak **and** r changes sign (with a hysteresis of
+2.5 % of α_max) at least 8 times, i.e. a sustained oscillation of the demanded acceleration with
+an amplitude comparable to the control range — the limit cycle of a too-high boundary-layer gain
+K or of a poorly damped sloped segment — not a single transient.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.fdsmc.derivations import Derived
+from control.fdsmc.params import DriveParams
+from sim.common import signals
+from sim.fdsmc import kernel as kn
+
+#: Thresholds of the chatter criterion (fractions of α_max) and the smoothing window [s].
+CHATTER_PTP_FRACTION = 0.2
+CHATTER_HYSTERESIS_FRACTION = 0.025
+CHATTER_MIN_SIGN_CHANGES = 8
+CHATTER_SMOOTHING_S = 0.005
+#: Longest chatter evaluation window [s] (its centre part is kept).
+CHATTER_MAX_WINDOW_S = 0.25
+
+
+@dataclass(frozen=True)
+class WindowSamples:
+    """Full-resolution samples of one chatter window (t0, t1) [s]: t [s], α_dem [rad/s²], ω_r [rad/s]."""
+
+    window: tuple[float, float]
+    t: np.ndarray
+    alpha_dem: np.ndarray
+    omega_r: np.ndarray
+
+
+@dataclass(frozen=True)
+class ChatterVerdict:
+    """Result of the chatter test.
+
+    Attributes
+    ----------
+    chatter : bool              Whether the criterion is met.
+    ptp : float                 Peak-to-peak of the high-pass α_dem in the window [rad/s²].
+    sign_changes : int          Hysteretic sign changes of the high-pass α_dem [-].
+    frequency_Hz : float        Estimated oscillation frequency sign_changes/(2·window) [Hz].
+    omega_ptp : float           Peak-to-peak of ω_r in the window [rad/s].
+    window : tuple of float     Evaluation window (t0, t1) [s].
+    """
+
+    chatter: bool
+    ptp: float
+    sign_changes: int
+    frequency_Hz: float
+    omega_ptp: float
+    window: tuple[float, float]
+
+
+def hysteretic_sign_changes(r: np.ndarray, hyst: float) -> int:
+    """Number of sign changes of ``r`` counting only swings beyond ±``hyst``.
+
+    Samples inside ±hyst are ignored; every change between consecutive remaining signs counts.
+    """
+    s = np.sign(r)[np.abs(r) > hyst]
+    return int(np.count_nonzero(s[1:] != s[:-1]))
+
+
+def detect_chatter(
+    t: np.ndarray, alpha_dem: np.ndarray, omega_r: np.ndarray, window: tuple[float, float],
+    alpha_max: float,
+) -> ChatterVerdict:
+    """Apply the chatter criterion of this module's docstring.
+
+    Parameters
+    ----------
+    t : numpy.ndarray          Time [s].
+    alpha_dem : numpy.ndarray  Demanded acceleration [rad/s²].
+    omega_r : numpy.ndarray    Rotor speed [rad/s].
+    window : tuple of float    Evaluation window [s].
+    alpha_max : float          Acceleration limit [rad/s²].
+    """
+    t0, t1 = window
+    sel = (t >= t0) & (t <= t1)
+    if np.count_nonzero(sel) < 8 or t1 <= t0:
+        return ChatterVerdict(False, 0.0, 0, 0.0, 0.0, window)
+    ts, a = t[sel], alpha_dem[sel]
+    dt = float(np.median(np.diff(ts)))
+    r = a - moving_average(a, max(1, int(round(CHATTER_SMOOTHING_S / dt))))
+    ptp = float(np.ptp(r))
+    changes = hysteretic_sign_changes(r, CHATTER_HYSTERESIS_FRACTION * alpha_max)
+    chatter = ptp > CHATTER_PTP_FRACTION * alpha_max and changes >= CHATTER_MIN_SIGN_CHANGES
+    return ChatterVerdict(chatter, ptp, changes, changes / (2.0 * (t1 - t0)),
+                          float(np.ptp(omega_r[sel])), window)
+
+
+def response_metrics(
+    t: np.ndarray, theta_r: np.ndarray, theta_dem: float, theta_at_Tm: float
+) -> dict[str, float | None]:
+    """2 % band entry and settling times, position error at T_m and overshoot.
+
+    Parameters
+    ----------
+    t : numpy.ndarray        Time [s].
+    theta_r : numpy.ndarray  Rotor angle [rad].
+    theta_dem : float        Demanded angle [rad] (start at 0).
+    theta_at_Tm : float      θ_r at T_m [rad].
+    """
+    band = 0.02 * abs(theta_dem)
+    return {
+        "t_2pct_first_s": signals.first_entry_time(t, theta_r, theta_dem, band),
+        "t_2pct_settle_s": signals.settling_time(t, theta_r, theta_dem, band),
+        "theta_error_at_Tm_rad": theta_at_Tm - theta_dem,
+        "overshoot_rad": signals.overshoot(theta_r, 0.0, theta_dem),
+    }
+
+
+def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
+    """Energies at T_m and at the end of the run, stored energies and the balance residual [J]."""
+    snap, end = info[kn.I_SNAP: kn.I_SNAP + kn.N_X], info[kn.I_END: kn.I_END + kn.N_X]
+    m = params.motor
+
+    def kinetic(x: np.ndarray) -> float:
+        return float(0.5 * params.J_total * x[kn.X_W] ** 2)
+
+    def magnetic(x: np.ndarray) -> float:
+        return float(0.75 * (m.L_d * x[kn.X_ID] ** 2 + m.L_q * x[kn.X_IQ] ** 2))
+
+    out: dict[str, float] = {}
+    for suffix, x in (("", snap), ("_total", end)):
+        out[f"friction{suffix}_J"] = float(x[kn.X_EF])
+        out[f"copper{suffix}_J"] = float(x[kn.X_ECU])
+        out[f"electrical_in{suffix}_J"] = float(x[kn.X_EEL])
+        out[f"motoring{suffix}_J"] = float(x[kn.X_EMOT])
+        out[f"regenerated{suffix}_J"] = float(x[kn.X_EMOT] - x[kn.X_EEL])
+        out[f"load_work{suffix}_J"] = float(x[kn.X_ELOAD])
+    out["kinetic_at_Tm_J"] = float(kinetic(snap))
+    out["kinetic_end_J"] = kinetic(end)
+    out["magnetic_end_J"] = magnetic(end)
+    stored = out["kinetic_end_J"] + out["magnetic_end_J"]
+    losses = out["copper_total_J"] + out["friction_total_J"] + out["load_work_total_J"]
+    residual = out["electrical_in_total_J"] - losses - stored
+    out["energy_balance_residual_J"] = float(residual)
+    ref = max(abs(out["electrical_in_total_J"]), out["motoring_total_J"], 1e-12)
+    out["energy_balance_residual_pct"] = float(100.0 * abs(residual) / ref)
+    return out
+
+
+def moving_average(a: np.ndarray, n: int) -> np.ndarray:
+    """Centred moving average of ``a`` over ``n`` samples (edges padded), O(len(a))."""
+    c = np.concatenate(([0.0], np.cumsum(np.pad(a, (n // 2, n - 1 - n // 2), mode="edge"))))
+    return (c[n:] - c[:-n]) / n
+
+
+def chatter_windows(
+    params: DriveParams, d: Derived, controller: str, t_end: float
+) -> dict[str, tuple[float, float]]:
+    """Chatter evaluation windows (t0, t1) [s] ``cruise`` and ``hold``: see the module docstring.
+
+    Parameters
+    ----------
+    params : DriveParams
+    d : Derived
+    controller : str
+    t_end : float  End of the simulated horizon [s].
+    """
+    T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
+    if controller != "fdsmc":  # the conventional law and the tracked optimum: no cruise segment
+        t0, t1 = 0.2 * T_m, T_m
+    else:
+        cruise = T_m - 4.0 * T_a
+        t0, t1 = T_a + 0.2 * cruise, T_a + 0.8 * cruise
+    if t1 - t0 > CHATTER_MAX_WINDOW_S:
+        mid = 0.5 * (t0 + t1)
+        t0, t1 = mid - 0.5 * CHATTER_MAX_WINDOW_S, mid + 0.5 * CHATTER_MAX_WINDOW_S
+    h0 = max(T_m + 0.5 * (t_end - T_m), t_end - CHATTER_MAX_WINDOW_S)
+    return {"cruise": (t0, t1), "hold": (h0, t_end)}
+
+
+def chatter_window_steps(window: tuple[float, float], T_step: float, n_steps: int) -> tuple[int, int]:
+    """First step index and number of steps [-] of ``window`` [s] for steps of T_step [s].
+
+    Only steps 0 … n_steps − 1 are recorded by the kernel: a window ending at the horizon
+    n_steps·T_step must not count the step at the horizon itself (it would stay 0.0 and inflate the
+    peak-to-peak figures).
+    """
+    t0, t1 = window
+    if t1 <= t0:
+        return 0, 0
+    k0 = int(np.ceil(t0 / T_step))
+    k1 = min(int(np.floor(t1 / T_step)), n_steps - 1)
+    return k0, max(0, k1 - k0 + 1)
+
+
+def run_metrics(
+    params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
+    samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None,
+) -> dict[str, float | bool | str | None]:
+    """All metrics of one run from the (decimated) trace, the full-resolution chatter-window
+    ``samples`` and the kernel's ``info`` vector.
+
+    Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
+    every number becomes None, ``stable`` False and ``reason`` says why. Stored energies use the
+    ``plant``'s true values when given.
+    """
+    failed = bool(info[kn.I_FAILED])
+    met: dict[str, float | bool | str | None] = {}
+    energies = energy_metrics(params if plant is None else plant, info)
+    theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
+    resp = response_metrics(t, theta_r, params.manoeuvre.theta_dem, theta_Tm)
+    verdicts = {name: detect_chatter(s.t, s.alpha_dem, s.omega_r, s.window, d.alpha.alpha_max)
+                for name, s in samples.items()}
+    phase = next((name for name, v in verdicts.items() if v.chatter), None)
+    cv = verdicts[phase or "cruise"]
+    met.update(energies)
+    met.update(resp)
+    met.update({
+        "theta_dem_rad": float(params.manoeuvre.theta_dem),
+        "omega_peak_rad_s": float(info[kn.I_PW]),
+        "i_q_peak_A": float(info[kn.I_PIQ]),
+        "i_d_peak_A": float(info[kn.I_PID]),
+        "u_peak_V": float(info[kn.I_PU]),
+        "torque_peak_Nm": float(info[kn.I_PTQ]),
+        "saturated_s": float(info[kn.I_TSAT]),
+        "chatter": phase is not None,
+        "chatter_phase": phase,
+        "chatter_alpha_ptp_rad_s2": cv.ptp,
+        "chatter_frequency_Hz": cv.frequency_Hz,
+        "cruise_omega_ptp_rad_s": verdicts["cruise"].omega_ptp,
+        "hold_omega_ptp_rad_s": verdicts["hold"].omega_ptp,
+        "stable": not failed,
+        "reason": None,
+    })
+    if failed:
+        for k, v in met.items():
+            if isinstance(v, float) and k not in ("saturated_s", "theta_dem_rad"):
+                met[k] = None
+        met["chatter"], met["chatter_phase"] = False, None
+        met["reason"] = _unstable_reason(d, controller, float(info[kn.I_TFAIL]))
+    return met
+
+
+def _unstable_reason(d: Derived, controller: str, t_fail: float) -> str:
+    text = f"diverged at t = {t_fail:.4g} s (a state became non-finite or left its bound)"
+    s = d.sample_rate
+    if s is not None and not s.stable:
+        need = f"≥ {s.f_s_min:.4g} Hz" if s.f_s_min is not None else "a faster controller"
+        text += (f": f_s = {s.f_s:g} Hz is too slow for T_so/T_sα (sampled inner loops + observer "
+                 f"have spectral radius {s.spectral_radius:.4f} ≥ 1; needs {need})")
+    elif controller == "fdsmc" and d.gain is not None and not d.gain.K_ok:
+        g = d.gain
+        text += (f": K = {g.K:g} s/rad exceeds the limit K_limit = {g.K_limit:.4g} s/rad of the "
+                 f"linearised FDSMC loop ({g.mode}); recommended K = {g.K_recommended:.4g} s/rad")
+    return text

@@ -1,0 +1,192 @@
+"""Monte-Carlo robustness: the controllers designed on the nominal model, run on sampled plants.
+
+Each sample draws the plant's true motor/load values from stated distributions (the controller
+keeps its model: the preset), simulates the FDSMC and the conventional controller on it, and
+the distributions of the run metrics are summarised. Samples are drawn from one
+``numpy.random.default_rng(seed)`` in a fixed order before any work is handed out, so the result
+depends only on (params, spreads, samples, seed) — not on the executor, the number of workers
+or the chunking. Work is handed to any executor with ``submit(fn, *args) -> future`` and
+``future.result()`` (``concurrent.futures.ProcessPoolExecutor`` locally, a
+``dask.distributed.Client`` on a cluster), chunk by chunk; results are collected in order.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from control.fdsmc.derivations import Derived, derive
+from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
+from control.fdsmc.params import DriveParams, ParameterError
+from sim.fdsmc.engine import CONTROLLERS, compare
+
+#: Metrics summarised per controller; the worst case is the largest value (errors as |·|).
+METRICS = ("friction_J", "copper_J", "electrical_in_total_J", "torque_peak_Nm",
+           "theta_error_abs_at_Tm_rad", "t_2pct_settle_s")
+#: Each task should compute for at least this long [s] (scheduling overhead stays small).
+MIN_TASK_S = 0.1
+#: Trace points kept per run (metrics only; the 2 % settling time is read from this trace).
+TRACE_POINTS = 2000
+#: Largest σ of a normal spread, relative to the nominal value [-] (kept well away from ≤ 0).
+MAX_NORMAL_SIGMA = 0.3
+
+
+@dataclass(frozen=True)
+class Spread:
+    """Distribution of one plant value. section "motor"/"load"; field the parameter's name;
+    kind "uniform" (absolute lo…hi in SI), "relative" (uniform nominal·(1 + lo…hi)) or "normal"
+    (nominal·(1 + σ·N(0, 1)) with σ = hi, truncated at ±3σ by redrawing)."""
+
+    section: str
+    field: str
+    kind: str
+    lo: float
+    hi: float
+
+
+@dataclass(frozen=True)
+class RobustnessResult:
+    """Per-sample metrics (``runs[i][controller][metric]``), the drawn values and the summary."""
+
+    values: dict[str, np.ndarray]
+    runs: list[dict[str, dict[str, Any]]]
+    summary: dict[str, Any]
+
+
+def draw(params: DriveParams, spreads: Sequence[Spread], n: int, seed: int) -> dict[str, np.ndarray]:
+    """n values [SI] of each spread's field, keyed ``section.field``, from one seeded generator."""
+    rng = np.random.default_rng(seed)
+    out: dict[str, np.ndarray] = {}
+    for s in spreads:
+        nominal = float(getattr(getattr(params, s.section), s.field))
+        if s.kind == "uniform":
+            v = rng.uniform(s.lo, s.hi, n) if s.hi > s.lo else np.full(n, s.lo)
+        elif s.kind == "relative":
+            v = nominal * (1.0 + (rng.uniform(s.lo, s.hi, n) if s.hi > s.lo else np.full(n, s.lo)))
+        else:
+            z = rng.standard_normal(n)
+            while np.any(bad := np.abs(z) > 3.0):
+                z[bad] = rng.standard_normal(int(np.count_nonzero(bad)))
+            v = nominal * (1.0 + s.hi * z)
+        out[f"{s.section}.{s.field}"] = v
+    return out
+
+
+def plant_for(params: DriveParams, values: dict[str, float]) -> DriveParams:
+    """``params`` with the plant values ``{"section.field": value}`` replaced (validated)."""
+    changes: dict[str, dict[str, float]] = {"motor": {}, "load": {}}
+    for key, v in values.items():
+        section, field = key.split(".")
+        changes[section][field] = float(v)
+    return dataclasses.replace(params, motor=dataclasses.replace(params.motor, **changes["motor"]),
+                               load=dataclasses.replace(params.load, **changes["load"]))
+
+
+def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None) -> dict[str, dict[str, Any]]:
+    """Both controllers' metrics on one plant, plus ``infeasible`` (unstable, or the peak torque
+    beyond the plant's torque limit) and ``saving_friction_pct``; ``d`` = derive(params)."""
+    cmp = compare(params, CONTROLLERS, d, plant=plant, max_points=TRACE_POINTS)
+    lim = torque_limit(plant)
+    out: dict[str, dict[str, Any]] = {}
+    for run in (cmp.fdsmc, cmp.conventional):
+        assert run is not None
+        m = dict(run.metrics)
+        err = m["theta_error_at_Tm_rad"]
+        m["theta_error_abs_at_Tm_rad"] = abs(err) if isinstance(err, float) else None
+        peak = m["torque_peak_Nm"]
+        m["infeasible"] = not m["stable"] or (isinstance(peak, float) and peak > lim * (1.0 + LIMIT_TOLERANCE))
+        out[run.controller] = {k: m[k] for k in (*METRICS, "chatter", "stable", "infeasible")}
+    out["fdsmc"]["saving_friction_pct"] = cmp.saving_friction_pct
+    return out
+
+
+def simulate_chunk(params: DriveParams, rows: list[dict[str, float]],
+                   d: Derived | None = None) -> list[dict[str, dict[str, Any]]]:
+    """Metrics of several samples (one task); module-level so that it pickles. ``d`` =
+    derive(params), the controller's design (the same for every sample; computed if None)."""
+    d = derive(params) if d is None else d
+    return [sample_metrics(params, plant_for(params, r), d) for r in rows]
+
+
+def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
+    """Samples per task [-]: each task ≥ MIN_TASK_S, unless that leaves a worker idle."""
+    size = max(1, math.ceil(MIN_TASK_S / max(seconds_per_sample, 1e-6)))
+    if n > 0 and math.ceil(n / size) < workers:
+        size = max(1, math.ceil(n / workers))  # every worker gets work, even if tasks are short
+    return size
+
+
+def _stats(x: np.ndarray, worst: str) -> dict[str, float | None]:
+    if x.size == 0:
+        return {"mean": None, "p05": None, "p50": None, "p95": None, "worst": None}
+    p05, p50, p95 = np.percentile(x, [5.0, 50.0, 95.0])
+    w = float(np.max(x) if worst == "max" else np.min(x))
+    return {"mean": float(np.mean(x)), "p05": float(p05), "p50": float(p50), "p95": float(p95), "worst": w}
+
+
+def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str, Any]:
+    """Per controller, per metric mean/p05/p50/p95/worst over the stable samples, chatter and
+    infeasible probabilities; the friction saving's distribution (worst = smallest)."""
+    out: dict[str, Any] = {"samples": len(runs), "seconds": seconds}
+    for ctrl in CONTROLLERS:
+        rs = [r[ctrl] for r in runs]
+        entry: dict[str, Any] = {}
+        for key in METRICS:
+            entry[key] = _stats(np.array([r[key] for r in rs if isinstance(r[key], float)]), "max")
+        entry["chatter_probability"] = float(np.mean([bool(r["chatter"]) for r in rs])) if rs else None
+        entry["infeasible_probability"] = float(np.mean([bool(r["infeasible"]) for r in rs])) if rs else None
+        out[ctrl] = entry
+    sav = np.array([r["fdsmc"]["saving_friction_pct"] for r in runs
+                    if isinstance(r["fdsmc"]["saving_friction_pct"], float)])
+    out["saving_friction_pct"] = _stats(sav, "min")
+    return out
+
+
+def robustness(
+    params: DriveParams, spreads: Sequence[Spread], samples: int, seed: int = 0, executor: Any = None,
+    workers: int = 1, progress: Callable[[int, int], None] | None = None,
+    cancelled: Callable[[], bool] | None = None,
+) -> RobustnessResult:
+    """Run the Monte-Carlo analysis (see the module docstring).
+
+    Parameters
+    ----------
+    params : DriveParams          The controller's model (and the nominal plant).
+    spreads : sequence of Spread  Distributions of the plant's values.
+    samples : int                 Number of sampled plants [-], ≥ 1.
+    seed : int                    Seed of the generator.
+    executor                      Object with ``submit``; None: computed here, serially.
+    workers : int                 Workers behind the executor (for the chunk size) [-].
+    progress : callable or None   ``progress(done, total)`` as samples complete, in order.
+    cancelled : callable or None  Polled between chunks; True stops (ParameterError raised).
+    """
+    if samples < 1:
+        raise ParameterError(f"samples = {samples} is not allowed: ≥ 1")
+    t0 = time.perf_counter()
+    values = draw(params, spreads, samples, seed)
+    rows = [{k: float(v[i]) for k, v in values.items()} for i in range(samples)]
+    d = derive(params)
+    runs = simulate_chunk(params, rows[:1], d)  # warm-up (compiled kernel loaded) …
+    t1 = time.perf_counter()
+    runs += simulate_chunk(params, rows[1:2], d)  # … and one timed sample
+    done = len(runs)
+    size = chunk_size(time.perf_counter() - t1, samples - done, workers)
+    chunks = [rows[i: i + size] for i in range(done, samples, size)]
+    if progress is not None:
+        progress(done, samples)
+    futures = [executor.submit(simulate_chunk, params, c, d) for c in chunks] if executor is not None else None
+    for j, c in enumerate(chunks):
+        if cancelled is not None and cancelled():
+            for f in futures or []:
+                f.cancel()
+            raise ParameterError(f"robustness run cancelled after {len(runs)} of {samples} samples")
+        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d))
+        if progress is not None:
+            progress(len(runs), samples)
+    return RobustnessResult(values, runs, summarise(runs, time.perf_counter() - t0))
