@@ -16,8 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 
 from .c_template import HEADER, SOURCE
 

@@ -30,8 +30,8 @@ from app.exports.c_module import TOOL, controller_files
 from app.io.derived_view import derived_rows
 from app.io.presets import SCHEMA, dumps, to_raw
 from app.io.units import SI_UNITS
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
-from control.fdsmc.params import ParameterError
 from sim.fdsmc.engine import Comparison
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 

@@ -14,7 +14,6 @@ import dataclasses
 import difflib
 import json
 import math
-import re
 import types
 import typing
 from pathlib import Path
@@ -25,7 +24,8 @@ import yaml
 from app.io import units
 from app.io.numbers import NumberFormatError, parse_integer, parse_number
 from control.bldc.params import BldcParams
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 
 SCHEMA = 2
 #: Schemas read: 1 (inputs only) is migrated to 2 (adds the informational export sections).
@@ -114,8 +114,7 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
         raise PresetError(f"{section} must be a mapping of field: value, got {raw!r}")
     hints = typing.get_type_hints(cls)
     names = [f.name for f in dataclasses.fields(cls)]
-    table = units.ALIASES.get(re.sub(r"\[\d+\]", "", section), {})  # scenario.cases[0] → scenario.cases
-    aliases = {k: a for k, a in table.items() if a.field in names}
+    aliases = units.aliases_of(cls)  # the unit-suffixed keys declared by the field specs
     extra = [units.KE_KEY] if "psi_pm" in names else []
     allowed = names + list(aliases) + extra
     values: dict[str, Any] = {}

@@ -34,7 +34,7 @@ from app.ui.text import checked_choice, md_text
 from app.ui.worker import Cancelled, Worker
 from control.bldc.design import bldc_design
 from control.bldc.params import EMF_SHAPES, BldcParams
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.bldc.emf import machine_table
 from sim.bldc.engine import CONTROLLERS, LABELS, BldcComparison, compare_bldc
 

@@ -23,7 +23,8 @@ from app.io.numbers import NumberFormatError
 from app.io.presets import parse_preset, to_raw
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 
 Conv = Callable[[float, int], float]  # (value, pole pairs) → value
 
