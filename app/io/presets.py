@@ -14,6 +14,7 @@ import dataclasses
 import difflib
 import json
 import math
+import re
 import types
 import typing
 from pathlib import Path
@@ -24,7 +25,7 @@ import yaml
 from app.io import units
 from app.io.numbers import NumberFormatError, parse_integer, parse_number
 from control.bldc.params import BldcParams
-from control.common.checks import ParameterError
+from control.common.checks import ParameterError, field_specs
 from control.fdsmc.params import DriveParams
 
 SCHEMA = 2
@@ -473,13 +474,42 @@ def dumps_preset(params: Any) -> str:
     return dumps(to_raw(params))
 
 
+_KEY_LINE = re.compile(r"^( *)(- )?(\w+):(.*)$")
+
+
+def annotate_units(text: str) -> str:
+    """YAML text of a preset → the same text with ``# [unit] allowed …`` after every input value.
+
+    The unit and range of each value come from its field spec (the loader ignores comments, so
+    the annotated text loads to the same object).
+    """
+    out, stack = [], []  # stack: (indent, key) of the mappings and lists the line is in
+    for line in text.splitlines():
+        m = _KEY_LINE.match(line)
+        if m is None:
+            out.append(line)
+            continue
+        indent = len(m.group(1)) + (2 if m.group(2) else 0)
+        stack = [(i, k) for i, k in stack if i < indent]
+        section = ".".join(k for _, k in stack)
+        stack.append((indent, m.group(3)))
+        cls = units.SECTION_CLASSES.get(section)
+        spec = field_specs(cls).get(m.group(3)) if cls is not None else None
+        value = m.group(4).strip()
+        if spec is not None and value and not value.startswith("["):
+            line = f"{line}  # [{spec.unit_text}] {spec.range_text()}"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def save_preset(params: Any, path: str | Path) -> None:
     """Write a parameter object as a preset file."""
     Path(path).write_text(dumps_preset(params), encoding="utf-8")
 
 
 __all__ = [
-    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "ParameterError", "PresetError", "apply_overrides", "dumps",
+    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "ParameterError", "PresetError", "annotate_units", "apply_overrides",
+    "dumps",
     "dumps_preset", "list_presets", "load_preset", "loads_preset", "parse_preset", "save_preset",
     "to_raw",
 ]

@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from control.bldc.params import BldcParams
-from control.common.checks import field_specs
+from control.common.checks import FieldSpec, field_specs, range_text
 from control.fdsmc.params import DriveParams
 
 
@@ -187,6 +187,29 @@ def sections(cls: type, prefix: str = "") -> Iterator[tuple[str, type]]:
 MODE_CLASSES: tuple[type, ...] = (DriveParams, BldcParams)
 #: Section path → parameter dataclass, both modes (section names are unique across modes).
 SECTION_CLASSES: dict[str, type] = {path: tp for cls in MODE_CLASSES for path, tp in sections(cls)}
+
+
+def spec_of(key: str) -> FieldSpec:
+    """The :class:`~control.common.checks.FieldSpec` of ``section.field``, e.g. ``"motor.L_d"``."""
+    section, _, name = key.rpartition(".")
+    return field_specs(SECTION_CLASSES[section])[name]
+
+
+def range_in(spec: FieldSpec, to_shown: Callable[[float], float], unit: str) -> str:
+    """The allowed range of ``spec`` converted to a shown unit by ``to_shown`` (linear, increasing).
+
+    E.g. L_d's range 1e-09 ≤ value ≤ 10 H shown in mH: ``"allowed 1e-06 ≤ value ≤ 10000 mH"``.
+    """
+    lo, hi = (None if b is None else to_shown(b) for b in (spec.low, spec.high))
+    return range_text(lo, hi, spec.low_open, unit, integer=spec.integer)
+
+
+def shown_range(spec: FieldSpec, unit: str | None = None) -> str:
+    """The allowed range of ``spec`` in ``unit`` (default its display unit), e.g. for a page hint."""
+    unit = unit or spec.shown_unit
+    return range_in(spec, lambda b: from_si(b, unit), unit)
+
+
 #: Unit-suffixed keys accepted per section, mapping to the SI field and its converter.
 ALIASES: dict[str, dict[str, Alias]] = {path: table for path, tp in SECTION_CLASSES.items()
                                         if (table := aliases_of(tp))}
