@@ -77,6 +77,16 @@ def scaled_observer(d: Derived) -> ScaledObserver:
     return ScaledObserver(scale, Phi, od.Gamma * f_s**2 / scale, od.L / scale)
 
 
+#: Constants that are inputs of the preset: C name → ``section.field`` (unit and range from its spec).
+INPUT_KEYS: dict[str, str] = {
+    "R_S": "motor.R_s", "L_D": "motor.L_d", "L_Q": "motor.L_q", "PSI_PM": "motor.psi_pm", "POLE_PAIRS": "motor.p",
+    "J_R": "motor.J_r", "T_SI": "controller.T_si", "T_SALPHA": "controller.T_salpha", "T_SO": "controller.T_so",
+    "K_BL": "controller.K", "THETA_DEM": "manoeuvre.theta_dem", "T_M": "manoeuvre.T_m",
+    "DELAY_SAMPLES": "controller.delay_samples", "V_DC": "controller.V_dc", "I_MAX": "controller.i_max",
+    "GAMMA_MAX": "motor.Gamma_max",
+}
+
+
 #: Non-ASCII unit and range symbols → their C-comment spelling.
 _ASCII_UNITS = (("Ω", "Ohm"), ("·", "*"), ("²", "^2"), ("≤", "<="), ("≥", ">="), ("…", "..."))
 
@@ -88,10 +98,10 @@ def c_unit(text: str) -> str:
     return text
 
 
-def _input(name: str, params: DriveParams, key: str, ref: str) -> CConstant:
+def _input(name: str, params: DriveParams, ref: str) -> CConstant:
     """An input of the preset as a constant: unit and allowed range from the field's spec."""
-    spec = spec_of(key)
-    section, field = key.split(".")
+    spec = spec_of(INPUT_KEYS[name])
+    section, field = INPUT_KEYS[name].split(".")
     value = getattr(getattr(params, section), field)
     return CConstant(name, value, c_unit(spec.unit), f"{ref}; {c_unit(spec.range_text())}", integer=spec.integer)
 
@@ -99,10 +109,10 @@ def _input(name: str, params: DriveParams, key: str, ref: str) -> CConstant:
 def _model_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     """Motor model: nameplate values and the coefficients A…M of eqs. (1)–(4) in [1]."""
     c = d.coefficients
-    k = [_input("R_S", params, "motor.R_s", "stator resistance"), _input("L_D", params, "motor.L_d", "d inductance"),
-         _input("L_Q", params, "motor.L_q", "q inductance"), _input("PSI_PM", params, "motor.psi_pm", "magnet flux"),
-         _input("POLE_PAIRS", params, "motor.p", "pole pairs p"),
-         _input("J_R", params, "motor.J_r", "rotor inertia (the load J_L is unknown to the controller)")]
+    k = [_input("R_S", params, "stator resistance"), _input("L_D", params, "d inductance"),
+         _input("L_Q", params, "q inductance"), _input("PSI_PM", params, "magnet flux"),
+         _input("POLE_PAIRS", params, "pole pairs p"),
+         _input("J_R", params, "rotor inertia (the load J_L is unknown to the controller)")]
     units = {"A": "1/s", "B": "-", "C": "-", "D": "1/s", "E": "A/rad", "F": "1/H", "G": "1/H",
              "H": "rad/s^2/A", "K": "rad/s^2/A^2", "M": "1/(kg*m^2)"}
     return k + [CConstant(f"COEF_{n}", getattr(c, n), u, "model coefficient, eqs. (1)-(4)") for n, u in units.items()]
@@ -111,17 +121,17 @@ def _model_constants(params: DriveParams, d: Derived) -> list[CConstant]:
 def _loop_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     """Inner loops, sliding-mode outer loop, comparator and the designed manoeuvre."""
     pr = d.profile
-    return [_input("T_SI", params, "controller.T_si", "d-current settling time, eq. (8)"),
-            _input("T_SALPHA", params, "controller.T_salpha", "acceleration settling time, eq. (13)"),
-            _input("T_SO", params, "controller.T_so", "observer settling time, eq. (17)"),
-            _input("K_BL", params, "controller.K", "boundary-layer gain K, eq. (45)"),
+    return [_input("T_SI", params, "d-current settling time, eq. (8)"),
+            _input("T_SALPHA", params, "acceleration settling time, eq. (13)"),
+            _input("T_SO", params, "observer settling time, eq. (17)"),
+            _input("K_BL", params, "boundary-layer gain K, eq. (45)"),
             CConstant("T_C", pr.T_c, "s", "sliding-mode time constant, eqs. (41), (59)"),
             CConstant("OMEGA_P", pr.omega_p, "rad/s", "peak speed, eq. (60)"),
             CConstant("ALPHA_MAX", d.alpha.alpha_max, "rad/s^2", f"acceleration limit ({d.alpha.rule} rule)"),
             CConstant("G1", d.conventional.g1, "1/s^2", "comparator gain, eq. (61)"),
             CConstant("G2", d.conventional.g2, "1/s", "comparator gain, eq. (61)"),
-            _input("THETA_DEM", params, "manoeuvre.theta_dem", "designed manoeuvre angle"),
-            _input("T_M", params, "manoeuvre.T_m", "designed manoeuvre time")]
+            _input("THETA_DEM", params, "designed manoeuvre angle"),
+            _input("T_M", params, "designed manoeuvre time")]
 
 
 def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
@@ -135,17 +145,17 @@ def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
          CConstant("F_S2", f_s**2, "1/s^2", "f_s^2 (observer scaling)"),
          CConstant("F_S3", f_s**3, "1/s^3", "f_s^3 (observer scaling)"),
          CConstant("T_S2", od.T_s**2, "s^2", "T_s^2 (observer scaling)"),
-         _input("DELAY_SAMPLES", params, "controller.delay_samples", "computation delay"),
+         _input("DELAY_SAMPLES", params, "computation delay"),
          CConstant("OBS_Q", d.observer.q, "1/s", "observer bandwidth 15/(2*T_so), eq. (17)"),
          CConstant("OBS_Z_POLE", od.z_pole, "-", "discrete observer pole exp(-q*T_s), four-fold")]
     k += [CConstant(f"OBS_L{i + 1}", float(v), u, "discrete observer gain (unscaled, information)")
           for i, (v, u) in enumerate(zip(od.L, ("-", "1/s", "N*m/rad", "N*m/(rad*s)"), strict=True))]
-    return k + [_input("V_DC", params, "controller.V_dc", "DC link (0 = ideal inverter)"),
+    return k + [_input("V_DC", params, "DC link (0 = ideal inverter)"),
                 CConstant("U_MAX", u_max, "V", "|u_dq| limit V_dc/sqrt(3)"),
                 CConstant("HAS_U_MAX", int(u_max > 0.0), "-", "voltage limit active", integer=True),
-                _input("I_MAX", params, "controller.i_max", "|i_q| limit (0 = none)"),
+                _input("I_MAX", params, "|i_q| limit (0 = none)"),
                 CConstant("HAS_I_MAX", int(ctrl.i_max > 0.0), "-", "current limit active", integer=True),
-                _input("GAMMA_MAX", params, "motor.Gamma_max", "motor torque limit (information)")]
+                _input("GAMMA_MAX", params, "motor torque limit (information)")]
 
 
 def controller_constants(params: DriveParams, d: Derived) -> list[CConstant]:

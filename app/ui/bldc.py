@@ -72,7 +72,7 @@ def show_si(field: NumberInput, key: str, si: float) -> None:
 def read_si(field: NumberInput, key: str) -> float | int:
     """The field's value in SI units; NumberFormatError naming the field and its label."""
     spec = spec_of(key)
-    return field.read(f"{key.replace('.cases', '')} ({field_label(key)})",
+    return field.read(f"{key} ({field_label(key)})",
                       lambda x: to_si(x, spec.shown_unit), integer=spec.integer)
 
 

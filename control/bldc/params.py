@@ -180,7 +180,7 @@ class BldcScenario:
     band_recovery: float = spec_field("rad/s", 0.0, 1e4, default=0.1, label="recovery band", aliases=("rpm",))
 
     def __post_init__(self) -> None:
-        check_fields(self, "scenario")
+        check_fields(self, "scenario.cases")
         steps = tuple(s if isinstance(s, TorqueStep) else TorqueStep(**s) for s in self.T_L_steps)
         times = [s.t for s in steps]
         if times != sorted(times) or any(t >= self.t_end for t in times):

@@ -104,6 +104,8 @@ class FieldSpec:
 def spec_field(unit: str, low: float | None = None, high: float | None = None, *, default: Any = dataclasses.MISSING,
                **kwargs: Any) -> Any:
     """A dataclass field carrying its :class:`FieldSpec` (keyword arguments as in ``FieldSpec``)."""
+    if kwargs.get("integer"):
+        kwargs["low_open"] = False  # an integer range is inclusive at both ends
     spec = FieldSpec(unit, low, high, **kwargs)
     return dataclasses.field(default=default, metadata={SPEC_KEY: spec})
 
