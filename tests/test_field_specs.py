@@ -208,3 +208,38 @@ def test_messages_of_list_sections_name_their_dotted_path():
     _section(bad, "scenario.cases")["t_window"] = 0.0
     with pytest.raises(ParameterError, match=r"scenario\.cases\.t_window = 0\.0 s is out of range: allowed 0 < value"):
         parse_preset(bad)
+
+
+@pytest.fixture(scope="module")
+def gui():
+    import socket
+
+    import viser
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = int(s.getsockname()[1])
+    server = viser.ViserServer(host="127.0.0.1", port=port)
+    try:
+        yield server.gui
+    finally:
+        server.stop()
+
+
+@pytest.mark.parametrize(("group", "key"), [("inertia", "motor.J_r"), ("angle", "manoeuvre.theta_dem"),
+                                            ("resistance", "motor.L_d"), ("flux", "motor.psi_pm")])
+def test_unit_choice_relabels_and_rehints_the_field_and_keeps_the_si_value(gui, group, key):
+    params = load_preset(POSITION)
+    panel = inputs.InputsPanel(gui, params)
+    field = next(f for f in inputs.FIELDS if f.key == key)
+    spec = units.spec_of(key)
+    for choice in inputs.UNIT_GROUPS[group]:
+        panel.selectors[group].value = choice.label
+        panel._unit_changed(group)
+        shown = panel.numbers[key]
+        unit = panel._unit(field)
+        assert shown.label == field.text(unit) and spec.label in shown.label or group == "flux"
+        assert shown.hint == field.hint(unit, params.motor.p)
+        _check_hint(shown.hint, spec, _hint_bounds(shown.hint)[2] or "-",
+                    lambda x, u=unit: u.to_si(x, params.motor.p))
+        assert panel.collect() == params  # an untouched value survives every unit change exactly
