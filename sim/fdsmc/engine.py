@@ -147,8 +147,8 @@ def continuous_step(params: DriveParams, h_max: float = CONTINUOUS_STEP_S) -> fl
 def plant_substeps(params: DriveParams) -> int:
     """Return the RK4 substeps per sample [-] that keep the plant step short enough.
 
-    The plant step is ≤ PLANT_STEP_MAX_S and ≤ 0.2 rad of the fastest electrical angle p·max(ω_b,
-    2.1·|θ_dem|/T_m) (the comparator peaks at Δθ·5.6/(e·T_m)); 1 at 20 kHz for the paper's motor.
+    The plant step is ≤ PLANT_STEP_MAX_S and ≤ 0.2 rad of the fastest electrical angle
+    p·max(ω_b, 2.1·|θ_dem|/T_m) (the comparator peaks at Δθ·5.6/(e·T_m)); 1 at 20 kHz for the paper's motor.
     """
     m = params.motor
     w_e = m.p * max(m.omega_b, 2.1 * abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
