@@ -59,8 +59,10 @@ class ScaledObserver:
 
 
 def scaled_observer(d: Derived) -> ScaledObserver:
-    """The derived discrete observer (prediction form, :func:`control.fdsmc.observer.discrete_observer`)
-    in coordinates where each state is the angle it moves in one sample [rad].
+    """Return the derived discrete observer in coordinates where each state is the angle it moves in one sample.
+
+    The observer is the prediction form of :func:`control.fdsmc.observer.discrete_observer`; each state is
+    scaled to the angle [rad] it moves in one sample.
 
     Raises
     ------
@@ -92,14 +94,14 @@ _ASCII_UNITS = (("Ω", "Ohm"), ("·", "*"), ("²", "^2"), ("≤", "<="), ("≥",
 
 
 def c_unit(text: str) -> str:
-    """A unit or range text in ASCII for a C comment, e.g. ``"kg·m²"`` → ``"kg*m^2"``."""
+    """Spell a unit or range text in ASCII for a C comment, e.g. ``"kg·m²"`` → ``"kg*m^2"``."""
     for old, new in _ASCII_UNITS:
         text = text.replace(old, new)
     return text
 
 
 def _input(name: str, params: DriveParams, ref: str) -> CConstant:
-    """An input of the preset as a constant: unit and allowed range from the field's spec."""
+    """Make an input of the preset a constant, with the unit and allowed range of the field's spec."""
     spec = spec_of(INPUT_KEYS[name])
     section, field = INPUT_KEYS[name].split(".")
     value = getattr(getattr(params, section), field)
@@ -164,7 +166,7 @@ def controller_constants(params: DriveParams, d: Derived) -> list[CConstant]:
 
 
 def c_literal(x: float) -> str:
-    """A C double literal that reads back exactly (17 significant digits), e.g. ``1.5e-05``."""
+    """Format a C double literal that reads back exactly (17 significant digits), e.g. ``1.5e-05``."""
     text = repr(float(x))
     if not math.isfinite(float(x)):
         raise ParameterError(f"constant {x!r} is not finite: a C module needs finite values")

@@ -146,17 +146,17 @@ KEY_SUFFIX = {"kg·cm²": "kgcm2"}
 
 
 def to_si(x: float, unit: str) -> float:
-    """A value in ``unit`` → SI (a unit without a conversion is the SI unit itself)."""
+    """Convert a value in ``unit`` to SI (a unit without a conversion is the SI unit itself)."""
     return CONVERSIONS[unit][0](x) if unit in CONVERSIONS else x
 
 
 def from_si(x: float, unit: str) -> float:
-    """An SI value → ``unit`` (a unit without a conversion is the SI unit itself)."""
+    """Convert an SI value to ``unit`` (a unit without a conversion is the SI unit itself)."""
     return CONVERSIONS[unit][1](x) if unit in CONVERSIONS else x
 
 
 def alias_key(name: str, unit: str) -> str:
-    """The loader key of field ``name`` given in ``unit``, e.g. ``L_d_mH``, ``J_r_kgcm2``."""
+    """Return the loader key of field ``name`` given in ``unit``, e.g. ``L_d_mH``, ``J_r_kgcm2``."""
     return f"{name}_{KEY_SUFFIX.get(unit, unit)}"
 
 
@@ -190,13 +190,13 @@ SECTION_CLASSES: dict[str, type] = {path: tp for cls in MODE_CLASSES for path, t
 
 
 def spec_of(key: str) -> FieldSpec:
-    """The :class:`~control.common.checks.FieldSpec` of ``section.field``, e.g. ``"motor.L_d"``."""
+    """Return the :class:`~control.common.checks.FieldSpec` of ``section.field``, e.g. ``"motor.L_d"``."""
     section, _, name = key.rpartition(".")
     return field_specs(SECTION_CLASSES[section])[name]
 
 
 def range_in(spec: FieldSpec, to_shown: Callable[[float], float], unit: str) -> str:
-    """The allowed range of ``spec`` converted to a shown unit by ``to_shown`` (linear, increasing).
+    """Write the allowed range of ``spec`` in a shown unit; ``to_shown`` converts (linear, increasing).
 
     E.g. L_d's range 1e-09 ≤ value ≤ 10 H shown in mH: ``"allowed 1e-06 ≤ value ≤ 10000 mH"``.
     """
@@ -205,7 +205,7 @@ def range_in(spec: FieldSpec, to_shown: Callable[[float], float], unit: str) -> 
 
 
 def shown_range(spec: FieldSpec, unit: str | None = None) -> str:
-    """The allowed range of ``spec`` in ``unit`` (default its display unit), e.g. for a page hint."""
+    """Write the allowed range of ``spec`` in ``unit`` (default its display unit), e.g. for a page hint."""
     unit = unit or spec.shown_unit
     return range_in(spec, lambda b: from_si(b, unit), unit)
 
@@ -239,7 +239,7 @@ def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
 
 
 def _unit_text(cls: type, name: str) -> str:
-    """The SI unit of field ``name`` as exported: its spec, a list section's fields, or ``-`` (a choice)."""
+    """Return the exported SI unit of ``name``: its spec, a list section's fields, or ``-`` (a choice)."""
     spec = field_specs(cls).get(name)
     if spec is not None:
         return spec.unit_text

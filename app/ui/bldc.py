@@ -53,13 +53,13 @@ SCENARIO_FIELDS: tuple[str, ...] = ("scenario.cases.omega_ref", "scenario.cases.
 
 
 def field_label(key: str) -> str:
-    """The page label of ``section.field``: spec label and display unit, e.g. ``"L_s − M_s [mH]"``."""
+    """Return the page label of ``section.field``: spec label and display unit, e.g. ``"L_s − M_s [mH]"``."""
     spec = spec_of(key)
     return f"{spec.label} [{spec.shown_unit}]"
 
 
 def number_input(gui: viser.GuiApi, key: str) -> NumberInput:
-    """A number field for ``key`` with its label and its allowed range (display unit) as hint."""
+    """Add a number field for ``key`` with its label and its allowed range (display unit) as hint."""
     return NumberInput(gui, field_label(key), hint=shown_range(spec_of(key)))
 
 
@@ -70,7 +70,7 @@ def show_si(field: NumberInput, key: str, si: float) -> None:
 
 
 def read_si(field: NumberInput, key: str) -> float | int:
-    """The field's value in SI units; NumberFormatError naming the field and its label."""
+    """Read the field's value in SI units; NumberFormatError naming the field and its label."""
     spec = spec_of(key)
     return field.read(f"{key} ({field_label(key)})",
                       lambda x: to_si(x, spec.shown_unit), integer=spec.integer)
@@ -84,7 +84,7 @@ def _placeholder(fid: str, title: str) -> go.Figure:
 
 
 def metrics_markdown(comp: BldcComparison) -> str:
-    """The side-by-side metrics as a Markdown table (shared rows with the CLI)."""
+    """Return the side-by-side metrics as a Markdown table (shared rows with the CLI)."""
     rows = metric_table(comp)
     head = "| " + " | ".join(rows[0]) + " |"
     lines = [head, "|" + "---|" * len(rows[0])] + ["| " + " | ".join(r) + " |" for r in rows[1:]]

@@ -42,12 +42,12 @@ class Unit:
 
 
 def _named(unit: str) -> Unit:
-    """A display unit converted by :mod:`app.io.units` (``"kg·cm²"``, ``"deg"`` …; an SI unit as is)."""
+    """Make a display unit converted by :mod:`app.io.units` (``"kg·cm²"``, ``"deg"`` …; an SI unit as is)."""
     return Unit(unit, lambda x, _p: units.to_si(x, unit), lambda x, _p: units.from_si(x, unit))
 
 
 def _choices(key: str) -> tuple[Unit, ...]:
-    """The units a field's spec offers: its shown unit first, then the loader's other units."""
+    """List the units a field's spec offers: its shown unit first, then the loader's other units."""
     spec = units.spec_of(key)
     return tuple(_named(u) for u in dict.fromkeys((spec.shown_unit, spec.unit, *spec.loader_units)))
 
@@ -124,7 +124,7 @@ class Field:
         return f"{self.label} [{self.unit_of(choice)}]"
 
     def hint(self, choice: Unit | None, p: int) -> str:
-        """The allowed range in the shown unit, e.g. ``"allowed 1e-06 ≤ value ≤ 10000 mH"``."""
+        """Write the allowed range in the shown unit, e.g. ``"allowed 1e-06 ≤ value ≤ 10000 mH"``."""
         if choice is None:
             return units.shown_range(self.spec)
         unit = choice.label.partition("[")[2].rstrip("]") if self.group == "flux" else self.unit_of(choice)
@@ -301,7 +301,7 @@ class InputsPanel:
             raise InputError(str(exc)) from None
 
     def nameplate_checks(self) -> dict[str, float]:
-        """The optional datasheet values typed for the cross-check (empty fields left out)."""
+        """Return the optional datasheet values typed for the cross-check (empty fields left out)."""
         out: dict[str, float] = {}
         for label, key in CHECKS:
             field = self.checks[key]

@@ -55,6 +55,7 @@ class BldcMachine:
     emf_samples: tuple[float, ...] = spec_field("Wb", -1e3, 1e3, default=(), label="Φ'_ra samples")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "machine")
         if self.emf not in EMF_SHAPES:
             raise ParameterError(f"machine.emf = {self.emf!r} is not allowed: one of {', '.join(EMF_SHAPES)}")
@@ -83,6 +84,7 @@ class BldcMechanics:
     B: float = spec_field("N·m·s/rad", 0.0, 1e4, low_open=False, label="B")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "mechanics")
 
 
@@ -103,6 +105,7 @@ class BldcInverter:
     f_s: float = spec_field("Hz", 1e3, 1e6, low_open=False, label="f_s", display="kHz")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "inverter")
 
 
@@ -131,6 +134,7 @@ class BldcGains:
     eps_lambda: float = spec_field("rad/s", 0.0, 1e5, label="ε_λ", display="rpm")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "gains")
 
 
@@ -142,6 +146,7 @@ class TorqueStep:
     T_L: float = spec_field("N·m", -1e5, 1e5, label="T_L load torque")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "scenario.cases.T_L_steps")
 
 
@@ -180,6 +185,7 @@ class BldcScenario:
     band_recovery: float = spec_field("rad/s", 0.0, 1e4, default=0.1, label="recovery band", aliases=("rpm",))
 
     def __post_init__(self) -> None:
+        """Check the fields' ranges, turn mapping load steps into :class:`TorqueStep`, check their times increase."""
         check_fields(self, "scenario.cases")
         steps = tuple(s if isinstance(s, TorqueStep) else TorqueStep(**s) for s in self.T_L_steps)
         times = [s.t for s in steps]
@@ -213,6 +219,7 @@ class BldcScenarios:
     cases: tuple[BldcScenario, ...]
 
     def __post_init__(self) -> None:
+        """Turn mapping cases into :class:`BldcScenario` and check that ``active`` names one of them."""
         cases = tuple(c if isinstance(c, BldcScenario) else BldcScenario(**c) for c in self.cases)
         if not cases:
             raise ParameterError("scenario.cases is empty: allowed one or more scenarios")

@@ -80,7 +80,7 @@ class FieldSpec:
         return extra + tuple(a for a in self.aliases if a not in extra and a != self.unit)
 
     def range_text(self, unit: str | None = None) -> str:
-        """The allowed range as written in messages, e.g. ``"allowed 0 < value ≤ 10 H"``.
+        """Write the allowed range as in messages, e.g. ``"allowed 0 < value ≤ 10 H"``.
 
         ``unit`` replaces the SI unit in the text (bounds are given in SI units; a caller that shows
         another unit converts the bounds first and builds a new spec).
@@ -103,7 +103,7 @@ class FieldSpec:
 
 def spec_field(unit: str, low: float | None = None, high: float | None = None, *, default: Any = dataclasses.MISSING,
                **kwargs: Any) -> Any:
-    """A dataclass field carrying its :class:`FieldSpec` (keyword arguments as in ``FieldSpec``)."""
+    """Declare a dataclass field carrying its :class:`FieldSpec` (keyword arguments as in ``FieldSpec``)."""
     if kwargs.get("integer"):
         kwargs["low_open"] = False  # an integer range is inclusive at both ends
     spec = FieldSpec(unit, low, high, **kwargs)
@@ -196,7 +196,7 @@ def _unit_word(unit: str) -> str:
 
 
 def range_text(low: float | None, high: float | None, low_open: bool, unit: str, *, integer: bool = False) -> str:
-    """``"allowed …"``: the range in the words of every range message (``unit`` ``"-"`` is not shown)."""
+    """Write ``"allowed …"``: the range in the words of every range message (unit ``"-"`` not shown)."""
     u = f" {_unit_word(unit)}".rstrip()
     if integer:
         return f"allowed an integer {low:g} … {high:g}{u}"

@@ -69,6 +69,7 @@ class Motor:
     J_r: float = spec_field("kg·m²", 1e-9, 1e4, low_open=False, label="J_r rotor inertia", aliases=("kg·cm²",))
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "motor")
 
 
@@ -80,6 +81,7 @@ class LoadStep:
     Gamma_Le: float = spec_field("N·m", -1e6, 1e6, label="Γ_Le load torque")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "load.steps")
 
 
@@ -108,6 +110,7 @@ class Load:
     Gamma_Le_ramp: float = spec_field("N·m/s", -1e6, 1e6, default=0.0, label="Γ_Le ramp")
 
     def __post_init__(self) -> None:
+        """Check the fields' ranges, turn mapping load steps into :class:`LoadStep`, check their times increase."""
         check_fields(self, "load")
         steps = tuple(s if isinstance(s, LoadStep) else LoadStep(**s) for s in self.steps)
         times = [s.t for s in steps]
@@ -161,6 +164,7 @@ class Controller:
                               label="i_max inverter peak current (0 = none)")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         if isinstance(self.T_c, str) and self.T_c != "T_a":
             raise ParameterError(f"controller.T_c = {self.T_c!r} is not allowed: a time > 0 s or 'T_a'")
         if isinstance(self.f_s, str) and self.f_s != "continuous":
@@ -194,6 +198,7 @@ class Manoeuvre:
     T_m: float = spec_field("s", 1e-4, 1e4, low_open=False, label="T_m manoeuvre time")
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_fields(self, "manoeuvre")
         if abs(self.theta_dem) < THETA_DEM_MIN:
             raise ParameterError(f"manoeuvre.theta_dem = {self.theta_dem!r} rad is out of range: allowed "
