@@ -310,7 +310,7 @@ def check_structure(text: str, origin: str) -> None:
 
 def _check_no_aliases(text: str) -> None:
     for event in yaml.parse(text, Loader=_TextLoader):
-        if isinstance(event, yaml.AliasEvent):
+        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:  # &name too
             raise PresetError("YAML anchors/aliases (*name) are not allowed in presets")
 
 
