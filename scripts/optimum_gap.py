@@ -21,11 +21,11 @@ def row(label: str, name: str, overrides: list[str]) -> None:
     """One line: energies [J] of the three runs and the gaps [%]."""
     c = compare(load_preset(name, overrides), ("fdsmc", "conventional", "optimum"))
     f, v, o = (r.metrics for r in (c.fdsmc, c.conventional, c.optimum))
-    print(f"{label:28s} {f['electrical_in_total_J']:10.4g} {v['electrical_in_total_J']:10.4g} "
-          f"{o['electrical_in_total_J']:10.4g} {saving_vs_optimum(c.fdsmc, c.optimum):8.1f} "
-          f"{saving_vs_optimum(c.conventional, c.optimum):8.1f}   F/Cu FDSMC {f['friction_J']:.4g}/"
-          f"{f['copper_J']:.4g}, opt {o['friction_J']:.4g}/{o['copper_J']:.4g}; "
-          f"opt peak {o['torque_peak_Nm']:.4g} N·m, θ err {o['theta_error_at_Tm_rad']:.3g} rad")
+    print(f"{label:28s} {f.electrical_in_total_J:10.4g} {v.electrical_in_total_J:10.4g} "
+          f"{o.electrical_in_total_J:10.4g} {saving_vs_optimum(c.fdsmc, c.optimum):8.1f} "
+          f"{saving_vs_optimum(c.conventional, c.optimum):8.1f}   F/Cu FDSMC {f.friction_J:.4g}/"
+          f"{f.copper_J:.4g}, opt {o.friction_J:.4g}/{o.copper_J:.4g}; "
+          f"opt peak {o.torque_peak_Nm:.4g} N·m, θ err {o.theta_error_at_Tm_rad:.3g} rad")
 
 
 def main() -> None:

@@ -62,8 +62,8 @@ def test_run_warnings_and_savings(paper_params):
     warnings = run_warnings(c)
     assert any(w.startswith("Chatter (FDSMC)") and "Recommended K" in w for w in warnings)
     s = annual_savings(c, 600.0, 4000.0, 0.25)
-    e_f = c.fdsmc.metrics["electrical_in_total_J"]
-    e_c = c.conventional.metrics["electrical_in_total_J"]
+    e_f = c.fdsmc.metrics.electrical_in_total_J
+    e_c = c.conventional.metrics.electrical_in_total_J
     assert s.per_cycle_J == pytest.approx(e_c - e_f)
     assert s.kWh_per_year == pytest.approx((e_c - e_f) * 600 * 4000 / 3.6e6)
     assert s.money_per_year == pytest.approx(0.25 * s.kWh_per_year)

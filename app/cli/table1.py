@@ -16,7 +16,7 @@ import json
 import sys
 
 from app.cli.main import add_preset_arguments
-from app.cli.simulate import finite_or_none
+from app.io.json_data import to_json
 from app.io.numbers import NumberFormatError, parse_number
 from app.io.preset_modes import load_mode_preset
 from control.fdsmc.params import ParameterError
@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
 
     rows = table1_sweep(params, tms, progress)
     if args.json:
-        print(json.dumps(finite_or_none({"rows": [row_json(r) for r in rows]}), indent=2))
+        print(json.dumps(to_json({"rows": [row_json(r) for r in rows]}), indent=2))
         return 0
     sys.stderr.write("\n")
     print(f"Preset: {params.name}, f_s = {params.controller.f_s}, K = {params.controller.K:g} s/rad\n")

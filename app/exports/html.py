@@ -79,8 +79,8 @@ def metrics_table(cmp: Comparison) -> str:
     body = []
     for key, label, unit, lim_key in METRICS:
         lim = limits.get(lim_key) if lim_key else None
-        cells = "".join(f"<td class='{'warn' if _over(r.metrics.get(key), lim) else ''}'>"
-                        f"{_fmt(r.metrics.get(key))}</td>" for r in runs)
+        cells = "".join(f"<td class='{'warn' if _over(getattr(r.metrics, key), lim) else ''}'>"
+                        f"{_fmt(getattr(r.metrics, key))}</td>" for r in runs)
         lim_text = f"{lim[0]:.5g} ({lim[1]})" if lim else ""
         body.append(f"<tr><td>{html.escape(label)}</td><td>{html.escape(unit)}</td>{cells}"
                     f"<td>{html.escape(lim_text)}</td></tr>")

@@ -26,6 +26,11 @@ def mH_to_H(L_mH: float) -> float:
     return L_mH * 1e-3
 
 
+def H_to_mH(L: float) -> float:
+    """Inductance [H] → [mH]."""
+    return L * 1e3
+
+
 def kW_to_W(P_kW: float) -> float:
     """Power [kW] → [W]."""
     return P_kW * 1e3
@@ -44,6 +49,11 @@ def s_to_ms(t: float) -> float:
 def kHz_to_Hz(f_kHz: float) -> float:
     """Frequency [kHz] → [Hz]."""
     return f_kHz * 1e3
+
+
+def Hz_to_kHz(f: float) -> float:
+    """Frequency [Hz] → [kHz]."""
+    return f * 1e-3
 
 
 def deg_to_rad(x_deg: float) -> float:

@@ -28,7 +28,7 @@ from app.io.bldc_view import metric_table
 from app.io.numbers import NumberFormatError
 from app.io.preset_modes import load_mode_preset
 from app.io.presets import dumps_preset, loads_preset
-from app.io.units import kHz_to_Hz, mH_to_H, rad_s_to_rpm, rpm_to_rad_s
+from app.io.units import H_to_mH, Hz_to_kHz, kHz_to_Hz, mH_to_H, rad_s_to_rpm, rpm_to_rad_s, s_to_ms
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice, md_text
 from app.ui.worker import Cancelled, Worker
@@ -44,13 +44,13 @@ ASPECT = 0.75
 #: (label, section, field, to-SI converter, from-SI converter, step) of the number inputs.
 FIELDS: tuple[tuple[str, str, str, Callable[[float], float], Callable[[float], float], float], ...] = (
     ("R_s [Ω]", "machine", "R_s", float, float, 0.01),
-    ("L_s − M_s [mH]", "machine", "L_s_minus_M_s", mH_to_H, lambda x: x * 1e3, 0.1),
+    ("L_s − M_s [mH]", "machine", "L_s_minus_M_s", mH_to_H, H_to_mH, 0.1),
     ("n_pp (pole pairs)", "machine", "n_pp", int, int, 1),
     ("Φ_m [Wb]", "machine", "Phi_m", float, float, 0.001),
     ("J [kg·m²]", "mechanics", "J", float, float, 1e-4),
     ("B [N·m·s/rad]", "mechanics", "B", float, float, 1e-4),
     ("V_dc [V]", "inverter", "V_dc", float, float, 1.0),
-    ("f_s [kHz]", "inverter", "f_s", kHz_to_Hz, lambda x: x * 1e-3, 1.0),
+    ("f_s [kHz]", "inverter", "f_s", kHz_to_Hz, Hz_to_kHz, 1.0),
     ("k_I [1/A]", "gains", "k_I", float, float, 0.1),
     ("k_ω [s/rad]", "gains", "k_omega", float, float, 0.1),
     ("T_max [N·m]", "gains", "T_max", float, float, 0.1),
@@ -202,7 +202,7 @@ class BldcTab:
         self.metrics.content = metrics_markdown(comp)
         sim_s = params.case.t_end * len(comp.runs)
         self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**, "
-                               f"{sim_s:g} s simulated in {comp.wall_s * 1e3:.0f} ms.")
+                               f"{sim_s:g} s simulated in {s_to_ms(comp.wall_s):.0f} ms.")
 
     def _cancel(self) -> None:
         if self._worker is not None and self._worker.cancel():
