@@ -11,9 +11,8 @@ import argparse
 
 from app.cli.simulate import saving_vs_optimum
 from app.io.presets import load_preset
-from sim.fdsmc.engine import compare
+from sim.fdsmc.engine import TABLE1_T_M, compare
 
-TABLE1_TM = (1.0, 1.4, 1.8, 2.2, 2.6)
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a")
 
 
@@ -35,7 +34,7 @@ def main() -> None:
     a = ap.parse_args()
     print(f"{'case':28s} {'W FDSMC':>10s} {'W conv':>10s} {'W opt':>10s} {'gap F %':>8s} {'gap C %':>8s}")
     print("(W: net electrical input over the whole run [J]; gap: share of it the optimum saves)")
-    for T_m in TABLE1_TM:
+    for T_m in TABLE1_T_M:
         row(f"paper T_m = {T_m:g} s", "paper_12kw_pmsm", [f"manoeuvre.T_m={T_m}", f"controller.K={a.paper_K}"])
     for name in REAL:
         row(name, name, [])

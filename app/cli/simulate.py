@@ -10,6 +10,7 @@ from app.cli.main import add_preset_arguments, check_writable
 from app.exports.model import trace_csv
 from app.io.derived_view import derived_json
 from app.io.json_data import to_json
+from app.io.numbers import format_metric
 from app.io.plant_overrides import load_model_and_plant
 from control.fdsmc.params import ParameterError
 from sim.fdsmc.engine import Comparison, RunResult, compare
@@ -90,14 +91,6 @@ def write_csv(path: str, cmp: Comparison) -> None:
         raise ParameterError(f"cannot write --csv {path!r}: {exc.strerror or exc}") from None
 
 
-def _fmt(v: Any) -> str:
-    if v is None:
-        return "—"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    return f"{v:.5g}" if isinstance(v, float) else str(v)
-
-
 def print_summary(cmp: Comparison) -> None:
     """Side-by-side table of the runs, savings, warnings and explanations."""
     runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None]
@@ -107,11 +100,11 @@ def print_summary(cmp: Comparison) -> None:
     print(f"{'':40s}" + "".join(f"{r.controller:>16s}" for r in runs))
     for key, label, unit in SUMMARY:
         head = label + (f" [{unit}]" if unit else "")
-        print(f"{head:40s}" + "".join(f"{_fmt(getattr(r.metrics, key)):>16s}" for r in runs))
+        print(f"{head:40s}" + "".join(f"{format_metric(getattr(r.metrics, key)):>16s}" for r in runs))
     if cmp.saving_friction_pct is not None:
         e = cmp.derived.energy
         print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
-              f"(eq. (52) predicts {_fmt(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
+              f"(eq. (52) predicts {format_metric(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
         print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
     for run in (cmp.fdsmc, cmp.conventional):
         gap = saving_vs_optimum(run, cmp.optimum)

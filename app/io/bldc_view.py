@@ -5,10 +5,10 @@ Shared by the page's BLDC tab and ``python -m app bldc``.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from app.io.json_data import to_json
+from app.io.numbers import format_metric
 from app.io.units import rad_s_to_rpm
 from control.bldc.design import BldcDesign
 from sim.bldc.engine import LABELS, BldcComparison
@@ -28,15 +28,6 @@ METRIC_ROWS: tuple[tuple[str, str, str, str], ...] = (
     ("copper_loss_mean_W", "Mean copper loss power", "W", ".2f"),
     ("energy_balance_residual_pct", "Energy-balance residual", "%", ".2e"),
 )
-
-
-def format_value(value: Any, fmt: str) -> str:
-    """A metric as text ('—' for None / not finite)."""
-    if isinstance(value, bool) or value is None:
-        return "—" if value is None else str(value)
-    if isinstance(value, float) and not math.isfinite(value):
-        return "—"
-    return format(value, fmt)
 
 
 #: Speed scale of the rpm keys [rpm per rad/s].
@@ -59,7 +50,7 @@ def metric_table(comp: BldcComparison) -> list[list[str]]:
     rows = [head]
     values = [metrics_json(r.metrics) for r in comp.runs]
     for key, label, unit, fmt in METRIC_ROWS:
-        rows.append([label, unit] + [format_value(v[key], fmt) for v in values])
+        rows.append([label, unit] + [format_metric(v[key], fmt) for v in values])
     return rows
 
 

@@ -26,11 +26,6 @@ def mH_to_H(L_mH: float) -> float:
     return L_mH * 1e-3
 
 
-def H_to_mH(L: float) -> float:
-    """Inductance [H] → [mH]."""
-    return L * 1e3
-
-
 def kW_to_W(P_kW: float) -> float:
     """Power [kW] → [W]."""
     return P_kW * 1e3
@@ -49,11 +44,6 @@ def s_to_ms(t: float) -> float:
 def kHz_to_Hz(f_kHz: float) -> float:
     """Frequency [kHz] → [Hz]."""
     return f_kHz * 1e3
-
-
-def Hz_to_kHz(f: float) -> float:
-    """Frequency [Hz] → [kHz]."""
-    return f * 1e-3
 
 
 def deg_to_rad(x_deg: float) -> float:
@@ -152,6 +142,16 @@ def psi_pm_to_kt_nm_per_arms(psi_pm: float, p: int) -> float:
 def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
     """Ψ_PM [Wb] → Ke [V_rms line-to-line per krpm]; inverse of :func:`ke_vrms_krpm_to_psi_pm`."""
     return psi_pm * p * rpm_to_rad_s(1000.0) / math.sqrt(2.0 / 3.0)
+
+
+def H_to_mH(L: float) -> float:
+    """Inductance [H] → [mH] (display): inverse of :func:`mH_to_H`."""
+    return L * (1.0 / mH_to_H(1.0))
+
+
+def Hz_to_kHz(f: float) -> float:
+    """Frequency [Hz] → [kHz] (display): inverse of :func:`kHz_to_Hz`."""
+    return f * (1.0 / kHz_to_Hz(1.0))
 
 
 #: SI unit of every input field of the position-drive parameter model (control/fdsmc/params.py), as

@@ -27,8 +27,9 @@ from app.io.bldc_emf import read_measured, with_measured
 from app.io.bldc_view import metric_table
 from app.io.numbers import NumberFormatError
 from app.io.preset_modes import load_mode_preset
-from app.io.presets import dumps_preset, loads_preset
+from app.io.presets import dumps_preset
 from app.io.units import H_to_mH, Hz_to_kHz, kHz_to_Hz, mH_to_H, rad_s_to_rpm, rpm_to_rad_s, s_to_ms
+from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice, md_text
 from app.ui.worker import Cancelled, Worker
@@ -239,12 +240,8 @@ class BldcTab:
     def _uploaded(self, _: viser.GuiEvent) -> None:
         f = self.upload.value
         try:
-            text = f.content.decode("utf-8")
-            measured = read_measured(text, f.name)
+            measured = read_measured(upload_text(f.name, f.content, "CSV or YAML"), f.name)
             self.params = with_measured(self.params, measured)
-        except UnicodeDecodeError:
-            self.status.content = f"**Upload rejected:** {md_text(f.name)} is not UTF-8 text: allowed CSV or YAML"
-            return
         except (ParameterError, ValueError) as exc:
             self.status.content = f"**Upload rejected — nothing changed:** {md_text(exc)}"
             return
@@ -258,16 +255,9 @@ class BldcTab:
     def _imported(self) -> None:
         f = self.import_preset.value
         try:
-            params = loads_preset(f.content.decode("utf-8"), f.name)
-        except UnicodeDecodeError:
-            self.status.content = f"**Import rejected — nothing changed:** {md_text(f.name)} is not UTF-8 text"
-            return
+            params = parse_upload(f.name, f.content, BldcParams)
         except (ParameterError, ValueError) as exc:
             self.status.content = f"**Import rejected — nothing changed:** {md_text(exc)}"
-            return
-        if not isinstance(params, BldcParams):
-            self.status.content = (f"**Import rejected — nothing changed:** {md_text(f.name)} is a position-drive "
-                                   "preset: import it in the *Position drive (FDSMC)* tab")
             return
         self.apply(params)
         self.status.content = (f"Imported **{md_text(params.name)}** ({md_text(f.name)}) — press "

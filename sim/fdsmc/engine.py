@@ -54,6 +54,8 @@ PLANT_STEP_MAX_S = 5e-5
 MAX_POINTS = 20000
 #: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
 PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
+#: The manoeuvre times [s] of Table 1 in [1]: the default sweep.
+TABLE1_T_M: tuple[float, ...] = tuple(PAPER_TABLE1)
 
 
 @dataclass(frozen=True)
