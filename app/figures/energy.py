@@ -22,7 +22,7 @@ ENERGIES = (
 
 
 def _styled(fig: go.Figure, fid: str, title: str, legend_y: float, **layout: Any) -> go.Figure:
-    """The common layout of the energy figures: id in ``meta``, title, margins, legend below."""
+    """Return the common layout of the energy figures: id in ``meta``, title, margins, legend below."""
     fig.update_layout(_layout(fid, title, legend_y, **layout))
     return fig
 
@@ -78,8 +78,11 @@ def make_energy_figure(comparison: Comparison) -> go.Figure:
 
 
 def energy_total(run: RunResult, attr: str, metric: str) -> float:
-    """Total of one energy kind over the horizon [J]: the metric ``metric`` (a
-    :class:`~sim.fdsmc.metrics.RunMetrics` field) if the run has it, else the trace's end."""
+    """Return the total of one energy kind over the horizon [J].
+
+    That is the metric ``metric`` (a :class:`~sim.fdsmc.metrics.RunMetrics` field) if the run has
+    it, else the end of the trace's channel ``attr``.
+    """
     value = getattr(run.metrics, metric)
     return float(getattr(run.trace, attr)[-1]) if value is None else float(value)
 

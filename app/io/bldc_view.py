@@ -55,7 +55,7 @@ def metric_table(comp: BldcComparison) -> list[list[str]]:
 
 
 def design_json(d: BldcDesign) -> dict[str, Any]:
-    """Derived values of a case as plain JSON data (SI units)."""
+    """Return the derived values of a case as plain JSON data (SI units)."""
     return {
         "K_Tx_Nm_per_A": d.K_Tx, "K_T_fig7_Nm_per_A": d.K_T_fig7, "i_qx_max_A": d.i_qx_max,
         "current_loop_gain_V_per_A": d.current.gain, "current_loop_bandwidth_rad_s": d.current.bandwidth,
@@ -69,7 +69,7 @@ def design_json(d: BldcDesign) -> dict[str, Any]:
 
 
 def comparison_json(comp: BldcComparison) -> dict[str, Any]:
-    """The stable JSON form: scenario, design, per-controller metrics, warnings."""
+    """Return the stable JSON form: scenario, design, per-controller metrics, warnings."""
     case = comp.params.case
     return {
         "preset": comp.params.name,

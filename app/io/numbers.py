@@ -95,8 +95,11 @@ def parse_T_m_list(text: str, field: str) -> list[float]:
 
 
 def format_metric(value: float | int | bool | str | None, fmt: str = ".5g") -> str:
-    """A result cell as text: "—" for None or a non-finite number, "yes"/"no" for a flag, a float
-    in ``fmt``, anything else as it is."""
+    """Format a result cell as text.
+
+    "—" for None or a non-finite number, "yes"/"no" for a flag, a float in ``fmt``, anything else
+    as it is.
+    """
     if value is None or isinstance(value, float) and not math.isfinite(value):
         return "—"
     if isinstance(value, bool):

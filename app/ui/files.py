@@ -47,8 +47,10 @@ def _flat(params: DriveParams) -> dict[str, Any]:
 
 
 def uncommitted(shown: DriveParams, committed: DriveParams) -> list[str]:
-    """``field = shown (simulated: value)`` for every input that differs (SI units); name and
-    source are not simulated inputs (the Export folder sets them)."""
+    """List ``field = shown (simulated: value)`` for every input that differs (SI units).
+
+    Name and source are not simulated inputs (the Export folder sets them).
+    """
     a, b = _flat(shown), _flat(committed)
     return [f"{k} = {a[k]!r} (simulated: {b.get(k)!r})" for k in a if a[k] != b.get(k)]
 
@@ -59,8 +61,11 @@ PRESET_KINDS: dict[type, tuple[str, str]] = {DriveParams: ("position-drive prese
 
 
 def upload_text(name: str, content: bytes, allowed: str) -> str:
-    """The text of an uploaded file; PresetError naming the file if it is over MAX_BYTES or not UTF-8
-    (``allowed`` says what the upload takes, e.g. "a YAML or JSON preset file")."""
+    """Return the text of an uploaded file.
+
+    Raises PresetError naming the file if it is over MAX_BYTES or not UTF-8 (``allowed`` says what
+    the upload takes, e.g. "a YAML or JSON preset file").
+    """
     if len(content) > MAX_BYTES:
         raise PresetError(f"{name} is too large ({len(content) // 1024} KiB): allowed ≤ {MAX_BYTES // 1024} KiB")
     try:
@@ -70,8 +75,11 @@ def upload_text(name: str, content: bytes, allowed: str) -> str:
 
 
 def parse_upload(name: str, content: bytes, mode: type = DriveParams) -> Any:
-    """Validate an uploaded preset file of ``mode`` (DriveParams or BldcParams); PresetError or
-    ParameterError with a clear message if bad, or if it is the other mode's preset."""
+    """Validate an uploaded preset file of ``mode`` (DriveParams or BldcParams).
+
+    Raises PresetError or ParameterError with a clear message if it is bad, or if it is the other
+    mode's preset.
+    """
     params = loads_preset(upload_text(name, content, "a YAML or JSON preset file"), name or "<upload>")
     if not isinstance(params, mode):
         kind, tab = PRESET_KINDS[type(params)]
@@ -80,7 +88,7 @@ def parse_upload(name: str, content: bytes, mode: type = DriveParams) -> Any:
 
 
 def renamed(cmp: Comparison, name: str, source: str) -> Comparison:
-    """The case with the name and source written into the exports (both must be non-blank)."""
+    """Return the case with the name and source written into the exports (both must be non-blank)."""
     for field, text in (("name", name), ("source", source)):
         if not text.strip():
             raise ExportRefusedError(f"Export › {field} = {text!r} is empty: allowed any non-blank text "

@@ -157,8 +157,10 @@ class LoopModel:
 
 @dataclass(frozen=True)
 class LoopCase(LoopModel):
-    """The linearised loop of one case with its outer laws: α_max [rad/s²] and T_c [s] of the
-    FDSMC (eqs. (41), (46) in [1]) and the conventional gains g1 [1/s²], g2 [1/s] of eq. (61).
+    """The linearised loop of one case with its outer laws.
+
+    α_max [rad/s²] and T_c [s] of the FDSMC (eqs. (41), (46) in [1]) and the conventional gains
+    g1 [1/s²], g2 [1/s] of eq. (61).
 
     Built by :func:`control.fdsmc.derivations.derive` before the derived case itself, which
     then holds the verdicts of :func:`recommend_K` and :func:`sample_rate_check`.

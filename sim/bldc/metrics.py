@@ -30,8 +30,10 @@ from sim.common.energy import energy_balance
 
 @dataclass(frozen=True)
 class BldcMetrics:
-    """The metrics of one run (module docstring); the fields are the keys of ``bldc --json``
-    except the two speeds, which the JSON gives in rpm (``speed_error_ss_rpm``, ``overshoot_rpm``).
+    """The metrics of one run (module docstring).
+
+    The fields are the keys of ``bldc --json`` except the two speeds, which the JSON gives in rpm
+    (``speed_error_ss_rpm``, ``overshoot_rpm``).
 
     Attributes
     ----------
@@ -142,7 +144,7 @@ def energy_metrics(tr: BldcTrace) -> dict[str, float]:
 
 
 def run_metrics(params: BldcParams, tr: BldcTrace, diverged: bool = False) -> BldcMetrics:
-    """The metrics of one run (module docstring); ``stable``/``reason`` say if it diverged."""
+    """Return the metrics of one run (module docstring); ``stable``/``reason`` say if it diverged."""
     case = params.case
     t_reach = signals.first_entry_time(tr.t, tr.omega, case.omega_ref, case.band_recovery)
     err_ss, ripple, window = _window_stats(params, tr, t_reach)

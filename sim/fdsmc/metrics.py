@@ -66,7 +66,7 @@ class ChatterVerdict:
 
 
 def hysteretic_sign_changes(r: np.ndarray, hyst: float) -> int:
-    """Number of sign changes of ``r`` counting only swings beyond ±``hyst``.
+    """Count the sign changes of ``r``, counting only swings beyond ±``hyst``.
 
     Samples inside ±hyst are ignored; every change between consecutive remaining signs counts.
     """
@@ -201,8 +201,10 @@ def response_metrics(
 
 
 def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
-    """Energies at T_m and at the end of the run, stored energies and the balance residual [J]
-    (RunMetrics fields)."""
+    """Return the energies at T_m and at the end, stored energies and the balance residual [J].
+
+    The keys are :class:`RunMetrics` fields.
+    """
     snap, end = info[kn.I_SNAP: kn.I_SNAP + kn.N_X], info[kn.I_END: kn.I_END + kn.N_X]
     m = params.motor
 
@@ -281,8 +283,10 @@ def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
     samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None,
 ) -> RunMetrics:
-    """All metrics of one run from the (decimated) trace, the full-resolution chatter-window
-    ``samples`` and the kernel's ``info`` vector.
+    """Return all metrics of one run.
+
+    They come from the (decimated) trace, the full-resolution chatter-window ``samples`` and the kernel's
+    ``info`` vector.
 
     Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
     every number becomes None, ``stable`` False and ``reason`` says why. Stored energies use the
