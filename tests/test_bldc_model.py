@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from app.io.presets import load_preset
+from app.io.units import rad_s_to_rpm
 from control.bldc.design import bldc_design
 from control.bldc.dqx import trapezoid_unit
 from control.bldc.speed_smc import reachability_bound, reachability_check
@@ -27,10 +28,10 @@ def test_energy_balance_closes(params, controller):
     (17)): closes to 1e-8 of the input; the load and copper terms are a sizeable share.
     """
     m = simulate_bldc(params, controller).metrics
-    assert m["stable"]
-    assert abs(m["energy_balance_residual_J"]) < 1e-8 * m["electrical_in_total_J"]
-    assert m["copper_total_J"] > 0.1 * m["electrical_in_total_J"]
-    assert m["kinetic_change_J"] == pytest.approx(0.5 * 0.0042 * (1000 * math.pi / 30) ** 2, rel=0.01)
+    assert m.stable
+    assert abs(m.energy_balance_residual_J) < 1e-8 * m.electrical_in_total_J
+    assert m.copper_total_J > 0.1 * m.electrical_in_total_J
+    assert m.kinetic_change_J == pytest.approx(0.5 * 0.0042 * (1000 * math.pi / 30) ** 2, rel=0.01)
 
 
 def test_emf_power_equals_mechanical_power_eq2_eq3(params):
@@ -93,6 +94,6 @@ def test_one_rk4_step_per_sample_is_converged():
     """The default N_SUB = 1 (h = 50 µs) against 4 substeps: metrics agree to 1e-3 relative."""
     p = load_preset("bldc_smc_paper", ["scenario.active=2000rpm"])
     a, b = simulate_bldc(p, n_sub=1).metrics, simulate_bldc(p, n_sub=4).metrics
-    for key in ("torque_ripple_pct", "copper_loss_J", "overshoot_rpm", "electrical_in_total_J"):
-        assert a[key] == pytest.approx(b[key], rel=1e-3)
-    assert abs(a["speed_error_ss_rpm"] - b["speed_error_ss_rpm"]) < 1e-3
+    for key in ("torque_ripple_pct", "copper_loss_J", "overshoot_rad_s", "electrical_in_total_J"):
+        assert getattr(a, key) == pytest.approx(getattr(b, key), rel=1e-3)
+    assert abs(rad_s_to_rpm(a.speed_error_ss_rad_s) - rad_s_to_rpm(b.speed_error_ss_rad_s)) < 1e-3

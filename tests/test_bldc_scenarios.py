@@ -10,6 +10,7 @@ import pytest
 
 from app.cli.main import main
 from app.io.presets import load_preset
+from app.io.units import rad_s_to_rpm
 from control.bldc.plain_smc import steady_state_error
 from sim.bldc.engine import compare_bldc
 from sim.bldc.metrics import steady_windows
@@ -38,11 +39,11 @@ def test_integral_surface_removes_steady_state_error_plain_tanh_does_not(name, r
     comp = request.getfixturevalue(name)
     p = comp.params
     integral, plain = comp.run("smc_integral").metrics, comp.run("smc_plain").metrics
-    assert integral["speed_error_ss_rpm"] < 0.5
-    assert plain["speed_error_ss_rpm"] > 2.0
+    assert rad_s_to_rpm(integral.speed_error_ss_rad_s) < 0.5
+    assert rad_s_to_rpm(plain.speed_error_ss_rad_s) > 2.0
     T_eq = p.mechanics.B * p.case.omega_ref + 2.2
     predicted = steady_state_error(T_eq, p.gains.k_omega, p.gains.T_max) * RPM
-    assert predicted * 0.95 < plain["speed_error_ss_rpm"] < predicted * 1.25
+    assert predicted * 0.95 < rad_s_to_rpm(plain.speed_error_ss_rad_s) < predicted * 1.25
 
 
 @pytest.mark.parametrize("name", ["run1000", "run2000"])
@@ -51,10 +52,10 @@ def test_speed_recovers_after_each_load_step(name, request):
     (the paper reports ≈ 50 ms at 2000 rpm); the plain law never returns under load.
     """
     comp = request.getfixturevalue(name)
-    rec = comp.run("smc_integral").metrics["recovery_times_s"]
+    rec = comp.run("smc_integral").metrics.recovery_times_s
     assert len(rec) == len(comp.params.case.T_L_steps)
     assert all(r is not None and r < 0.06 for r in rec)
-    assert comp.run("smc_plain").metrics["recovery_time_s"] is None
+    assert comp.run("smc_plain").metrics.recovery_time_s is None
 
 
 @pytest.mark.parametrize("name", ["run1000", "run2000"])
@@ -63,8 +64,8 @@ def test_dqx_has_clearly_lower_torque_ripple_than_sinusoidal_dq(name, request):
     at least 1.8× less peak-to-peak torque ripple in the loaded steady window.
     """
     comp = request.getfixturevalue(name)
-    r_x = comp.run("smc_integral").metrics["torque_ripple_pct"]
-    r_s = comp.run("pi_sinusoidal").metrics["torque_ripple_pct"]
+    r_x = comp.run("smc_integral").metrics.torque_ripple_pct
+    r_s = comp.run("pi_sinusoidal").metrics.torque_ripple_pct
     assert 0.0 < r_x < r_s / 1.8
 
 
@@ -78,9 +79,9 @@ def test_six_step_ripple_is_clearly_higher_than_dqx_on_the_distorted_machine(nam
     """
     comp = request.getfixturevalue(name)
     six = comp.run("six_step").metrics
-    ripple = {r.controller: r.metrics["torque_ripple_pct"] for r in comp.runs}
-    assert six["speed_error_ss_rpm"] < 0.5
-    assert all(r is not None and r < 0.06 for r in six["recovery_times_s"])
+    ripple = {r.controller: r.metrics.torque_ripple_pct for r in comp.runs}
+    assert rad_s_to_rpm(six.speed_error_ss_rad_s) < 0.5
+    assert all(r is not None and r < 0.06 for r in six.recovery_times_s)
     assert ripple["six_step"] > factor * ripple["smc_integral"]
     assert min(ripple, key=ripple.get) in ("smc_integral", "smc_plain")
 
@@ -99,8 +100,8 @@ def test_anti_windup_keeps_overshoot_small(run1000):
     overshoots by less than 1 % of ω*; torque never exceeds T_max by more than the ripple.
     """
     m = run1000.run("smc_integral").metrics
-    assert m["overshoot_rpm"] < 10.0
-    assert m["torque_peak_Nm"] < 1.1 * run1000.params.gains.T_max
+    assert rad_s_to_rpm(m.overshoot_rad_s) < 10.0
+    assert m.torque_peak_Nm < 1.1 * run1000.params.gains.T_max
 
 
 def test_cli_json_has_the_contract_keys(capsys):

@@ -15,6 +15,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from app.io.presets import load_preset
+from app.io.units import rad_s_to_rpm
 from control.bldc import six_step as six
 from control.bldc.dqx import torque_constant_fig7, trapezoid_unit, trapezoid_unit_slope
 from sim.bldc.engine import simulate_bldc
@@ -97,7 +98,7 @@ def ideal_run():
 
 def _loaded_window(run):
     tr = run.trace
-    a, b = run.metrics["ripple_window_s"]
+    a, b = run.metrics.ripple_window_s
     return tr, (tr.t >= a) & (tr.t < b)
 
 
@@ -115,7 +116,7 @@ def test_torque_is_kt_times_line_current_on_the_ideal_trapezoid(ideal_run):
     assert np.max(np.abs(T[quiet] - K_T * I[quiet])) < 0.005 * np.mean(T)
     assert np.mean(T) == pytest.approx(K_T * np.mean(I), rel=0.04)
     assert np.mean(T) == pytest.approx(p.mechanics.B * np.mean(tr.omega[m]) + 2.2, rel=0.01)
-    assert run.metrics["speed_error_ss_rpm"] < 0.5
+    assert rad_s_to_rpm(run.metrics.speed_error_ss_rad_s) < 0.5
 
 
 def test_ideal_trapezoid_torque_is_flat_except_at_commutations(ideal_run):
@@ -128,7 +129,7 @@ def test_ideal_trapezoid_torque_is_flat_except_at_commutations(ideal_run):
     T = tr.T_EL[m]
     flat = 100.0 * np.ptp(T[since > 15.0]) / np.mean(T)
     assert flat < 3.0
-    assert run.metrics["torque_ripple_pct"] > 4.0 * flat
+    assert run.metrics.torque_ripple_pct > 4.0 * flat
     worst = np.argmax(np.abs(T - np.mean(T)))
     assert since[worst] < 15.0
 
@@ -148,6 +149,6 @@ def test_commutation_bump_turns_into_a_dip_as_the_dc_link_falls(ideal_run):
         T, settled = tr.T_EL[m], np.median(tr.T_EL[m][since > 40.0])
         early = T[since < 10.0] / settled - 1.0
         excursions.append((early.max(), early.min()))
-        assert r.metrics["speed_error_ss_rpm"] < 0.5
+        assert rad_s_to_rpm(r.metrics.speed_error_ss_rad_s) < 0.5
     assert excursions[0][0] > 0.05 and excursions[0][1] > -0.05
     assert excursions[1][1] < -0.15 and excursions[1][0] < 0.0

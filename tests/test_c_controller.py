@@ -68,7 +68,7 @@ def test_double_build_reproduces_digital_mode(tmp_path, case):
     err = agreement(params, closed_loop(build(tmp_path, False), False, params))
     assert max(err.values()) < 1e-6, err
     if case == "delay_limits":  # the limits acted, so the test exercised them
-        assert simulate(params, "fdsmc").metrics["saturated_s"] > 0.0
+        assert simulate(params, "fdsmc").metrics.saturated_s > 0.0
 
 
 def test_double_build_conventional_step_reproduces_comparator(tmp_path):

@@ -20,13 +20,13 @@ REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskaw
 
 def _assert_clean_run(dd) -> None:
     p, m = dd.params, dd.comparison.fdsmc.metrics
-    assert m["stable"] and not m["chatter"]
-    assert m["torque_peak_Nm"] <= torque_limit(p) * 1.005
-    assert m["u_peak_V"] <= voltage_limit(p) * 1.005
-    assert m["omega_peak_rad_s"] <= p.motor.omega_b * 1.005
+    assert m.stable and not m.chatter
+    assert m.torque_peak_Nm <= torque_limit(p) * 1.005
+    assert m.u_peak_V <= voltage_limit(p) * 1.005
+    assert m.omega_peak_rad_s <= p.motor.omega_b * 1.005
     if p.controller.i_max > 0:
-        assert m["i_q_peak_A"] <= p.controller.i_max * 1.005
-    assert abs(m["theta_error_at_Tm_rad"]) <= 0.02 * abs(p.manoeuvre.theta_dem)
+        assert m.i_q_peak_A <= p.controller.i_max * 1.005
+    assert abs(m.theta_error_at_Tm_rad) <= 0.02 * abs(p.manoeuvre.theta_dem)
     assert run_checks(p, dd.comparison.fdsmc) == []
 
 

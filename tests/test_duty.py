@@ -24,7 +24,7 @@ def test_cycle_energy_is_the_sum_of_the_moves_and_yearly_figures_follow(tmp_path
     single = compare(load_preset(PRESET, ["manoeuvre.theta_dem=31.4", "manoeuvre.T_m=0.5"]),
                      ("fdsmc", "conventional", "optimum"))
     for c in ("fdsmc", "conventional", "optimum"):
-        assert out["moves_J"][1][c] == pytest.approx(getattr(single, c).metrics["electrical_in_total_J"])
+        assert out["moves_J"][1][c] == pytest.approx(getattr(single, c).metrics.electrical_in_total_J)
         assert out["cycle_J"][c] == pytest.approx(out["moves_J"][0][c] + out["moves_J"][1][c])
         assert out["kWh_per_year"][c] == pytest.approx(out["cycle_J"][c] * 1000 * 2000 / J_PER_KWH)
         assert out["cost_per_year"][c] == pytest.approx(0.3 * out["kWh_per_year"][c])

@@ -44,15 +44,15 @@ def continuous_cmp(continuous_paper):
 @pytest.mark.parametrize("K", [1000.0, 0.45])
 def test_continuous_step_halving_changes_friction_less_than_0_05_pct(continuous_paper, K):
     p = _with(continuous_paper, "controller", K=K)
-    w1 = simulate(p, "fdsmc", h_continuous=5e-6).metrics["friction_J"]
-    w2 = simulate(p, "fdsmc", h_continuous=2.5e-6).metrics["friction_J"]
+    w1 = simulate(p, "fdsmc", h_continuous=5e-6).metrics.friction_J
+    w2 = simulate(p, "fdsmc", h_continuous=2.5e-6).metrics.friction_J
     assert abs(w1 / w2 - 1.0) < 5e-4
 
 
 def test_digital_substep_halving_changes_friction_less_than_0_05_pct(paper_params):
     for ctrl in ("fdsmc", "conventional"):
-        w1 = simulate(paper_params, ctrl, n_sub=1).metrics["friction_J"]
-        w2 = simulate(paper_params, ctrl, n_sub=2).metrics["friction_J"]
+        w1 = simulate(paper_params, ctrl, n_sub=1).metrics.friction_J
+        w2 = simulate(paper_params, ctrl, n_sub=2).metrics.friction_J
         assert abs(w1 / w2 - 1.0) < 5e-4
 
 
@@ -71,15 +71,15 @@ def test_energy_balance_closes_to_0_1_pct_with_and_without_load(mode):
         cmp = compare(p)
         for run in (cmp.fdsmc, cmp.conventional):
             m = run.metrics
-            assert m["stable"]
-            e_in = m["electrical_in_total_J"]
-            parts = (m["copper_total_J"] + m["friction_total_J"] + m["load_work_total_J"]
-                     + m["kinetic_end_J"] + m["magnetic_end_J"])
+            assert m.stable
+            e_in = m.electrical_in_total_J
+            parts = (m.copper_total_J + m.friction_total_J + m.load_work_total_J
+                     + m.kinetic_end_J + m.magnetic_end_J)
             assert abs(e_in - parts) < 1e-3 * abs(e_in)
-            assert abs(m["energy_balance_residual_J"]) < 1e-3 * abs(e_in)
-            assert m["regenerated_total_J"] >= 0.0
+            assert abs(m.energy_balance_residual_J) < 1e-3 * abs(e_in)
+            assert m.regenerated_total_J >= 0.0
             if p.load.steps:
-                assert abs(m["load_work_total_J"]) > 1.0  # the load torque did work
+                assert abs(m.load_work_total_J) > 1.0  # the load torque did work
 
 
 def test_energy_trace_matches_power_integral(paper_params):
@@ -92,14 +92,14 @@ def test_energy_trace_matches_power_integral(paper_params):
 # --- paper values (continuous mode, section 5 of [1]) ------------------------------------
 
 def test_fdsmc_friction_within_0_3_pct_of_eq52(continuous_cmp):
-    w = continuous_cmp.fdsmc.metrics["friction_J"]
+    w = continuous_cmp.fdsmc.metrics.friction_J
     assert w == pytest.approx(continuous_cmp.derived.energy.W_fdsmc, rel=3e-3)
 
 
 def test_conventional_friction_within_0_2_pct_of_closed_form(continuous_cmp, continuous_paper):
     F_v, dth = continuous_paper.load.F_v, continuous_paper.manoeuvre.theta_dem
     a = 5.6 / continuous_paper.manoeuvre.T_m
-    w = continuous_cmp.conventional.metrics["friction_J"]
+    w = continuous_cmp.conventional.metrics.friction_J
     assert w == pytest.approx(F_v * dth**2 * a / 4.0, rel=2e-3)
 
 
@@ -110,17 +110,17 @@ def test_conventional_peak_speed_about_twice_fdsmc(continuous_paper):
     Checked with the recommended K (with K = 1000 the chatter adds ±1.3 rad/s to the FDSMC).
     """
     cmp = compare(_recommended(continuous_paper))
-    ratio = cmp.conventional.metrics["omega_peak_rad_s"] / cmp.fdsmc.metrics["omega_peak_rad_s"]
+    ratio = cmp.conventional.metrics.omega_peak_rad_s / cmp.fdsmc.metrics.omega_peak_rad_s
     assert 1.9 <= ratio <= 2.0
     dth, a = continuous_paper.manoeuvre.theta_dem, 5.6 / continuous_paper.manoeuvre.T_m
-    assert cmp.conventional.metrics["omega_peak_rad_s"] == pytest.approx(dth * a / math.e, rel=0.01)
-    assert cmp.fdsmc.metrics["omega_peak_rad_s"] == pytest.approx(cmp.derived.profile.omega_p, rel=0.01)
+    assert cmp.conventional.metrics.omega_peak_rad_s == pytest.approx(dth * a / math.e, rel=0.01)
+    assert cmp.fdsmc.metrics.omega_peak_rad_s == pytest.approx(cmp.derived.profile.omega_p, rel=0.01)
 
 
 def test_fdsmc_inside_2pct_band_by_Tm(continuous_cmp, continuous_paper):
     m = continuous_cmp.fdsmc.metrics
-    assert m["t_2pct_first_s"] <= continuous_paper.manoeuvre.T_m
-    assert abs(m["theta_error_at_Tm_rad"]) < 0.02 * continuous_paper.manoeuvre.theta_dem
+    assert m.t_2pct_first_s <= continuous_paper.manoeuvre.T_m
+    assert abs(m.theta_error_at_Tm_rad) < 0.02 * continuous_paper.manoeuvre.theta_dem
 
 
 def test_saving_rises_with_Tm_towards_bound_and_tracks_eq52(continuous_paper):
@@ -140,8 +140,8 @@ def test_fdsmc_reaches_target_for_unknown_load_inertia(paper_params, J_L_over_J_
     p = _recommended(_with(paper_params, "load", J_L=J_L_over_J_r * paper_params.motor.J_r))
     run = simulate(p, "fdsmc")
     m, tr = run.metrics, run.trace
-    assert m["stable"] and not m["chatter"]
-    assert abs(m["theta_error_at_Tm_rad"]) < 0.02 * abs(p.manoeuvre.theta_dem)
+    assert m.stable and not m.chatter
+    assert abs(m.theta_error_at_Tm_rad) < 0.02 * abs(p.manoeuvre.theta_dem)
     # Γ̂_L tracks Γ_L = J_L·dω/dt + F_v·ω + Γ_Le (eq. 6): median error ≪ 0.1 % of its peak.
     err = np.abs(tr.Gamma_L_hat - tr.Gamma_L)[tr.t > 0.01]
     assert np.median(err) < 1e-3 * np.max(np.abs(tr.Gamma_L))
@@ -151,8 +151,8 @@ def test_fdsmc_rejects_external_load_step(paper_params):
     p = _recommended(_with(paper_params, "load", steps=(LoadStep(0.3, 30.0), LoadStep(0.7, -20.0))))
     run = simulate(p, "fdsmc")
     tr = run.trace
-    assert run.metrics["stable"]
-    assert abs(run.metrics["theta_error_at_Tm_rad"]) < 0.02 * p.manoeuvre.theta_dem
+    assert run.metrics.stable
+    assert abs(run.metrics.theta_error_at_Tm_rad) < 0.02 * p.manoeuvre.theta_dem
     # after each step the observer settles (T_so = 0.2 ms): Γ̂_L − Γ_L small 5 ms later
     for t_step in (0.3, 0.7):
         sel = (tr.t > t_step + 0.005) & (tr.t < t_step + 0.1)
@@ -168,21 +168,21 @@ def test_fdsmc_rejects_external_load_step(paper_params):
 def test_chatter_flagged_for_paper_K_not_for_recommended(mode):
     p = load_preset("paper_12kw_pmsm", [f"controller.f_s={mode}"])
     hot = simulate(p, "fdsmc").metrics
-    assert hot["chatter"]
-    assert hot["copper_total_J"] > 1000.0  # the limit cycle burns kJ in the copper
+    assert hot.chatter
+    assert hot.copper_total_J > 1000.0  # the limit cycle burns kJ in the copper
     cool_p = _recommended(p)
     cmp = compare(cool_p)
-    assert not cmp.fdsmc.metrics["chatter"]
-    assert not cmp.conventional.metrics["chatter"]
-    assert cmp.fdsmc.metrics["copper_total_J"] < 0.1 * hot["copper_total_J"]
+    assert not cmp.fdsmc.metrics.chatter
+    assert not cmp.conventional.metrics.chatter
+    assert cmp.fdsmc.metrics.copper_total_J < 0.1 * hot.copper_total_J
     assert 20.0 < cmp.saving_electrical_pct < 26.0  # ≈ 23 % reported for a chatter-free K
 
 
 def test_paper_K_limit_cycle_matches_reported_amplitude_and_frequency(continuous_cmp):
     """At the paper's K = 1000 the loop limit-cycles: ω_r swings ~2.6 rad/s peak-to-peak at ≈ 400 Hz in the cruise."""
     m = continuous_cmp.fdsmc.metrics
-    assert 2.0 < m["cruise_omega_ptp_rad_s"] < 3.2
-    assert 300.0 < m["chatter_frequency_Hz"] < 500.0
+    assert 2.0 < m.cruise_omega_ptp_rad_s < 3.2
+    assert 300.0 < m.chatter_frequency_Hz < 500.0
 
 
 def test_too_slow_sample_rate_reported_unstable_not_plotted(paper_params):
@@ -192,9 +192,9 @@ def test_too_slow_sample_rate_reported_unstable_not_plotted(paper_params):
     assert cmp.derived.sample_rate is not None and not cmp.derived.sample_rate.stable
     assert any("too slow" in w for w in cmp.derived.warnings)
     for run in (cmp.fdsmc, cmp.conventional):
-        assert run.metrics["stable"] is False
-        assert "too slow" in run.metrics["reason"]
-        assert run.metrics["friction_J"] is None
+        assert run.metrics.stable is False
+        assert "too slow" in run.metrics.reason
+        assert run.metrics.friction_J is None
         assert np.all(np.isfinite(run.trace.omega_r))
     assert cmp.saving_friction_pct is None
 
@@ -213,14 +213,14 @@ def test_negative_demand_is_mirror_image(paper_params):
     p = _recommended(paper_params)
     pos = simulate(p, "fdsmc").metrics
     neg = simulate(_with(p, "manoeuvre", theta_dem=-p.manoeuvre.theta_dem), "fdsmc").metrics
-    assert neg["friction_J"] == pytest.approx(pos["friction_J"], rel=1e-9)
-    assert neg["theta_error_at_Tm_rad"] == pytest.approx(-pos["theta_error_at_Tm_rad"], rel=1e-6, abs=1e-9)
+    assert neg.friction_J == pytest.approx(pos.friction_J, rel=1e-9)
+    assert neg.theta_error_at_Tm_rad == pytest.approx(-pos.theta_error_at_Tm_rad, rel=1e-6, abs=1e-9)
 
 
 def test_one_sample_delay_still_reaches_target(paper_params):
     p = _recommended(_with(paper_params, "controller", delay_samples=1, f_s=20000.0))
     m = simulate(p, "fdsmc").metrics
-    assert m["stable"] and abs(m["theta_error_at_Tm_rad"]) < 0.02 * p.manoeuvre.theta_dem
+    assert m.stable and abs(m.theta_error_at_Tm_rad) < 0.02 * p.manoeuvre.theta_dem
 
 
 def test_inverter_limits_are_respected_and_reported(paper_params):
@@ -230,11 +230,11 @@ def test_inverter_limits_are_respected_and_reported(paper_params):
     cmp = compare(p)
     for run, free in ((cmp.fdsmc, ideal.fdsmc), (cmp.conventional, ideal.conventional)):
         m = run.metrics
-        assert free.metrics["saturated_s"] == 0.0 and m["saturated_s"] > 0.0
-        assert m["u_peak_V"] <= 700.0 / math.sqrt(3.0) * (1 + 1e-9)
-        assert m["i_q_peak_A"] < 106.0  # the limit holds di_q/dt = 0 one sample late at most
-        assert m["energy_balance_residual_pct"] < 0.1
-    assert abs(cmp.fdsmc.metrics["theta_error_at_Tm_rad"]) < 0.02 * p.manoeuvre.theta_dem
+        assert free.metrics.saturated_s == 0.0 and m.saturated_s > 0.0
+        assert m.u_peak_V <= 700.0 / math.sqrt(3.0) * (1 + 1e-9)
+        assert m.i_q_peak_A < 106.0  # the limit holds di_q/dt = 0 one sample late at most
+        assert m.energy_balance_residual_pct < 0.1
+    assert abs(cmp.fdsmc.metrics.theta_error_at_Tm_rad) < 0.02 * p.manoeuvre.theta_dem
 
 
 def test_hysteretic_sign_changes_counts_half_cycles_and_ignores_small_noise():
@@ -254,9 +254,9 @@ def test_chatter_verdict_does_not_depend_on_trace_decimation(paper_params):
     """
     fine = simulate(paper_params, "fdsmc").metrics
     coarse = simulate(paper_params, "fdsmc", max_points=200).metrics
-    assert fine["chatter"] and coarse["chatter"]
-    assert coarse["chatter_frequency_Hz"] == pytest.approx(fine["chatter_frequency_Hz"], rel=1e-12)
-    assert coarse["cruise_omega_ptp_rad_s"] == pytest.approx(fine["cruise_omega_ptp_rad_s"], rel=1e-12)
+    assert fine.chatter and coarse.chatter
+    assert coarse.chatter_frequency_Hz == pytest.approx(fine.chatter_frequency_Hz, rel=1e-12)
+    assert coarse.cruise_omega_ptp_rad_s == pytest.approx(fine.cruise_omega_ptp_rad_s, rel=1e-12)
 
 
 def test_continuous_step_follows_the_fastest_designed_pole(continuous_paper):
@@ -270,8 +270,8 @@ def test_continuous_step_follows_the_fastest_designed_pole(continuous_paper):
     fast = _with(continuous_paper, "controller", T_so=2e-5, K=0.45)
     assert continuous_step(fast) == pytest.approx(5e-7, rel=1e-12)
     m = simulate(fast, "fdsmc").metrics
-    assert m["stable"] and not m["chatter"]
-    assert m["friction_J"] == pytest.approx(derive(fast).energy.W_fdsmc, rel=3e-3)
+    assert m.stable and not m.chatter
+    assert m.friction_J == pytest.approx(derive(fast).energy.W_fdsmc, rel=3e-3)
 
 
 def test_slow_digital_controller_plant_substeps_converged():
@@ -286,9 +286,9 @@ def test_slow_digital_controller_plant_substeps_converged():
     p = load_preset("paper_12kw_pmsm", [*base, f"controller.K={d.gain.K_recommended}"])
     assert plant_substeps(p) == 10
     m1, m2 = simulate(p, "fdsmc").metrics, simulate(p, "fdsmc", n_sub=20).metrics
-    assert m1["stable"] and not m1["chatter"]
-    assert abs(m1["friction_J"] / m2["friction_J"] - 1.0) < 5e-4
-    assert m1["energy_balance_residual_pct"] < 0.1
+    assert m1.stable and not m1.chatter
+    assert abs(m1.friction_J / m2.friction_J - 1.0) < 5e-4
+    assert m1.energy_balance_residual_pct < 0.1
 
 
 def test_divergence_near_the_sample_rate_limit_names_the_K_limit(paper_params):
@@ -299,8 +299,8 @@ def test_divergence_near_the_sample_rate_limit_names_the_K_limit(paper_params):
     d = derive(p)
     assert d.sample_rate.stable and not d.gain.K_ok
     m = simulate(p, "fdsmc", d).metrics
-    assert m["stable"] is False and "K_limit" in m["reason"]
-    assert simulate(_with(p, "controller", K=d.gain.K_recommended), "fdsmc").metrics["stable"]
+    assert m.stable is False and "K_limit" in m.reason
+    assert simulate(_with(p, "controller", K=d.gain.K_recommended), "fdsmc").metrics.stable
 
 
 def test_chatter_window_never_counts_the_unrecorded_horizon_step():

@@ -76,7 +76,7 @@ def test_yaml_and_json_carry_the_same_data_with_units_gains_and_verdicts(motor_c
     v = j["verdicts"]
     assert v["feasible"] is True and any("chatter" in w.lower() for w in v["run_warnings"])  # K = 1000
     assert v["saving_friction_pct"] == pytest.approx(motor_case.saving_friction_pct)
-    assert j["results"]["fdsmc"]["friction_J"] == motor_case.fdsmc.metrics["friction_J"]
+    assert j["results"]["fdsmc"]["friction_J"] == motor_case.fdsmc.metrics.friction_J
     assert j["results"]["conventional"]["stable"] is True
 
 
@@ -140,7 +140,7 @@ def test_html_report_has_metrics_table_and_legible_plots(motor_case):
     table = page[page.index("<h2>Simulated metrics</h2>"):page.index("<h2>Inputs")]
     for label in ("Peak torque", "Peak |u_dq|", "2 % settling time", "Overshoot", "Friction loss", "Stable"):
         assert label in table
-    assert f"{motor_case.fdsmc.metrics['friction_J']:.5g}" in table and "40 (Γ_max)" in table
+    assert f"{motor_case.fdsmc.metrics.friction_J:.5g}" in table and "40 (Γ_max)" in table
     heights = [int(h) for h in re.findall(r'"height":\s*(\d+)', page)]
     assert max(heights) >= 6 * ROW_HEIGHT_PX and ROW_HEIGHT_PX >= 250  # six time plots, ≥ 250 px each
     assert html_report(motor_case) == page  # reproducible bytes (fixed figure ids, no clock)

@@ -115,7 +115,7 @@ def test_time_plots_have_all_signals_of_both_controllers(comparison):
 def test_energy_figures_show_totals_and_saving(comparison):
     bars = make_energy_bars_figure(comparison)
     fdsmc = next(t for t in bars.data if t.name == "FDSMC")
-    assert fdsmc.y[0] == pytest.approx(comparison.fdsmc.metrics["friction_total_J"])
+    assert fdsmc.y[0] == pytest.approx(comparison.fdsmc.metrics.friction_total_J)
     assert f"{comparison.saving_friction_pct:.1f} %" in bars.layout.title.text
     energy = make_energy_figure(comparison)
     assert len(energy.data) == 6

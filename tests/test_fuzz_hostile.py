@@ -23,12 +23,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from app.cli.table1 import parse_tm
 from app.io import units
 from app.io.bldc_emf import read_measured
-from app.io.numbers import NumberFormatError, parse_integer, parse_number
+from app.io.numbers import NumberFormatError, parse_integer, parse_number, parse_T_m_list
 from app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
-from app.ui.results import parse_T_m_list
 from app.ui.text import checked_choice
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive, predicted_energy
@@ -244,9 +242,9 @@ def test_fuzz_emf_uploads(rows, three, edits, sep, header, yaml):
        choice=st.one_of(st.sampled_from(["paper_12kw_pmsm", "bldc_smc_paper", "../../../../tmp/x", ""]),
                         st.text(max_size=20)))
 def test_fuzz_page_inputs(text, choice):
-    for parse, label in ((parse_T_m_list, "Table 1 › T_m list"), (parse_tm, "--tm")):
+    for label in ("Table 1 › T_m list", "--tm"):
         try:
-            values = parse(text)
+            values = parse_T_m_list(text, label)
         except ValueError as exc:
             _names_field_and_allowed(str(exc), label)
         else:

@@ -64,7 +64,7 @@ def test_delay_samples_one_point_zero_simulates():
     p = load_preset("paper_12kw_pmsm", ["controller.delay_samples=1.0", "manoeuvre.T_m=0.5",
                                         "controller.K=0.1"])
     run = engine.simulate(p, "fdsmc")
-    assert run.metrics["stable"] is True
+    assert run.metrics.stable is True
 
 
 @pytest.mark.parametrize(("edit", "needles"), [
@@ -189,8 +189,8 @@ def test_derive_at_exactly_t_m_min_is_answered_not_raised():
 def test_rotor_that_never_moves_has_no_saving():
     p = load_preset("paper_12kw_pmsm", ["controller.K=1e-300", "manoeuvre.T_m=0.5"])
     cmp = engine.compare(p)
-    assert cmp.fdsmc is not None and cmp.fdsmc.metrics["stable"] is True
-    assert cmp.fdsmc.metrics["t_2pct_first_s"] is None  # never reached θ_dem
+    assert cmp.fdsmc is not None and cmp.fdsmc.metrics.stable is True
+    assert cmp.fdsmc.metrics.t_2pct_first_s is None  # never reached θ_dem
     assert cmp.saving_friction_pct is None and cmp.saving_electrical_pct is None
 
 

@@ -36,7 +36,7 @@ def test_ideal_plant_closed_loop_poles_are_closed_form():
     """
     d = derive(_params("load.J_L=0", "load.F_v=0", "controller.f_s=continuous"))
     K = 0.5
-    ev = np.linalg.eigvals(reduce_shift_mode(continuous_loop(d, "cruise", K)))
+    ev = np.linalg.eigvals(reduce_shift_mode(continuous_loop(d.loop, "cruise", K)))
     f = 3.0 / d.params.controller.T_salpha
     expected = np.concatenate([np.roots([1.0, f, f * d.alpha.alpha_max * K]), [-d.observer.q] * 4])
     got = np.sort_complex(ev)
@@ -47,14 +47,14 @@ def test_ideal_plant_closed_loop_poles_are_closed_form():
 
 def test_paper_K_limit_continuous_near_reported_value():
     """The reported chatter bound is K_limit ≈ 0.9 s/rad for J_L = 4·J_r; this linearisation gives ≈ 0.96."""
-    g = recommend_K(derive(_params("controller.f_s=continuous")))
+    g = recommend_K(derive(_params("controller.f_s=continuous")).loop)
     assert 0.85 < g.K_limit < 1.05
     assert g.K_recommended == pytest.approx(g.K_limit / 2.0)
     assert not g.K_ok and g.margin_of_K < 1e-3  # the paper's K = 1000 is far beyond it
 
 
 def test_K_limit_shrinks_with_inertia_ratio():
-    limits = [gain_limit(derive(_params(f"load.J_L={J}", "controller.f_s=continuous")), "cruise", None)
+    limits = [gain_limit(derive(_params(f"load.J_L={J}", "controller.f_s=continuous")).loop, "cruise", None)
               for J in (0.0, 0.12, 0.3)]
     assert limits[0] > 10 * limits[1]  # J_L = 0: model exact, only the inner-loop lag limits K
     assert limits[1] > limits[2]
@@ -63,7 +63,7 @@ def test_K_limit_shrinks_with_inertia_ratio():
 def test_sampled_loop_tends_to_continuous_loop():
     d_c = derive(_params("controller.f_s=continuous"))
     d_f = derive(_params("controller.f_s=1000000"))
-    assert gain_limit(d_f, "cruise", 1e6) == pytest.approx(gain_limit(d_c, "cruise", None), rel=0.03)
+    assert gain_limit(d_f.loop, "cruise", 1e6) == pytest.approx(gain_limit(d_c.loop, "cruise", None), rel=0.03)
 
 
 def test_K_limit_predicts_nonlinear_chatter_onset():
@@ -72,8 +72,8 @@ def test_K_limit_predicts_nonlinear_chatter_onset():
         g = derive(_params(f"controller.f_s={mode}")).gain
         below = simulate(_params(f"controller.f_s={mode}", f"controller.K={0.85 * g.K_limit}"), "fdsmc")
         above = simulate(_params(f"controller.f_s={mode}", f"controller.K={1.15 * g.K_limit}"), "fdsmc")
-        assert not below.metrics["chatter"]
-        assert above.metrics["chatter"]
+        assert not below.metrics.chatter
+        assert above.metrics.chatter
 
 
 def test_sample_rate_limits_with_and_without_delay():
@@ -81,37 +81,37 @@ def test_sample_rate_limits_with_and_without_delay():
     limit with a one-sample computation delay; without delay this discretisation needs ≈ 10.7 kHz.
     """
     d0 = derive(_params())
-    assert 10.0e3 < minimum_sample_rate(d0, 0) < 11.5e3
-    assert 14.0e3 < minimum_sample_rate(d0, 1) < 16.0e3
-    assert not sample_rate_check(derive(_params("controller.f_s=10000"))).stable
-    assert sample_rate_check(d0).stable
-    assert not sample_rate_check(derive(_params("controller.f_s=14000", "controller.delay_samples=1"))).stable
+    assert 10.0e3 < minimum_sample_rate(d0.loop, 0) < 11.5e3
+    assert 14.0e3 < minimum_sample_rate(d0.loop, 1) < 16.0e3
+    assert not sample_rate_check(derive(_params("controller.f_s=10000")).loop).stable
+    assert sample_rate_check(d0.loop).stable
+    assert not sample_rate_check(derive(_params("controller.f_s=14000", "controller.delay_samples=1")).loop).stable
 
 
 def test_sample_rate_check_agrees_with_simulation():
     d = derive(_params())
-    f_min = minimum_sample_rate(d, 0)
+    f_min = minimum_sample_rate(d.loop, 0)
     slow = simulate(_params(f"controller.f_s={0.93 * f_min}", "controller.K=0.3"), "conventional")
     fast = simulate(_params(f"controller.f_s={1.1 * f_min}", "controller.K=0.3"), "conventional")
-    assert slow.metrics["stable"] is False
-    assert fast.metrics["stable"] is True
+    assert slow.metrics.stable is False
+    assert fast.metrics.stable is True
 
 
 def test_faster_observer_needs_faster_sampling():
-    a = minimum_sample_rate(derive(_params("controller.T_so=0.0002")), 0)
-    b = minimum_sample_rate(derive(_params("controller.T_so=0.0004")), 0)
+    a = minimum_sample_rate(derive(_params("controller.T_so=0.0002")).loop, 0)
+    b = minimum_sample_rate(derive(_params("controller.T_so=0.0004")).loop, 0)
     assert b < a
 
 
 def test_stability_measure_sign_convention():
     d = derive(_params())
-    assert stability_measure(d, "conventional", 0.0, 20000.0) < 0.0
-    assert stability_measure(d, "cruise", 1000.0, 20000.0) > 0.0
+    assert stability_measure(d.loop, "conventional", 0.0, 20000.0) < 0.0
+    assert stability_measure(d.loop, "cruise", 1000.0, 20000.0) > 0.0
 
 
 def test_derived_carries_verdicts_and_warning():
     d = derive(_params())
-    assert d.gain is not None and d.sample_rate is not None
+    assert d.gain == recommend_K(d.loop) and d.sample_rate == sample_rate_check(d.loop)  # one construction
     assert any("Recommended K" in w for w in d.warnings)
     ok = derive(dataclasses.replace(d.params, controller=dataclasses.replace(d.params.controller, K=0.3)))
     assert not any("Boundary-layer gain" in w for w in ok.warnings)
@@ -143,10 +143,10 @@ def test_slow_manoeuvre_sloped_segment_needs_larger_T_c():
     assert any("Sloped segment" in w and "controller.T_c ≥" in w for w in d.warnings)
     base = ["manoeuvre.T_m=60", f"controller.K={g.K_recommended}"]
     bad = simulate(_params(*base), "fdsmc").metrics
-    assert bad["chatter"] and bad["chatter_phase"] == "hold"  # limit cycle about θ_dem
+    assert bad.chatter and bad.chatter_phase == "hold"  # limit cycle about θ_dem
     fixed_p = _params(*base, f"controller.T_c={g.T_c_min}")
     assert not any("Sloped segment" in w for w in derive(fixed_p).warnings)
     good = simulate(fixed_p, "fdsmc").metrics
-    assert not good["chatter"]
-    assert good["copper_total_J"] < 1e-2 * bad["copper_total_J"]
-    assert abs(good["theta_error_at_Tm_rad"]) < 0.02 * 60.0
+    assert not good.chatter
+    assert good.copper_total_J < 1e-2 * bad.copper_total_J
+    assert abs(good.theta_error_at_Tm_rad) < 0.02 * 60.0

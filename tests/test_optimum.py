@@ -94,15 +94,15 @@ def _check_tracked(name: str, overrides: list[str]) -> None:
     p = load_preset(name, overrides)
     cmp = compare(p, ("fdsmc", "conventional", "optimum"))
     opt = cmp.optimum.metrics
-    assert opt["stable"] and not opt["chatter"]
+    assert opt.stable and not opt.chatter
     for run in (cmp.fdsmc, cmp.conventional):
-        assert run.metrics["stable"]
-        assert opt["electrical_in_total_J"] <= run.metrics["electrical_in_total_J"]
-        assert opt["copper_total_J"] + opt["friction_total_J"] <= (
-            run.metrics["copper_total_J"] + run.metrics["friction_total_J"])
+        assert run.metrics.stable
+        assert opt.electrical_in_total_J <= run.metrics.electrical_in_total_J
+        assert opt.copper_total_J + opt.friction_total_J <= (
+            run.metrics.copper_total_J + run.metrics.friction_total_J)
     lim = max(torque_limit(p), cmp.derived.feasibility.torque_needed)
-    assert opt["torque_peak_Nm"] <= lim * (1.0 + LIMIT_TOLERANCE)
-    assert abs(opt["theta_error_at_Tm_rad"]) < 0.01 * p.manoeuvre.theta_dem
+    assert opt.torque_peak_Nm <= lim * (1.0 + LIMIT_TOLERANCE)
+    assert abs(opt.theta_error_at_Tm_rad) < 0.01 * p.manoeuvre.theta_dem
 
 
 @pytest.mark.parametrize("name", REAL)
@@ -116,7 +116,7 @@ def test_tracked_optimum_paper_drive_and_energy_achieved():
     p = load_preset("paper_12kw_pmsm", ["manoeuvre.T_m=2.6", "controller.K=0.3"])
     planned = closed_form(move_model(p)).energy_J
     run = compare(p, ("optimum",)).optimum
-    assert run.metrics["electrical_in_total_J"] == pytest.approx(planned, rel=0.02)
+    assert run.metrics.electrical_in_total_J == pytest.approx(planned, rel=0.02)
 
 
 def test_simulate_json_has_optimum_and_gap(capsys):

@@ -11,7 +11,6 @@ from app.io.presets import load_preset
 from app.io.units import kt_nm_per_arms_to_psi_pm, psi_pm_to_ke_vrms_krpm, psi_pm_to_kt_nm_per_arms
 from control.fdsmc.derivations import derive
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, exceeds
-from control.fdsmc.loop_analysis import loop_model
 from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.transient import acceleration_overshoot
 from sim.fdsmc.engine import compare
@@ -26,7 +25,7 @@ def test_no_overshoot_when_the_controller_knows_the_whole_inertia(paper_params):
     # J_L = 0 and F_v = 0: the observer has nothing to learn, the FDC acceleration loop of eq. (13)
     # is first order (3/T_sα) and never overshoots: η = 1 exactly (continuous implementation).
     p = _replace(_replace(paper_params, "load", J_L=0.0, F_v=0.0), "controller", f_s="continuous")
-    assert acceleration_overshoot(loop_model(derive(p)), None) == pytest.approx(1.0, abs=1e-9)
+    assert acceleration_overshoot(derive(p).loop, None) == pytest.approx(1.0, abs=1e-9)
 
 
 def test_overshoot_predicts_the_simulated_start_of_acceleration(paper_params):
@@ -37,11 +36,11 @@ def test_overshoot_predicts_the_simulated_start_of_acceleration(paper_params):
     d = derive(p)
     run = compare(p, derived=d).fdsmc
     inertial = d.alpha.overshoot * d.alpha.alpha_max * p.J_total
-    assert inertial <= run.metrics["torque_peak_Nm"] <= d.feasibility.torque_needed * (1 + LIMIT_TOLERANCE)
+    assert inertial <= run.metrics.torque_peak_Nm <= d.feasibility.torque_needed * (1 + LIMIT_TOLERANCE)
     # without friction the peak is the inertial transient alone: the linear η predicts it within 1 %
     p0 = _replace(p, "load", F_v=0.0)
     d0 = derive(p0)
-    peak0 = compare(p0, derived=d0).fdsmc.metrics["torque_peak_Nm"]
+    peak0 = compare(p0, derived=d0).fdsmc.metrics.torque_peak_Nm
     assert peak0 == pytest.approx(d0.alpha.overshoot * d0.alpha.alpha_max * p.J_total, rel=0.01)
 
 

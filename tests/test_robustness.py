@@ -39,9 +39,9 @@ def test_plant_override_changes_the_drive_not_the_controller():
     nominal, heavy = compare(params), compare(params, plant=plant)
     assert heavy.derived.alpha.alpha_max == nominal.derived.alpha.alpha_max
     f0, f1 = nominal.fdsmc.metrics, heavy.fdsmc.metrics
-    assert f1["torque_peak_Nm"] > 1.1 * f0["torque_peak_Nm"]
-    assert f1["copper_J"] > f0["copper_J"]
-    assert abs(f1["energy_balance_residual_pct"]) < 0.5
+    assert f1.torque_peak_Nm > 1.1 * f0.torque_peak_Nm
+    assert f1.copper_J > f0.copper_J
+    assert abs(f1.energy_balance_residual_pct) < 0.5
 
 
 def test_plant_override_names_a_bad_field():
@@ -82,9 +82,9 @@ def test_zero_spread_reproduces_the_nominal_run_exactly():
     for run in res.runs:
         for ctrl in ("fdsmc", "conventional"):
             m = getattr(nominal, ctrl).metrics
-            assert run[ctrl]["theta_error_abs_at_Tm_rad"] == abs(m["theta_error_at_Tm_rad"])
+            assert run[ctrl]["theta_error_abs_at_Tm_rad"] == abs(m.theta_error_at_Tm_rad)
             for key in set(METRICS) - {"theta_error_abs_at_Tm_rad"}:
-                assert run[ctrl][key] == m[key]
+                assert run[ctrl][key] == getattr(m, key)
     assert res.summary["fdsmc"]["friction_J"]["p05"] == res.summary["fdsmc"]["friction_J"]["p95"]
 
 

@@ -9,8 +9,8 @@ import time
 import pytest
 
 from app.cli.serve import is_loopback
+from app.io.numbers import parse_T_m_list
 from app.ui.inputs import InputError, parse_steps
-from app.ui.results import parse_T_m_list
 from app.ui.text import annual_savings, derived_markdown, warnings_html
 from app.ui.worker import Worker
 from control.fdsmc.derivations import derive
@@ -62,8 +62,8 @@ def test_run_warnings_and_savings(paper_params):
     warnings = run_warnings(c)
     assert any(w.startswith("Chatter (FDSMC)") and "Recommended K" in w for w in warnings)
     s = annual_savings(c, 600.0, 4000.0, 0.25)
-    e_f = c.fdsmc.metrics["electrical_in_total_J"]
-    e_c = c.conventional.metrics["electrical_in_total_J"]
+    e_f = c.fdsmc.metrics.electrical_in_total_J
+    e_c = c.conventional.metrics.electrical_in_total_J
     assert s.per_cycle_J == pytest.approx(e_c - e_f)
     assert s.kWh_per_year == pytest.approx((e_c - e_f) * 600 * 4000 / 3.6e6)
     assert s.money_per_year == pytest.approx(0.25 * s.kWh_per_year)
@@ -75,11 +75,11 @@ def test_parse_steps_and_T_m_list():
     assert parse_steps("  ") == []
     with pytest.raises(InputError, match="allowed 't:Γ_Le' pairs"):
         parse_steps("0.5-10")
-    assert parse_T_m_list("1.0, 1.4;1.8") == [1.0, 1.4, 1.8]
+    assert parse_T_m_list("1.0, 1.4;1.8", "Table 1 › T_m list") == [1.0, 1.4, 1.8]
     with pytest.raises(ValueError, match="allowed 0 < T_m"):
-        parse_T_m_list("1.0, -2")
+        parse_T_m_list("1.0, -2", "Table 1 › T_m list")
     with pytest.raises(ValueError, match="not a number"):
-        parse_T_m_list("1.0, x")
+        parse_T_m_list("1.0, x", "Table 1 › T_m list")
 
 
 def test_loopback_detection():

@@ -24,9 +24,9 @@ def test_paper_case_exceeds_torque_and_voltage_of_the_real_drive(quiet_paper):
     fd = quiet_paper.fdsmc
     msgs = limit_warnings(fd, quiet_paper.derived)
     # the simulated peaks, not the predictions, are quoted
-    assert any(f"{fd.metrics['torque_peak_Nm']:.4g} N·m > Γ_max = 40 N·m" in m for m in msgs)
+    assert any(f"{fd.metrics.torque_peak_Nm:.4g} N·m > Γ_max = 40 N·m" in m for m in msgs)
     u_avail = available_voltage(quiet_paper.derived.params.motor)
-    assert fd.metrics["u_peak_V"] > u_avail
+    assert fd.metrics.u_peak_V > u_avail
     assert any("peak |u_dq|" in m for m in msgs)
     assert not any(m.startswith("Chatter") for m in run_warnings(quiet_paper))
 
@@ -52,7 +52,7 @@ def test_target_missed_is_reported_not_hidden_behind_a_saving(paper_params, quie
     cmp = compare(slow)
     msgs = [w for w in run_warnings(cmp) if "Target missed" in w]
     assert len(msgs) == 1 and "FDSMC" in msgs[0]
-    assert abs(cmp.fdsmc.metrics["theta_error_at_Tm_rad"]) > 0.02 * paper_params.manoeuvre.theta_dem
+    assert abs(cmp.fdsmc.metrics.theta_error_at_Tm_rad) > 0.02 * paper_params.manoeuvre.theta_dem
 
 
 def test_slow_manoeuvre_gets_T_c_advice_that_removes_the_limit_cycle(paper_params):
@@ -70,6 +70,6 @@ def test_slow_manoeuvre_gets_T_c_advice_that_removes_the_limit_cycle(paper_param
     with_k = dataclasses.replace(slow.controller, K=k_rec)
     before = compare(dataclasses.replace(slow, controller=with_k)).fdsmc
     after = compare(dataclasses.replace(slow, controller=dataclasses.replace(with_k, T_c=T_c))).fdsmc
-    assert before.metrics["chatter"] and before.metrics["chatter_phase"] == "hold"
-    assert not after.metrics["chatter"]
-    assert after.metrics["copper_total_J"] < 0.01 * before.metrics["copper_total_J"]
+    assert before.metrics.chatter and before.metrics.chatter_phase == "hold"
+    assert not after.metrics.chatter
+    assert after.metrics.copper_total_J < 0.01 * before.metrics.copper_total_J

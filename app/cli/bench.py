@@ -16,10 +16,8 @@ from app.cli.main import add_preset_arguments
 from app.io.preset_modes import load_mode_preset
 from app.io.presets import load_preset
 from control.fdsmc.derivations import derive
-from sim.fdsmc.engine import CONTINUOUS_STEP_S, compare, run_steps, table1_sweep
+from sim.fdsmc.engine import CONTINUOUS_STEP_S, TABLE1_T_M, compare, run_steps, table1_sweep
 from sim.fdsmc.reference import run_reference
-
-TM_SWEEP = (1.0, 1.4, 1.8, 2.2, 2.6)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -58,13 +56,13 @@ def run(args: argparse.Namespace) -> int:
     print(f"comparison T_m = 2.6 s (+30 % tail), f_s = 20 kHz, derive included ({rep} runs): first call "
           f"{first * 1e3:.0f} ms (cache load), warm {_ms(_medians(rep, compare, p))}   [target ≤ 15 ms CPU]")
     pd = load_preset(args.preset, [*base, "controller.f_s=20000"])
-    table1_sweep(pd, TM_SWEEP[:1])
-    print(f"Table-1 sweep, 5 points, digital 20 kHz: {_ms(_medians(rep, table1_sweep, pd, TM_SWEEP))}   "
+    table1_sweep(pd, TABLE1_T_M[:1])
+    print(f"Table-1 sweep, 5 points, digital 20 kHz: {_ms(_medians(rep, table1_sweep, pd, TABLE1_T_M))}   "
           "[target ≤ 0.5 s]")
     pc = load_preset(args.preset, [*base, "controller.f_s=continuous"])
-    table1_sweep(pc, TM_SWEEP[:1])
+    table1_sweep(pc, TABLE1_T_M[:1])
     print(f"Table-1 sweep, 5 points, continuous (RK4 h = {CONTINUOUS_STEP_S * 1e6:g} µs): "
-          f"{_ms(_medians(rep, table1_sweep, pc, TM_SWEEP))}   [target ≤ 3 s]")
+          f"{_ms(_medians(rep, table1_sweep, pc, TABLE1_T_M))}   [target ≤ 3 s]")
     d = derive(pd)
     n_k, n_r = 200_000, 4_000
     run_steps(pd, "fdsmc", 10, derived=d)

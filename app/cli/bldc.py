@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import time
 
 from app.cli.main import add_preset_arguments
 from app.io.bldc_view import comparison_json, metric_table
 from app.io.preset_modes import load_mode_preset
 from app.io.presets import load_preset
+from app.io.units import Hz_to_kHz, rad_s_to_rpm, s_to_ms
 from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
 from sim.bldc.engine import CONTROLLERS, LABELS, compare_bldc, simulate_bldc
@@ -49,8 +49,8 @@ def bench_figure(params: BldcParams | None = None, repeat: int = 5) -> str:
         simulate_bldc(p)
         walls.append(time.perf_counter() - t0)
     best, t_sim = min(walls), p.case.t_end
-    return (f"bldc: {p.case.name} scenario, {t_sim:g} s at f_s = {p.inverter.f_s / 1e3:g} kHz, "
-            f"paper drive: best {best * 1e3:.1f} ms → {t_sim / best:,.0f}× real time   [goal ≥ 20×]")
+    return (f"bldc: {p.case.name} scenario, {t_sim:g} s at f_s = {Hz_to_kHz(p.inverter.f_s):g} kHz, "
+            f"paper drive: best {s_to_ms(best):.1f} ms → {t_sim / best:,.0f}× real time   [goal ≥ 20×]")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -67,8 +67,8 @@ def run(args: argparse.Namespace) -> int:
         return 0
     case = params.case
     print(f"Preset: {params.name}  ({params.source})")
-    print(f"Scenario {case.name}: ω {case.omega_0 * 60 / (2 * math.pi):g} → "
-          f"{case.omega_ref * 60 / (2 * math.pi):g} rpm over {case.t_end:g} s; machine back-EMF: "
+    print(f"Scenario {case.name}: ω {rad_s_to_rpm(case.omega_0):g} → "
+          f"{rad_s_to_rpm(case.omega_ref):g} rpm over {case.t_end:g} s; machine back-EMF: "
           f"{params.machine.emf}\n")
     rows = metric_table(comp)
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]

@@ -6,8 +6,8 @@ import argparse
 import json
 
 from app.cli.main import add_preset_arguments
-from app.cli.simulate import finite_or_none
 from app.io.derived_view import derived_json, derived_rows, format_table
+from app.io.json_data import to_json
 from app.io.preset_modes import load_mode_preset
 from control.fdsmc.derivations import derive
 
@@ -23,7 +23,7 @@ def run(args: argparse.Namespace) -> int:
     params = load_mode_preset(args.preset, args.overrides, mode="position")
     d = derive(params)
     if args.json:
-        print(json.dumps(finite_or_none(derived_json(d)), indent=2, ensure_ascii=False, allow_nan=False))
+        print(json.dumps(to_json(derived_json(d)), indent=2, ensure_ascii=False, allow_nan=False))
         return 0
     print(f"Preset: {params.name}  ({params.source})\n")
     print(format_table(derived_rows(d)))

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from pathlib import Path
 from typing import Any
 
 from app.cli.main import add_preset_arguments
+from app.io.json_data import to_json
 from app.io.presets import dumps, load_preset, to_raw
 from sim.fdsmc.design import DriveDesign, design_drive
 
@@ -23,10 +23,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("-o", "--output", metavar="FILE", help="write the designed preset (YAML) to FILE")
 
 
-def _finite(x: Any) -> Any:
-    return None if isinstance(x, float) and not math.isfinite(x) else x
-
-
 def design_json(dd: DriveDesign) -> dict[str, Any]:
     """Return the JSON contract of ``design --json``."""
     c, cmp = dd.params.controller, dd.comparison
@@ -34,11 +30,12 @@ def design_json(dd: DriveDesign) -> dict[str, Any]:
     for name in ("fdsmc", "conventional"):
         run = getattr(cmp, name) if cmp is not None else None
         if run is not None:
-            verified[name] = {k: _finite(run.metrics.get(k)) for k in _VERIFIED_KEYS}
+            metrics = to_json(run.metrics)
+            verified[name] = {k: metrics[k] for k in _VERIFIED_KEYS}
             verified[name]["i_peak_A"] = verified[name]["i_q_peak_A"]
-    return {
+    return to_json({
         "clean": dd.clean,
-        "limiting": [{"name": x.name, "value": _finite(x.value), "limit": _finite(x.limit), "unit": x.unit,
+        "limiting": [{"name": x.name, "value": x.value, "limit": x.limit, "unit": x.unit,
                       "violated": x.violated, "text": x.text} for x in dd.limiting],
         "notes": list(dd.notes),
         "comparator_notes": list(dd.comparator),
@@ -46,10 +43,10 @@ def design_json(dd: DriveDesign) -> dict[str, Any]:
                    "T_c": dd.derived.profile.T_c, "T_c_rule": "T_a" if c.T_c == "T_a" else "given",
                    "f_s": c.f_s, "overshoot_eta": dd.derived.alpha.overshoot},
         "verified": verified,
-        "saving_friction_pct": _finite(cmp.saving_friction_pct) if cmp else None,
-        "saving_electrical_pct": _finite(cmp.saving_electrical_pct) if cmp else None,
+        "saving_friction_pct": cmp.saving_friction_pct if cmp else None,
+        "saving_electrical_pct": cmp.saving_electrical_pct if cmp else None,
         "preset": to_raw(dd.params),
-    }
+    })
 
 
 def run(args: argparse.Namespace) -> int:

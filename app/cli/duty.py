@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from app.cli.main import add_preset_arguments
-from app.cli.simulate import finite_or_none
+from app.io.json_data import to_json
 from app.io.numbers import parse_number
 from app.io.presets import load_preset, loads_raw
 from control.common.checks import ParameterError
@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
            "kWh_per_year": {c: (v[0] if v else None) for c, v in year.items()},
            "cost_per_year": {c: (v[1] if v else None) for c, v in year.items()}}
     if args.json:
-        print(json.dumps(finite_or_none(out), indent=2, ensure_ascii=False))
+        print(json.dumps(to_json(out), indent=2, ensure_ascii=False))
         return 0
     print(f"Cycle of {len(res.moves)} moves, {res.cycle_s:.4g} s")
     for c, w in res.cycle_J.items():

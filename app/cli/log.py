@@ -11,8 +11,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from app.cli.simulate import finite_or_none
 from app.io.drive_log import DriveLog, read_log, run_identification
+from app.io.json_data import to_json
 from app.io.presets import DEFAULT_PRESET, load_preset, loads_log_mapping
 from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
                                "overlay": overlay_json(ov)}
         if ident is not None:
             out["identified"] = identified_json(ident)
-        print(json.dumps(finite_or_none(out), indent=2, ensure_ascii=False))
+        print(json.dumps(to_json(out), indent=2, ensure_ascii=False))
     else:
         _print(log, ov, ident)
     return 0

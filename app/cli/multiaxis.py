@@ -14,7 +14,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from app.cli.simulate import finite_or_none
+from app.io.json_data import to_json
 from app.io.presets import load_preset, loads_raw
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
@@ -64,7 +64,7 @@ def multiaxis_json(res: MultiAxisResult) -> dict[str, Any]:
                      "clean": a.common.clean, "K": a.common.params.controller.K})
     own = [x["energy_own_fastest_J"] for x in axes]
     com = [x["energy_common_J"] for x in axes]
-    return finite_or_none({
+    return to_json({
         "T_m_s": res.T_m, "axes": axes,
         "total_energy_common_J": sum(com) if None not in com else None,
         "total_energy_own_fastest_J": sum(own) if None not in own else None,

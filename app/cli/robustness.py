@@ -19,7 +19,7 @@ from multiprocessing import get_context
 from typing import Any
 
 from app.cli.main import add_preset_arguments
-from app.cli.simulate import finite_or_none
+from app.io.json_data import to_json
 from app.io.plant_overrides import load_model_and_plant, plant_section
 from control.common.checks import ParameterError
 from sim.studies.robustness import MAX_NORMAL_SIGMA, METRICS, RobustnessResult, Spread, robustness
@@ -139,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         write_csv(args.csv, res)
     if args.json:
-        print(json.dumps(finite_or_none(res.summary), indent=2, ensure_ascii=False))
+        print(json.dumps(to_json(res.summary), indent=2, ensure_ascii=False))
     else:
         _print_table(res.summary)
     return 0

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
 from app.exports.model import trace_csv
 from app.io.derived_view import derived_json
+from app.io.json_data import to_json
+from app.io.numbers import format_metric
 from app.io.plant_overrides import load_model_and_plant
 from control.common.checks import ParameterError
 from sim.fdsmc.engine import Comparison, RunResult, compare
@@ -49,30 +50,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--csv", metavar="FILE", help="write the time series (CSV: controller column, units in the headers)")
 
 
-def finite_or_none(value: Any) -> Any:
-    """JSON-safe value: non-finite floats become None, containers are converted recursively."""
-    if isinstance(value, dict):
-        return {k: finite_or_none(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [finite_or_none(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-#: Energy compared with the optimum: the net electrical input over the whole simulated horizon.
-OPTIMUM_BASIS = "electrical_in_total_J"
-
-
 def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float | None:
     """Return 100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save.
 
     W is the net electrical input over the whole horizon; None unless both runs are stable.
     """
-    if run is None or optimum is None or not (run.metrics["stable"] and optimum.metrics["stable"]):
+    if run is None or optimum is None or not (run.metrics.stable and optimum.metrics.stable):
         return None
-    w, w_opt = run.metrics[OPTIMUM_BASIS], optimum.metrics[OPTIMUM_BASIS]
-    if not isinstance(w, float) or not isinstance(w_opt, float) or w <= 0.0:
+    w, w_opt = run.metrics.electrical_in_total_J, optimum.metrics.electrical_in_total_J
+    if w is None or w_opt is None or w <= 0.0:
         return None
     return 100.0 * (1.0 - w_opt / w)
 
@@ -86,7 +72,7 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     out: dict[str, Any] = {"derived": derived_json(cmp.derived)}
     for run in (cmp.fdsmc, cmp.conventional, cmp.optimum):
         if run is not None:
-            out[run.controller] = dict(run.metrics)
+            out[run.controller] = to_json(run.metrics)
     if cmp.optimum is not None:
         for run in (cmp.fdsmc, cmp.conventional):
             if run is not None:
@@ -95,7 +81,7 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["run_warnings"] = run_warnings(cmp)
     out["comparator_notes"] = comparator_notes(cmp)
-    return finite_or_none(out)
+    return to_json(out)
 
 
 def write_csv(path: str, cmp: Comparison) -> None:
@@ -107,14 +93,6 @@ def write_csv(path: str, cmp: Comparison) -> None:
         raise ParameterError(f"cannot write --csv {path!r}: {exc.strerror or exc}") from None
 
 
-def _fmt(v: Any) -> str:
-    if v is None:
-        return "—"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    return f"{v:.5g}" if isinstance(v, float) else str(v)
-
-
 def print_summary(cmp: Comparison) -> None:
     """Side-by-side table of the runs, savings, warnings and explanations."""
     runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None]
@@ -124,11 +102,11 @@ def print_summary(cmp: Comparison) -> None:
     print(f"{'':40s}" + "".join(f"{r.controller:>16s}" for r in runs))
     for key, label, unit in SUMMARY:
         head = label + (f" [{unit}]" if unit else "")
-        print(f"{head:40s}" + "".join(f"{_fmt(r.metrics.get(key)):>16s}" for r in runs))
+        print(f"{head:40s}" + "".join(f"{format_metric(getattr(r.metrics, key)):>16s}" for r in runs))
     if cmp.saving_friction_pct is not None:
         e = cmp.derived.energy
         print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
-              f"(eq. (52) predicts {_fmt(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
+              f"(eq. (52) predicts {format_metric(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
         print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
     for run in (cmp.fdsmc, cmp.conventional):
         gap = saving_vs_optimum(run, cmp.optimum)

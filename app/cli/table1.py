@@ -16,13 +16,12 @@ import json
 import sys
 
 from app.cli.main import add_preset_arguments
-from app.cli.simulate import finite_or_none
-from app.io.numbers import NumberFormatError, parse_number
+from app.io.json_data import to_json
+from app.io.numbers import format_metric, parse_T_m_list
 from app.io.preset_modes import load_mode_preset
-from control.common.checks import ParameterError
-from sim.fdsmc.engine import PAPER_TABLE1, Table1Row, table1_sweep
+from sim.fdsmc.engine import PAPER_TABLE1, TABLE1_T_M, Table1Row, table1_sweep
 
-DEFAULT_TM = "1.0,1.4,1.8,2.2,2.6"
+DEFAULT_TM = ",".join(map(str, TABLE1_T_M))
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -31,20 +30,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tm", default=DEFAULT_TM, metavar="T1,T2,…",
                    help=f"comma-separated manoeuvre times in s (default {DEFAULT_TM})")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
-
-
-def parse_tm(text: str) -> list[float]:
-    """Manoeuvre times from ``"1.0,1.4"``; ParameterError naming the bad entry."""
-    out: list[float] = []
-    for item in text.split(","):
-        try:
-            v = parse_number(item, "--tm entry")
-        except NumberFormatError:
-            raise ParameterError(f"--tm entry {item.strip()!r} is not a number: allowed a time > 0 s") from None
-        if not 0.0 < v <= 1e4:
-            raise ParameterError(f"--tm entry {v:g} s is out of range: allowed 0 < T_m ≤ 10000 s")
-        out.append(v)
-    return out
 
 
 def reversed_paper() -> dict[float, float]:
@@ -60,14 +45,10 @@ def row_json(r: Table1Row) -> dict[str, float | None]:
     return out
 
 
-def _fmt(v: float | None) -> str:
-    return "—" if v is None else f"{v:.2f}"
-
-
 def run(args: argparse.Namespace) -> int:
     """Run the sweep and print the table (or JSON)."""
     params = load_mode_preset(args.preset, args.overrides, mode="position")
-    tms = parse_tm(args.tm)
+    tms = parse_T_m_list(args.tm, "--tm")
 
     def progress(done: int, total: int) -> None:
         if not args.json:
@@ -76,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
 
     rows = table1_sweep(params, tms, progress)
     if args.json:
-        print(json.dumps(finite_or_none({"rows": [row_json(r) for r in rows]}), indent=2))
+        print(json.dumps(to_json({"rows": [row_json(r) for r in rows]}), indent=2))
         return 0
     sys.stderr.write("\n")
     print(f"Preset: {params.name}, f_s = {params.controller.f_s}, K = {params.controller.K:g} s/rad\n")
@@ -84,9 +65,9 @@ def run(args: argparse.Namespace) -> int:
           f"{'bound %':>8} {'paper %':>8} {'reversed %':>10}")
     rev = reversed_paper()
     for r in rows:
+        paper, mirrored = format_metric(r.paper_pct, ".2f"), format_metric(rev.get(round(r.T_m, 3)), ".2f")
         print(f"{r.T_m:8.3g} {r.friction_fdsmc_J:12.2f} {r.friction_conventional_J:12.2f} "
-              f"{r.saving_pct:9.2f} {r.saving_eq52_pct:8.2f} {r.bound_pct:8.2f} {_fmt(r.paper_pct):>8} "
-              f"{_fmt(rev.get(round(r.T_m, 3))):>10}")
+              f"{r.saving_pct:9.2f} {r.saving_eq52_pct:8.2f} {r.bound_pct:8.2f} {paper:>8} {mirrored:>10}")
     print("\nSaving = 1 − W_FDSMC/W_conv, friction over [0, T_m]. 'reversed' = the paper's printed "
           "row read right-to-left (see docs/paper_reproduction.md).")
     return 0

@@ -17,6 +17,7 @@ from app.exports.c_module import TOOL
 from app.figures.comparison import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
 from app.figures.energy import make_energy_bars_figure, make_energy_figure
 from app.io.derived_view import derived_rows
+from app.io.numbers import format_metric
 from app.io.presets import to_raw
 from control.fdsmc.model import available_voltage
 from sim.fdsmc.engine import Comparison
@@ -57,14 +58,6 @@ def _limits(cmp: Comparison) -> dict[str, tuple[float, str]]:
     return out
 
 
-def _fmt(v: object) -> str:
-    if v is None:
-        return "—"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    return f"{v:.5g}" if isinstance(v, float) else str(v)
-
-
 def _over(value: object, limit: tuple[float, str] | None) -> bool:
     return isinstance(value, float) and limit is not None and abs(value) > limit[0]
 
@@ -79,12 +72,12 @@ def metrics_table(cmp: Comparison) -> str:
     body = []
     for key, label, unit, lim_key in METRICS:
         lim = limits.get(lim_key) if lim_key else None
-        cells = "".join(f"<td class='{'warn' if _over(r.metrics.get(key), lim) else ''}'>"
-                        f"{_fmt(r.metrics.get(key))}</td>" for r in runs)
+        cells = "".join(f"<td class='{'warn' if _over(getattr(r.metrics, key), lim) else ''}'>"
+                        f"{format_metric(getattr(r.metrics, key))}</td>" for r in runs)
         lim_text = f"{lim[0]:.5g} ({lim[1]})" if lim else ""
         body.append(f"<tr><td>{html.escape(label)}</td><td>{html.escape(unit)}</td>{cells}"
                     f"<td>{html.escape(lim_text)}</td></tr>")
-    saving = f"<p>Friction saving over [0, T_m]: {_fmt(cmp.saving_friction_pct)} %</p>"
+    saving = f"<p>Friction saving over [0, T_m]: {format_metric(cmp.saving_friction_pct)} %</p>"
     return (f"<table><thead><tr><th>metric</th><th>unit</th>{head}<th>limit</th></tr></thead>"
             f"<tbody>{''.join(body)}</tbody></table>{saving}")
 

@@ -28,6 +28,7 @@ import numpy as np
 
 from app.exports.c_module import TOOL, controller_files
 from app.io.derived_view import derived_rows
+from app.io.json_data import to_json
 from app.io.presets import SCHEMA, annotate_units, dumps, to_raw
 from app.io.units import SI_UNITS
 from control.common.checks import ParameterError
@@ -81,19 +82,6 @@ def drive_gains(d: Derived) -> list[Gain]:
     return gains
 
 
-def _finite(value: Any) -> Any:
-    """JSON/YAML-safe data: non-finite floats → None, numpy scalars → Python, recursively."""
-    if isinstance(value, dict):
-        return {str(k): _finite(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_finite(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value
-
-
 def verdicts(cmp: Comparison) -> dict[str, Any]:
     """Feasibility, design warnings, run warnings and savings of one case."""
     d = cmp.derived
@@ -110,9 +98,9 @@ def parameter_data(cmp: Comparison) -> dict[str, Any]:
     raw["units"] = {sec: dict(SI_UNITS[sec]) for sec in ("motor", "load", "controller", "manoeuvre")}
     raw["drive_gains"] = {g.name: {"value": g.value, "unit": g.unit, "ref": g.ref} for g in drive_gains(cmp.derived)}
     raw["verdicts"] = verdicts(cmp)
-    raw["results"] = {r.controller: dict(r.metrics) for r in (cmp.fdsmc, cmp.conventional) if r is not None}
+    raw["results"] = {r.controller: to_json(r.metrics) for r in (cmp.fdsmc, cmp.conventional) if r is not None}
     raw["exported_by"] = TOOL
-    return _finite(raw)
+    return to_json(raw)
 
 
 def parameter_yaml(cmp: Comparison) -> str:

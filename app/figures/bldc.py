@@ -14,12 +14,12 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from app.io.units import rad_s_to_rpm
 from control.bldc.design import BldcDesign
 from control.bldc.dqx import dqx_coefficients, ideal_coefficients
 from sim.bldc import emf as bldc_emf
 from sim.bldc.engine import LABELS, BldcComparison
 
-RPM = 60.0 / (2.0 * math.pi)
 MAX_POINTS = 3000
 COLORS = {"smc_integral": "#1f77b4", "smc_plain": "#ff7f0e", "pi_sinusoidal": "#2ca02c", "six_step": "#9467bd"}
 PHASE_COLORS = ("#d62728", "#2ca02c", "#1f77b4")
@@ -71,11 +71,11 @@ def make_speed_figure(comp: BldcComparison) -> go.Figure:
     fig = make_subplots(rows=2, cols=1, shared_xaxes=True, row_heights=[0.72, 0.28], vertical_spacing=0.06)
     tr0 = comp.runs[0].trace
     k = _stride(tr0.t.size)
-    fig.add_scatter(x=tr0.t[::k], y=tr0.omega_ref[::k] * RPM, name="ω*", line={"dash": "dot", "color": "#000"},
+    fig.add_scatter(x=tr0.t[::k], y=rad_s_to_rpm(tr0.omega_ref[::k]), name="ω*", line={"dash": "dot", "color": "#000"},
                     row=1, col=1)
     for r in comp.runs:
         tr = r.trace
-        fig.add_scatter(x=tr.t[::k], y=tr.omega[::k] * RPM, name=LABELS[r.controller],
+        fig.add_scatter(x=tr.t[::k], y=rad_s_to_rpm(tr.omega[::k]), name=LABELS[r.controller],
                         line={"color": COLORS[r.controller]}, row=1, col=1)
     fig.add_scatter(x=tr0.t[::k], y=tr0.T_L[::k], name="T_L", line={"color": "#8c564b", "shape": "hv"},
                     row=2, col=1)
@@ -139,11 +139,11 @@ def make_reachability_figure(design: BldcDesign) -> go.Figure:
     fig = go.Figure()
     bound = np.where(np.isfinite(rc.bound), rc.bound, np.nan)
     top = max(5.0 * float(np.max(rc.lam)), 1.0)
-    fig.add_scatter(x=rc.eps * RPM, y=np.clip(bound, -top, top), name="hyperbola, eq. (24)",
+    fig.add_scatter(x=rad_s_to_rpm(rc.eps), y=np.clip(bound, -top, top), name="hyperbola, eq. (24)",
                     line={"color": "#d62728"}, connectgaps=False)
-    fig.add_scatter(x=rc.eps * RPM, y=rc.lam, name="λ(ε) = λ₀/(1 + (ε/ε_λ)²)", line={"color": "#1f77b4"})
+    fig.add_scatter(x=rad_s_to_rpm(rc.eps), y=rc.lam, name="λ(ε) = λ₀/(1 + (ε/ε_λ)²)", line={"color": "#1f77b4"})
     for a, b in rc.violated:
-        fig.add_vrect(x0=a * RPM, x1=b * RPM, fillcolor="red", opacity=0.15, line_width=0)
+        fig.add_vrect(x0=rad_s_to_rpm(a), x1=rad_s_to_rpm(b), fillcolor="red", opacity=0.15, line_width=0)
     fig.update_xaxes(title="ε_ω [rpm]")
     fig.update_yaxes(title="λ [1/s]", range=[0.0, top])
     verdict = "inside everywhere" if rc.ok else "VIOLATED (red bands)"

@@ -17,6 +17,7 @@ import plotly.graph_objects as go
 
 from app.figures.plain import to_figure
 from control.fdsmc.sliding_mode import boundary_speed
+from sim.fdsmc.engine import LABELS, Comparison, RunResult
 
 #: Most points drawn per trace.
 MAX_POINTS = 2000
@@ -24,7 +25,6 @@ MAX_POINTS = 2000
 MAX_POINTS_TIME = 800
 #: Line colours per controller.
 COLOURS = {"fdsmc": "#1f6fd1", "conventional": "#e8590c"}
-LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional"}
 BOUNDARY_COLOUR = "#2b2b2b"
 BAND_COLOUR = "rgba(120, 120, 120, 0.18)"
 _MARGIN = {"l": 60, "r": 16, "t": 40, "b": 44}
@@ -57,7 +57,7 @@ def f32(a: np.ndarray) -> np.ndarray:
     return np.asarray(a, dtype=np.float32)
 
 
-def runs(comparison: Any) -> list[tuple[str, Any]]:
+def runs(comparison: Comparison) -> list[tuple[str, RunResult]]:
     """``(key, RunResult)`` of the controllers present in a comparison, FDSMC first."""
     return [
         (key, getattr(comparison, key)) for key in ("fdsmc", "conventional")
@@ -65,7 +65,7 @@ def runs(comparison: Any) -> list[tuple[str, Any]]:
     ]
 
 
-def phase_plane_extent(comparison: Any) -> tuple[float, float]:
+def phase_plane_extent(comparison: Comparison) -> tuple[float, float]:
     """θ_re range [rad] covering the manoeuvre and the trajectories, with a margin."""
     d = comparison.derived
     dth = d.params.manoeuvre.theta_dem
@@ -77,7 +77,7 @@ def phase_plane_extent(comparison: Any) -> tuple[float, float]:
     return lo - pad, hi + pad
 
 
-def boundary_xy(comparison: Any, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
+def boundary_xy(comparison: Comparison, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
     """Return the switching boundary of eq. (41) in [1] over the phase-plane extent: (θ_re [rad], ω_r [rad/s])."""
     lo, hi = phase_plane_extent(comparison)
     prof = comparison.derived.profile
@@ -86,7 +86,7 @@ def boundary_xy(comparison: Any, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
     return x, boundary_speed(x, prof.omega_p, prof.T_c)
 
 
-def _phase_static_traces(comparison: Any) -> list[dict[str, Any]]:
+def _phase_static_traces(comparison: Comparison) -> list[dict[str, Any]]:
     x, y = boundary_xy(comparison)
     half = 1.0 / comparison.derived.params.controller.K
     return [
@@ -98,7 +98,7 @@ def _phase_static_traces(comparison: Any) -> list[dict[str, Any]]:
     ]
 
 
-def layer_entry_index(comparison: Any, run: Any) -> int | None:
+def layer_entry_index(comparison: Comparison, run: RunResult) -> int | None:
     """First sample inside the boundary layer |ω_r − ω_b(θ_re)| ≤ 1/K, eqs. (41), (45) in [1]; None if never.
 
     Before it the drive is *reaching* the switching boundary, from it on it is *sliding* along it.
@@ -110,12 +110,12 @@ def layer_entry_index(comparison: Any, run: Any) -> int | None:
     return int(inside[0]) if inside.size else None
 
 
-def load_step_times(comparison: Any) -> list[float]:
+def load_step_times(comparison: Comparison) -> list[float]:
     """Return the times [s] of the external load-torque steps of the manoeuvre."""
     return [float(s.t) for s in comparison.derived.params.load.steps]
 
 
-def _phase_marks(comparison: Any, key: str, run: Any) -> list[dict[str, Any]]:
+def _phase_marks(comparison: Comparison, key: str, run: RunResult) -> list[dict[str, Any]]:
     """Boundary-layer entry and load-step markers of one trajectory."""
     tr, th = run.trace, comparison.derived.params.manoeuvre.theta_dem
     out = []
@@ -138,7 +138,7 @@ def _phase_marks(comparison: Any, key: str, run: Any) -> list[dict[str, Any]]:
     return out
 
 
-def phase_plane_spec(comparison: Any) -> dict[str, Any]:
+def phase_plane_spec(comparison: Comparison) -> dict[str, Any]:
     """Phase plane θ_re–ω_r as a plain-dict figure (see :func:`make_phase_plane_figure`)."""
     d = comparison.derived
     data = _phase_static_traces(comparison)
@@ -168,7 +168,7 @@ def phase_plane_spec(comparison: Any) -> dict[str, Any]:
     }}
 
 
-def make_phase_plane_figure(comparison: Any) -> go.Figure:
+def make_phase_plane_figure(comparison: Comparison) -> go.Figure:
     """Phase plane θ_re–ω_r: boundary (41), band ±1/K (45), both trajectories and their markers.
 
     Per controller, in this order: the whole trajectory (``"<name> trajectory"``), the
@@ -200,7 +200,7 @@ TIME_ROWS: tuple[tuple[str, str, tuple[tuple[str, str, str], ...]], ...] = (
 )
 
 
-def _references(comparison: Any, t_end: float) -> list[dict[str, Any]]:
+def _references(comparison: Comparison, t_end: float) -> list[dict[str, Any]]:
     d = comparison.derived
     th, wp = d.params.manoeuvre.theta_dem, d.profile.omega_p
     grey = {"color": "#555", "width": 1.5, "dash": "dash"}
@@ -229,7 +229,7 @@ def _time_axes(n_rows: int, spacing: float = 0.025) -> tuple[dict[str, Any], lis
     return layout, notes
 
 
-def time_plots_spec(comparison: Any, rows: tuple[int, ...] | None = None,
+def time_plots_spec(comparison: Comparison, rows: tuple[int, ...] | None = None,
                     n_max: int = MAX_POINTS_TIME) -> dict[str, Any]:
     """Time plots as a plain-dict figure (see :func:`make_time_plots_figure`); ``rows`` picks rows of TIME_ROWS."""
     rows = tuple(range(len(TIME_ROWS))) if rows is None else rows
@@ -263,7 +263,7 @@ def time_plots_spec(comparison: Any, rows: tuple[int, ...] | None = None,
         "legend": {"orientation": "h", "y": -0.04, "x": 0.0}, "font": {"size": 11}}}
 
 
-def make_time_plots_figure(comparison: Any) -> go.Figure:
+def make_time_plots_figure(comparison: Comparison) -> go.Figure:
     """Time plots of both controllers: θ_r/θ_dem, ω_r/ω_p, i_d/i_q, u_d/u_q, α/α_dem, Γ_L/Γ̂_L.
 
     Dotted vertical lines (``layout.shapes``) mark the load steps.

@@ -10,7 +10,8 @@ from typing import Any
 
 import plotly.graph_objects as go
 
-from app.figures.comparison import COLOURS, LABELS, MAX_POINTS_TIME, f32, runs, stride_index, time_axis
+from app.figures.comparison import COLOURS, MAX_POINTS_TIME, f32, runs, stride_index, time_axis
+from sim.fdsmc.engine import LABELS, Comparison, RunResult, Table1Row
 
 #: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
 ENERGIES = (
@@ -32,7 +33,7 @@ def _layout(fid: str, title: str, legend_y: float, **layout: Any) -> dict[str, A
             **layout}
 
 
-def energy_spec(comparison: Any) -> dict[str, Any]:
+def energy_spec(comparison: Comparison) -> dict[str, Any]:
     """Cumulative energies as a plain-dict figure (see :func:`make_energy_figure`)."""
     data = []
     for key, run in runs(comparison):
@@ -48,7 +49,7 @@ def energy_spec(comparison: Any) -> dict[str, Any]:
                                             yaxis={"title": {"text": "energy [J]"}})}
 
 
-def energy_bars_spec(comparison: Any) -> dict[str, Any]:
+def energy_bars_spec(comparison: Comparison) -> dict[str, Any]:
     """Energy totals as a plain-dict figure (see :func:`make_energy_bars_figure`)."""
     kinds = [label for _, _, label, _ in ENERGIES]
     data = []
@@ -62,7 +63,7 @@ def energy_bars_spec(comparison: Any) -> dict[str, Any]:
                                             yaxis={"title": {"text": "energy [J]"}})}
 
 
-def make_energy_figure(comparison: Any) -> go.Figure:
+def make_energy_figure(comparison: Comparison) -> go.Figure:
     """Cumulative friction, copper and electrical input energy [J] vs time for both controllers.
 
     Parameters
@@ -76,19 +77,21 @@ def make_energy_figure(comparison: Any) -> go.Figure:
     return go.Figure(energy_spec(comparison))
 
 
-def energy_total(run: Any, attr: str, metric: str) -> float:
-    """Total of one energy kind over the horizon [J]: the metric if given, else the trace's end."""
-    value = run.metrics.get(metric)
-    if isinstance(value, int | float) and not isinstance(value, bool):
-        return float(value)
-    return float(getattr(run.trace, attr)[-1])
+def energy_total(run: RunResult, attr: str, metric: str) -> float:
+    """Return the total of one energy kind over the horizon [J].
+
+    That is the metric ``metric`` (a :class:`~sim.fdsmc.metrics.RunMetrics` field) if the run has
+    it, else the end of the trace's channel ``attr``.
+    """
+    value = getattr(run.metrics, metric)
+    return float(getattr(run.trace, attr)[-1]) if value is None else float(value)
 
 
 def _pct(value: float | None) -> str:
     return "–" if value is None else f"{value:.1f} %"
 
 
-def make_energy_bars_figure(comparison: Any) -> go.Figure:
+def make_energy_bars_figure(comparison: Comparison) -> go.Figure:
     """Bar chart of the energy totals [J] per controller, titled with the savings [%].
 
     Parameters
@@ -103,7 +106,7 @@ def make_energy_bars_figure(comparison: Any) -> go.Figure:
     return go.Figure(energy_bars_spec(comparison))
 
 
-def make_table1_figure(rows: Sequence[Any], paper: Mapping[float, float] | None = None) -> go.Figure:
+def make_table1_figure(rows: Sequence[Table1Row], paper: Mapping[float, float] | None = None) -> go.Figure:
     """Friction saving [%] vs manoeuvre time T_m [s]: simulation, eq. (52), bound (53), paper's Table 1.
 
     Parameters

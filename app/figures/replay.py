@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from app.figures.comparison import runs
+from sim.fdsmc.engine import Comparison
 
 #: Replay speeds: button label → simulated seconds per wall-clock second.
 SPEEDS = {"1×": 1.0, "0.25×": 0.25, "0.1×": 0.1, "0.01×": 0.01}
@@ -25,7 +26,7 @@ FRAME_RATE, MAX_FRAMES = 30.0, 600
 SLIDER_STEPS = 100
 
 
-def _frames_json(comparison: Any, now: list[int], t_grid: np.ndarray) -> str:
+def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray) -> str:
     """JSON list of frames: per time of ``t_grid`` [s] the x/y of each "now" marker (and a time label).
 
     Written as text directly: a few thousand small frames are ~10× faster this way than as dicts.
@@ -51,7 +52,7 @@ def _n_frames(t_end: float, speed: float) -> int:
     return int(min(MAX_FRAMES, max(2, math.ceil(t_end / speed * FRAME_RATE) + 1)))
 
 
-def replay_layout(comparison: Any, trace_names: list[str]) -> tuple[dict[str, Any], dict[str, str]]:
+def replay_layout(comparison: Comparison, trace_names: list[str]) -> tuple[dict[str, Any], dict[str, str]]:
     """Layout entries (``updatemenus``, ``sliders``) that replay ``comparison`` in the browser.
 
     Parameters

@@ -5,13 +5,16 @@ Shared by the page's BLDC tab and ``python -m app bldc``.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
+from app.io.json_data import to_json
+from app.io.numbers import format_metric
+from app.io.units import rad_s_to_rpm
 from control.bldc.design import BldcDesign
 from sim.bldc.engine import LABELS, BldcComparison
+from sim.bldc.metrics import BldcMetrics
 
-#: (metric key, label, unit, format) of the side-by-side table, in reading order.
+#: (JSON key, label, unit, format) of the side-by-side table, in reading order.
 METRIC_ROWS: tuple[tuple[str, str, str, str], ...] = (
     ("speed_error_ss_rpm", "Steady-state speed error", "rpm", ".3f"),
     ("overshoot_rpm", "Overshoot", "rpm", ".2f"),
@@ -27,30 +30,28 @@ METRIC_ROWS: tuple[tuple[str, str, str, str], ...] = (
 )
 
 
-def format_value(value: Any, fmt: str) -> str:
-    """Format a metric as text ('—' for None / not finite)."""
-    if isinstance(value, bool) or value is None:
-        return "—" if value is None else str(value)
-    if isinstance(value, float) and not math.isfinite(value):
-        return "—"
-    return format(value, fmt)
+#: Speed scale of the rpm keys [rpm per rad/s].
+RPM_PER_RAD_S = rad_s_to_rpm(1.0)
+
+
+def _rpm(omega: float | None) -> float | None:
+    return None if omega is None else omega * RPM_PER_RAD_S
+
+
+def metrics_json(m: BldcMetrics) -> dict[str, Any]:
+    """One run's metrics as JSON data: the dataclass fields, the two speeds in rpm."""
+    rpm_keys = {"speed_error_ss_rad_s": "speed_error_ss_rpm", "overshoot_rad_s": "overshoot_rpm"}
+    return {rpm_keys.get(k, k): _rpm(v) if k in rpm_keys else v for k, v in to_json(m).items()}
 
 
 def metric_table(comp: BldcComparison) -> list[list[str]]:
     """Header + one row per metric, one column per controller (text cells)."""
     head = ["metric", "unit"] + [r.controller for r in comp.runs]
     rows = [head]
+    values = [metrics_json(r.metrics) for r in comp.runs]
     for key, label, unit, fmt in METRIC_ROWS:
-        rows.append([label, unit] + [format_value(r.metrics.get(key), fmt) for r in comp.runs])
+        rows.append([label, unit] + [format_metric(v[key], fmt) for v in values])
     return rows
-
-
-def _plain(value: Any) -> Any:
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
-    return value
 
 
 def design_json(d: BldcDesign) -> dict[str, Any]:
@@ -75,8 +76,7 @@ def comparison_json(comp: BldcComparison) -> dict[str, Any]:
         "scenario": {"name": case.name, "omega_0_rad_s": case.omega_0, "omega_ref_rad_s": case.omega_ref,
                      "t_end_s": case.t_end, "emf": comp.params.machine.emf},
         "design": design_json(comp.design),
-        "controllers": {r.controller: {"label": LABELS[r.controller],
-                                       **{k: _plain(v) for k, v in r.metrics.items()}}
+        "controllers": {r.controller: {"label": LABELS[r.controller], **metrics_json(r.metrics)}
                         for r in comp.runs},
         "warnings": list(comp.design.warnings),
     }

@@ -5,10 +5,10 @@ Shared by the CLI (``derive``), the web UI's derived-values panel and the parame
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
+from app.io.json_data import to_json
 from control.fdsmc.derivations import Derived
 
 
@@ -65,15 +65,12 @@ def derived_rows(d: Derived) -> list[Row]:
 
 def _loop_rows(d: Derived) -> list[Row]:
     """Recommended K and sample-rate verdict of :mod:`control.fdsmc.loop_analysis`."""
-    rows: list[Row] = []
-    if d.gain is not None:
-        g = d.gain
-        rows += [
-            Row(f"K stability limit, linearised loop ({g.mode})", "K_limit", g.K_limit, "s/rad", "loop analysis"),
-            Row(f"Recommended K (gain margin {g.margin:g})", "K_rec", g.K_recommended, "s/rad", "loop analysis"),
-        ]
-    if d.sample_rate is not None and d.sample_rate.f_s is not None:
-        s = d.sample_rate
+    g, s = d.gain, d.sample_rate
+    rows = [
+        Row(f"K stability limit, linearised loop ({g.mode})", "K_limit", g.K_limit, "s/rad", "loop analysis"),
+        Row(f"Recommended K (gain margin {g.margin:g})", "K_rec", g.K_recommended, "s/rad", "loop analysis"),
+    ]
+    if s.f_s is not None:
         rows += [
             Row("Spectral radius, sampled inner loops", "ρ", s.spectral_radius, "-", "loop analysis"),
             Row("Slowest stable sample rate", "f_s,min", s.f_s_min, "Hz", "loop analysis"),
@@ -103,17 +100,12 @@ def derived_json(d: Derived) -> dict[str, Any]:
         "W_min_J": e.W_min,
         "saving_predicted_pct": e.saving_pct,
         "saving_bound_pct": e.bound_pct,
-        "feasibility": {
-            k: getattr(d.feasibility, k) for k in d.feasibility.__dataclass_fields__
-        },
+        "feasibility": to_json(d.feasibility),
         "warnings": list(d.warnings),
+        # a K limit that does not exist (the loop is never or always unstable) becomes null
+        "loop": to_json(d.gain),
+        "sample_rate": to_json(d.sample_rate),
     }
-    if d.gain is not None:
-        loop = {k: getattr(d.gain, k) for k in d.gain.__dataclass_fields__}
-        # JSON has no NaN/inf: a limit that does not exist (never/always unstable) becomes null
-        out["loop"] = {k: None if isinstance(x, float) and not math.isfinite(x) else x for k, x in loop.items()}
-    if d.sample_rate is not None:
-        out["sample_rate"] = {k: getattr(d.sample_rate, k) for k in d.sample_rate.__dataclass_fields__}
     if d.observer_discrete is not None:
         od = d.observer_discrete
         out["observer_discrete"] = {

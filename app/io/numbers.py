@@ -61,6 +61,52 @@ def parse_integer(text: str, field: str) -> int:
     return int(value)
 
 
+#: Longest list of manoeuvre times one sweep takes [-].
+T_M_LIST_MAX = 40
+
+
+def parse_T_m_list(text: str, field: str) -> list[float]:
+    """Manoeuvre times [s] from ``"1.0, 1.4; 1.8"`` (commas or semicolons; empty items skipped).
+
+    Parameters
+    ----------
+    text : str   What the user typed.
+    field : str  Field name shown in the message, e.g. ``"--tm"``.
+
+    Raises
+    ------
+    NumberFormatError
+        Naming ``field``, the bad item and the allowed form: every time 0 < T_m ≤ 10000 s,
+        1 … :data:`T_M_LIST_MAX` of them.
+    """
+    values: list[float] = []
+    for item in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):
+        try:
+            value = parse_number(item, field)
+        except NumberFormatError:
+            raise NumberFormatError(f"{field}: {item!r} is not a number: allowed a comma-separated "
+                                    "list of times > 0 s, e.g. 1.0, 1.4, 1.8") from None
+        if not 0.0 < value <= 1e4:
+            raise NumberFormatError(f"{field}: {value:g} s is out of range: allowed 0 < T_m ≤ 10000 s")
+        values.append(value)
+    if not 1 <= len(values) <= T_M_LIST_MAX:
+        raise NumberFormatError(f"{field} has {len(values)} values: allowed 1 … {T_M_LIST_MAX}")
+    return values
+
+
+def format_metric(value: float | int | bool | str | None, fmt: str = ".5g") -> str:
+    """Format a result cell as text.
+
+    "—" for None or a non-finite number, "yes"/"no" for a flag, a float in ``fmt``, anything else
+    as it is.
+    """
+    if value is None or isinstance(value, float) and not math.isfinite(value):
+        return "—"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    return format(value, fmt) if isinstance(value, float) else str(value)
+
+
 def format_number(value: float) -> str:
     """Shortest text that parses back to exactly ``value`` (``repr`` of the double)."""
     if isinstance(value, int) or float(value).is_integer() and abs(value) < 1e16:
@@ -68,4 +114,5 @@ def format_number(value: float) -> str:
     return repr(float(value))
 
 
-__all__ = ["FORMS", "NumberFormatError", "format_number", "parse_integer", "parse_number"]
+__all__ = ["FORMS", "T_M_LIST_MAX", "NumberFormatError", "format_metric", "format_number", "parse_T_m_list",
+           "parse_integer", "parse_number"]

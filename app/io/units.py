@@ -236,6 +236,17 @@ def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
     return psi_pm * p * rpm_to_rad_s(1000.0) / math.sqrt(2.0 / 3.0)
 
 
+def H_to_mH(L: float) -> float:
+    """Inductance [H] → [mH] (display): inverse of :func:`mH_to_H`."""
+    return L * (1.0 / mH_to_H(1.0))
+
+
+def Hz_to_kHz(f: float) -> float:
+    """Frequency [Hz] → [kHz] (display): inverse of :func:`kHz_to_Hz`."""
+    return f * (1.0 / kHz_to_Hz(1.0))
+
+
+
 
 
 def _unit_text(cls: type, name: str) -> str:

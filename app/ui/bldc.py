@@ -27,8 +27,9 @@ from app.io.bldc_emf import read_measured, with_measured
 from app.io.bldc_view import metric_table
 from app.io.numbers import NumberFormatError
 from app.io.preset_modes import load_mode_preset
-from app.io.presets import annotate_units, dumps_preset, loads_preset
-from app.io.units import from_si, shown_range, spec_of, to_si
+from app.io.presets import annotate_units, dumps_preset
+from app.io.units import from_si, s_to_ms, shown_range, spec_of, to_si
+from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice, md_text
 from app.ui.worker import Cancelled, Worker
@@ -216,7 +217,7 @@ class BldcTab:
         self.metrics.content = metrics_markdown(comp)
         sim_s = params.case.t_end * len(comp.runs)
         self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**, "
-                               f"{sim_s:g} s simulated in {comp.wall_s * 1e3:.0f} ms.")
+                               f"{sim_s:g} s simulated in {s_to_ms(comp.wall_s):.0f} ms.")
 
     def _cancel(self) -> None:
         if self._worker is not None and self._worker.cancel():
@@ -258,12 +259,8 @@ class BldcTab:
     def _uploaded(self, _: viser.GuiEvent) -> None:
         f = self.upload.value
         try:
-            text = f.content.decode("utf-8")
-            measured = read_measured(text, f.name)
+            measured = read_measured(upload_text(f.name, f.content, "CSV or YAML"), f.name)
             self.params = with_measured(self.params, measured)
-        except UnicodeDecodeError:
-            self.status.content = f"**Upload rejected:** {md_text(f.name)} is not UTF-8 text: allowed CSV or YAML"
-            return
         except (ParameterError, ValueError) as exc:
             self.status.content = f"**Upload rejected — nothing changed:** {md_text(exc)}"
             return
@@ -277,16 +274,9 @@ class BldcTab:
     def _imported(self) -> None:
         f = self.import_preset.value
         try:
-            params = loads_preset(f.content.decode("utf-8"), f.name)
-        except UnicodeDecodeError:
-            self.status.content = f"**Import rejected — nothing changed:** {md_text(f.name)} is not UTF-8 text"
-            return
+            params = parse_upload(f.name, f.content, BldcParams)
         except (ParameterError, ValueError) as exc:
             self.status.content = f"**Import rejected — nothing changed:** {md_text(exc)}"
-            return
-        if not isinstance(params, BldcParams):
-            self.status.content = (f"**Import rejected — nothing changed:** {md_text(f.name)} is a position-drive "
-                                   "preset: import it in the *Position drive (FDSMC)* tab")
             return
         self.apply(params)
         self.status.content = (f"Imported **{md_text(params.name)}** ({md_text(f.name)}) — press "

@@ -19,6 +19,7 @@ import viser
 
 from app.exports.model import export_download, safe_stem
 from app.io.presets import MAX_BYTES, PresetError, loads_preset, to_raw
+from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import Comparison
@@ -55,17 +56,35 @@ def uncommitted(shown: DriveParams, committed: DriveParams) -> list[str]:
     return [f"{k} = {a[k]!r} (simulated: {b.get(k)!r})" for k in a if a[k] != b.get(k)]
 
 
-def parse_upload(name: str, content: bytes) -> DriveParams:
-    """Validate an uploaded preset file; PresetError/ParameterError with a clear message if bad."""
+#: Each mode's presets as an import message names them, and the tab that imports them.
+PRESET_KINDS: dict[type, tuple[str, str]] = {DriveParams: ("position-drive preset", "Position drive (FDSMC)"),
+                                             BldcParams: ("BLDC speed-drive preset", "BLDC speed SMC")}
+
+
+def upload_text(name: str, content: bytes, allowed: str) -> str:
+    """Return the text of an uploaded file.
+
+    Raises PresetError naming the file if it is over MAX_BYTES or not UTF-8 (``allowed`` says what
+    the upload takes, e.g. "a YAML or JSON preset file").
+    """
     if len(content) > MAX_BYTES:
         raise PresetError(f"{name} is too large ({len(content) // 1024} KiB): allowed ≤ {MAX_BYTES // 1024} KiB")
     try:
-        text = content.decode("utf-8")
+        return content.decode("utf-8")
     except UnicodeDecodeError:
-        raise PresetError(f"{name} is not UTF-8 text: allowed a YAML or JSON preset file") from None
-    params = loads_preset(text, name or "<upload>")
-    if not isinstance(params, DriveParams):
-        raise PresetError(f"{name} is a preset for another mode: allowed a position-drive (FDSMC) preset")
+        raise PresetError(f"{name} is not UTF-8 text: allowed {allowed}") from None
+
+
+def parse_upload(name: str, content: bytes, mode: type = DriveParams) -> Any:
+    """Validate an uploaded preset file of ``mode`` (DriveParams or BldcParams).
+
+    Raises PresetError or ParameterError with a clear message if it is bad, or if it is the other
+    mode's preset.
+    """
+    params = loads_preset(upload_text(name, content, "a YAML or JSON preset file"), name or "<upload>")
+    if not isinstance(params, mode):
+        kind, tab = PRESET_KINDS[type(params)]
+        raise PresetError(f"{name} is a {kind}: allowed a {PRESET_KINDS[mode][0]}; import it in the {tab} tab")
     return params
 
 

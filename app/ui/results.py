@@ -14,32 +14,14 @@ import viser
 
 from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.figures.plain import figure_json
-from app.io.numbers import NumberFormatError, parse_number
+from app.io.numbers import parse_T_m_list
 from app.ui.replay import Replay, set_figure_json
 from app.ui.scene import RotorScene
 from app.ui.text import annual_savings, savings_markdown
+from sim.fdsmc.engine import TABLE1_T_M
 
-#: Default T_m list of the Table-1 sweep [s] (the paper's columns).
-TABLE1_T_M = "1.0, 1.4, 1.8, 2.2, 2.6"
 #: Plot height / width per figure [-].
 ASPECT_PHASE, ASPECT_TIME, ASPECT_SMALL = 0.72, 1.45, 0.55
-
-
-def parse_T_m_list(text: str) -> list[float]:
-    """``"1.0, 1.4"`` → [1.0, 1.4] [s]; ValueError naming the bad item and the allowed form."""
-    values: list[float] = []
-    for item in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):
-        try:
-            value = parse_number(item, "Table 1 › T_m list")
-        except NumberFormatError:
-            raise ValueError(f"Table 1 › T_m list: {item!r} is not a number: allowed a comma-separated "
-                             "list of times > 0 s, e.g. 1.0, 1.4, 1.8") from None
-        if not 0.0 < value <= 1e4:
-            raise ValueError(f"Table 1 › T_m list: {value:g} s is out of range: allowed 0 < T_m ≤ 10000 s")
-        values.append(value)
-    if not 1 <= len(values) <= 40:
-        raise ValueError(f"Table 1 › T_m list has {len(values)} values: allowed 1 … 40")
-    return values
 
 
 class ResultsPanel:
@@ -64,7 +46,7 @@ class ResultsPanel:
             self.bars = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
             self._build_savings(gui)
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
-            self.t_m_list = gui.add_text("T_m list [s]", TABLE1_T_M)
+            self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
             self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
             self.progress = gui.add_progress_bar(0.0, animated=False)
             self.table1 = gui.add_plotly(make_table1_figure([]), aspect=ASPECT_SMALL)
@@ -98,7 +80,7 @@ class ResultsPanel:
 
     def _sweep_clicked(self, client: viser.ClientHandle) -> None:
         try:
-            values = parse_T_m_list(self.t_m_list.value)
+            values = parse_T_m_list(self.t_m_list.value, "Table 1 › T_m list")
         except ValueError as exc:
             client.add_notification("Table-1 sweep not started", str(exc), color="red",
                                     auto_close_seconds=10.0)

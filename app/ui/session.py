@@ -282,7 +282,7 @@ class Session:
         if self.comparison.fdsmc is None:
             items.append("Not simulated: the manoeuvre is infeasible (see above).")
         self.warnings.content = warnings_html(items, self.error, comparator_notes(self.comparison))
-        chatter = any(r is not None and r.metrics.get("chatter")
+        chatter = any(r is not None and r.metrics.chatter
                       for r in (self.comparison.fdsmc, self.comparison.conventional))
         k_rec = recommended_K(d)
         self.use_k.visible = k_rec is not None and (chatter or 1.001 * k_rec < self.params.controller.K)

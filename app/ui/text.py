@@ -120,10 +120,10 @@ def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: floa
     price_per_kWh : float    Energy price [currency/kWh].
     """
     f, c = comparison.fdsmc, comparison.conventional
-    if f is None or c is None or not (f.metrics.get("stable") and c.metrics.get("stable")):
+    if f is None or c is None or not (f.metrics.stable and c.metrics.stable):
         return None
-    e_f, e_c = f.metrics.get("electrical_in_total_J"), c.metrics.get("electrical_in_total_J")
-    if not isinstance(e_f, float) or not isinstance(e_c, float):
+    e_f, e_c = f.metrics.electrical_in_total_J, c.metrics.electrical_in_total_J
+    if e_f is None or e_c is None:
         return None
     per_cycle = e_c - e_f
     kwh = per_cycle * cycles_per_hour * hours_per_year / J_PER_KWH

@@ -8,12 +8,13 @@ UI and the CLI need, plus human-readable warnings.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from control.fdsmc.conventional import ConventionalGains, conventional_gains, friction_energy_conventional
 from control.fdsmc.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
 from control.fdsmc.loop_analysis import (
     GainRecommendation,
+    LoopCase,
     LoopModel,
     SampleRateCheck,
     loop_warnings,
@@ -50,7 +51,11 @@ class EnergyPrediction:
 
 @dataclass(frozen=True)
 class Derived:
-    """Every derived quantity of a commissioning case (see the field types for units)."""
+    """Every derived quantity of a commissioning case (see the field types for units).
+
+    ``gain`` and ``sample_rate`` are the verdicts of the linearised loop
+    (:mod:`control.fdsmc.loop_analysis`) on :attr:`loop`.
+    """
 
     params: DriveParams
     coefficients: ModelCoefficients
@@ -62,8 +67,14 @@ class Derived:
     energy: EnergyPrediction
     feasibility: Feasibility
     warnings: tuple[str, ...]
-    gain: GainRecommendation | None = None
-    sample_rate: SampleRateCheck | None = None
+    gain: GainRecommendation
+    sample_rate: SampleRateCheck
+
+    @property
+    def loop(self) -> LoopCase:
+        """The linearised loop of this case (model, observer and outer laws)."""
+        return LoopCase(self.coefficients, self.params, self.observer, self.alpha.alpha_max, self.profile.T_c,
+                        self.conventional.g1, self.conventional.g2)
 
 
 def predicted_energy(params: DriveParams, profile: VelocityProfile) -> EnergyPrediction:
@@ -99,22 +110,24 @@ def derive(params: DriveParams) -> Derived:
     obs_d = None if ctrl.is_continuous else discrete_observer(obs, coeff.M, float(ctrl.f_s))
     prof = velocity_profile(params.manoeuvre.theta_dem, alpha.alpha_max, params.manoeuvre.T_m, ctrl.T_c)
     feas = feasibility(params, alpha, prof.omega_p)
-    d = Derived(
+    conv = conventional_gains(params.manoeuvre.T_m)
+    loop = LoopCase(coeff, params, obs, alpha.alpha_max, prof.T_c, conv.g1, conv.g2)
+    gain, rate = recommend_K(loop), sample_rate_check(loop)
+    return Derived(
         params=params,
         coefficients=coeff,
         alpha=alpha,
         observer=obs,
         observer_discrete=obs_d,
         profile=prof,
-        conventional=conventional_gains(params.manoeuvre.T_m),
+        conventional=conv,
         energy=predicted_energy(params, prof),
         feasibility=feas,
-        warnings=_warnings(params, alpha, prof, feas),
+        warnings=(_warnings(params, alpha, prof, feas) + loop_warnings(gain, rate)
+                  + _layer_warning(ctrl.K, gain, prof)),
+        gain=gain,
+        sample_rate=rate,
     )
-    # Recommended K and sample-rate verdict of the linearised loop (control.fdsmc.loop_analysis).
-    gain, rate = recommend_K(d), sample_rate_check(d)
-    extra = loop_warnings(gain, rate) + _layer_warning(ctrl.K, gain, prof)
-    return replace(d, gain=gain, sample_rate=rate, warnings=d.warnings + extra)
 
 
 def _layer_warning(K: float, gain: GainRecommendation, prof: VelocityProfile) -> tuple[str, ...]:

@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.linalg import expm
@@ -34,9 +33,6 @@ from scipy.linalg import expm
 from control.fdsmc.model import ModelCoefficients
 from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer
 from control.fdsmc.params import DriveParams
-
-if TYPE_CHECKING:  # derivations imports this module
-    from control.fdsmc.derivations import Derived
 
 #: Default gain margin of the recommended K [-] (2 = 6 dB).
 GAIN_MARGIN = 2.0
@@ -102,17 +98,17 @@ class SampleRateCheck:
     delay_samples: int
 
 
-def _outer_gains(d: Derived, law: str, K: float) -> tuple[float, float]:
+def _outer_gains(d: LoopCase, law: str, K: float) -> tuple[float, float]:
     """α_dem = a_th·θ̂ + a_w·ω̂ (linear part) for the law [1/s², 1/s]."""
-    a_max, T_c = d.alpha.alpha_max, d.profile.T_c
+    a_max, T_c = d.alpha_max, d.T_c
     if law == "cruise":
         return 0.0, -a_max * K
     if law == "slope":
         return -a_max * K / T_c, -a_max * K
-    return -d.conventional.g1, -d.conventional.g2
+    return -d.g1, -d.g2
 
 
-def control_row(d: Derived, law: str, K: float) -> np.ndarray:
+def control_row(d: LoopCase, law: str, K: float) -> np.ndarray:
     """u_q = row·z, the linear part of eq. (14) in [1] at i_d = 0 with the outer law [V per state]."""
     return fdc_row(d.coefficients, d.params.controller.T_salpha, *_outer_gains(d, law, K))
 
@@ -137,7 +133,7 @@ def fdc_input_gain(c: ModelCoefficients, T_salpha: float) -> float:
     return 3.0 / T_salpha / c.H / c.G
 
 
-def plant_matrices(d: Derived) -> tuple[np.ndarray, np.ndarray]:
+def plant_matrices(d: LoopCase) -> tuple[np.ndarray, np.ndarray]:
     """Continuous plant [i_q, θ_r, ω_r] with input u_q, eqs. (2), (3), (4b) at i_d = 0."""
     return plant_matrices_of(d.coefficients, d.params)
 
@@ -159,14 +155,26 @@ class LoopModel:
     observer: ObserverGains
 
 
-def loop_model(d: Derived) -> LoopModel:
-    """Return the :class:`LoopModel` of a derived case."""
-    return LoopModel(d.coefficients, d.params, d.observer)
+@dataclass(frozen=True)
+class LoopCase(LoopModel):
+    """The linearised loop of one case with its outer laws.
+
+    α_max [rad/s²] and T_c [s] of the FDSMC (eqs. (41), (46) in [1]) and the conventional gains
+    g1 [1/s²], g2 [1/s] of eq. (61).
+
+    Built by :func:`control.fdsmc.derivations.derive` before the derived case itself, which
+    then holds the verdicts of :func:`recommend_K` and :func:`sample_rate_check`.
+    """
+
+    alpha_max: float
+    T_c: float
+    g1: float
+    g2: float
 
 
-def continuous_loop(d: Derived, law: str, K: float) -> np.ndarray:
+def continuous_loop(d: LoopCase, law: str, K: float) -> np.ndarray:
     """Closed-loop matrix (7×7) of the continuous implementation [1/s]."""
-    return continuous_matrix(loop_model(d), control_row(d, law, K))
+    return continuous_matrix(d, control_row(d, law, K))
 
 
 def continuous_matrix(lm: LoopModel, row: np.ndarray) -> np.ndarray:
@@ -195,7 +203,7 @@ class SampledParts:
     observer: DiscreteObserver
 
 
-def sampled_parts(d: Derived | LoopModel, f_s: float) -> SampledParts:
+def sampled_parts(d: LoopModel, f_s: float) -> SampledParts:
     """Plant [i_q, θ_r, ω_r] discretised exactly for held u_q, and the observer, at ``f_s`` [Hz]."""
     T_s = 1.0 / f_s
     Ap, bp = plant_matrices_of(d.coefficients, d.params)
@@ -206,7 +214,7 @@ def sampled_parts(d: Derived | LoopModel, f_s: float) -> SampledParts:
 
 
 def discrete_loop(
-    d: Derived, law: str, K: float, f_s: float, delay: int = 0, parts: SampledParts | None = None
+    d: LoopCase, law: str, K: float, f_s: float, delay: int = 0, parts: SampledParts | None = None
 ) -> np.ndarray:
     """Closed-loop transition matrix of the sampled implementation (7×7, or 8×8 with delay)."""
     sp = sampled_parts(d, f_s) if parts is None else parts
@@ -250,7 +258,7 @@ def reduce_shift_mode(M: np.ndarray) -> np.ndarray:
 
 
 def stability_measure(
-    d: Derived, law: str, K: float, f_s: float | None, delay: int = 0,
+    d: LoopCase, law: str, K: float, f_s: float | None, delay: int = 0,
     parts: SampledParts | None = None,
 ) -> float:
     """Largest Re(s) [1/s] (continuous) or largest |z| − 1 [-] (sampled); < 0 means stable."""
@@ -263,7 +271,7 @@ def stability_measure(
     return float(np.max(ev.real)) if f_s is None else float(np.max(np.abs(ev)) - 1.0)
 
 
-def gain_limit(d: Derived, law: str, f_s: float | None, delay: int = 0) -> float:
+def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> float:
     """Upper stability limit in K [s/rad] of the linearised loop with ``law``.
 
     K is scanned on a log grid (2 points per decade, 1e−5 … 1e6 s/rad, scaled by
@@ -276,7 +284,7 @@ def gain_limit(d: Derived, law: str, f_s: float | None, delay: int = 0) -> float
     def unstable(K: float) -> bool:
         return stability_measure(d, law, K, f_s, delay, parts) >= 0.0
 
-    grid = [float(K) for K in np.logspace(-5, 6, 23) * 1000.0 / d.alpha.alpha_max]
+    grid = [float(K) for K in np.logspace(-5, 6, 23) * 1000.0 / d.alpha_max]
     flags = [unstable(K) for K in grid]
     if all(flags):
         return 0.0
@@ -303,17 +311,17 @@ def slope_damping(alpha_max: float, K: float, T_c: float) -> float:
     return math.sqrt(alpha_max * K * T_c) / 2.0
 
 
-def _f_s(d: Derived) -> float | None:
+def _f_s(d: LoopCase) -> float | None:
     ctrl = d.params.controller
     return None if ctrl.is_continuous else float(ctrl.f_s)
 
 
-def recommend_K(d: Derived, margin: float = GAIN_MARGIN) -> GainRecommendation:
+def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN) -> GainRecommendation:
     """Recommended boundary-layer gain K = K_limit/margin for the preset's implementation.
 
     Parameters
     ----------
-    d : Derived
+    d : LoopCase
         Derivations of the case (inertia J_r + J_L, observer, α_max, T_c, f_s).
     margin : float
         Gain margin [-], default 2 (6 dB).
@@ -328,12 +336,12 @@ def recommend_K(d: Derived, margin: float = GAIN_MARGIN) -> GainRecommendation:
     # A sloped segment unstable for every K is a damping problem (see slope_damping), reported
     # by zeta_slope/T_c_min; the limit-cycle bound is then the cruise segment's.
     k_lim = min(k_c, k_s) if k_s > 0.0 else k_c
-    K, a_max = d.params.controller.K, d.alpha.alpha_max
+    K, a_max = d.params.controller.K, d.alpha_max
     mode = "continuous" if f_s is None else f"f_s = {f_s:g} Hz"
     k_ok = k_lim > K
-    zeta = slope_damping(a_max, K if k_ok else k_lim / margin, d.profile.T_c)
+    zeta = slope_damping(a_max, K if k_ok else k_lim / margin, d.T_c)
     T_c_min = 4.0 * margin / (a_max * k_c) if 0.0 < k_c < math.inf else math.nan
-    zeta_rec = slope_damping(a_max, k_lim / margin, d.profile.T_c)
+    zeta_rec = slope_damping(a_max, k_lim / margin, d.T_c)
     return GainRecommendation(k_lim, k_c, k_s, margin, k_lim / margin, K, k_ok, k_lim / K, mode,
                               zeta, T_c_min, zeta_rec)
 
@@ -373,12 +381,12 @@ def _slope_warning(g: GainRecommendation) -> str:
             f"T_c = T_a, eq. 59), so the drive will oscillate about θ_dem. {fix}")
 
 
-def sample_rate_check(d: Derived) -> SampleRateCheck:
+def sample_rate_check(d: LoopCase) -> SampleRateCheck:
     """Spectral radius of the sampled inner loops + observer and the slowest stable f_s.
 
     Parameters
     ----------
-    d : Derived
+    d : LoopCase
 
     Returns
     -------
@@ -392,7 +400,7 @@ def sample_rate_check(d: Derived) -> SampleRateCheck:
     return SampleRateCheck(f_s, rho, rho < 1.0, minimum_sample_rate(d, delay), delay)
 
 
-def minimum_sample_rate(d: Derived, delay: int = 0) -> float | None:
+def minimum_sample_rate(d: LoopCase, delay: int = 0) -> float | None:
     """Smallest f_s [Hz] for which the sampled inner loops + observer are stable (1 % steps).
 
     Searched between 100 Hz and 10 MHz; None if even 10 MHz is unstable.

@@ -27,11 +27,12 @@ import numpy as np
 
 from control.bldc.design import BldcDesign, bldc_design
 from control.bldc.params import BldcParams
-from control.fdsmc.params import ParameterError
 from sim.bldc import kernel as kn
 from sim.bldc.emf import machine_table
-from sim.bldc.metrics import run_metrics
+from sim.bldc.metrics import BldcMetrics, run_metrics
+from sim.bldc.trace import BldcTrace
 from sim.common import budget
+from sim.common.choices import check_controller
 
 CONTROLLERS = ("smc_integral", "smc_plain", "pi_sinusoidal", "six_step")
 LABELS = {
@@ -46,49 +47,12 @@ N_SUB = 1
 
 
 @dataclass(frozen=True)
-class BldcTrace:
-    """Time series of one run, one row per controller sample (SI units).
-
-    Attributes
-    ----------
-    t [s]; omega [rad/s] mechanical speed; omega_ref [rad/s]; T_L [N·m] load torque;
-    T_EL [N·m] electromagnetic torque, eq. (3); T_ref [N·m] torque reference; sigma [rad/s]
-    σ_ω of eq. (16) (ε_ω for the plain law, ε + I/K_p for PI); i_abc [A] shape (3, n);
-    i_dx, i_qx [A] currents in the controller's frame (six-step: open-phase current and line
-    current of the conducting pair); i_qx_ref [A] (six-step: I*); v_phase [V] winding
-    voltages v_x − v_n, shape (3, n); theta_e [rad]; E_in [J] electrical input energy;
-    E_copper, E_friction, E_load [J] cumulative losses / load work (integrated with the plant);
-    E_kin [J] ½·J·(ω² − ω_0²); E_mag [J] ½·(L_s − M_s)·Σi_x².
-    """
-
-    t: np.ndarray
-    omega: np.ndarray
-    omega_ref: np.ndarray
-    T_L: np.ndarray
-    T_EL: np.ndarray
-    T_ref: np.ndarray
-    sigma: np.ndarray
-    i_abc: np.ndarray
-    i_dx: np.ndarray
-    i_qx: np.ndarray
-    i_qx_ref: np.ndarray
-    v_phase: np.ndarray
-    theta_e: np.ndarray
-    E_in: np.ndarray
-    E_copper: np.ndarray
-    E_friction: np.ndarray
-    E_load: np.ndarray
-    E_kin: np.ndarray
-    E_mag: np.ndarray
-
-
-@dataclass(frozen=True)
 class BldcRunResult:
-    """One controller's run: trace and metrics (``speed_error_ss_rpm`` … , ``stable``, ``reason``)."""
+    """One controller's run: trace and metrics."""
 
     controller: str
     trace: BldcTrace
-    metrics: dict[str, float | bool | str | list | None]
+    metrics: BldcMetrics
 
 
 @dataclass(frozen=True)
@@ -130,11 +94,6 @@ def pack_parameters(params: BldcParams, design: BldcDesign, controller: str) -> 
     prm[kn.P_KTS] = K_T.get(controller, design.K_Tx)
     prm[kn.P_CTRL] = CONTROLLERS.index(controller)
     return prm
-
-
-def _check_controller(controller: str) -> None:
-    if controller not in CONTROLLERS:
-        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(CONTROLLERS)}")
 
 
 #: Bytes of trace memory per recorded sample and controller: the kernel's record row (N_CH
@@ -187,9 +146,9 @@ def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
     Returns
     -------
     BldcRunResult
-        Never raises for a diverging run: ``metrics["stable"]`` is False with a ``reason``.
+        Never raises for a diverging run: ``metrics.stable`` is False with a ``reason``.
     """
-    _check_controller(controller)
+    check_controller(controller, CONTROLLERS)
     check_budget(params, 1, n_sub)
     d = bldc_design(params) if design is None else design
     tab = machine_table(params.machine) if table is None else np.ascontiguousarray(table, dtype=float)
@@ -232,7 +191,7 @@ def compare_bldc(params: BldcParams, controllers: tuple[str, ...] = CONTROLLERS,
     table : numpy.ndarray or None  Machine Φ'_ra table [Wb]; default from ``params.machine``.
     """
     for c in controllers:
-        _check_controller(c)
+        check_controller(c, CONTROLLERS)
     check_budget(params, len(controllers))
     d = bldc_design(params)
     tab = machine_table(params.machine) if table is None else np.asarray(table, dtype=float)

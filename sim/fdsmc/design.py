@@ -194,7 +194,7 @@ def _verify(p: DriveParams, limiting: list[Constraint]) -> DriveDesign:
     for _ in range(MAX_K_HALVINGS + 1):
         d = derive(p)
         cmp = compare(p, derived=d)
-        if cmp.fdsmc is None or not cmp.fdsmc.metrics.get("chatter"):
+        if cmp.fdsmc is None or not cmp.fdsmc.metrics.chatter:
             break
         p = _with(p, "controller", K=p.controller.K / 2.0)
     if cmp.fdsmc is None:  # infeasible after all: derive's warnings say why
@@ -207,7 +207,7 @@ def _verify(p: DriveParams, limiting: list[Constraint]) -> DriveDesign:
 
 def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
     lim = torque_limit(p)
-    peak = float(run.metrics["torque_peak_Nm"] or 0.0)
+    peak = run.metrics.torque_peak_Nm or 0.0
     return Constraint("torque", peak, lim, "N·m", False,
                       f"α_max = {alpha_max(p, _overshoot(p)).alpha_max:.5g} rad/s² is set by the torque limit "
                       f"{lim:.4g} N·m (Γ_max or i_max); simulated peak {peak:.4g} N·m.")
@@ -216,30 +216,30 @@ def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
 def run_checks(p: DriveParams, run: RunResult) -> list[Constraint]:
     """Return the simulated run's violations of the drive's limits, the arrival band and chatter."""
     m = run.metrics
-    if m.get("stable") is False:
-        return [Constraint("stable", 1.0, 0.0, "-", True, f"Unstable run: {m.get('reason')}.")]
+    if not m.stable:
+        return [Constraint("stable", 1.0, 0.0, "-", True, f"Unstable run: {m.reason}.")]
     out: list[Constraint] = []
     i_max = p.controller.i_max
-    peaks = [("torque", "torque_peak_Nm", torque_limit(p), "N·m", "lower T_m demand or a larger motor"),
-             ("voltage", "u_peak_V", voltage_limit(p), "V", "a longer T_m (lower ω_p) or a higher V_dc"),
-             ("speed", "omega_peak_rad_s", p.motor.omega_b, "rad/s", "a longer T_m")]
+    peaks = [("torque", m.torque_peak_Nm, torque_limit(p), "N·m", "lower T_m demand or a larger motor"),
+             ("voltage", m.u_peak_V, voltage_limit(p), "V", "a longer T_m (lower ω_p) or a higher V_dc"),
+             ("speed", m.omega_peak_rad_s, p.motor.omega_b, "rad/s", "a longer T_m")]
     if i_max > 0.0:
-        peaks.append(("current", "i_q_peak_A", i_max, "A", "a larger inverter"))
-    for name, key, lim, unit, fix in peaks:
-        v = float(m[key] or 0.0)
+        peaks.append(("current", m.i_q_peak_A, i_max, "A", "a larger inverter"))
+    for name, peak, lim, unit, fix in peaks:
+        v = peak or 0.0
         if exceeds(v, lim):
             out.append(Constraint(name, v, lim, unit, True, f"Simulated peak {name} {v:.4g} {unit} > {lim:.4g} "
                                                             f"{unit}: needs {fix}."))
-    sat = float(m.get("saturated_s") or 0.0)
+    sat = m.saturated_s
     if sat > 0.0:
         out.append(Constraint("saturation", sat, 0.0, "s", True,
                               f"The inverter limits the voltage/current for {sat:.3g} s."))
     frac = TARGET_BAND[run.controller]
-    err, band = abs(float(m["theta_error_at_Tm_rad"] or 0.0)), frac * abs(p.manoeuvre.theta_dem)
+    err, band = abs(m.theta_error_at_Tm_rad or 0.0), frac * abs(p.manoeuvre.theta_dem)
     if err > band:
         out.append(Constraint("arrival", err, band, "rad", True, f"Position error {err:.4g} rad at T_m is outside "
                                                                  f"the {100 * frac:g} % band ({band:.4g} rad)."))
-    if m.get("chatter"):
+    if m.chatter:
         out.append(Constraint("chatter", p.controller.K, 0.0, "s/rad", True,
                               f"Still chatters at K = {p.controller.K:.4g} s/rad."))
     return out

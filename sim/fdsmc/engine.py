@@ -2,7 +2,7 @@
 
 The model (plant, FDC inner loops, observer, outer loop, energies) is integrated by the
 compiled kernel :func:`sim.fdsmc.kernel.run_kernel`; this module packs the parameters, chooses the
-time grid, and turns the raw arrays into frozen results with their metrics (:mod:`sim.fdsmc.metrics`).
+time grid, and turns the raw arrays into frozen results with their :class:`~sim.fdsmc.metrics.RunMetrics`.
 
 Rest-to-rest manoeuvre from θ_r = 0 to θ_dem, simulated over [0, (1 + TAIL_FRACTION)·T_m].
 Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) in [1]); the
@@ -25,13 +25,23 @@ from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams, ParameterError
 from sim.common import budget
+from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
-from sim.fdsmc.metrics import CHATTER_MAX_WINDOW_S, WindowSamples, chatter_window_steps, chatter_windows, run_metrics
+from sim.fdsmc.metrics import (
+    CHATTER_MAX_WINDOW_S,
+    RunMetrics,
+    WindowSamples,
+    chatter_window_steps,
+    chatter_windows,
+    run_metrics,
+)
 
 CONTROLLERS = ("fdsmc", "conventional")
 #: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
 #: (:mod:`control.fdsmc.optimum`); the kernel's P_CTRL is the index in this tuple.
 COMPARATORS = CONTROLLERS + ("optimum",)
+#: The name each simulated outer loop goes by in messages, tables and figures.
+LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Minimum-energy optimum"}
 #: Simulated horizon beyond T_m, as a fraction of T_m [-].
 TAIL_FRACTION = 0.3
 #: RK4 step of continuous mode [s]; friction energies converged to < 0.05 % (see tests).
@@ -44,6 +54,8 @@ PLANT_STEP_MAX_S = 5e-5
 MAX_POINTS = 20000
 #: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
 PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
+#: The manoeuvre times [s] of Table 1 in [1]: the default sweep.
+TABLE1_T_M: tuple[float, ...] = tuple(PAPER_TABLE1)
 
 
 @dataclass(frozen=True)
@@ -84,11 +96,11 @@ class Trace:
 
 @dataclass(frozen=True)
 class RunResult:
-    """One controller's run: trace and the metrics of ``simulate --json`` (plus ``reason``)."""
+    """One controller's run: trace and the metrics of ``simulate --json``."""
 
     controller: str
     trace: Trace
-    metrics: dict[str, float | bool | str | None]
+    metrics: RunMetrics
 
 
 @dataclass(frozen=True)
@@ -270,11 +282,6 @@ def _load_steps(params: DriveParams) -> tuple[np.ndarray, np.ndarray]:
             np.array([s.Gamma_Le for s in steps], dtype=float))
 
 
-def _check_controller(controller: str) -> None:
-    if controller not in COMPARATORS:
-        raise ParameterError(f"controller = {controller!r} is not allowed: one of {', '.join(COMPARATORS)}")
-
-
 def _reference(d: Derived, controller: str) -> np.ndarray:
     """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
     if controller != "optimum":
@@ -327,14 +334,14 @@ def simulate(
     Returns
     -------
     RunResult
-        Never raises for an unstable run: ``metrics["stable"]`` is False with a ``reason``.
+        Never raises for an unstable run: ``metrics.stable`` is False with a ``reason``.
 
     Raises
     ------
     ParameterError
         For an unknown controller or an infeasible manoeuvre (T_m < T_m,min).
     """
-    _check_controller(controller)
+    check_controller(controller, COMPARATORS)
     check_budget(params, 1, n_sub=n_sub, h_continuous=h_continuous, max_points=max_points)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
@@ -370,7 +377,7 @@ def run_steps(
         Final kernel state [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, E_mot, E_load, θ̂, ω̂, L̂0, L̂1]
         (indices ``X_*`` of :mod:`sim.fdsmc.kernel`; SI units).
     """
-    _check_controller(controller)
+    check_controller(controller, COMPARATORS)
     d = derive(params) if derived is None else derived
     prm = pack_parameters(params, d, controller)
     step_t, step_v = _load_steps(params)
@@ -398,14 +405,15 @@ def reached_target(run: RunResult) -> bool:
 
     A run that never gets there (e.g. a rotor that never moves) has no energy figure worth comparing.
     """
-    return bool(run.metrics["stable"]) and run.metrics.get("t_2pct_first_s") is not None
+    return run.metrics.stable and run.metrics.t_2pct_first_s is not None
 
 
-def _saving(a: RunResult | None, b: RunResult | None, key: str) -> float | None:
+def _saving(a: RunResult | None, b: RunResult | None, energy: Callable[[RunMetrics], float | None]) -> float | None:
+    """100·(1 − energy(a)/energy(b)) [%], None unless both runs reached the target."""
     if a is None or b is None or not (reached_target(a) and reached_target(b)):
         return None
-    va, vb = a.metrics[key], b.metrics[key]
-    if not isinstance(va, float) or not isinstance(vb, float) or vb == 0.0:
+    va, vb = energy(a.metrics), energy(b.metrics)
+    if va is None or vb is None or vb == 0.0:
         return None
     return 100.0 * (1.0 - va / vb)
 
@@ -434,7 +442,7 @@ def compare(
         Savings are None unless both runs exist, are stable and reached the 2 % band.
     """
     for c in controllers:
-        _check_controller(c)
+        check_controller(c, COMPARATORS)
     check_budget(params, len(controllers), **options)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
@@ -446,8 +454,8 @@ def compare(
     else:
         runs = {c: simulate(params, c, d, plant=plant, **options) for c in controllers}
     f, c = runs.get("fdsmc"), runs.get("conventional")
-    return Comparison(d, f, c, _saving(f, c, "friction_J"), _saving(f, c, "electrical_in_total_J"),
-                      runs.get("optimum"))
+    return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
+                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"))
 
 
 def table1_sweep(
@@ -486,13 +494,14 @@ def table1_sweep(
         cmp = compare(p, **options)
         assert cmp.fdsmc is not None and cmp.conventional is not None
         for run in (cmp.fdsmc, cmp.conventional):
-            if not run.metrics["stable"]:
+            if not run.metrics.stable:
                 raise ParameterError(
-                    f"manoeuvre.T_m = {T_m:g} s: {run.controller} run unstable — {run.metrics['reason']}")
+                    f"manoeuvre.T_m = {T_m:g} s: {run.controller} run unstable — {run.metrics.reason}")
             if not reached_target(run):
                 raise ParameterError(f"manoeuvre.T_m = {T_m:g} s: the {run.controller} run never reached the "
                                      "2 % band around θ_dem, so its energy is not comparable")
-        wf, wc = float(cmp.fdsmc.metrics["friction_J"]), float(cmp.conventional.metrics["friction_J"])  # type: ignore[arg-type]
+        wf, wc = cmp.fdsmc.metrics.friction_J, cmp.conventional.metrics.friction_J
+        assert wf is not None and wc is not None  # a run that reached its target has its energies
         e = cmp.derived.energy
         rows.append(Table1Row(float(T_m), wf, wc, 100.0 * (1.0 - wf / wc),
                               float(e.saving_pct) if e.saving_pct is not None else math.nan,

@@ -21,6 +21,7 @@ import numpy as np
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
 from sim.common import signals
+from sim.common.energy import energy_balance
 from sim.fdsmc import kernel as kn
 
 #: Thresholds of the chatter criterion (fractions of α_max) and the smoothing window [s].
@@ -101,10 +102,87 @@ def detect_chatter(
                           float(np.ptp(omega_r[sel])), window)
 
 
+@dataclass(frozen=True)
+class RunMetrics:
+    """The metrics of one run; the field names are the keys of ``simulate --json``.
+
+    Energies [J] without suffix are over [0, T_m] (W_L of eq. (47) in [1]), ``_total`` over the
+    whole run; ``regenerated`` = motoring − net electrical input. A diverged run has every number
+    None (except ``saturated_s`` and ``theta_dem_rad``), ``stable`` False and a ``reason``.
+
+    Attributes
+    ----------
+    friction_J, copper_J, electrical_in_J, motoring_J, regenerated_J, load_work_J : float or None
+        Energies over [0, T_m] [J].
+    friction_total_J … load_work_total_J : float or None
+        The same over the whole run [J].
+    kinetic_at_Tm_J, kinetic_end_J, magnetic_end_J : float or None
+        Stored energies at T_m and at the end [J].
+    energy_balance_residual_J, energy_balance_residual_pct : float or None
+        Residual of the balance (:func:`sim.common.energy.energy_balance`) [J], [%].
+    t_2pct_first_s, t_2pct_settle_s : float or None
+        First entry into, and settling in, the 2 % band around θ_dem [s].
+    theta_error_at_Tm_rad, overshoot_rad, theta_dem_rad : float or None
+        θ_r(T_m) − θ_dem, overshoot beyond θ_dem, the demand [rad].
+    omega_peak_rad_s, i_q_peak_A, i_d_peak_A, u_peak_V, torque_peak_Nm : float or None
+        Peaks of |ω_r| [rad/s], |i_q|, |i_d| [A], |u_dq| [V], |Γ| [N·m].
+    saturated_s : float
+        Time the inverter limited the voltage or current [s].
+    chatter : bool
+        Whether the chatter criterion of this module is met in a window.
+    chatter_phase : str or None
+        ``cruise`` or ``hold``: the window that chatters.
+    chatter_alpha_ptp_rad_s2, chatter_frequency_Hz : float or None
+        Peak-to-peak of the high-pass α_dem [rad/s²] and its frequency [Hz] in that window.
+    cruise_omega_ptp_rad_s, hold_omega_ptp_rad_s : float or None
+        Peak-to-peak of ω_r in each window [rad/s].
+    stable : bool
+    reason : str or None
+        Why the run diverged.
+    """
+
+    friction_J: float | None
+    copper_J: float | None
+    electrical_in_J: float | None
+    motoring_J: float | None
+    regenerated_J: float | None
+    load_work_J: float | None
+    friction_total_J: float | None
+    copper_total_J: float | None
+    electrical_in_total_J: float | None
+    motoring_total_J: float | None
+    regenerated_total_J: float | None
+    load_work_total_J: float | None
+    kinetic_at_Tm_J: float | None
+    kinetic_end_J: float | None
+    magnetic_end_J: float | None
+    energy_balance_residual_J: float | None
+    energy_balance_residual_pct: float | None
+    t_2pct_first_s: float | None
+    t_2pct_settle_s: float | None
+    theta_error_at_Tm_rad: float | None
+    overshoot_rad: float | None
+    theta_dem_rad: float
+    omega_peak_rad_s: float | None
+    i_q_peak_A: float | None
+    i_d_peak_A: float | None
+    u_peak_V: float | None
+    torque_peak_Nm: float | None
+    saturated_s: float
+    chatter: bool
+    chatter_phase: str | None
+    chatter_alpha_ptp_rad_s2: float | None
+    chatter_frequency_Hz: float | None
+    cruise_omega_ptp_rad_s: float | None
+    hold_omega_ptp_rad_s: float | None
+    stable: bool
+    reason: str | None
+
+
 def response_metrics(
     t: np.ndarray, theta_r: np.ndarray, theta_dem: float, theta_at_Tm: float
 ) -> dict[str, float | None]:
-    """2 % band entry and settling times, position error at T_m and overshoot.
+    """2 % band entry and settling times, position error at T_m and overshoot (RunMetrics fields).
 
     Parameters
     ----------
@@ -123,7 +201,10 @@ def response_metrics(
 
 
 def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
-    """Energies at T_m and at the end of the run, stored energies and the balance residual [J]."""
+    """Return the energies at T_m and at the end, stored energies and the balance residual [J].
+
+    The keys are :class:`RunMetrics` fields.
+    """
     snap, end = info[kn.I_SNAP: kn.I_SNAP + kn.N_X], info[kn.I_END: kn.I_END + kn.N_X]
     m = params.motor
 
@@ -144,12 +225,11 @@ def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
     out["kinetic_at_Tm_J"] = float(kinetic(snap))
     out["kinetic_end_J"] = kinetic(end)
     out["magnetic_end_J"] = magnetic(end)
-    stored = out["kinetic_end_J"] + out["magnetic_end_J"]
-    losses = out["copper_total_J"] + out["friction_total_J"] + out["load_work_total_J"]
-    residual = out["electrical_in_total_J"] - losses - stored
-    out["energy_balance_residual_J"] = float(residual)
-    ref = max(abs(out["electrical_in_total_J"]), out["motoring_total_J"], 1e-12)
-    out["energy_balance_residual_pct"] = float(100.0 * abs(residual) / ref)
+    bal = energy_balance(out["electrical_in_total_J"],
+                         (out["copper_total_J"], out["friction_total_J"], out["load_work_total_J"]),
+                         (out["kinetic_end_J"], out["magnetic_end_J"]), out["motoring_total_J"])
+    out["energy_balance_residual_J"] = bal.residual_J
+    out["energy_balance_residual_pct"] = bal.residual_pct
     return out
 
 
@@ -202,7 +282,7 @@ def chatter_window_steps(window: tuple[float, float], T_step: float, n_steps: in
 def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
     samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None,
-) -> dict[str, float | bool | str | None]:
+) -> RunMetrics:
     """Return all metrics of one run.
 
     They come from the (decimated) trace, the full-resolution chatter-window ``samples`` and the kernel's
@@ -213,50 +293,41 @@ def run_metrics(
     ``plant``'s true values when given.
     """
     failed = bool(info[kn.I_FAILED])
-    met: dict[str, float | bool | str | None] = {}
     energies = energy_metrics(params if plant is None else plant, info)
     theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
     resp = response_metrics(t, theta_r, params.manoeuvre.theta_dem, theta_Tm)
     verdicts = {name: detect_chatter(s.t, s.alpha_dem, s.omega_r, s.window, d.alpha.alpha_max)
                 for name, s in samples.items()}
-    phase = next((name for name, v in verdicts.items() if v.chatter), None)
+    phase = None if failed else next((name for name, v in verdicts.items() if v.chatter), None)
     cv = verdicts[phase or "cruise"]
-    met.update(energies)
-    met.update(resp)
-    met.update({
-        "theta_dem_rad": float(params.manoeuvre.theta_dem),
+    figures: dict[str, float | None] = {
+        **energies, **resp,
         "omega_peak_rad_s": float(info[kn.I_PW]),
         "i_q_peak_A": float(info[kn.I_PIQ]),
         "i_d_peak_A": float(info[kn.I_PID]),
         "u_peak_V": float(info[kn.I_PU]),
         "torque_peak_Nm": float(info[kn.I_PTQ]),
-        "saturated_s": float(info[kn.I_TSAT]),
-        "chatter": phase is not None,
-        "chatter_phase": phase,
         "chatter_alpha_ptp_rad_s2": cv.ptp,
         "chatter_frequency_Hz": cv.frequency_Hz,
         "cruise_omega_ptp_rad_s": verdicts["cruise"].omega_ptp,
         "hold_omega_ptp_rad_s": verdicts["hold"].omega_ptp,
-        "stable": not failed,
-        "reason": None,
-    })
+    }
     if failed:
-        for k, v in met.items():
-            if isinstance(v, float) and k not in ("saturated_s", "theta_dem_rad"):
-                met[k] = None
-        met["chatter"], met["chatter_phase"] = False, None
-        met["reason"] = _unstable_reason(d, controller, float(info[kn.I_TFAIL]))
-    return met
+        figures = dict.fromkeys(figures)
+    return RunMetrics(
+        **figures, theta_dem_rad=float(params.manoeuvre.theta_dem), saturated_s=float(info[kn.I_TSAT]),
+        chatter=phase is not None, chatter_phase=phase, stable=not failed,
+        reason=_unstable_reason(d, controller, float(info[kn.I_TFAIL])) if failed else None)
 
 
 def _unstable_reason(d: Derived, controller: str, t_fail: float) -> str:
     text = f"diverged at t = {t_fail:.4g} s (a state became non-finite or left its bound)"
     s = d.sample_rate
-    if s is not None and not s.stable:
+    if not s.stable:
         need = f"≥ {s.f_s_min:.4g} Hz" if s.f_s_min is not None else "a faster controller"
         text += (f": f_s = {s.f_s:g} Hz is too slow for T_so/T_sα (sampled inner loops + observer "
                  f"have spectral radius {s.spectral_radius:.4f} ≥ 1; needs {need})")
-    elif controller == "fdsmc" and d.gain is not None and not d.gain.K_ok:
+    elif controller == "fdsmc" and not d.gain.K_ok:
         g = d.gain
         text += (f": K = {g.K:g} s/rad exceeds the limit K_limit = {g.K_limit:.4g} s/rad of the "
                  f"linearised FDSMC loop ({g.mode}); recommended K = {g.K_recommended:.4g} s/rad")

@@ -12,21 +12,19 @@ import math
 from control.fdsmc.derivations import Derived
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
 from control.fdsmc.model import available_voltage
-from sim.fdsmc.engine import Comparison, RunResult, reached_target
-
-NAMES = {"fdsmc": "FDSMC", "conventional": "Conventional"}
+from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
 
 
 def recommended_K(derived: Derived) -> float | None:
     """Recommended boundary-layer gain K [s/rad] from the loop analysis, or None if none helps."""
     g = derived.gain
-    return g.K_recommended if g is not None and g.K_recommended > 0.0 else None
+    return g.K_recommended if g.K_recommended > 0.0 else None
 
 
 def _chatter_hint(derived: Derived) -> str:
     """Say what to change: K above its limit, or a poorly damped sloped segment (T_c too small)."""
     g = derived.gain
-    if g is None or g.K_limit <= 0.0:
+    if g.K_limit <= 0.0:
         return " Reduce K, eq. (45)."
     if not g.K_ok:
         return f" Recommended K = {g.K_recommended:.4g} s/rad."
@@ -44,18 +42,18 @@ def T_c_advice(derived: Derived) -> float | None:
     about θ_dem. T_c,min gives ζ = 1 with the recommended K (``control.fdsmc.loop_analysis``).
     """
     g = derived.gain
-    if g is None or not math.isfinite(g.T_c_min) or g.zeta_slope_recommended >= ZETA_SLOPE_MIN:
+    if not math.isfinite(g.T_c_min) or g.zeta_slope_recommended >= ZETA_SLOPE_MIN:
         return None
     return g.T_c_min if derived.profile.T_c < g.T_c_min else None
 
 
 def _chatter(run: RunResult, derived: Derived) -> str:
     m = run.metrics
-    freq = m.get("chatter_frequency_Hz")
-    at = f" at about {freq:.3g} Hz" if isinstance(freq, float) else ""
-    where = ("while holding θ_dem after T_m" if m.get("chatter_phase") == "hold"
+    freq = m.chatter_frequency_Hz
+    at = f" at about {freq:.3g} Hz" if freq is not None else ""
+    where = ("while holding θ_dem after T_m" if m.chatter_phase == "hold"
              else "during the cruise")
-    return (f"Chatter ({NAMES[run.controller]}): the demanded acceleration switches{at} {where} — "
+    return (f"Chatter ({LABELS[run.controller]}): the demanded acceleration switches{at} {where} — "
             f"a limit cycle of the sliding-mode loop at this K and T_c.{_chatter_hint(derived)}")
 
 
@@ -74,17 +72,17 @@ def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
     list of str
         One message per limit exceeded.
     """
-    m, motor, name = run.metrics, derived.params.motor, NAMES[run.controller]
+    m, motor, name = run.metrics, derived.params.motor, LABELS[run.controller]
     out: list[str] = []
-    torque, volts, speed = m.get("torque_peak_Nm"), m.get("u_peak_V"), m.get("omega_peak_rad_s")
+    torque, volts, speed = m.torque_peak_Nm, m.u_peak_V, m.omega_peak_rad_s
     u_avail = available_voltage(motor)
-    if isinstance(torque, float) and torque > motor.Gamma_max:
+    if torque is not None and torque > motor.Gamma_max:
         out.append(f"Not feasible on the real drive ({name}): peak torque {torque:.4g} N·m > "
                    f"Γ_max = {motor.Gamma_max:g} N·m.")
-    if isinstance(volts, float) and volts > u_avail:
+    if volts is not None and volts > u_avail:
         out.append(f"Not feasible on the real drive ({name}): peak |u_dq| {volts:.4g} V > "
                    f"{u_avail:.4g} V available (√(2/3)·V_0).")
-    if isinstance(speed, float) and speed > motor.omega_b:
+    if speed is not None and speed > motor.omega_b:
         out.append(f"Not feasible on the real drive ({name}): peak speed {speed:.4g} rad/s > "
                    f"ω_b = {motor.omega_b:g} rad/s.")
     return out
@@ -98,11 +96,11 @@ TARGET_BAND = {"fdsmc": 0.02, "conventional": 0.05}
 
 def _target_missed(run: RunResult) -> str | None:
     """Warning when a stable run is outside its band around θ_dem at T_m, else None."""
-    err, dem = run.metrics.get("theta_error_at_Tm_rad"), run.metrics.get("theta_dem_rad")
+    err, dem = run.metrics.theta_error_at_Tm_rad, run.metrics.theta_dem_rad
     band = TARGET_BAND[run.controller]
-    if not isinstance(err, float) or not isinstance(dem, float) or abs(err) <= band * abs(dem):
+    if err is None or abs(err) <= band * abs(dem):
         return None
-    return (f"Target missed ({NAMES[run.controller]}): position error {err:.4g} rad at T_m is outside "
+    return (f"Target missed ({LABELS[run.controller]}): position error {err:.4g} rad at T_m is outside "
             f"the {100 * band:g} % band of θ_dem = {dem:g} rad; the energy comparison is between "
             "unequal manoeuvres.")
 
@@ -118,11 +116,11 @@ def run_warnings(comparison: Comparison) -> list[str]:
     for run in (comparison.fdsmc, comparison.conventional):
         if run is None:
             continue
-        m, name = run.metrics, NAMES[run.controller]
-        if m.get("stable") is False:
-            out.append(f"Unstable run ({name}): {m.get('reason') or 'diverged'}.")
+        m, name = run.metrics, LABELS[run.controller]
+        if not m.stable:
+            out.append(f"Unstable run ({name}): {m.reason or 'diverged'}.")
             continue
-        if m.get("chatter"):
+        if m.chatter:
             out.append(_chatter(run, comparison.derived))
         miss = _target_missed(run)
         if miss:
@@ -133,9 +131,9 @@ def run_warnings(comparison: Comparison) -> list[str]:
 
 
 def _saturation(run: RunResult) -> list[str]:
-    sat = run.metrics.get("saturated_s")
-    if isinstance(sat, float) and sat > 0.0:
-        return [f"Saturation ({NAMES[run.controller]}): voltage/current limited for {sat:.4g} s."]
+    sat = run.metrics.saturated_s
+    if sat > 0.0:
+        return [f"Saturation ({LABELS[run.controller]}): voltage/current limited for {sat:.4g} s."]
     return []
 
 
@@ -145,7 +143,7 @@ def comparator_notes(comparison: Comparison) -> list[str]:
     Its energy is then not a fair baseline for the saving.
     """
     run = comparison.conventional
-    if run is None or run.metrics.get("stable") is False:
+    if run is None or not run.metrics.stable:
         return []
     issues = _saturation(run) + limit_warnings(run, comparison.derived)
     if not issues:
@@ -162,15 +160,15 @@ def _saving_verdicts(comparison: Comparison) -> list[str]:
     saving, bound = comparison.saving_friction_pct, comparison.derived.energy.bound_pct
     if saving is None:
         never = [r for r in (comparison.fdsmc, comparison.conventional)
-                 if r is not None and r.metrics["stable"] and not reached_target(r)]
+                 if r is not None and r.metrics.stable and not reached_target(r)]
         if never:
-            return [f"Saving not comparable: {', '.join(NAMES[r.controller] for r in never)} never reached the "
+            return [f"Saving not comparable: {', '.join(LABELS[r.controller] for r in never)} never reached the "
                     "2 % band around θ_dem, so no saving is given."]
         return []
     out: list[str] = []
     missed = [r for r in (comparison.fdsmc, comparison.conventional) if r is not None and _target_missed(r)]
     if missed:
-        out.append(f"Saving not comparable: {', '.join(NAMES[r.controller] for r in missed)} did not arrive "
+        out.append(f"Saving not comparable: {', '.join(LABELS[r.controller] for r in missed)} did not arrive "
                    f"by T_m, so the {saving:.4g} % friction saving compares unequal manoeuvres.")
     elif saving > bound + 0.05:
         out.append(f"Saving {saving:.4g} % exceeds the theoretical bound {bound:.4g} % of eq. (53): the moves "

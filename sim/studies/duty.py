@@ -75,7 +75,7 @@ def duty_cycle(params: DriveParams, moves: Sequence[Move]) -> DutyResult:
         row: dict[str, float | None] = {}
         for c in COMPARATORS:
             run = getattr(cmp, c)
-            w = run.metrics.get("electrical_in_total_J") if run is not None and run.metrics["stable"] else None
+            w = run.metrics.electrical_in_total_J if run is not None and run.metrics.stable else None
             row[c] = float(w) + hold if isinstance(w, float) else None
         per_move.append(row)
     total = {c: (None if any(r[c] is None for r in per_move) else float(sum(r[c] for r in per_move)))  # type: ignore[misc]

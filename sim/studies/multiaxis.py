@@ -32,14 +32,14 @@ class AxisResult:
         """FDSMC net electrical input over the whole run [J] of ``fastest`` or ``common``."""
         cmp = getattr(self, which).comparison
         run = cmp.fdsmc if cmp is not None else None
-        v = run.metrics.get("electrical_in_total_J") if run is not None else None
+        v = run.metrics.electrical_in_total_J if run is not None else None
         return float(v) if isinstance(v, float) else None
 
     @property
     def theta_error_at_Tm_rad(self) -> float | None:
         """Position error at the common T_m [rad]."""
         cmp = self.common.comparison
-        v = cmp.fdsmc.metrics.get("theta_error_at_Tm_rad") if cmp is not None and cmp.fdsmc else None
+        v = cmp.fdsmc.metrics.theta_error_at_Tm_rad if cmp is not None and cmp.fdsmc else None
         return float(v) if isinstance(v, float) else None
 
     @property

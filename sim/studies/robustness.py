@@ -101,11 +101,10 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
     out: dict[str, dict[str, Any]] = {}
     for run in (cmp.fdsmc, cmp.conventional):
         assert run is not None
-        m = dict(run.metrics)
-        err = m["theta_error_at_Tm_rad"]
-        m["theta_error_abs_at_Tm_rad"] = abs(err) if isinstance(err, float) else None
-        peak = m["torque_peak_Nm"]
-        m["infeasible"] = not m["stable"] or (isinstance(peak, float) and peak > lim * (1.0 + LIMIT_TOLERANCE))
+        m: dict[str, Any] = dataclasses.asdict(run.metrics)
+        err, peak = run.metrics.theta_error_at_Tm_rad, run.metrics.torque_peak_Nm
+        m["theta_error_abs_at_Tm_rad"] = None if err is None else abs(err)
+        m["infeasible"] = not run.metrics.stable or (peak is not None and peak > lim * (1.0 + LIMIT_TOLERANCE))
         out[run.controller] = {k: m[k] for k in (*METRICS, "chatter", "stable", "infeasible")}
     out["fdsmc"]["saving_friction_pct"] = cmp.saving_friction_pct
     return out

@@ -47,7 +47,7 @@ def test_default_page_is_a_clean_real_servo_design(page, default_server):
     cmp = _latest(default_server).comparison
     motor = cmp.derived.params.motor
     assert motor.Gamma_max == 15.0  # the Siemens 1FT7044 preset, not the paper's drive
-    assert cmp.fdsmc.metrics["torque_peak_Nm"] <= 15.0 * 1.005
+    assert cmp.fdsmc.metrics.torque_peak_Nm <= 15.0 * 1.005
 
 
 def test_design_button_turns_a_typed_catalogue_servo_clean(page, default_server):
@@ -73,6 +73,6 @@ def test_design_button_turns_a_typed_catalogue_servo_clean(page, default_server)
     assert p.motor.psi_pm == pytest.approx(0.544 / (1.5 * 2 ** 0.5 * 5), rel=1e-12)
     assert p.controller.alpha_max_rule == "torque_limit" and p.controller.K < 1.0
     m = session.comparison.fdsmc.metrics
-    assert m["torque_peak_Nm"] <= 4.46 * 1.005 and not m["chatter"]
-    assert m["i_q_peak_A"] <= 13.15 * 1.005
+    assert m.torque_peak_Nm <= 4.46 * 1.005 and not m.chatter
+    assert m.i_q_peak_A <= 13.15 * 1.005
     assert float(field(page, "K boundary-layer gain [s/rad]").input_value()) == pytest.approx(p.controller.K, rel=1e-9)
