@@ -12,7 +12,8 @@ from app.exports.model import trace_csv
 from app.io.derived_view import derived_json
 from app.io.plant_overrides import load_model_and_plant
 from control.fdsmc.params import ParameterError
-from sim.fdsmc.engine import Comparison, RunResult, compare
+from sim.fdsmc.engine import Comparison, compare
+from sim.fdsmc.optimum_gap import OPTIMUM_BASIS, saving_vs_optimum
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
@@ -39,6 +40,10 @@ SUMMARY = (
 )
 
 
+__all__ = ["OPTIMUM_BASIS", "add_arguments", "comparison_json", "finite_or_none", "print_summary", "run",
+           "saving_vs_optimum", "write_csv"]
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``simulate``."""
     add_preset_arguments(p)
@@ -58,21 +63,6 @@ def finite_or_none(value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
-
-
-#: Energy compared with the optimum: the net electrical input over the whole simulated horizon.
-OPTIMUM_BASIS = "electrical_in_total_J"
-
-
-def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float | None:
-    """100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save
-    (W = net electrical input over the whole horizon); None unless both runs are stable."""
-    if run is None or optimum is None or not (run.metrics["stable"] and optimum.metrics["stable"]):
-        return None
-    w, w_opt = run.metrics[OPTIMUM_BASIS], optimum.metrics[OPTIMUM_BASIS]
-    if not isinstance(w, float) or not isinstance(w_opt, float) or w <= 0.0:
-        return None
-    return 100.0 * (1.0 - w_opt / w)
 
 
 def comparison_json(cmp: Comparison) -> dict[str, Any]:
