@@ -96,7 +96,7 @@ def robustness_spec(result: RobustnessResult, torque_limit_Nm: float) -> dict[st
     values = sample_values(result, torque_limit_Nm)
     data: list[dict[str, Any]] = []
     layout = _grid_axes(2, 2)
-    notes = []
+    drawn: dict[str, dict[str, int]] = {}
     for k, (key, title, unit, _) in enumerate(PANELS):
         sfx = "" if k == 0 else str(k + 1)
         series = values[key]
@@ -109,12 +109,15 @@ def robustness_spec(result: RobustnessResult, torque_limit_Nm: float) -> dict[st
                          "marker": {"color": COLOURS[ctrl]}, "xaxis": f"x{sfx}", "yaxis": f"y{sfx}",
                          "meta": {"panel": key, "controller": ctrl},
                          "hovertemplate": f"%{{x:.4g}} {unit}: %{{y}} samples<extra>{name}</extra>"})
-        layout[f"xaxis{sfx}"]["title"] = {"text": f"{title} [{unit}]"}
-        notes.append(key)
+        n = len(result.runs)
+        missing = max(n - int(c.sum()) for c in counts)
+        layout[f"xaxis{sfx}"]["title"] = {"text": f"{title} [{unit}]" + (
+            f" — {missing} of {n} samples without a value" if missing else "")}
+        drawn[key] = {ctrl: int(c.sum()) for ctrl, c in zip(series, counts, strict=True)}
     n = len(result.runs)
     return {"data": data, "layout": {
         **layout, "barmode": "overlay", "template": "plotly_white", "meta": {"id": "robustness", "samples": n,
-                                                                             "panels": notes},
+                                                                             "drawn": drawn},
         "title": {"text": f"Robustness — {n} sampled plants (controller designed on the nominal model)", "x": 0.01},
         "margin": {"l": 60, "r": 16, "t": 40, "b": 50}, "legend": {"orientation": "h", "y": -0.12},
         "font": {"size": 11}}}

@@ -103,6 +103,7 @@ class RobustnessView:
         self.run_button.on_click(lambda _: self.start())
         self.cancel_button.on_click(lambda _: self.cancel())
         self._done = 0
+        self.result: RobustnessResult | None = None
 
     def start(self) -> bool:
         """Check the inputs and the budget, then run the study on the session's worker; False if refused."""
@@ -176,6 +177,7 @@ class RobustnessView:
 
     def show(self, result: RobustnessResult, torque_limit_Nm: float) -> None:
         """Draw the histograms and the summary table of a finished study."""
+        self.result = result
         set_figure_json(self.figure, figure_json(robustness_spec(result, torque_limit_Nm)))
         self.table.content = robustness_table_markdown(result.summary)
         with contextlib.suppress(Exception):
