@@ -79,12 +79,12 @@ def histogram(values: Sequence[np.ndarray], n_bins: int = N_BINS) -> tuple[np.nd
 
 def _grid_axes(n_rows: int, n_cols: int, gap: float = 0.1) -> dict[str, Any]:
     """Layout axes of an ``n_rows`` × ``n_cols`` grid of subplots, numbered row by row."""
-    w, h = (1.0 - gap * (n_cols - 1)) / n_cols, (1.0 - gap * 1.3 * (n_rows - 1)) / n_rows
+    w, h = (1.0 - gap * (n_cols - 1)) / n_cols, (1.0 - gap * 2.0 * (n_rows - 1)) / n_rows
     out: dict[str, Any] = {}
     for k in range(n_rows * n_cols):
         r, c = divmod(k, n_cols)
         sfx = "" if k == 0 else str(k + 1)
-        x0, y1 = c * (w + gap), 1.0 - r * (h + 1.3 * gap)
+        x0, y1 = c * (w + gap), 1.0 - r * (h + 2.0 * gap)
         out[f"xaxis{sfx}"] = {"domain": [round(x0, 9), round(x0 + w, 9)], "anchor": f"y{sfx}"}
         out[f"yaxis{sfx}"] = {"domain": [round(max(y1 - h, 0.0), 9), round(y1, 9)], "anchor": f"x{sfx}",
                               "title": {"text": "samples"} if c == 0 else {}}
@@ -97,6 +97,7 @@ def robustness_spec(result: RobustnessResult, torque_limit_Nm: float) -> dict[st
     data: list[dict[str, Any]] = []
     layout = _grid_axes(2, 2)
     drawn: dict[str, dict[str, int]] = {}
+    notes: list[dict[str, Any]] = []
     for k, (key, title, unit, _) in enumerate(PANELS):
         sfx = "" if k == 0 else str(k + 1)
         series = values[key]
@@ -111,15 +112,18 @@ def robustness_spec(result: RobustnessResult, torque_limit_Nm: float) -> dict[st
                          "hovertemplate": f"%{{x:.4g}} {unit}: %{{y}} samples<extra>{name}</extra>"})
         n = len(result.runs)
         missing = max(n - int(c.sum()) for c in counts)
-        layout[f"xaxis{sfx}"]["title"] = {"text": f"{title} [{unit}]" + (
-            f" — {missing} of {n} samples without a value" if missing else "")}
+        dom_x, dom_y = layout[f"xaxis{sfx}"]["domain"], layout[f"yaxis{sfx}"]["domain"]
+        notes.append({"text": f"{title} [{unit}]" + (f"<br>({missing} of {n} samples without a value)"
+                                                       if missing else ""),
+                      "x": 0.5 * (dom_x[0] + dom_x[1]), "y": dom_y[1], "xref": "paper", "yref": "paper",
+                      "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11}})
         drawn[key] = {ctrl: int(c.sum()) for ctrl, c in zip(series, counts, strict=True)}
     n = len(result.runs)
     return {"data": data, "layout": {
-        **layout, "barmode": "overlay", "template": "plotly_white", "meta": {"id": "robustness", "samples": n,
-                                                                             "drawn": drawn},
+        **layout, "annotations": notes, "barmode": "overlay", "template": "plotly_white",
+        "meta": {"id": "robustness", "samples": n, "drawn": drawn},
         "title": {"text": f"Robustness — {n} sampled plants (controller designed on the nominal model)", "x": 0.01},
-        "margin": {"l": 60, "r": 16, "t": 40, "b": 50}, "legend": {"orientation": "h", "y": -0.12},
+        "margin": {"l": 60, "r": 16, "t": 70, "b": 40}, "legend": {"orientation": "h", "y": -0.08},
         "font": {"size": 11}}}
 
 
