@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -20,6 +22,7 @@ from app.io.presets import load_preset
 from app.ui.studies import optimum_markdown
 from app.ui.studies_multiaxis import axis_line, check_axes, default_axes, parse_page_axes
 from app.ui.studies_robustness import STUDY_MAX_STEPS, check_study, parse_page_spreads
+from app.ui.text import md_text
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.params import ParameterError
 from sim.common.budget import BudgetError
@@ -151,9 +154,13 @@ def test_page_axes_are_the_cli_list_restricted_to_shipped_presets():
     assert check_axes(axes, 0.0) is None and check_axes(axes, 2.0) == 2.0
 
 
-def test_multiaxis_figure_shows_every_axis_arriving_at_the_common_time():
-    axes = parse_page_axes(default_axes(PRESETS), PRESETS)
-    res = coordinate(axes)
+@pytest.fixture(scope="module")
+def coordinated():
+    return coordinate(parse_page_axes(default_axes(PRESETS), PRESETS))
+
+
+def test_multiaxis_figure_shows_every_axis_arriving_at_the_common_time(coordinated):
+    res = coordinated
     spec = multiaxis_spec(res)
     band = TARGET_BAND["fdsmc"]
     positions = [t for t in spec["data"] if t["yaxis"] == "y"]
@@ -165,3 +172,12 @@ def test_multiaxis_figure_shows_every_axis_arriving_at_the_common_time():
     md = multiaxis_table_markdown(res)
     assert md.count("| yes |") == len(res.axes) and f"{res.T_m:.4g} s" in md
     to_figure(spec)
+
+
+def test_axis_names_are_shown_as_text_not_markup(coordinated):
+    evil = "<img src=x onerror=alert(1)>|**bold**"
+    res = dataclasses.replace(coordinated, axes=(dataclasses.replace(coordinated.axes[0], name=evil),))
+    md = multiaxis_table_markdown(res, md_text)
+    assert "<img" not in md and "**bold**" not in md and "&lt;img" in md
+    spec = multiaxis_spec(res)
+    assert spec["data"][0]["name"].startswith("&lt;img") and spec["layout"]["meta"]["names"][0].startswith("&lt;")

@@ -8,8 +8,9 @@ binned here (numpy) and drawn as bars, so the figure carries counts, not every s
 
 from __future__ import annotations
 
+import html
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -190,7 +191,8 @@ def multiaxis_spec(result: MultiAxisResult) -> dict[str, Any]:
         i = stride_index(len(tr.t), MAX_POINTS_TIME)
         colour = AXIS_COLOURS[k % len(AXIS_COLOURS)]
         for ax, y in (("", tr.theta_r[i] / th), ("2", tr.omega_r[i])):
-            data.append({"type": "scatter", **time_axis(tr.t[i]), "y": f32(y), "mode": "lines", "name": a.name,
+            data.append({"type": "scatter", **time_axis(tr.t[i]), "y": f32(y), "mode": "lines",
+                         "name": html.escape(a.name),
                          "legendgroup": a.name, "showlegend": ax == "", "line": {"color": colour, "width": 2},
                          "xaxis": f"x{ax}", "yaxis": f"y{ax}"})
         err = a.theta_error_at_Tm_rad
@@ -208,7 +210,7 @@ def multiaxis_spec(result: MultiAxisResult) -> dict[str, Any]:
         "yaxis2": {"domain": [0.0, 0.46], "title": {"text": "ω_r [rad/s]"}},
         "shapes": shapes, "template": "plotly_white", "hovermode": "x unified",
         "meta": {"id": "multiaxis", "T_m": result.T_m, "band": band, "theta_error_frac_at_T_m": errors,
-                 "names": [a.name for a in result.axes]},
+                 "names": [html.escape(a.name) for a in result.axes]},
         "title": {"text": f"Axes finishing together at T_m = {result.T_m:.4g} s (band ±{100 * band:g} % of θ_dem)",
                   "x": 0.01},
         "margin": {"l": 60, "r": 16, "t": 40, "b": 40}, "legend": {"orientation": "h", "y": -0.12},
@@ -229,8 +231,9 @@ def make_multiaxis_figure(result: MultiAxisResult) -> go.Figure:
     return to_figure(multiaxis_spec(result))
 
 
-def multiaxis_table_markdown(result: MultiAxisResult) -> str:
-    """Markdown table per axis: own shortest T_m, energies at it and at the common T_m, arrival."""
+def multiaxis_table_markdown(result: MultiAxisResult, text: Callable[[str], str] = str) -> str:
+    """Markdown table per axis: own shortest T_m, energies at it and at the common T_m, arrival.
+    ``text`` makes the user's axis names safe to show (the page passes :func:`app.ui.text.md_text`)."""
     rows = ["| axis | own shortest T_m [s] | W at own T_m [J] | W at common T_m [J] | θ error at T_m [rad] | arrived |",
             "|---|---|---|---|---|---|"]
     tot_own, tot_com = 0.0, 0.0
@@ -238,7 +241,7 @@ def multiaxis_table_markdown(result: MultiAxisResult) -> str:
         own, com = a.energy("fastest"), a.energy("common")
         tot_own += own if own is not None else math.nan
         tot_com += com if com is not None else math.nan
-        rows.append(f"| {a.name} | {a.fastest.params.manoeuvre.T_m:.4g} | {_cell(own)} | {_cell(com)} | "
+        rows.append(f"| {text(a.name)} | {a.fastest.params.manoeuvre.T_m:.4g} | {_cell(own)} | {_cell(com)} | "
                     f"{_cell(a.theta_error_at_Tm_rad)} | {'yes' if a.arrived else '**no**'} |")
     rows.append(f"| **total** | | {_cell(tot_own)} | {_cell(tot_com)} | | |")
     return (f"**Common T_m = {result.T_m:.4g} s** (the longest of the axes' shortest feasible times, or the "

@@ -18,6 +18,7 @@ from app.io.preset_modes import list_presets_of
 from app.io.presets import MAX_BYTES, loads_raw
 from app.io.study_inputs import parse_axes
 from app.ui.replay import set_figure_json
+from app.ui.text import md_text
 from control.fdsmc.params import DriveParams, ParameterError
 from sim.fdsmc.engine import check_budget
 from sim.studies.multiaxis import MultiAxisResult, coordinate
@@ -60,8 +61,9 @@ def parse_page_axes(text: str, presets: tuple[str, ...]) -> list[tuple[str, Driv
 
 def check_axes(axes: list[tuple[str, DriveParams]], T_m: float) -> float | None:
     """The requested common T_m [s] (None for 0 = the shortest all can do) once every axis fits the budget."""
-    if not 0.0 <= T_m <= MAX_T_M:
-        raise ParameterError(f"Multi-axis › common T_m = {T_m:g} s is out of range: allowed 0 (the shortest "
+    if isinstance(T_m, bool) or not isinstance(T_m, int | float) or not 0.0 <= T_m <= MAX_T_M:
+        shown = f"{T_m:g}" if isinstance(T_m, int | float) else repr(T_m)
+        raise ParameterError(f"Multi-axis › common T_m = {shown} s is out of range: allowed 0 (the shortest "
                              f"all axes can do) or 0 < T_m ≤ {MAX_T_M:g} s")
     for name, p in axes:
         try:
@@ -98,10 +100,14 @@ class MultiAxisView:
         self.run_button.on_click(lambda _: self.start())
 
     def _add_axis(self) -> None:
-        theta = self.add_theta.value
-        line = axis_line(self.add_preset.value, self.add_name.value.strip() or "axis",
+        theta, preset = self.add_theta.value, self.add_preset.value
+        if preset not in self._presets:  # a value the dropdown never offered
+            self._s.client.add_notification("Axis not added", f"Axis preset {preset!r} is not allowed: one of "
+                                            + ", ".join(self._presets), color="red", auto_close_seconds=12.0)
+            return
+        line = axis_line(preset, str(self.add_name.value).strip() or "axis",
                          float(theta) if isinstance(theta, int | float) and theta != 0 else None)
-        text = self.axes.value
+        text = str(self.axes.value)
         self.axes.value = text + ("" if not text or text.endswith("\n") else "\n") + line
 
     def _uploaded(self) -> None:
@@ -119,10 +125,10 @@ class MultiAxisView:
     def start(self) -> bool:
         """Parse and check the axes, then coordinate them on the session's worker; False if refused."""
         try:
-            axes = parse_page_axes(self.axes.value, self._presets)
-            T_m = check_axes(axes, float(self.T_m.value))
+            axes = parse_page_axes(str(self.axes.value), self._presets)
+            T_m = check_axes(axes, self.T_m.value)
         except ParameterError as exc:
-            self.status.content = f"**Not started:** {exc}"
+            self.status.content = f"**Not started:** {md_text(exc)}"
             self._s.client.add_notification("Multi-axis move not started", str(exc), color="red",
                                             auto_close_seconds=12.0)
             return False
@@ -135,7 +141,7 @@ class MultiAxisView:
             result = coordinate(axes, T_m)
             self._s.worker.checkpoint()
         except ParameterError as exc:
-            self.status.content = f"**Failed:** {exc}"
+            self.status.content = f"**Failed:** {md_text(exc)}"
             self._s.client.add_notification("Multi-axis move failed", str(exc), color="red", auto_close_seconds=12.0)
             self._s.status.content = "Ready — the multi-axis move failed (see its tab)."
             return
@@ -146,7 +152,7 @@ class MultiAxisView:
 
     def show(self, result: MultiAxisResult) -> None:
         """Draw the per-axis table and the axes' motion."""
-        self.table.content = multiaxis_table_markdown(result)
+        self.table.content = multiaxis_table_markdown(result, md_text)
         set_figure_json(self.figure, figure_json(multiaxis_spec(result)))
         arrived = sum(a.arrived for a in result.axes)
         self.status.content = f"Done: {arrived} of {len(result.axes)} axes arrived at T_m = {result.T_m:.4g} s."

@@ -22,6 +22,7 @@ from app.figures.plain import figure_json
 from app.figures.studies import robustness_spec, robustness_table_markdown
 from app.io.study_inputs import parse_spread
 from app.ui.replay import set_figure_json
+from app.ui.text import md_text
 from app.ui.worker import Cancelled
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.params import DriveParams, ParameterError
@@ -52,7 +53,7 @@ def parse_page_spreads(texts: dict[str, str]) -> list[Spread]:
     """The typed spreads (label → text) as :class:`Spread` s; ParameterError naming the field."""
     out: list[Spread] = []
     for label, fields, _ in SPREAD_FIELDS:
-        text = texts.get(label, "").strip()
+        text = str(texts.get(label, "")).strip()
         if not text:
             continue
         for f in fields:
@@ -69,6 +70,9 @@ def check_study(params: DriveParams, samples: float, seed: float) -> tuple[int, 
     One sample (both controllers) must fit the single-request budget (the message names the drive's
     fields), and all samples together :data:`STUDY_MAX_STEPS`.
     """
+    for label, v in (("samples", samples), ("seed", seed)):
+        if isinstance(v, bool) or not isinstance(v, int | float) or v != v:
+            raise ParameterError(f"Robustness › {label} = {v!r} is not a number: allowed a whole number")
     if not float(samples).is_integer() or not 1 <= samples <= MAX_SAMPLES:
         raise ParameterError(f"Robustness › samples = {samples:g} is out of range: allowed a whole number "
                              f"1 … {MAX_SAMPLES}")
@@ -124,7 +128,7 @@ class RobustnessView:
         return True
 
     def _refuse(self, message: str) -> None:
-        self.status.content = f"**Not started:** {message}"
+        self.status.content = f"**Not started:** {md_text(message)}"
         self._s.client.add_notification("Robustness study not started", message, color="red",
                                         auto_close_seconds=12.0)
 
@@ -154,7 +158,7 @@ class RobustnessView:
                 self.status.content = (f"**Cancelled** after {self._done} of {samples} samples; the remaining "
                                        "work was cancelled and the pool shut down.")
                 raise Cancelled(str(exc)) from None
-            self.status.content = f"**Failed:** {exc}"
+            self.status.content = f"**Failed:** {md_text(exc)}"
             self._s.client.add_notification("Robustness study failed", str(exc), color="red", auto_close_seconds=12.0)
             self._s.status.content = "Ready — the robustness study failed (see its tab)."
             return
