@@ -3,7 +3,7 @@
 * :class:`OptimumToggle` (left panel): when ticked, every Simulate also runs the tracked
   minimum-energy optimum (:mod:`control.fdsmc.optimum`), drawn as a third trajectory, time-plot
   line and energy bar, and the share of each controller's energy it would save is shown.
-* :class:`StudiesSection` adds the "Robustness" and "Multi-axis" result tabs
+* :class:`StudiesSection` adds the "Studies" result tab with its "Robustness" and "Multi-axis" tabs
   (:mod:`app.ui.studies_robustness`, :mod:`app.ui.studies_multiaxis`). Their runs go to the
   session's worker like every Simulate (one job per client at a time) and can be cancelled.
 """
@@ -56,7 +56,7 @@ class OptimumToggle:
 
 
 class StudiesSection:
-    """The "Robustness" and "Multi-axis" tabs of a session's results panel.
+    """The "Studies" tab of a session's results panel: "Robustness" and "Multi-axis".
 
     ``session`` provides ``client``, ``worker``, ``submit(fn)``, ``params`` (the simulated inputs)
     and ``status`` (the session's status line).
@@ -64,10 +64,12 @@ class StudiesSection:
 
     def __init__(self, session: Any) -> None:
         panel = session.results.panel
-        with panel.add_tab("Robustness", viser.Icon.CHART_HISTOGRAM):
-            self.robustness = RobustnessView(session)
-        with panel.add_tab("Multi-axis", viser.Icon.ARROWS_MAXIMIZE):
-            self.multiaxis = MultiAxisView(session)
+        with panel.add_tab("Studies", viser.Icon.FLASK):  # one tab: the results' tab row stays one line
+            tabs = session.client.gui.add_tab_group()
+            with tabs.add_tab("Robustness", viser.Icon.CHART_HISTOGRAM):
+                self.robustness = RobustnessView(session)
+            with tabs.add_tab("Multi-axis", viser.Icon.ARROWS_MAXIMIZE):
+                self.multiaxis = MultiAxisView(session)
 
 
 __all__ = ["OptimumToggle", "StudiesSection", "optimum_markdown"]

@@ -39,7 +39,12 @@ ARRIVAL_JS = """() => {
 
 
 def _open_tab(page: Any, name: str) -> None:
-    page.get_by_role("tab", name=name).click()
+    """Select a results tab (the studies' tabs sit inside "Studies"). The click is dispatched to the
+    tab itself: viser's "software WebGL" notice, shown in headless Chromium, may cover the tab row."""
+    for label in (("Studies", name) if name in ("Robustness", "Multi-axis") else (name,)):
+        tab = page.get_by_role("tab", name=label)
+        tab.dispatch_event("click")
+        page.wait_for_function("(el) => el.getAttribute('aria-selected') === 'true'", arg=tab.element_handle())
 
 
 def _session(ui_server: Any, page: Any) -> Any:
@@ -94,6 +99,7 @@ def test_robustness_run_progress_reaches_100_and_draws_histograms(page, ui_serve
 def test_cancel_stops_a_large_robustness_run(page, ui_server):
     _open_tab(page, "Robustness")
     set_number(page, "Samples", 5000)
+    before = set(multiprocessing.active_children())
     page.get_by_role("button", name="Run robustness study").click()
     page.get_by_text(re.compile(r"Running: \d+ of 5000 samples")).wait_for(timeout=90_000)
     page.get_by_role("button", name="Cancel robustness study").click()
@@ -103,7 +109,7 @@ def test_cancel_stops_a_large_robustness_run(page, ui_server):
     assert done < 5000
     session = _session(ui_server, page)
     assert not session.worker.busy  # the job has ended …
-    assert multiprocessing.active_children() == []  # … and the pool's processes are gone
+    assert set(multiprocessing.active_children()) <= before  # … and the pool's processes are gone
     assert page.evaluate(PROGRESS_JS) < 100
     assert session.studies.robustness.progress.value < 100
     page.get_by_text("Cancelled — the previous results are kept.").wait_for()
