@@ -39,12 +39,12 @@ ARRIVAL_JS = """() => {
 
 
 def _open_tab(page: Any, name: str) -> None:
-    """Select a results tab (the studies' tabs sit inside "Studies"). The click is dispatched to the
-    tab itself: viser's "software WebGL" notice, shown in headless Chromium, may cover the tab row."""
+    """Select a results tab (the studies' tabs sit inside "Studies"). Viser's "software WebGL" notice,
+    shown in headless Chromium, may cover the tab row: notifications let clicks through first."""
+    page.add_style_tag(content=".mantine-Notifications-root, .mantine-Notifications-root * "
+                               "{ pointer-events: none !important; }")
     for label in (("Studies", name) if name in ("Robustness", "Multi-axis") else (name,)):
-        tab = page.get_by_role("tab", name=label)
-        tab.dispatch_event("click")
-        page.wait_for_function("(el) => el.getAttribute('aria-selected') === 'true'", arg=tab.element_handle())
+        page.get_by_role("tab", name=label).click()
 
 
 def _session(ui_server: Any, page: Any) -> Any:
