@@ -15,12 +15,12 @@ from pathlib import Path
 from typing import Any
 
 from app.io.json_data import to_json
-from app.io.presets import load_preset, loads_raw
+from app.io.presets import loads_raw
+from app.io.study_inputs import MAX_AXES, parse_axes
 from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
 from sim.studies.multiaxis import MultiAxisResult, coordinate
 
-MAX_AXES = 16
+__all__ = ["MAX_AXES", "add_arguments", "multiaxis_json", "parse_axes", "run"]
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -29,29 +29,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--T-m", dest="T_m", type=float, default=None,
                    help="requested common manoeuvre time [s] (default: the shortest all axes can do)")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
-
-
-def parse_axes(raw: Any, origin: str) -> list[tuple[str, DriveParams]]:
-    """Parse the YAML list into (name, params) per axis, with clear messages for a bad entry."""
-    if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_AXES:
-        raise ParameterError(f"{origin}: expected a YAML list of 1 … {MAX_AXES} axes")
-    axes = []
-    for i, item in enumerate(raw):
-        where = f"{origin}: axis {i + 1}"
-        if not isinstance(item, dict) or not isinstance(item.get("preset"), str):
-            raise ParameterError(f"{where}: expected a mapping with 'preset: NAME' (and optional set, name)")
-        unknown = set(item) - {"preset", "set", "name"}
-        if unknown:
-            raise ParameterError(f"{where}: unknown key(s) {', '.join(sorted(map(str, unknown)))}: "
-                                 "allowed preset, set, name")
-        sets = item.get("set", [])
-        if not isinstance(sets, list) or not all(isinstance(s, str) for s in sets):
-            raise ParameterError(f"{where}: 'set' must be a list of SECTION.FIELD=VALUE strings")
-        params = load_preset(item["preset"], sets)
-        if not isinstance(params, DriveParams):
-            raise ParameterError(f"{where}: preset {item['preset']!r} is not a position drive")
-        axes.append((str(item.get("name", f"axis {i + 1}")), params))
-    return axes
 
 
 def multiaxis_json(res: MultiAxisResult) -> dict[str, Any]:

@@ -20,12 +20,14 @@ from typing import Any
 
 from app.cli.main import add_preset_arguments
 from app.io.json_data import to_json
-from app.io.plant_overrides import load_model_and_plant, plant_section
+from app.io.plant_overrides import load_model_and_plant
+from app.io.study_inputs import parse_spread, parse_spreads
 from control.common.checks import ParameterError
-from sim.studies.robustness import MAX_NORMAL_SIGMA, METRICS, RobustnessResult, Spread, robustness
+from sim.studies.robustness import METRICS, RobustnessResult, robustness
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
 MAX_SAMPLES = 1_000_000
+__all__ = ["add_arguments", "parse_spread", "parse_spreads", "run", "write_csv"]
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -42,47 +44,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"Dask scheduler address tcp://HOST:PORT (or ${SCHEDULER_ENV})")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--csv", metavar="FILE", help="write one row per sample (drawn values and metrics)")
-
-
-def _number(text: str, item: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise ParameterError(f"--spread {item!r}: {text!r} is not a number") from None
-    if v != v or v in (float("inf"), float("-inf")):
-        raise ParameterError(f"--spread {item!r}: {text!r} is not a finite number")
-    return v
-
-
-def parse_spread(item: str) -> Spread:
-    """One ``plant.FIELD=DIST`` item → :class:`Spread` (see the module docstring)."""
-    key, sep, dist = item.strip().partition("=")
-    if not sep or not key.startswith("plant."):
-        raise ParameterError(f"--spread {item!r} is not allowed: the form is plant.FIELD=DIST")
-    field, dist = key[len("plant."):], dist.strip()
-    section = plant_section(field)
-    if dist.startswith(("±", "+-", "~")) and dist.endswith("%"):
-        x = _number(dist.lstrip("±+-~")[:-1], item) / 100.0
-        if dist.startswith("~"):
-            if not 0.0 <= x <= MAX_NORMAL_SIGMA:
-                raise ParameterError(f"--spread {item!r}: σ = {100 * x:g} % is not allowed: 0 … "
-                                     f"{100 * MAX_NORMAL_SIGMA:g} %")
-            return Spread(section, field, "normal", 0.0, x)
-        if not 0.0 <= x < 1.0:
-            raise ParameterError(f"--spread {item!r}: ±{100 * x:g} % is not allowed: 0 … <100 %")
-        return Spread(section, field, "relative", -x, x)
-    lo, colon, hi = dist.partition(":")
-    if not colon:
-        raise ParameterError(f"--spread {item!r}: {dist!r} is not allowed: LO:HI, ±X% or ~X%")
-    a, b = _number(lo, item), _number(hi, item)
-    if b < a:
-        raise ParameterError(f"--spread {item!r}: the range {a:g}:{b:g} is not allowed: LO ≤ HI")
-    return Spread(section, field, "uniform", a, b)
-
-
-def parse_spreads(items: list[str]) -> list[Spread]:
-    """All ``--spread`` options (each may hold a comma-separated list)."""
-    return [parse_spread(x) for item in items for x in item.split(",") if x.strip()]
 
 
 def _progress(done: int, total: int) -> None:

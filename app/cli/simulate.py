@@ -13,7 +13,8 @@ from app.io.json_data import to_json
 from app.io.numbers import format_metric
 from app.io.plant_overrides import load_model_and_plant
 from control.common.checks import ParameterError
-from sim.fdsmc.engine import Comparison, RunResult, compare
+from sim.fdsmc.engine import Comparison, compare
+from sim.fdsmc.optimum_gap import OPTIMUM_BASIS, saving_vs_optimum
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
@@ -40,6 +41,10 @@ SUMMARY = (
 )
 
 
+__all__ = ["OPTIMUM_BASIS", "add_arguments", "comparison_json", "print_summary", "run",
+           "saving_vs_optimum", "write_csv"]
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``simulate``."""
     add_preset_arguments(p)
@@ -50,17 +55,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--csv", metavar="FILE", help="write the time series (CSV: controller column, units in the headers)")
 
 
-def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float | None:
-    """Return 100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save.
-
-    W is the net electrical input over the whole horizon; None unless both runs are stable.
-    """
-    if run is None or optimum is None or not (run.metrics.stable and optimum.metrics.stable):
-        return None
-    w, w_opt = run.metrics.electrical_in_total_J, optimum.metrics.electrical_in_total_J
-    if w is None or w_opt is None or w <= 0.0:
-        return None
-    return 100.0 * (1.0 - w_opt / w)
 
 
 def comparison_json(cmp: Comparison) -> dict[str, Any]:

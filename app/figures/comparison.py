@@ -23,8 +23,8 @@ from sim.fdsmc.engine import LABELS, Comparison, RunResult
 MAX_POINTS = 2000
 #: Most points per trace in the (24-trace) time plots: about one per pixel of the plot's width.
 MAX_POINTS_TIME = 800
-#: Line colours per controller.
-COLOURS = {"fdsmc": "#1f6fd1", "conventional": "#e8590c"}
+#: Line colours per controller (the tracked minimum-energy optimum when simulated).
+COLOURS = {"fdsmc": "#1f6fd1", "conventional": "#e8590c", "optimum": "#2f9e44"}
 BOUNDARY_COLOUR = "#2b2b2b"
 BAND_COLOUR = "rgba(120, 120, 120, 0.18)"
 _MARGIN = {"l": 60, "r": 16, "t": 40, "b": 44}
@@ -58,9 +58,9 @@ def f32(a: np.ndarray) -> np.ndarray:
 
 
 def runs(comparison: Comparison) -> list[tuple[str, RunResult]]:
-    """``(key, RunResult)`` of the controllers present in a comparison, FDSMC first."""
+    """Return ``(key, RunResult)`` of the controllers present, FDSMC first, the optimum last."""
     return [
-        (key, getattr(comparison, key)) for key in ("fdsmc", "conventional")
+        (key, getattr(comparison, key)) for key in COLOURS
         if getattr(comparison, key, None) is not None
     ]
 
@@ -119,7 +119,7 @@ def _phase_marks(comparison: Comparison, key: str, run: RunResult) -> list[dict[
     """Boundary-layer entry and load-step markers of one trajectory."""
     tr, th = run.trace, comparison.derived.params.manoeuvre.theta_dem
     out = []
-    k = layer_entry_index(comparison, run)
+    k = layer_entry_index(comparison, run) if key != "optimum" else None  # the optimum does not slide
     if k is not None:
         out.append({"type": "scatter", "x": [float(tr.theta_r[k] - th)], "y": [float(tr.omega_r[k])],
                     "mode": "markers+text", "text": ["sliding from here"] if key == "fdsmc" else [""],

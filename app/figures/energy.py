@@ -12,6 +12,7 @@ import plotly.graph_objects as go
 
 from app.figures.comparison import COLOURS, MAX_POINTS_TIME, f32, runs, stride_index, time_axis
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, Table1Row
+from sim.fdsmc.optimum_gap import saving_vs_optimum
 
 #: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
 ENERGIES = (
@@ -59,8 +60,25 @@ def energy_bars_spec(comparison: Comparison) -> dict[str, Any]:
                      "text": [f"{v:.4g} J" for v in totals], "textposition": "outside"})
     title = (f"Totals — FDSMC saves {_pct(comparison.saving_friction_pct)} friction, "
              f"{_pct(comparison.saving_electrical_pct)} electrical input")
+    gaps = optimum_gaps(comparison)
+    extra: dict[str, Any] = {}
+    if gaps:
+        title += ("<br>the optimum would save " + ", ".join(f"{_pct(v)} of {LABELS[k]}'s" for k, v in gaps.items())
+                  + " electrical input")
+        extra["margin"] = {"l": 60, "r": 16, "t": 64, "b": 40}
     return {"data": data, "layout": _layout("energy_bars", title, -0.15, barmode="group",
-                                            yaxis={"title": {"text": "energy [J]"}})}
+                                            yaxis={"title": {"text": "energy [J]"}},
+                                            meta={"id": "energy_bars", "gap_to_optimum_pct": gaps}, **extra)}
+
+
+def optimum_gaps(comparison: Any) -> dict[str, float | None]:
+    """Return, per controller, the share of its net electrical input [%] the optimum would save.
+
+    See (:func:`sim.fdsmc.optimum_gap.saving_vs_optimum`); empty without an optimum run.
+    """
+    if getattr(comparison, "optimum", None) is None:
+        return {}
+    return {key: saving_vs_optimum(run, comparison.optimum) for key, run in runs(comparison) if key != "optimum"}
 
 
 def make_energy_figure(comparison: Comparison) -> go.Figure:
@@ -140,4 +158,4 @@ def make_table1_figure(rows: Sequence[Table1Row], paper: Mapping[float, float] |
 
 __all__ = ["ENERGIES", "energy_bars_spec", "energy_spec", "energy_total", "make_energy_bars_figure",
            "make_energy_figure",
-           "make_table1_figure"]
+           "make_table1_figure", "optimum_gaps"]

@@ -24,6 +24,7 @@ from app.ui.inputs import InputError, InputsPanel
 from app.ui.log import LogPanel
 from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene
+from app.ui.studies import OptimumToggle, StudiesSection
 from app.ui.text import checked_choice, derived_markdown, design_markdown, md_text, warnings_html
 from app.ui.tuning import LiveTuning
 from app.ui.web_guard import Guard, guarded
@@ -32,19 +33,22 @@ from control.fdsmc.derivations import derive
 from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.design import design_drive
-from sim.fdsmc.engine import PAPER_TABLE1, Comparison, compare, table1_sweep
+from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
 from sim.fdsmc.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
 
 #: Widths of the control panel (left) and the results panel (right) [px].
 CONTROL_WIDTH, RESULTS_WIDTH = 430, 780
 
 
-def comparison_or_derived(params: DriveParams) -> Comparison:
-    """Simulate both controllers; for an infeasible case, the derivations alone (no runs)."""
+def comparison_or_derived(params: DriveParams, optimum: bool = False) -> Comparison:
+    """Simulate both controllers (and the tracked optimum if ``optimum``).
+
+    For an infeasible case, return the derivations alone (no runs).
+    """
     d = derive(params)  # a ParameterError here is an input error for the caller
     if not d.profile.feasible:
         return Comparison(d, None, None, None, None)
-    return compare(params, derived=d)
+    return compare(params, COMPARATORS if optimum else CONTROLLERS, derived=d)
 
 
 @dataclass
@@ -94,6 +98,7 @@ class Session:
         with tabs.add_tab("Position drive (FDSMC)"):
             self._controls()
         self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep)
+        self.studies = StudiesSection(self)
         _add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
         self.results.panel.dock_right()
         self.results.panel.set_width(RESULTS_WIDTH)
@@ -114,6 +119,7 @@ class Session:
                                                  "verified by simulation")
         self.design_button.on_click(lambda _: self.design())
         self.design_note = gui.add_markdown("")
+        self.optimum = OptimumToggle(gui, self.simulate)
         self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
         self.cancel_button.on_click(lambda _: self.cancel())
         self.status = gui.add_markdown("Ready.")
@@ -155,7 +161,8 @@ class Session:
         dd = design_drive(params)
         self.inputs.populate(dd.params)
         self.params, self.error, self._recentre = dd.params, None, True
-        self.comparison = dd.comparison or comparison_or_derived(dd.params)
+        self.comparison = (None if self.optimum.wanted else dd.comparison) or comparison_or_derived(
+            dd.params, self.optimum.wanted)
         self.runs += 1
         self.design_note.content = design_markdown(dd)
         if self.comparison.fdsmc is not None:
@@ -208,7 +215,7 @@ class Session:
         self.status.content = "Simulating…"
         self.design_note.content = ""
         self.worker.checkpoint()
-        comparison = comparison_or_derived(params)  # ParameterError from derive → _job_failed
+        comparison = comparison_or_derived(params, self.optimum.wanted)  # ParameterError → _job_failed
         self.worker.checkpoint()
         self.params, self.comparison, self.error = params, comparison, None
         self.runs += 1
@@ -274,6 +281,7 @@ class Session:
     def _show_text(self) -> None:
         d = self.comparison.derived
         self.derived.content = derived_markdown(d)
+        self.optimum.show(self.comparison)
         self.inputs.show_T_c_in_force(d.profile.T_c)
         if self._recentre:
             self._recentre = False

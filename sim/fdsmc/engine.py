@@ -41,7 +41,7 @@ CONTROLLERS = ("fdsmc", "conventional")
 #: (:mod:`control.fdsmc.optimum`); the kernel's P_CTRL is the index in this tuple.
 COMPARATORS = CONTROLLERS + ("optimum",)
 #: The name each simulated outer loop goes by in messages, tables and figures.
-LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Minimum-energy optimum"}
+LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum"}
 #: Simulated horizon beyond T_m, as a fraction of T_m [-].
 TAIL_FRACTION = 0.3
 #: RK4 step of continuous mode [s]; friction energies converged to < 0.05 % (see tests).

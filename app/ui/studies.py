@@ -1,0 +1,75 @@
+"""The studies beyond the paper in the position-drive page: optimum toggle, robustness, multi-axis.
+
+* :class:`OptimumToggle` (left panel): when ticked, every Simulate also runs the tracked
+  minimum-energy optimum (:mod:`control.fdsmc.optimum`), drawn as a third trajectory, time-plot
+  line and energy bar, and the share of each controller's energy it would save is shown.
+* :class:`StudiesSection` adds the "Studies" result tab with its "Robustness" and "Multi-axis" tabs
+  (:mod:`app.ui.studies_robustness`, :mod:`app.ui.studies_multiaxis`). Their runs go to the
+  session's worker like every Simulate (one job per client at a time) and can be cancelled.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import viser
+
+from app.figures.comparison import LABELS
+from app.figures.energy import optimum_gaps
+from app.ui.studies_multiaxis import MultiAxisView
+from app.ui.studies_robustness import RobustnessView
+from sim.fdsmc.optimum_gap import OPTIMUM_BASIS
+
+
+def optimum_markdown(comparison: Any) -> str:
+    """One line: the optimum's energy [J] and the share of each controller's it would save [%]."""
+    opt = getattr(comparison, "optimum", None)
+    if opt is None:
+        return ""
+    w = getattr(opt.metrics, OPTIMUM_BASIS)
+    gaps = optimum_gaps(comparison)
+    parts = [f"{LABELS[k]}'s by **{v:.1f} %**" for k, v in gaps.items() if v is not None]
+    head = f"Optimum (tracked): **{w:.4g} J** net electrical input" if isinstance(w, float) else "Optimum (tracked)"
+    return head + ("; it undercuts " + ", ".join(parts) + "." if parts else " (no stable comparison).")
+
+
+class OptimumToggle:
+    """Checkbox "Show the minimum-energy optimum" and a line of numbers under it."""
+
+    def __init__(self, gui: viser.GuiApi, on_change: Callable[[], Any]) -> None:
+        self.checkbox = gui.add_checkbox(
+            "Show the minimum-energy optimum", False,
+            hint="Also simulate the true minimum-energy move (copper + friction + load, torque limit) tracked "
+                 "in closed loop; drawn in green as a third trajectory, line and bar")
+        self.checkbox.on_update(lambda event: on_change() if event.client is not None else None)
+        self.numbers = gui.add_markdown("")
+
+    @property
+    def wanted(self) -> bool:
+        """True when the optimum should be simulated with the two controllers."""
+        return bool(self.checkbox.value)
+
+    def show(self, comparison: Any) -> None:
+        """Return the optimum's numbers of the comparison shown (empty without an optimum run)."""
+        self.numbers.content = optimum_markdown(comparison)
+
+
+class StudiesSection:
+    """The "Studies" tab of a session's results panel: "Robustness" and "Multi-axis".
+
+    ``session`` provides ``client``, ``worker``, ``submit(fn)``, ``params`` (the simulated inputs)
+    and ``status`` (the session's status line).
+    """
+
+    def __init__(self, session: Any) -> None:
+        panel = session.results.panel
+        with panel.add_tab("Studies", viser.Icon.FLASK):  # one tab: the results' tab row stays one line
+            tabs = session.client.gui.add_tab_group()
+            with tabs.add_tab("Robustness", viser.Icon.CHART_HISTOGRAM):
+                self.robustness = RobustnessView(session)
+            with tabs.add_tab("Multi-axis", viser.Icon.ARROWS_MAXIMIZE):
+                self.multiaxis = MultiAxisView(session)
+
+
+__all__ = ["OptimumToggle", "StudiesSection", "optimum_markdown"]

@@ -1,0 +1,25 @@
+"""How far a controller's run is from the tracked minimum-energy optimum (:mod:`control.fdsmc.optimum`)."""
+
+from __future__ import annotations
+
+from sim.fdsmc.engine import RunResult
+
+#: Energy compared with the optimum: the net electrical input over the whole simulated horizon.
+OPTIMUM_BASIS = "electrical_in_total_J"
+
+
+def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float | None:
+    """Return 100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save.
+
+    W is the net electrical input over the whole horizon [J] (:data:`OPTIMUM_BASIS`); None unless
+    both runs are stable.
+    """
+    if run is None or optimum is None or not (run.metrics.stable and optimum.metrics.stable):
+        return None
+    w, w_opt = getattr(run.metrics, OPTIMUM_BASIS), getattr(optimum.metrics, OPTIMUM_BASIS)
+    if w is None or w_opt is None or w <= 0.0:
+        return None
+    return 100.0 * (1.0 - w_opt / w)
+
+
+__all__ = ["OPTIMUM_BASIS", "saving_vs_optimum"]
