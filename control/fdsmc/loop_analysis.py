@@ -29,8 +29,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.linalg import expm
 
+from control.common.discrete import zoh
 from control.fdsmc.model import ModelCoefficients
 from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer
 from control.fdsmc.params import DriveParams
@@ -199,10 +199,8 @@ def sampled_parts(d: Derived | LoopModel, f_s: float) -> SampledParts:
     """Plant [i_q, θ_r, ω_r] discretised exactly for held u_q, and the observer, at ``f_s`` [Hz]."""
     T_s = 1.0 / f_s
     Ap, bp = plant_matrices_of(d.coefficients, d.params)
-    aug = np.zeros((4, 4))
-    aug[:3, :3], aug[:3, 3] = Ap * T_s, bp * T_s
-    E = expm(aug)
-    return SampledParts(E[:3, :3], E[:3, 3], discrete_observer(d.observer, d.coefficients.M, f_s))
+    Ad, bd = zoh(Ap, bp, T_s)
+    return SampledParts(Ad, bd, discrete_observer(d.observer, d.coefficients.M, f_s))
 
 
 def discrete_loop(
