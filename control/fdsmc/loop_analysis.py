@@ -252,13 +252,28 @@ def stability_measure(
     parts: SampledParts | None = None,
 ) -> float:
     """Largest Re(s) [1/s] (continuous) or largest |z| − 1 [-] (sampled); < 0 means stable."""
-    M = continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
+    return stability_measures(d, law, [K], f_s, delay, parts)[0]
+
+
+def stability_measures(
+    d: Derived, law: str, Ks: list[float], f_s: float | None, delay: int = 0,
+    parts: SampledParts | None = None,
+) -> list[float]:
+    """:func:`stability_measure` for each gain in ``Ks``, with one batched eigenvalue call."""
+    if f_s is not None and parts is None:
+        parts = sampled_parts(d, f_s)
+    mats = [continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
+            for K in Ks]
     if law == "cruise":
-        M = reduce_shift_mode(M)
-    if not np.all(np.isfinite(M)):  # a gain so large (or a model so extreme) that the loop overflows
-        return math.inf
-    ev = np.linalg.eigvals(M)
-    return float(np.max(ev.real)) if f_s is None else float(np.max(np.abs(ev)) - 1.0)
+        mats = [reduce_shift_mode(M) for M in mats]
+    finite = [bool(np.all(np.isfinite(M))) for M in mats]  # a huge gain can overflow the loop
+    out = [math.inf] * len(mats)
+    if any(finite):
+        ev = np.linalg.eigvals(np.stack([M for M, ok in zip(mats, finite, strict=True) if ok]))
+        worst = np.max(ev.real, axis=1) if f_s is None else np.max(np.abs(ev), axis=1) - 1.0
+        for i, w in zip((i for i, ok in enumerate(finite) if ok), worst, strict=True):
+            out[i] = float(w)
+    return out
 
 
 def gain_limit(d: Derived, law: str, f_s: float | None, delay: int = 0) -> float:
@@ -275,7 +290,7 @@ def gain_limit(d: Derived, law: str, f_s: float | None, delay: int = 0) -> float
         return stability_measure(d, law, K, f_s, delay, parts) >= 0.0
 
     grid = [float(K) for K in np.logspace(-5, 6, 23) * 1000.0 / d.alpha.alpha_max]
-    flags = [unstable(K) for K in grid]
+    flags = [m >= 0.0 for m in stability_measures(d, law, grid, f_s, delay, parts)]
     if all(flags):
         return 0.0
     last_stable = max(i for i, f in enumerate(flags) if not f)
