@@ -91,9 +91,10 @@ def rss_mb(pid: int) -> float:
     return float("nan")
 
 
-def start_server(port: int) -> subprocess.Popen:
+def start_server(port: int, scene_3d: bool) -> subprocess.Popen:
     env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
-    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port), "--preset", PRESET],
+    extra = [] if scene_3d else ["--no-3d"]
+    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port), "--preset", PRESET, *extra],
                             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert proc.stdout is not None
     for line in proc.stdout:
@@ -206,12 +207,24 @@ def replay_rate(page, ws: WsCounter, runs: int) -> None:
           f"{med(traffic, 1e-3, '.2f')} kB/s from the server   [target ≥ 30 frames/s, ≤ 1 kB/frame]")
 
 
-def open_pages(browser, url: str, n: int, pid: int) -> list:
-    opened = [open_page(browser, url) for _ in range(n)]
-    print(f"page open → usable ({n} pages, one after the other): {med([o[0] for o in opened], 1, '.2f')} s; "
-          f"websocket bytes {med([o[1] for o in opened], 1e-6, '.2f')} MB   [target ≤ 1 MB]")
+def open_pages(browser, url: str, n: int, timed: int, pid: int) -> list:
+    """``timed`` pages opened one after the other (timed), then the rest of ``n`` all at once."""
+    opened = [open_page(browser, url) for _ in range(min(n, timed))]
+    print(f"page open → usable ({len(opened)} pages, one after the other): {med([o[0] for o in opened], 1, '.2f')} s;"
+          f" websocket bytes {med([o[1] for o in opened], 1e-6, '.2f')} MB   [target ≤ 1 MB]")
+    rest = []
+    for _ in range(n - len(opened)):
+        ctx = browser.new_context(viewport=VIEWPORT)
+        page = ctx.new_page()
+        page.set_default_timeout(120_000)
+        ws = WsCounter(page)
+        page.goto(url, wait_until="commit")
+        rest.append((0.0, 0, ctx, page, ws))
+    for o in rest:
+        o[3].get_by_role("button", name="Simulate").wait_for()
+        o[3].wait_for_function(PHASE_READY, arg=None, polling="raf")
     print(f"server RSS with {n} pages: {rss_mb(pid):.1f} MB")
-    return opened
+    return opened + rest
 
 
 def main() -> int:
@@ -219,16 +232,19 @@ def main() -> int:
     ap.add_argument("--runs", type=int, default=5, help="rounds per figure (median; at least 5)")
     ap.add_argument("--clients", default="1,5,10", help="numbers of pages clicking at once")
     ap.add_argument("--replay-wait", type=float, default=4.0, help="time allowed for a full replay [s]")
+    ap.add_argument("--with-3d", action="store_true",
+                    help="serve the 3D rotor view too (each headless page then renders WebGL in software on "
+                         "the server's cores, which distorts the server figures on a small machine)")
     args = ap.parse_args()
     runs, counts, t_start = max(5, args.runs), [int(c) for c in args.clients.split(",")], time.perf_counter()
-    print(f"start: {load_average()}")
+    print(f"start: {load_average()}; 3D view {'on' if args.with_3d else 'off (--no-3d)'}")
     port = free_port()
-    server = start_server(port)
+    server = start_server(port, args.with_3d)
     try:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=LAUNCH_ARGS)
             print(f"server RSS idle, no client: {rss_mb(server.pid):.1f} MB")
-            opened = open_pages(browser, f"http://127.0.0.1:{port}", max(counts), server.pid)
+            opened = open_pages(browser, f"http://127.0.0.1:{port}", max(counts), runs, server.pid)
             page, ws = opened[0][3], opened[0][4]
             per_simulate(page, ws, server.pid, runs, args.replay_wait)
             for n in counts:
