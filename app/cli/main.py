@@ -54,7 +54,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
     Only the module of ``command`` is imported (and its arguments added): a sub-command's module
     imports what it needs (numba kernels, scipy, plotly …), so importing all of them would make
-    every call pay for the slowest. With ``command=None`` every module is imported.
+    every call pay for the slowest. With ``command=None`` every module is imported; with an empty
+    string (``python -m app --help``) none is.
     """
     parser = _Parser(prog="python -m app", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -101,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
 
     limit_blas_threads()  # before the sub-command imports numpy: then it costs nothing
     argv = sys.argv[1:] if argv is None else argv
-    args = build_parser(chosen_command(argv)).parse_args(argv)
+    args = build_parser(chosen_command(argv) or "").parse_args(argv)  # "": --help alone imports none
     try:
         return int(args._run(args) or 0)
     except ValueError as exc:  # ParameterError, PresetError: bad input
