@@ -37,12 +37,12 @@ class _Parser(argparse.ArgumentParser):
 
 
 def chosen_command(argv: list[str]) -> str | None:
-    """The sub-command named on the command line (its first positional word), or None."""
+    """Return the sub-command named on the command line (its first positional word), or None."""
     return next((a for a in argv if not a.startswith("-")), None)
 
 
 def _available(module: str) -> bool:
-    """True if the sub-command's module exists (found without importing it)."""
+    """Tell whether the sub-command's module exists (found without importing it)."""
     try:
         return importlib.util.find_spec(module) is not None
     except ModuleNotFoundError:
@@ -50,7 +50,7 @@ def _available(module: str) -> bool:
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The argument parser with every available sub-command.
+    """Build the argument parser with every available sub-command.
 
     Only the module of ``command`` is imported (and its arguments added): a sub-command's module
     imports what it needs (numba kernels, scipy, plotly …), so importing all of them would make
@@ -71,7 +71,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None) -> None:
-    """The PRESET positional and repeatable ``--set section.field=value`` options."""
+    """Add the PRESET positional and repeatable ``--set section.field=value`` options."""
     if default is None:
         p.add_argument("preset", metavar="PRESET", help="preset name (presets/NAME.yaml) or a YAML/JSON file path")
     else:
