@@ -45,8 +45,10 @@ PHASE_READY = ("(w) => [...document.querySelectorAll('.js-plotly-plot')].some(e 
                " && e.layout.meta.id === 'phase_plane' && (w === null || Math.abs(e.layout.meta.omega_p - w)"
                " < 1e-6 * w) && e.data.some(t => t.name === 'Conventional trajectory'))")
 #: Resolves with the Date.now() at which the phase plane shows ω_p = w (polled every frame).
-WATCH_READY = "(w) => new Promise(r => { const f = () => (" + PHASE_READY + ")(w) ? r(Date.now()) " \
-              ": requestAnimationFrame(f); f(); })"
+#: Installs (without waiting) ``window.__ready``: a promise of the Date.now() at which the phase plane
+#: shows ω_p = w (polled every frame), or NaN after 60 s.
+WATCH_READY = ("(w) => { const t0 = Date.now(); window.__ready = new Promise(r => { const f = () => (" + PHASE_READY
+               + ")(w) ? r(Date.now()) : (Date.now() - t0 > 60000 ? r(NaN) : requestAnimationFrame(f)); f(); }); }")
 COUNT_FRAMES = """(ms) => new Promise(resolve => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
   let n = 0; const on = () => { n += 1; };
@@ -136,17 +138,20 @@ def click_all(pages: list, k: int) -> list[float]:
     w = omega_p_of(T_m)
     for page in pages:
         type_T_m(page, T_m)
-    handles, starts = [], []
+    starts = []
     for page in pages:
-        handles.append(page.evaluate_handle(WATCH_READY, w))  # watcher installed before the click
+        page.evaluate(WATCH_READY, w)  # watcher installed before the click
     for page in pages:
         starts.append(time.time() * 1e3)
         page.get_by_role("button", name="Simulate").click(no_wait_after=True)
-    return [(h.json_value() - t0) / 1e3 for h, t0 in zip(handles, starts, strict=True)]
+    ends = [page.evaluate("() => window.__ready") for page in pages]
+    return [(t1 - t0) / 1e3 for t1, t0 in zip(ends, starts, strict=True) if t1 == t1]  # NaN: not drawn in 60 s
 
 
 def med(xs: list[float], scale: float = 1e3, fmt: str = ".0f") -> str:
     """'median m (min a, max b)' of ``xs`` scaled by ``scale``."""
+    if not xs:
+        return "none measured"
     m, lo, hi = (scale * statistics.median(xs), scale * min(xs), scale * max(xs))
     return f"median {m:{fmt}} (min {lo:{fmt}}, max {hi:{fmt}})"
 
