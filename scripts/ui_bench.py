@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import itertools
 import os
 import statistics
 import subprocess
@@ -132,9 +133,12 @@ def type_T_m(page, T_m: float) -> None:
     page.wait_for_timeout(200)
 
 
+_CLICKS = itertools.count()
+
+
 def click_all(pages: list, k: int) -> list[float]:
     """Every page types a new T_m, then all click Simulate at once; per-page round trip [s]."""
-    T_m = 1.0 + 0.05 * (k % 2 + 1)
+    T_m = 1.0 + 0.05 * (next(_CLICKS) % 2 + 1)  # alternates over all calls: every click changes ω_p
     w = omega_p_of(T_m)
     for page in pages:
         type_T_m(page, T_m)
