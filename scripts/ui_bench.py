@@ -166,25 +166,29 @@ def load_average() -> str:
 
 BAND_NAME = """() => [...document.querySelectorAll('.js-plotly-plot')]
   .find(e => e.layout.meta && e.layout.meta.id === 'phase_plane').data[0].name"""
-#: Counts the phase-plane redraws with a new boundary layer (a new K) during ``ms`` [ms].
-COUNT_REDRAWS = """(ms) => new Promise(resolve => {
+#: Counts the phase-plane redraws with a new boundary layer (a new K) until ``window.__stop`` is set;
+#: resolves with [redraws, elapsed ms].
+COUNT_REDRAWS = """() => { window.__stop = false; window.__redraws = new Promise(resolve => {
   const band = """ + BAND_NAME + """;
   let last = band(), n = 0; const t0 = performance.now();
   const f = () => { const b = band(); if (b !== last) { n += 1; last = b; }
-                    if (performance.now() - t0 < ms) requestAnimationFrame(f); else resolve(n); };
-  f(); })"""
+                    if (!window.__stop) requestAnimationFrame(f); else resolve([n, performance.now() - t0]); };
+  f(); }); }"""
 
 
 def slider_redraws(page, seconds: float, direction: str) -> float:
-    """Re-simulated phase planes drawn per second while the K slider moves every 50 ms."""
+    """Re-simulated phase planes drawn per second while the K slider moves every 50 ms (+ 0.5 s to settle)."""
     thumb = page.locator('xpath=//label[normalize-space(.)="K [s/rad]"]/ancestor::*[.//*[@role="slider"]][1]'
                          '//*[@role="slider"]').first
     thumb.focus()
-    counter = page.evaluate_handle(COUNT_REDRAWS, 1e3 * (seconds + 0.5))
+    page.evaluate(COUNT_REDRAWS)
     for _ in range(int(seconds / 0.05)):
         thumb.press(direction)
         page.wait_for_timeout(50)
-    return counter.json_value() / (seconds + 0.5)
+    page.wait_for_timeout(500)
+    page.evaluate("() => { window.__stop = true; }")
+    n, ms = page.evaluate("() => window.__redraws")
+    return n / (ms / 1e3)
 
 
 def per_simulate(page, ws: WsCounter, pid: int, runs: int, replay_wait: float) -> None:
