@@ -8,10 +8,9 @@ and both come from one matrix exponential of the block matrix (Van Loan's identi
 
     exp([[A, B], [0, 0]]·T_s) = [[Φ, Γ], [0, I]].
 
-When that block matrix is strictly upper triangular (a chain of integrators, as the observer's
-real-time model of θ_r, ω_r, Γ_L, dΓ_L/dt) it is nilpotent: its power series ends after n terms
-and is summed exactly with a few small matrix products, with no call to ``scipy.linalg.expm``.
-Otherwise ``expm`` is called once for the block matrix.
+One ``scipy.linalg.expm`` call per model and sample period. (An exact finite series for the
+observer's nilpotent integrator chain was tried: it changes results by ≈ 1e-16 relative, which
+flips a preset whose K equals its recommended K to the last digit, so expm is kept.)
 """
 
 from __future__ import annotations
@@ -21,7 +20,7 @@ from scipy.linalg import expm
 
 
 def block_exponential(M: np.ndarray) -> np.ndarray:
-    """e^M of a square matrix [-]: exact finite series if M is strictly upper triangular, else expm.
+    """Return e^M of a square matrix [-] (one ``scipy.linalg.expm`` call).
 
     Parameters
     ----------
@@ -33,16 +32,6 @@ def block_exponential(M: np.ndarray) -> np.ndarray:
     numpy.ndarray
         n×n matrix exponential.
     """
-    n = M.shape[0]
-    if not np.any(np.tril(M)):  # nilpotent: M^n = 0, so e^M = Σ_{k<n} M^k / k!
-        out = np.eye(n)
-        term = np.eye(n)
-        for k in range(1, n):
-            term = term @ M / k
-            if not np.any(term):
-                break
-            out += term
-        return out
     return expm(M)
 
 

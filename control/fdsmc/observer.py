@@ -162,11 +162,8 @@ def discrete_observer(g: ObserverGains, M: float, f_s: float) -> DiscreteObserve
     Phi, Gamma = zoh(A, b, T_s)  # exact: the model is a chain of integrators
     z = math.exp(-g.q * T_s)
     # Ackermann: L = p(Φ) · O⁻¹ · e4 with p(λ) = (λ − z)⁴ and O the observability matrix.
-    O = np.empty((4, 4))
-    O[0] = c
-    for k in range(1, 4):
-        O[k] = O[k - 1] @ Phi  # c·Φ^k
+    O = np.vstack([c @ np.linalg.matrix_power(Phi, k) for k in range(4)])
     I4 = np.eye(4)
-    X2 = (Phi - z * I4) @ (Phi - z * I4)
-    L = (X2 @ X2) @ np.linalg.solve(O, I4[:, 3])
+    p_Phi = np.linalg.matrix_power(Phi - z * I4, 4)
+    L = p_Phi @ np.linalg.solve(O, I4[:, 3])
     return DiscreteObserver(T_s=T_s, z_pole=z, Phi=Phi, Gamma=Gamma, L=L)
