@@ -1,21 +1,36 @@
-"""One BLAS thread for the whole process: the drive's linear algebra is 2×2 … 6×6 matrices.
+"""One BLAS thread for the whole process: the drive's linear algebra is 2×2 … 8×8 matrices.
 
 OpenBLAS by default starts a worker per core; for the tiny matrices of ``derive()`` (``expm`` of
-the observer and loop models) a second thread costs more than it computes, and its spinning
-worker takes the core that another client's simulation needs. Measured on a 2-core machine:
-a warm comparison takes ≈ 290 ms CPU with the default BLAS pool and ≈ 30 ms with one thread.
+the loop models, eigenvalues of the sampled loops) a second thread costs more than it computes,
+and its spinning worker takes the core that another client's simulation needs. Measured on a
+2-core machine: a warm comparison takes ≈ 290 ms CPU with the default BLAS pool and ≈ 30 ms with
+one thread.
+
+Two ways, both applied by :func:`limit_blas_threads`: the ``*_NUM_THREADS`` environment variables
+(read by a BLAS library when it loads, so they cover numpy and scipy imported later, and cost
+nothing — the CLI sets them before importing numpy), and ``threadpoolctl`` for libraries already
+loaded (it scans the process's shared libraries, ≈ 20–60 ms, so it runs only when numpy is
+already imported).
 """
 
 from __future__ import annotations
 
-import scipy.linalg  # noqa: F401  (loads the BLAS library so threadpoolctl can find it)
-from threadpoolctl import threadpool_limits
+import os
+import sys
+
+#: Environment variables read by the BLAS / OpenMP libraries numpy and scipy may load.
+THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
 
 _limiter: object | None = None
 
 
 def limit_blas_threads() -> None:
-    """Limit every loaded BLAS library to one thread for the rest of the process (idempotent)."""
+    """Limit every BLAS library, loaded now or later, to one thread for this process (idempotent)."""
     global _limiter
-    if _limiter is None:
+    for name in THREAD_VARIABLES:
+        os.environ[name] = "1"
+    if _limiter is None and "numpy" in sys.modules:
+        import scipy.linalg  # noqa: F401  (loads scipy's BLAS so that threadpoolctl limits it too)
+        from threadpoolctl import threadpool_limits
+
         _limiter = threadpool_limits(limits=1, user_api="blas")

@@ -7,19 +7,26 @@
   click → both new trajectories drawn;
 * the same round trip with 1, 5 and 10 pages clicking at once;
 * replay frame rate actually drawn by the browser (phase plane) and the server traffic meanwhile;
+* live tuning: re-simulated phase planes drawn per second while the K slider is moved
+  (one key step every 50 ms, paper preset at 20 kHz);
 * server memory (RSS) idle and with the pages connected.
+
+Every figure is the median of ``--runs`` rounds (≥ 5) with its min and max; the machine's load
+average is printed at the start and at the end (figures from a shared machine are pessimistic).
+The whole script takes about 3–5 minutes. It is a measurement, never a test.
 
 Websocket bytes are the decoded message payloads (msgpack) as the page receives them; the wire
 carries them deflate-compressed. The server runs as a separate ``python -m app serve`` process
 (as the README starts it).
 
-Usage: ``.venv/bin/python scripts/ui_bench.py [--runs 6] [--clients 1,5,10]``
+Usage: ``.venv/bin/python scripts/ui_bench.py [--runs 5] [--clients 1,5,10]``
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import itertools
 import os
 import statistics
 import subprocess
@@ -39,8 +46,10 @@ PHASE_READY = ("(w) => [...document.querySelectorAll('.js-plotly-plot')].some(e 
                " && e.layout.meta.id === 'phase_plane' && (w === null || Math.abs(e.layout.meta.omega_p - w)"
                " < 1e-6 * w) && e.data.some(t => t.name === 'Conventional trajectory'))")
 #: Resolves with the Date.now() at which the phase plane shows ω_p = w (polled every frame).
-WATCH_READY = "(w) => new Promise(r => { const f = () => (" + PHASE_READY + ")(w) ? r(Date.now()) " \
-              ": requestAnimationFrame(f); f(); })"
+#: Installs (without waiting) ``window.__ready``: a promise of the Date.now() at which the phase plane
+#: shows ω_p = w (polled every frame), or NaN after 60 s.
+WATCH_READY = ("(w) => { const t0 = Date.now(); window.__ready = new Promise(r => { const f = () => (" + PHASE_READY
+               + ")(w) ? r(Date.now()) : (Date.now() - t0 > 60000 ? r(NaN) : requestAnimationFrame(f)); f(); }); }")
 COUNT_FRAMES = """(ms) => new Promise(resolve => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
   let n = 0; const on = () => { n += 1; };
@@ -85,9 +94,10 @@ def rss_mb(pid: int) -> float:
     return float("nan")
 
 
-def start_server(port: int) -> subprocess.Popen:
+def start_server(port: int, scene_3d: bool) -> subprocess.Popen:
     env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
-    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port), "--preset", PRESET],
+    extra = [] if scene_3d else ["--no-3d"]
+    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port), "--preset", PRESET, *extra],
                             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert proc.stdout is not None
     for line in proc.stdout:
@@ -123,75 +133,147 @@ def type_T_m(page, T_m: float) -> None:
     page.wait_for_timeout(200)
 
 
+_CLICKS = itertools.count()
+
+
 def click_all(pages: list, k: int) -> list[float]:
     """Every page types a new T_m, then all click Simulate at once; per-page round trip [s]."""
-    T_m = 1.0 + 0.05 * (k % 2 + 1)
+    T_m = 1.0 + 0.05 * (next(_CLICKS) % 2 + 1)  # alternates over all calls: every click changes ω_p
     w = omega_p_of(T_m)
     for page in pages:
         type_T_m(page, T_m)
-    handles, starts = [], []
+    starts = []
     for page in pages:
-        handles.append(page.evaluate_handle(WATCH_READY, w))  # watcher installed before the click
+        page.evaluate(WATCH_READY, w)  # watcher installed before the click
     for page in pages:
         starts.append(time.time() * 1e3)
         page.get_by_role("button", name="Simulate").click(no_wait_after=True)
-    return [(h.json_value() - t0) / 1e3 for h, t0 in zip(handles, starts, strict=True)]
+    ends = [page.evaluate("() => window.__ready") for page in pages]
+    return [(t1 - t0) / 1e3 for t1, t0 in zip(ends, starts, strict=True) if t1 == t1]  # NaN: not drawn in 60 s
 
 
-def med(xs: list[float], scale: float = 1e3) -> str:
-    return f"median {scale * statistics.median(xs):.0f}, max {scale * max(xs):.0f}"
+def med(xs: list[float], scale: float = 1e3, fmt: str = ".0f") -> str:
+    """'median m (min a, max b)' of ``xs`` scaled by ``scale``."""
+    if not xs:
+        return "none measured"
+    m, lo, hi = (scale * statistics.median(xs), scale * min(xs), scale * max(xs))
+    return f"median {m:{fmt}} (min {lo:{fmt}}, max {hi:{fmt}})"
+
+
+def load_average() -> str:
+    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*os.getloadavg(), os.cpu_count())
+
+
+BAND_NAME = """() => [...document.querySelectorAll('.js-plotly-plot')]
+  .find(e => e.layout.meta && e.layout.meta.id === 'phase_plane').data[0].name"""
+#: Counts the phase-plane redraws with a new boundary layer (a new K) until ``window.__stop`` is set;
+#: resolves with [redraws, elapsed ms].
+COUNT_REDRAWS = """() => { window.__stop = false; window.__redraws = new Promise(resolve => {
+  const band = """ + BAND_NAME + """;
+  let last = band(), n = 0; const t0 = performance.now();
+  const f = () => { const b = band(); if (b !== last) { n += 1; last = b; }
+                    if (!window.__stop) requestAnimationFrame(f); else resolve([n, performance.now() - t0]); };
+  f(); }); }"""
+
+
+def slider_redraws(page, seconds: float, direction: str) -> float:
+    """Re-simulated phase planes drawn per second while the K slider moves every 50 ms (+ 0.5 s to settle)."""
+    thumb = page.locator('xpath=//label[normalize-space(.)="K [s/rad]"]/ancestor::*[.//*[@role="slider"]][1]'
+                         '//*[@role="slider"]').first
+    thumb.focus()
+    page.evaluate(COUNT_REDRAWS)
+    for _ in range(int(seconds / 0.05)):
+        thumb.press(direction)
+        page.wait_for_timeout(50)
+    page.wait_for_timeout(500)
+    page.evaluate("() => { window.__stop = true; }")
+    n, ms = page.evaluate("() => window.__redraws")
+    return n / (ms / 1e3)
+
+
+def per_simulate(page, ws: WsCounter, pid: int, runs: int, replay_wait: float) -> None:
+    """Server CPU, websocket bytes (incl. the replay that follows) and round trip of one page."""
+    cpus, sizes, msgs, lat = [], [], [], []
+    for k in range(runs):
+        b0, m0, c0 = ws.bytes, ws.messages, cpu_s(pid)
+        lat += click_all([page], k)
+        page.wait_for_timeout(1e3 * replay_wait)  # the full replay, if the server pushes it
+        cpus.append(cpu_s(pid) - c0)
+        sizes.append(ws.bytes - b0)
+        msgs.append(ws.messages - m0)
+    print(f"per Simulate, 1 page ({runs} runs, incl. {replay_wait:g} s of replay): server CPU "
+          f"{med(cpus)} ms [target ≤ 60]; websocket {med(sizes, 1e-3)} kB in "
+          f"{statistics.median(msgs):.0f} messages [target ≤ 500 kB]; round trip {med(lat)} ms")
+
+
+def replay_rate(page, ws: WsCounter, runs: int) -> None:
+    """Phase-plane frames/s drawn by the browser during the in-plot replay, server bytes meanwhile."""
+    rates, traffic = [], []
+    for _ in range(runs):
+        b0 = ws.bytes
+        if not page.evaluate(PLAY_IN_PLOT, "▶ 0.1×"):
+            print("replay: no in-plot replay buttons found")
+            return
+        rates.append(page.evaluate(COUNT_FRAMES, 2000) / 2.0)
+        traffic.append((ws.bytes - b0) / 2.0)
+    print(f"replay (client-side animation, {runs} runs): {med(rates, 1, '.1f')} frames/s drawn; "
+          f"{med(traffic, 1e-3, '.2f')} kB/s from the server   [target ≥ 30 frames/s, ≤ 1 kB/frame]")
+
+
+def open_pages(browser, url: str, n: int, timed: int, pid: int) -> list:
+    """``timed`` pages opened one after the other (timed), then the rest of ``n`` all at once."""
+    opened = [open_page(browser, url) for _ in range(min(n, timed))]
+    print(f"page open → usable ({len(opened)} pages, one after the other): {med([o[0] for o in opened], 1, '.2f')} s;"
+          f" websocket bytes {med([o[1] for o in opened], 1e-6, '.2f')} MB   [target ≤ 1 MB]")
+    rest = []
+    for _ in range(n - len(opened)):
+        ctx = browser.new_context(viewport=VIEWPORT)
+        page = ctx.new_page()
+        page.set_default_timeout(120_000)
+        ws = WsCounter(page)
+        page.goto(url, wait_until="commit")
+        rest.append((0.0, 0, ctx, page, ws))
+    for o in rest:
+        o[3].get_by_role("button", name="Simulate").wait_for()
+        o[3].wait_for_function(PHASE_READY, arg=None, polling="raf")
+    print(f"server RSS with {n} pages: {rss_mb(pid):.1f} MB")
+    return opened + rest
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=6, help="rounds per figure (median)")
+    ap.add_argument("--runs", type=int, default=5, help="rounds per figure (median; at least 5)")
     ap.add_argument("--clients", default="1,5,10", help="numbers of pages clicking at once")
-    ap.add_argument("--replay-wait", type=float, default=8.0, help="time allowed for a full replay [s]")
+    ap.add_argument("--replay-wait", type=float, default=4.0, help="time allowed for a full replay [s]")
+    ap.add_argument("--with-3d", action="store_true",
+                    help="serve the 3D rotor view too (each headless page then renders WebGL in software on "
+                         "the server's cores, which distorts the server figures on a small machine)")
     args = ap.parse_args()
-    counts = [int(c) for c in args.clients.split(",")]
+    runs, counts, t_start = max(5, args.runs), [int(c) for c in args.clients.split(",")], time.perf_counter()
+    print(f"start: {load_average()}; 3D view {'on' if args.with_3d else 'off (--no-3d)'}")
     port = free_port()
-    server = start_server(port)
-    url = f"http://127.0.0.1:{port}"
+    server = start_server(port, args.with_3d)
     try:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=LAUNCH_ARGS)
             print(f"server RSS idle, no client: {rss_mb(server.pid):.1f} MB")
-            opened = [open_page(browser, url) for _ in range(max(counts))]
-            print(f"page open → usable ({len(opened)} pages): median {statistics.median(o[0] for o in opened):.2f} s, "
-                  f"first {opened[0][0]:.2f} s; websocket bytes median "
-                  f"{statistics.median(o[1] for o in opened) / 1e6:.2f} MB   [target ≤ 1 MB]")
-            print(f"server RSS with {len(opened)} pages: {rss_mb(server.pid):.1f} MB")
+            opened = open_pages(browser, f"http://127.0.0.1:{port}", max(counts), runs, server.pid)
             page, ws = opened[0][3], opened[0][4]
-            cpus, sizes, msgs, lat = [], [], [], []
-            for k in range(args.runs):
-                b0, m0, c0 = ws.bytes, ws.messages, cpu_s(server.pid)
-                lat += click_all([page], k)
-                page.wait_for_timeout(1e3 * args.replay_wait)  # the full replay, if the server pushes it
-                cpus.append(cpu_s(server.pid) - c0)
-                sizes.append(ws.bytes - b0)
-                msgs.append(ws.messages - m0)
-            print(f"per Simulate, 1 page ({args.runs} runs, incl. {args.replay_wait:g} s of replay): server CPU "
-                  f"{med(cpus)} ms [target ≤ 60]; websocket {statistics.median(sizes) / 1e3:.0f} kB in "
-                  f"{statistics.median(msgs):.0f} messages [target ≤ 500 kB]; round trip {med(lat)} ms")
+            per_simulate(page, ws, server.pid, runs, args.replay_wait)
             for n in counts:
                 pages = [o[3] for o in opened[:n]]
-                rts = [t for k in range(args.runs) for t in (click_all(pages, k), pages[0].wait_for_timeout(500))[0]]
-                print(f"Simulate → drawn, {n:2d} pages clicking at once ({args.runs} rounds): {med(rts)} ms"
+                rts = [t for k in range(runs) for t in (click_all(pages, k), pages[0].wait_for_timeout(500))[0]]
+                print(f"Simulate → drawn, {n:2d} pages clicking at once ({runs} rounds): {med(rts)} ms"
                       f"   [target: 1 page ≤ 150, 10 pages median ≤ 600]")
-            b0 = ws.bytes
-            if page.evaluate(PLAY_IN_PLOT, "▶ 0.25×"):
-                frames = page.evaluate(COUNT_FRAMES, 2000)
-                where = "client-side animation"
-            else:
-                page.get_by_role("button", name="Replay", exact=True).click()
-                frames = page.evaluate(COUNT_FRAMES, 2000)
-                where = "server-pushed figures"
-            print(f"replay ({where}): {frames / 2.0:.1f} phase-plane frames/s drawn, "
-                  f"{(ws.bytes - b0) / 2.0 / 1e3:.1f} kB/s from the server   [target ≥ 30 frames/s, ≤ 1 kB/frame]")
+            replay_rate(page, ws, runs)
+            rates = [slider_redraws(page, 2.0, "ArrowLeft" if k % 2 else "ArrowRight") for k in range(runs)]
+            print(f"live tuning, K slider moved every 50 ms for 2 s ({runs} rounds): re-simulated redraws "
+                  f"{med(rates, 1, '.1f')} per s   [target ≥ 10]")
             browser.close()
     finally:
         server.terminate()
         server.wait(timeout=10)
+    print(f"end: {load_average()}; the benchmark took {time.perf_counter() - t_start:.0f} s")
     return 0
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import os
 import sys
 from pathlib import Path
@@ -35,20 +36,37 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """Build the argument parser with every available sub-command."""
+def chosen_command(argv: list[str]) -> str | None:
+    """Return the sub-command named on the command line (its first positional word), or None."""
+    return next((a for a in argv if not a.startswith("-")), None)
+
+
+def _available(module: str) -> bool:
+    """Tell whether the sub-command's module exists (found without importing it)."""
+    try:
+        return importlib.util.find_spec(module) is not None
+    except ModuleNotFoundError:
+        return False
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """Build the argument parser with every available sub-command.
+
+    Only the module of ``command`` is imported (and its arguments added): a sub-command's module
+    imports what it needs (numba kernels, scipy, plotly …), so importing all of them would make
+    every call pay for the slowest. With ``command=None`` every module is imported; with an empty
+    string (``python -m app --help``) none is.
+    """
     parser = _Parser(prog="python -m app", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for name, (module, help_text) in COMMANDS.items():
-        try:
-            mod = importlib.import_module(module)
-        except ModuleNotFoundError as exc:
-            if exc.name != module:
-                raise
+        if not _available(module):
             continue
         p = sub.add_parser(name, help=help_text, description=help_text)
-        mod.add_arguments(p)
-        p.set_defaults(_run=mod.run)
+        if command is None or command == name:
+            mod = importlib.import_module(module)
+            mod.add_arguments(p)
+            p.set_defaults(_run=mod.run)
     return parser
 
 
@@ -82,8 +100,9 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the process exit code."""
     from app.threads import limit_blas_threads
 
-    limit_blas_threads()
-    args = build_parser().parse_args(argv)
+    limit_blas_threads()  # before the sub-command imports numpy: then it costs nothing
+    argv = sys.argv[1:] if argv is None else argv
+    args = build_parser(chosen_command(argv) or "").parse_args(argv)  # "": --help alone imports none
     try:
         return int(args._run(args) or 0)
     except ValueError as exc:  # ParameterError, PresetError: bad input

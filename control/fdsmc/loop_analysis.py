@@ -28,8 +28,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import expm
 
+from control.common.discrete import zoh
 from control.fdsmc.model import ModelCoefficients
 from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer
 from control.fdsmc.params import DriveParams
@@ -207,10 +207,8 @@ def sampled_parts(d: LoopModel, f_s: float) -> SampledParts:
     """Plant [i_q, θ_r, ω_r] discretised exactly for held u_q, and the observer, at ``f_s`` [Hz]."""
     T_s = 1.0 / f_s
     Ap, bp = plant_matrices_of(d.coefficients, d.params)
-    aug = np.zeros((4, 4))
-    aug[:3, :3], aug[:3, 3] = Ap * T_s, bp * T_s
-    E = expm(aug)
-    return SampledParts(E[:3, :3], E[:3, 3], discrete_observer(d.observer, d.coefficients.M, f_s))
+    Ad, bd = zoh(Ap, bp, T_s)
+    return SampledParts(Ad, bd, discrete_observer(d.observer, d.coefficients.M, f_s))
 
 
 def discrete_loop(
@@ -262,13 +260,28 @@ def stability_measure(
     parts: SampledParts | None = None,
 ) -> float:
     """Largest Re(s) [1/s] (continuous) or largest |z| − 1 [-] (sampled); < 0 means stable."""
-    M = continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
+    return stability_measures(d, law, [K], f_s, delay, parts)[0]
+
+
+def stability_measures(
+    d: LoopCase, law: str, Ks: list[float], f_s: float | None, delay: int = 0,
+    parts: SampledParts | None = None,
+) -> list[float]:
+    """:func:`stability_measure` for each gain in ``Ks``, with one batched eigenvalue call."""
+    if f_s is not None and parts is None:
+        parts = sampled_parts(d, f_s)
+    mats = [continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
+            for K in Ks]
     if law == "cruise":
-        M = reduce_shift_mode(M)
-    if not np.all(np.isfinite(M)):  # a gain so large (or a model so extreme) that the loop overflows
-        return math.inf
-    ev = np.linalg.eigvals(M)
-    return float(np.max(ev.real)) if f_s is None else float(np.max(np.abs(ev)) - 1.0)
+        mats = [reduce_shift_mode(M) for M in mats]
+    finite = [bool(np.all(np.isfinite(M))) for M in mats]  # a huge gain can overflow the loop
+    out = [math.inf] * len(mats)
+    if any(finite):
+        ev = np.linalg.eigvals(np.stack([M for M, ok in zip(mats, finite, strict=True) if ok]))
+        worst = np.max(ev.real, axis=1) if f_s is None else np.max(np.abs(ev), axis=1) - 1.0
+        for i, w in zip((i for i, ok in enumerate(finite) if ok), worst, strict=True):
+            out[i] = float(w)
+    return out
 
 
 def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> float:
@@ -285,7 +298,7 @@ def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> floa
         return stability_measure(d, law, K, f_s, delay, parts) >= 0.0
 
     grid = [float(K) for K in np.logspace(-5, 6, 23) * 1000.0 / d.alpha_max]
-    flags = [unstable(K) for K in grid]
+    flags = [m >= 0.0 for m in stability_measures(d, law, grid, f_s, delay, parts)]
     if all(flags):
         return 0.0
     last_stable = max(i for i, f in enumerate(flags) if not f)

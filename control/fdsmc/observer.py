@@ -21,7 +21,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import expm
+
+from control.common.discrete import zoh
 
 
 @dataclass(frozen=True)
@@ -158,11 +159,7 @@ def discrete_observer(g: ObserverGains, M: float, f_s: float) -> DiscreteObserve
     """
     T_s = 1.0 / f_s
     A, b, c = _plant_matrices(M)
-    aug = np.zeros((5, 5))
-    aug[:4, :4] = A * T_s
-    aug[:4, 4] = b * T_s
-    E = expm(aug)
-    Phi, Gamma = E[:4, :4], E[:4, 4]
+    Phi, Gamma = zoh(A, b, T_s)  # exact: the model is a chain of integrators
     z = math.exp(-g.q * T_s)
     # Ackermann: L = p(Φ) · O⁻¹ · e4 with p(λ) = (λ − z)⁴ and O the observability matrix.
     O = np.vstack([c @ np.linalg.matrix_power(Phi, k) for k in range(4)])

@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.linalg import expm
 
+from control.common.discrete import zoh
 from control.fdsmc.loop_analysis import (
     LoopModel,
     continuous_matrix,
@@ -58,11 +58,8 @@ def _step_system(lm: LoopModel, f_s: float | None, delay: int) -> tuple[np.ndarr
     b[0] = c.G * g_in
     tau = min(ctrl.T_si, ctrl.T_salpha, ctrl.T_so) / 3.0
     h = max(tau / _STEPS_PER_TAU, _horizon(lm) / _MAX_STEPS)
-    n = A.shape[0]
-    aug = np.zeros((n + 1, n + 1))
-    aug[:n, :n], aug[:n, n] = A * h, b * h
-    E = expm(aug)
-    return E[:n, :n], E[:n, n], h
+    Phi, gamma = zoh(A, b, h)
+    return Phi, gamma, h
 
 
 def acceleration_overshoot(lm: LoopModel, f_s: float | None, delay: int = 0) -> float:
