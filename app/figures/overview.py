@@ -135,7 +135,7 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
     layout["meta"] = {**layout["meta"], "overview": True}
     layout["title"] = {**layout["title"], "font": {"size": 15}, "y": 0.995, "yref": "container", "yanchor": "top"}
     layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": 10},
-                        "entrywidth": 0.33, "entrywidthmode": "fraction"}
+                        "entrywidth": 0.36, "entrywidthmode": "fraction"}
     layout["margin"] = {"l": 56, "r": 12, "t": 96, "b": 84, "autoexpand": False}
     if not runs(comparison):
         return spec

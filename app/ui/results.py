@@ -19,8 +19,8 @@ import viser
 from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.figures.plain import figure_json
 from app.io.numbers import NumberFormatError, parse_number
-from app.ui.replay import Replay, set_figure_json
 from app.ui.layout import PanelLayout
+from app.ui.replay import Replay, set_figure_json
 from app.ui.scene import RotorScene
 from app.ui.text import annual_savings, key_numbers_html, savings_markdown
 

@@ -4,6 +4,7 @@ BLDC tabs; the warnings box folds to one line; the replay moves the time cursor 
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from typing import Any
 
@@ -33,8 +34,8 @@ STATE_JS = """() => {
   const get = n => el._fullData.find(t => t.name === n);
   const m = get('FDSMC now');
   return {marker: [Number(m.x[0]), Number(m.y[0]), (m.text || [''])[0]],
-          cursors: %s.map(n => Array.from(get(n).x).map(Number))};
-}""" % str(list(CURSORS)).replace("'", '"')
+          cursors: CURSORS.map(n => Array.from(get(n).x).map(Number))};
+}""".replace("CURSORS", json.dumps(list(CURSORS)))
 FRAMES_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
   window.__frames = 0; window.__pairs = [];
@@ -42,9 +43,9 @@ FRAMES_JS = """() => {
     window.__frames += 1;
     const get = n => el._fullData.find(t => t.name === n);
     const text = (get('FDSMC now').text || [''])[0];
-    window.__pairs.push([text, Number(get(%s).x[0])]);
+    window.__pairs.push([text, Number(get(CURSOR).x[0])]);
   });
-}""" % repr(CURSORS[0]).replace("'", '"')
+}""".replace("CURSOR", json.dumps(CURSORS[0]))
 
 
 def _open(browser: Any, url: str, width: int, height: int) -> tuple[Any, Any]:
