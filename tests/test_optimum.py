@@ -1,5 +1,6 @@
 """The minimum-energy move: closed form vs Hamiltonian vs QP, limits, and the tracked optimum
-never drawing more energy than the FDSMC or the conventional controller on the same move."""
+never drawing more energy than the FDSMC or the conventional controller on the same move.
+"""
 
 from __future__ import annotations
 
@@ -36,7 +37,8 @@ def test_closed_form_meets_the_boundary_conditions():
 
 def test_closed_form_equals_the_hamiltonian_two_point_solution():
     """Where e^(M·T) is well conditioned, shooting with the Hamiltonian's matrix exponential gives
-    the same ω(t) and Γ(t) = −λ2/(2·a·J) as the stable closed form."""
+    the same ω(t) and Γ(t) = −λ2/(2·a·J) as the stable closed form.
+    """
     mm = MoveModel(J=1.0, F_v=0.5, a=0.2, delta_theta=2.0, T_m=1.5)
     cf = closed_form(mm, 300)
     M = hamiltonian_matrix(mm)

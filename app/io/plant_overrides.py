@@ -31,7 +31,7 @@ def plant_section(field: str) -> str:
 
 
 def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
-    """(the model's overrides, the plant's overrides mapped to ``motor.``/``load.`` fields)."""
+    """Split the overrides into (the model's overrides, the plant's overrides mapped to ``motor.``/``load.`` fields)."""
     model, plant = [], []
     for item in overrides:
         if not item.startswith(PREFIX):
@@ -45,7 +45,7 @@ def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
 
 
 def load_model_and_plant(preset: str, overrides: Iterable[str]) -> tuple[DriveParams, DriveParams | None]:
-    """The controller's model and the plant (None when no ``plant.`` override is given)."""
+    """Return the controller's model and the plant (None when no ``plant.`` override is given)."""
     model_ov, plant_ov = split_overrides(overrides)
     params = load_mode_preset(preset, model_ov, mode="position")
     if not plant_ov:

@@ -57,8 +57,11 @@ N_INTERVALS = 2000
 
 @dataclass(frozen=True)
 class MoveModel:
-    """The move's data. J [kg·m²]; F_v [N·m·s/rad]; a [W/(N·m)²] copper coefficient; delta_theta
-    [rad]; T_m [s]; Gamma_lim [N·m] torque limit (inf = none); Gamma_Le [N·m] constant load."""
+    """The move's data.
+
+    J [kg·m²]; F_v [N·m·s/rad]; a [W/(N·m)²] copper coefficient; delta_theta [rad]; T_m [s]; Gamma_lim [N·m]
+    torque limit (inf = none); Gamma_Le [N·m] constant load.
+    """
 
     J: float
     F_v: float
@@ -71,9 +74,11 @@ class MoveModel:
 
 @dataclass(frozen=True)
 class OptimalMove:
-    """An optimal move on the grid t [s] (N + 1 nodes): theta [rad], omega [rad/s], alpha
-    [rad/s²] (dω/dt), Gamma_em [N·m]; energies over [0, T_m] [J]; torque_peak [N·m];
-    limited (a torque limit is active); method ("closed form" or the solver's name)."""
+    """An optimal move on the grid t [s] (N + 1 nodes).
+
+    theta [rad], omega [rad/s], alpha [rad/s²] (dω/dt), Gamma_em [N·m]; energies over [0, T_m] [J];
+    torque_peak [N·m]; limited (a torque limit is active); method ("closed form" or the solver's name).
+    """
 
     t: np.ndarray
     theta: np.ndarray
@@ -94,8 +99,10 @@ class OptimalMove:
 
 
 def move_model(params: DriveParams, margin: float = 1.0) -> MoveModel:
-    """The move of ``params`` with the torque limit divided by ``margin`` ≥ 1 [-] (room for the
-    inner loops' overshoot when the optimum is tracked)."""
+    """Return the move of ``params`` with the torque limit divided by ``margin`` ≥ 1 [-].
+
+    The margin leaves room for the inner loops' overshoot when the optimum is tracked.
+    """
     from control.fdsmc.feasibility import torque_limit  # local: feasibility imports the profile
 
     m, ld, mv = params.motor, params.load, params.manoeuvre
@@ -119,7 +126,7 @@ def mu(mm: MoveModel) -> float:
 
 
 def closed_form(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
-    """The unconstrained optimum of the module docstring on n + 1 nodes (Γ_Le constant)."""
+    """Return the unconstrained optimum of the module docstring on n + 1 nodes (Γ_Le constant)."""
     T, dth, m_ = mm.T_m, mm.delta_theta, mu(mm)
     t = np.linspace(0.0, T, n + 1)
     s = t - 0.5 * T
@@ -159,7 +166,7 @@ def _zoh(mm: MoveModel, h: float) -> tuple[float, float, float, float]:
 
 
 def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
-    """The optimum with |Γ_em| ≤ Γ_lim as a QP on n intervals (Clarabel via cvxpy).
+    """Solve for the optimum with |Γ_em| ≤ Γ_lim as a QP on n intervals (Clarabel via cvxpy).
 
     Raises
     ------
@@ -201,8 +208,10 @@ def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
 
 
 def optimal_move(params: DriveParams, margin: float = 1.0, n: int = N_INTERVALS) -> OptimalMove:
-    """The minimum-energy move of ``params`` within the torque limit / ``margin`` (see
-    :func:`move_model`): the closed form where no limit is active, else the QP."""
+    """Return the minimum-energy move of ``params`` within the torque limit / ``margin``.
+
+    See :func:`move_model`: the closed form where no limit is active, else the QP.
+    """
     mm = move_model(params, margin)
     cf = closed_form(mm, n)
     if cf.torque_peak <= mm.Gamma_lim:
@@ -211,7 +220,7 @@ def optimal_move(params: DriveParams, margin: float = 1.0, n: int = N_INTERVALS)
 
 
 def tracked_move(d: Derived, n: int = N_INTERVALS) -> OptimalMove:
-    """The optimum the closed-loop simulation tracks for the derived case ``d``.
+    """Return the optimum the closed-loop simulation tracks for the derived case ``d``.
 
     Its torque limit is the drive's (Γ_max or i_max's torque), or the FDSMC's own planned peak
     torque when that is larger (the paper's section-5 drive plans beyond Γ_max: the optimum is

@@ -34,8 +34,10 @@ class Move:
 
 @dataclass(frozen=True)
 class DutyResult:
-    """Energy per cycle [J] per comparator (None if a run was unstable), the cycle time [s], and
-    the per-move energies ``moves[i][comparator]`` [J]."""
+    """Return the energy per cycle [J] per comparator (None if a run was unstable) and the cycle time [s].
+
+    Also the per-move energies ``moves[i][comparator]`` [J].
+    """
 
     cycle_J: dict[str, float | None]
     cycle_s: float

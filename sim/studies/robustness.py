@@ -39,9 +39,12 @@ MAX_NORMAL_SIGMA = 0.3
 
 @dataclass(frozen=True)
 class Spread:
-    """Distribution of one plant value. section "motor"/"load"; field the parameter's name;
-    kind "uniform" (absolute lo…hi in SI), "relative" (uniform nominal·(1 + lo…hi)) or "normal"
-    (nominal·(1 + σ·N(0, 1)) with σ = hi, truncated at ±3σ by redrawing)."""
+    """Distribution of one plant value.
+
+    section "motor"/"load"; field the parameter's name; kind "uniform" (absolute lo…hi in SI), "relative"
+    (uniform nominal·(1 + lo…hi)) or "normal" (nominal·(1 + σ·N(0, 1)) with σ = hi, truncated at ±3σ by
+    redrawing).
+    """
 
     section: str
     field: str
@@ -60,7 +63,7 @@ class RobustnessResult:
 
 
 def draw(params: DriveParams, spreads: Sequence[Spread], n: int, seed: int) -> dict[str, np.ndarray]:
-    """n values [SI] of each spread's field, keyed ``section.field``, from one seeded generator."""
+    """Draw n values [SI] of each spread's field, keyed ``section.field``, from one seeded generator."""
     rng = np.random.default_rng(seed)
     out: dict[str, np.ndarray] = {}
     for s in spreads:
@@ -89,8 +92,10 @@ def plant_for(params: DriveParams, values: dict[str, float]) -> DriveParams:
 
 
 def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None) -> dict[str, dict[str, Any]]:
-    """Both controllers' metrics on one plant, plus ``infeasible`` (unstable, or the peak torque
-    beyond the plant's torque limit) and ``saving_friction_pct``; ``d`` = derive(params)."""
+    """Return both controllers' metrics on one plant, plus ``infeasible`` and ``saving_friction_pct``.
+
+    ``infeasible``: unstable, or the peak torque beyond the plant's torque limit; ``d`` = derive(params).
+    """
     cmp = compare(params, CONTROLLERS, d, plant=plant, max_points=TRACE_POINTS)
     lim = torque_limit(plant)
     out: dict[str, dict[str, Any]] = {}
@@ -108,14 +113,16 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
 
 def simulate_chunk(params: DriveParams, rows: list[dict[str, float]],
                    d: Derived | None = None) -> list[dict[str, dict[str, Any]]]:
-    """Metrics of several samples (one task); module-level so that it pickles. ``d`` =
-    derive(params), the controller's design (the same for every sample; computed if None)."""
+    """Return the metrics of several samples (one task); module-level so that it pickles.
+
+    ``d`` = derive(params), the controller's design (the same for every sample; computed if None).
+    """
     d = derive(params) if d is None else d
     return [sample_metrics(params, plant_for(params, r), d) for r in rows]
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
-    """Samples per task [-]: each task ≥ MIN_TASK_S, unless that leaves a worker idle."""
+    """Return the samples per task [-]: each task ≥ MIN_TASK_S, unless that leaves a worker idle."""
     size = max(1, math.ceil(MIN_TASK_S / max(seconds_per_sample, 1e-6)))
     if n > 0 and math.ceil(n / size) < workers:
         size = max(1, math.ceil(n / workers))  # every worker gets work, even if tasks are short
@@ -131,8 +138,10 @@ def _stats(x: np.ndarray, worst: str) -> dict[str, float | None]:
 
 
 def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str, Any]:
-    """Per controller, per metric mean/p05/p50/p95/worst over the stable samples, chatter and
-    infeasible probabilities; the friction saving's distribution (worst = smallest)."""
+    """Summarise the samples per controller: mean/p05/p50/p95/worst of each metric over the stable ones.
+
+    Also the chatter and infeasible probabilities and the friction saving's distribution (worst = smallest).
+    """
     out: dict[str, Any] = {"samples": len(runs), "seconds": seconds}
     for ctrl in CONTROLLERS:
         rs = [r[ctrl] for r in runs]
