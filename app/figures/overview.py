@@ -115,7 +115,7 @@ def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> di
 
 
 def overview_spec(comparison: Any) -> dict[str, Any]:
-    """The phase plane (left) and the compact time plot (right) as one plain-dict figure.
+    """Build the phase plane (left) and the compact time plot (right) as one plain-dict figure.
 
     ``layout.meta.id`` stays ``"phase_plane"`` (the page and its tests find the figure by it);
     ``layout.meta.overview`` is True.

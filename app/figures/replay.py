@@ -27,8 +27,10 @@ SLIDER_STEPS = 100
 
 
 def _frames_json(comparison: Any, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = ()) -> str:
-    """JSON list of frames: per time t of ``t_grid`` [s] the x/y of each "now" marker (and a time label)
-    and ``x = [t, t]`` of each time-cursor trace (indices ``cursors``).
+    """Write the JSON list of frames at the times ``t_grid`` [s].
+
+    Per time t: the x/y of each "now" marker (and a time label) and ``x = [t, t]`` of each
+    time-cursor trace (indices ``cursors``).
 
     Written as text directly: a few thousand small frames are ~10× faster this way than as dicts.
     """

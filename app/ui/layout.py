@@ -48,7 +48,7 @@ class PanelLayout:
 
 
 def layout_for_window(width: float, height: float, show_3d: bool = False) -> PanelLayout:
-    """The panel layout for a ``width`` × ``height`` [px] window.
+    """Size the panels for a ``width`` × ``height`` [px] window.
 
     The control panel keeps its width, the 3D canvas gets :data:`CANVAS_SPARE` (folded) or
     :data:`SCENE_SHARE` of the width (shown), the results panel the rest; the overview plot is as
@@ -85,7 +85,7 @@ class WindowFit:
         apply(self.layout)
 
     def canvas_reported(self, canvas_width: float, canvas_height: float) -> None:
-        """A camera message: refit when the window it implies changed."""
+        """Refit when the window implied by a camera message (its canvas size [px]) changed."""
         with self._lock:
             self._canvas_reported(canvas_width, canvas_height)
 

@@ -1,5 +1,4 @@
-"""The results panel (docked next to the control panel, the rest of the window): overview, time
-plots, energy, Table 1.
+"""The results panel (docked right, the rest of the window): overview, time plots, energy, Table 1.
 
 The *Overview* tab is what a projector shows: one line of key numbers above one figure holding
 the phase plane and a compact time plot (ω_r and Γ vs t), replayed together in the browser.
@@ -110,7 +109,7 @@ class ResultsPanel:
         self._update_savings()
 
     def show_derived_only(self, comparison: Any) -> None:
-        """An infeasible case (no runs): key numbers say so, the overview shows the boundary alone."""
+        """Show an infeasible case (no runs): the key numbers say so, the overview shows the boundary."""
         self.key_numbers.content = key_numbers_html(comparison)
         self.replay.load(comparison, autoplay=False)
 

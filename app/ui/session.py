@@ -89,8 +89,10 @@ class Session:
 
     # ---- layout -------------------------------------------------------------------------------
     def _layout(self, scene: RotorScene | None) -> None:
-        """Control panel docked left, results panel right, the 3D canvas between them; the widths
-        follow the window the browser reports (:mod:`app.ui.layout`)."""
+        """Dock the control panel left, the results panel right, the 3D canvas between them.
+
+        The widths follow the window the browser reports (:mod:`app.ui.layout`).
+        """
         gui = self.gui
         gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
         gui.add_html(PAGE_STYLE)

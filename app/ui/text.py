@@ -86,15 +86,18 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
 
 
 def _saves(pct: float | None) -> str:
-    """"saves 25.2 %", "costs 3.1 % more" or "saving –" (not both runs stable)."""
+    """Word a saving [%]: "saves 25.2 %", "costs 3.1 % more" or "saving –" (not both runs stable)."""
     if pct is None:
         return "saving –"
     return f"saves {pct:.1f} %" if pct >= 0 else f"costs {-pct:.1f} % more"
 
 
 def key_numbers_html(comparison: Any) -> str:
-    """One line of key numbers above the overview figure: savings [%], friction and electrical input
-    energies [J] of both controllers, peak torques [N·m] vs the drive's limit Γ_max (red when above)."""
+    """Render one line of key numbers above the overview figure.
+
+    Savings [%], friction and electrical input energies [J] of both controllers, peak torques
+    [N·m] vs the drive's limit Γ_max (red when above).
+    """
     f, c = comparison.fdsmc, comparison.conventional
     if f is None:
         return '<div data-role="key-numbers" style="font-size:0.9em">Not simulated (infeasible manoeuvre).</div>'

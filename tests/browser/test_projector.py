@@ -1,6 +1,7 @@
 """Projector layout: at 1280×720 the phase plane, the compact time plot and the key numbers are on
 screen without scrolling; wide screens use their width; the 3D view folds away and hides in the
-BLDC tabs; the warnings box folds to one line; the replay moves the time cursor with the marker."""
+BLDC tabs; the warnings box folds to one line; the replay moves the time cursor with the marker.
+"""
 
 from __future__ import annotations
 
