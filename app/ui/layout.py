@@ -22,7 +22,7 @@ CANVAS_MIN = 121.0
 #: by the camera still tells the window width.
 CANVAS_SPARE = 140.0
 #: Share of the window width given to the 3D view when it is shown [-], and its least width [px].
-SCENE_SHARE, SCENE_MIN = 0.28, 320.0
+SCENE_SHARE, SCENE_MIN = 0.22, 280.0
 #: Panel borders and resize handles between the docked panels [px] (measured).
 BORDERS = 8.0
 #: Control panel width [px] on windows up to WIDE_WINDOW px wide, and beyond.

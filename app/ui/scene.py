@@ -30,8 +30,9 @@ class RotorScene:
         self._frames: dict[str, viser.FrameHandle] = {}
         scene.set_up_direction("+z")
         self._root = scene.add_frame("/drives", show_axes=False, visible=visible)
-        for key, label, x, colour in (("fdsmc", "FDSMC", -0.45, (31, 111, 209)),
-                                      ("conventional", "Conventional", 0.45, (232, 89, 12))):
+        # the camera looks along −Y, so +X is on the left of the picture
+        for key, label, x, colour in (("fdsmc", "FDSMC", 0.45, (31, 111, 209)),
+                                      ("conventional", "Conventional", -0.45, (232, 89, 12))):
             base = f"/drives/{key}"
             scene.add_box(f"{base}_stator", dimensions=(0.3, 0.3, 0.3), color=(90, 90, 90),
                           position=(x, -0.35, 0.0))
