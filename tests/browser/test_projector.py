@@ -54,9 +54,10 @@ def _open(browser: Any, url: str, width: int, height: int) -> tuple[Any, Any]:
     page = context.new_page()
     page.set_default_timeout(TIMEOUT_MS)
     page.goto(url)
+    # first draw of the page: allowed 3× the usual wait (a loaded 2-core machine needs > 30 s)
     page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')]"
                            ".some(e => e.layout && e.layout.meta && e.layout.meta.overview"
-                           " && e._fullLayout && e._fullLayout.xaxis2)")
+                           " && e._fullLayout && e._fullLayout.xaxis2)", timeout=3 * TIMEOUT_MS)
     for close in page.locator(".mantine-Notification-closeButton").all():
         close.click()  # e.g. viser's "software WebGL" notice
     return context, page
@@ -99,7 +100,7 @@ def test_1280x720_shows_phase_plane_time_plot_and_numbers_without_scrolling(proj
 def test_wide_screen_gives_the_results_more_than_half_the_width(browser, ui_server):
     context, page = _open(browser, ui_server.url, 1920, 1080)
     try:
-        page.wait_for_function(f"() => ({BOXES_JS})().results > 960")
+        page.wait_for_function(f"() => {{ const b = ({BOXES_JS})(); return b.results > 960 && b.phase.width > 600; }}")
         boxes = page.evaluate(BOXES_JS)
         assert boxes["results"] > 960
         assert _inside(boxes["phase"], 1920, 1080) and _inside(boxes["torque"], 1920, 1080)
