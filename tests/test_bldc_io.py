@@ -9,7 +9,7 @@ import pytest
 
 from app.io.bldc_emf import read_measured, with_measured
 from app.io.presets import PresetError, dumps_preset, load_preset, loads_preset
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.bldc import emf as bldc_emf
 from sim.bldc.engine import simulate_bldc
 

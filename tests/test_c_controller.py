@@ -27,8 +27,9 @@ import pytest
 from app.exports.c_module import controller_files
 from app.exports.c_verify import CFLAGS, agreement, build, closed_loop, compiler, write_module
 from app.io.presets import SCHEMA, list_presets, load_preset
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import simulate
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -9,10 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from control.common.checks import ParameterError
 from control.fdsmc.conventional import conventional_gains, friction_energy_conventional
 from control.fdsmc.derivations import derive
 from control.fdsmc.model import model_coefficients
-from control.fdsmc.params import ParameterError
 from control.fdsmc.profile import (
     C_52,
     C_57,

@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from app.io.presets import load_preset
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams, LoadStep, ParameterError
+from control.fdsmc.params import DriveParams, LoadStep
 from sim.fdsmc.engine import compare, simulate
 
 

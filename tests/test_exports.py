@@ -28,8 +28,8 @@ from app.exports.model import (
 from app.io.presets import SCHEMA, load_preset, loads_preset, loads_raw
 from app.io.units import SI_UNITS
 from app.ui.files import parse_upload, safe_stem, uncommitted
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
-from control.fdsmc.params import ParameterError
 from sim.fdsmc.engine import Comparison, compare
 
 

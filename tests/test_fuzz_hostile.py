@@ -30,11 +30,11 @@ from app.io.numbers import NumberFormatError, parse_integer, parse_number
 from app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
 from app.ui.results import parse_T_m_list
 from app.ui.text import checked_choice
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive, predicted_energy
 from control.fdsmc.feasibility import alpha_max, feasibility
 from control.fdsmc.model import model_coefficients
 from control.fdsmc.observer import discrete_observer, observer_gains
-from control.fdsmc.params import ParameterError
 from control.fdsmc.profile import velocity_profile
 from sim.bldc.engine import check_budget as bldc_check_budget
 from sim.common import budget

@@ -14,8 +14,8 @@ import pytest
 
 from app.cli.main import main
 from app.io.presets import MAX_BYTES, PRESET_DIR, PresetError, load_preset, loads_preset
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
-from control.fdsmc.params import ParameterError
 from sim.bldc.engine import check_budget as bldc_check_budget
 from sim.bldc.engine import compare_bldc
 from sim.common import budget

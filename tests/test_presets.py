@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from app.io import presets
 from app.io.presets import PresetError, dumps_preset, load_preset, loads_preset, to_raw
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 
 RAW_OK = dict  # alias for readability
 

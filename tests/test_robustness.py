@@ -14,7 +14,7 @@ from app.cli.main import main
 from app.cli.robustness import parse_spread, parse_spreads
 from app.io.plant_overrides import load_model_and_plant
 from app.io.presets import load_preset
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.fdsmc.engine import compare
 from sim.studies.robustness import METRICS, TRACE_POINTS, Spread, draw, robustness
 

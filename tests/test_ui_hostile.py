@@ -22,7 +22,7 @@ from app.ui.session import create_server
 from app.ui.text import checked_choice, md_text
 from app.ui.web_guard import COOKIE, Guard
 from app.ui.worker import Cancelled, Worker
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 
 PROTOCOL = f"viser-v{viser.__version__}"
 

@@ -16,7 +16,7 @@ from app.io.bldc_view import comparison_json, metric_table
 from app.io.preset_modes import load_mode_preset
 from app.io.presets import load_preset
 from control.bldc.params import BldcParams
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.bldc.engine import CONTROLLERS, LABELS, compare_bldc, simulate_bldc
 
 

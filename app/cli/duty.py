@@ -16,7 +16,8 @@ from app.cli.main import add_preset_arguments
 from app.cli.simulate import finite_or_none
 from app.io.numbers import parse_number
 from app.io.presets import load_preset, loads_raw
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 from sim.studies.duty import Move, duty_cycle
 
 MAX_MOVES = 50

@@ -15,8 +15,9 @@ from pathlib import Path
 from app.cli.main import add_preset_arguments
 from app.exports.model import FORMATS, export_files
 from app.io.preset_modes import load_mode_preset
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import Comparison, compare
 
 

@@ -14,8 +14,9 @@ from typing import Any
 from app.cli.simulate import finite_or_none
 from app.io.drive_log import DriveLog, read_log, run_identification
 from app.io.presets import DEFAULT_PRESET, load_preset, loads_log_mapping
+from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.drivelog.overlay import Overlay, overlay
 from sim.fdsmc.engine import CONTROLLERS, simulate
 

@@ -16,7 +16,8 @@ from typing import Any
 
 from app.cli.simulate import finite_or_none
 from app.io.presets import load_preset, loads_raw
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 from sim.studies.multiaxis import MultiAxisResult, coordinate
 
 MAX_AXES = 16

@@ -21,7 +21,7 @@ from typing import Any
 from app.cli.main import add_preset_arguments
 from app.cli.simulate import finite_or_none
 from app.io.plant_overrides import load_model_and_plant, plant_section
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.studies.robustness import MAX_NORMAL_SIGMA, METRICS, RobustnessResult, Spread, robustness
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"

@@ -11,7 +11,7 @@ from app.cli.main import add_preset_arguments, check_writable
 from app.exports.model import trace_csv
 from app.io.derived_view import derived_json
 from app.io.plant_overrides import load_model_and_plant
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.fdsmc.engine import Comparison, RunResult, compare
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 

@@ -19,7 +19,7 @@ from app.cli.main import add_preset_arguments
 from app.cli.simulate import finite_or_none
 from app.io.numbers import NumberFormatError, parse_number
 from app.io.preset_modes import load_mode_preset
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.fdsmc.engine import PAPER_TABLE1, Table1Row, table1_sweep
 
 DEFAULT_TM = "1.0,1.4,1.8,2.2,2.6"

@@ -16,8 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from app.io.units import spec_of
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 
 from .c_template import HEADER, SOURCE
 
@@ -77,13 +79,42 @@ def scaled_observer(d: Derived) -> ScaledObserver:
     return ScaledObserver(scale, Phi, od.Gamma * f_s**2 / scale, od.L / scale)
 
 
+#: Constants that are inputs of the preset: C name → ``section.field`` (unit and range from its spec).
+INPUT_KEYS: dict[str, str] = {
+    "R_S": "motor.R_s", "L_D": "motor.L_d", "L_Q": "motor.L_q", "PSI_PM": "motor.psi_pm", "POLE_PAIRS": "motor.p",
+    "J_R": "motor.J_r", "T_SI": "controller.T_si", "T_SALPHA": "controller.T_salpha", "T_SO": "controller.T_so",
+    "K_BL": "controller.K", "THETA_DEM": "manoeuvre.theta_dem", "T_M": "manoeuvre.T_m",
+    "DELAY_SAMPLES": "controller.delay_samples", "V_DC": "controller.V_dc", "I_MAX": "controller.i_max",
+    "GAMMA_MAX": "motor.Gamma_max",
+}
+
+
+#: Non-ASCII unit and range symbols → their C-comment spelling.
+_ASCII_UNITS = (("Ω", "Ohm"), ("·", "*"), ("²", "^2"), ("≤", "<="), ("≥", ">="), ("…", "..."))
+
+
+def c_unit(text: str) -> str:
+    """Spell a unit or range text in ASCII for a C comment, e.g. ``"kg·m²"`` → ``"kg*m^2"``."""
+    for old, new in _ASCII_UNITS:
+        text = text.replace(old, new)
+    return text
+
+
+def _input(name: str, params: DriveParams, ref: str) -> CConstant:
+    """Make an input of the preset a constant, with the unit and allowed range of the field's spec."""
+    spec = spec_of(INPUT_KEYS[name])
+    section, field = INPUT_KEYS[name].split(".")
+    value = getattr(getattr(params, section), field)
+    return CConstant(name, value, c_unit(spec.unit), f"{ref}; {c_unit(spec.range_text())}", integer=spec.integer)
+
+
 def _model_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     """Motor model: nameplate values and the coefficients A…M of eqs. (1)–(4) in [1]."""
-    m, c = params.motor, d.coefficients
-    k = [CConstant("R_S", m.R_s, "Ohm", "stator resistance"), CConstant("L_D", m.L_d, "H", "d inductance"),
-         CConstant("L_Q", m.L_q, "H", "q inductance"), CConstant("PSI_PM", m.psi_pm, "Wb", "magnet flux"),
-         CConstant("POLE_PAIRS", m.p, "-", "pole pairs p", integer=True),
-         CConstant("J_R", m.J_r, "kg*m^2", "rotor inertia (the load J_L is unknown to the controller)")]
+    c = d.coefficients
+    k = [_input("R_S", params, "stator resistance"), _input("L_D", params, "d inductance"),
+         _input("L_Q", params, "q inductance"), _input("PSI_PM", params, "magnet flux"),
+         _input("POLE_PAIRS", params, "pole pairs p"),
+         _input("J_R", params, "rotor inertia (the load J_L is unknown to the controller)")]
     units = {"A": "1/s", "B": "-", "C": "-", "D": "1/s", "E": "A/rad", "F": "1/H", "G": "1/H",
              "H": "rad/s^2/A", "K": "rad/s^2/A^2", "M": "1/(kg*m^2)"}
     return k + [CConstant(f"COEF_{n}", getattr(c, n), u, "model coefficient, eqs. (1)-(4)") for n, u in units.items()]
@@ -91,18 +122,18 @@ def _model_constants(params: DriveParams, d: Derived) -> list[CConstant]:
 
 def _loop_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     """Inner loops, sliding-mode outer loop, comparator and the designed manoeuvre."""
-    ctrl, pr = params.controller, d.profile
-    return [CConstant("T_SI", ctrl.T_si, "s", "d-current settling time, eq. (8)"),
-            CConstant("T_SALPHA", ctrl.T_salpha, "s", "acceleration settling time, eq. (13)"),
-            CConstant("T_SO", ctrl.T_so, "s", "observer settling time, eq. (17)"),
-            CConstant("K_BL", ctrl.K, "s/rad", "boundary-layer gain K, eq. (45)"),
+    pr = d.profile
+    return [_input("T_SI", params, "d-current settling time, eq. (8)"),
+            _input("T_SALPHA", params, "acceleration settling time, eq. (13)"),
+            _input("T_SO", params, "observer settling time, eq. (17)"),
+            _input("K_BL", params, "boundary-layer gain K, eq. (45)"),
             CConstant("T_C", pr.T_c, "s", "sliding-mode time constant, eqs. (41), (59)"),
             CConstant("OMEGA_P", pr.omega_p, "rad/s", "peak speed, eq. (60)"),
             CConstant("ALPHA_MAX", d.alpha.alpha_max, "rad/s^2", f"acceleration limit ({d.alpha.rule} rule)"),
             CConstant("G1", d.conventional.g1, "1/s^2", "comparator gain, eq. (61)"),
             CConstant("G2", d.conventional.g2, "1/s", "comparator gain, eq. (61)"),
-            CConstant("THETA_DEM", params.manoeuvre.theta_dem, "rad", "designed manoeuvre angle"),
-            CConstant("T_M", params.manoeuvre.T_m, "s", "designed manoeuvre time")]
+            _input("THETA_DEM", params, "designed manoeuvre angle"),
+            _input("T_M", params, "designed manoeuvre time")]
 
 
 def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
@@ -116,17 +147,17 @@ def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
          CConstant("F_S2", f_s**2, "1/s^2", "f_s^2 (observer scaling)"),
          CConstant("F_S3", f_s**3, "1/s^3", "f_s^3 (observer scaling)"),
          CConstant("T_S2", od.T_s**2, "s^2", "T_s^2 (observer scaling)"),
-         CConstant("DELAY_SAMPLES", ctrl.delay_samples, "samples", "computation delay", integer=True),
+         _input("DELAY_SAMPLES", params, "computation delay"),
          CConstant("OBS_Q", d.observer.q, "1/s", "observer bandwidth 15/(2*T_so), eq. (17)"),
          CConstant("OBS_Z_POLE", od.z_pole, "-", "discrete observer pole exp(-q*T_s), four-fold")]
     k += [CConstant(f"OBS_L{i + 1}", float(v), u, "discrete observer gain (unscaled, information)")
           for i, (v, u) in enumerate(zip(od.L, ("-", "1/s", "N*m/rad", "N*m/(rad*s)"), strict=True))]
-    return k + [CConstant("V_DC", ctrl.V_dc, "V", "DC link (0 = ideal inverter)"),
+    return k + [_input("V_DC", params, "DC link (0 = ideal inverter)"),
                 CConstant("U_MAX", u_max, "V", "|u_dq| limit V_dc/sqrt(3)"),
                 CConstant("HAS_U_MAX", int(u_max > 0.0), "-", "voltage limit active", integer=True),
-                CConstant("I_MAX", ctrl.i_max, "A", "|i_q| limit (0 = none)"),
+                _input("I_MAX", params, "|i_q| limit (0 = none)"),
                 CConstant("HAS_I_MAX", int(ctrl.i_max > 0.0), "-", "current limit active", integer=True),
-                CConstant("GAMMA_MAX", params.motor.Gamma_max, "N*m", "motor torque limit (information)")]
+                _input("GAMMA_MAX", params, "motor torque limit (information)")]
 
 
 def controller_constants(params: DriveParams, d: Derived) -> list[CConstant]:

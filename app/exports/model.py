@@ -28,10 +28,10 @@ import numpy as np
 
 from app.exports.c_module import TOOL, controller_files
 from app.io.derived_view import derived_rows
-from app.io.presets import SCHEMA, dumps, to_raw
+from app.io.presets import SCHEMA, annotate_units, dumps, to_raw
 from app.io.units import SI_UNITS
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
-from control.fdsmc.params import ParameterError
 from sim.fdsmc.engine import Comparison
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
@@ -117,10 +117,11 @@ def parameter_data(cmp: Comparison) -> dict[str, Any]:
 
 def parameter_yaml(cmp: Comparison) -> str:
     """Drive parameter file as YAML (written by :func:`app.io.presets.dumps`)."""
-    head = (f"# Drive parameter file (schema {SCHEMA}) — {TOOL}. SI units; the unit of each input is in\n"
-            "# `units`. Re-import: the page's Import button or any command taking PRESET, e.g.\n"
-            "# `python -m app derive FILE`; drive_gains, verdicts and results are then recomputed.\n")
-    return head + dumps(parameter_data(cmp))
+    head = (f"# Drive parameter file (schema {SCHEMA}) — {TOOL}. SI units; the unit and allowed range of each\n"
+            "# input are in the comment beside it, the units also in `units`. Re-import: the page's Import\n"
+            "# button or any command taking PRESET, e.g. `python -m app derive FILE`; drive_gains, verdicts\n"
+            "# and results are then recomputed.\n")
+    return head + annotate_units(dumps(parameter_data(cmp)))
 
 
 def parameter_json(cmp: Comparison) -> str:

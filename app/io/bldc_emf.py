@@ -25,7 +25,7 @@ from app.io.numbers import NumberFormatError, parse_number
 from app.io.presets import loads_raw
 from app.io.units import rpm_to_rad_s
 from control.bldc.params import EMF_SAMPLES_MAX, BldcParams
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.bldc.emf import MeasuredEmf, resample_measured
 
 STORE_SAMPLES = 360  # samples per period kept in a preset (1° electrical)

@@ -11,7 +11,8 @@ import dataclasses
 from collections.abc import Iterable
 
 from app.io.preset_modes import load_mode_preset
-from control.fdsmc.params import DriveParams, Load, Motor, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams, Load, Motor
 
 PREFIX = "plant."
 MOTOR_FIELDS = tuple(f.name for f in dataclasses.fields(Motor))

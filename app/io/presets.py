@@ -25,7 +25,8 @@ import yaml
 from app.io import units
 from app.io.numbers import NumberFormatError, parse_integer, parse_number
 from control.bldc.params import BldcParams
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError, field_specs
+from control.fdsmc.params import DriveParams
 
 SCHEMA = 2
 #: Schemas read: 1 (inputs only) is migrated to 2 (adds the informational export sections).
@@ -117,8 +118,7 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
         raise PresetError(f"{section} must be a mapping of field: value, got {raw!r}")
     hints = typing.get_type_hints(cls)
     names = [f.name for f in dataclasses.fields(cls)]
-    table = units.ALIASES.get(re.sub(r"\[\d+\]", "", section), {})  # scenario.cases[0] → scenario.cases
-    aliases = {k: a for k, a in table.items() if a.field in names}
+    aliases = units.aliases_of(cls)  # the unit-suffixed keys declared by the field specs
     extra = [units.KE_KEY] if "psi_pm" in names else []
     allowed = names + list(aliases) + extra
     values: dict[str, Any] = {}
@@ -310,7 +310,7 @@ def check_structure(text: str, origin: str) -> None:
 
 def _check_no_aliases(text: str) -> None:
     for event in yaml.parse(text, Loader=_TextLoader):
-        if isinstance(event, yaml.AliasEvent):
+        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:  # &name too
             raise PresetError("YAML anchors/aliases (*name) are not allowed in presets")
 
 
@@ -482,13 +482,42 @@ def dumps_preset(params: Any) -> str:
     return dumps(to_raw(params))
 
 
+_KEY_LINE = re.compile(r"^( *)(- )?(\w+):(.*)$")
+
+
+def annotate_units(text: str) -> str:
+    """YAML text of a preset → the same text with ``# [unit] allowed …`` after every input value.
+
+    The unit and range of each value come from its field spec (the loader ignores comments, so
+    the annotated text loads to the same object).
+    """
+    out, stack = [], []  # stack: (indent, key) of the mappings and lists the line is in
+    for line in text.splitlines():
+        m = _KEY_LINE.match(line)
+        if m is None:
+            out.append(line)
+            continue
+        indent = len(m.group(1)) + (2 if m.group(2) else 0)
+        stack = [(i, k) for i, k in stack if i < indent]
+        section = ".".join(k for _, k in stack)
+        stack.append((indent, m.group(3)))
+        cls = units.SECTION_CLASSES.get(section)
+        spec = field_specs(cls).get(m.group(3)) if cls is not None else None
+        value = m.group(4).strip()
+        if spec is not None and value and not value.startswith("["):
+            line = f"{line}  # [{spec.unit_text}] {spec.range_text()}"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def save_preset(params: Any, path: str | Path) -> None:
     """Write a parameter object as a preset file."""
     Path(path).write_text(dumps_preset(params), encoding="utf-8")
 
 
 __all__ = [
-    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "ParameterError", "PresetError", "apply_overrides", "dumps",
+    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "ParameterError", "PresetError", "annotate_units", "apply_overrides",
+    "dumps",
     "dumps_preset", "list_presets", "load_preset", "loads_preset", "parse_preset", "save_preset",
     "to_raw",
 ]

@@ -2,13 +2,23 @@
 
 A preset or ``--set`` key may carry a unit suffix instead of the SI field name, e.g.
 ``omega_b_rpm: 1432``, ``L_d_mH: 5.4``, ``P_r_kW: 12``, or ``Ke_Vrms_krpm`` instead of ``psi_pm``.
+Which units a field accepts is declared once, next to the field (its
+:class:`~control.common.checks.FieldSpec`); this module only knows how to convert each unit
+(:data:`CONVERSIONS`) and derives the loader's key table :data:`ALIASES` and the exported
+:data:`SI_UNITS` from the specs.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Callable
+import typing
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+
+from control.bldc.params import BldcParams
+from control.common.checks import FieldSpec, field_specs, range_text
+from control.fdsmc.params import DriveParams
 
 
 def rpm_to_rad_s(n_rpm: float) -> float:
@@ -39,6 +49,36 @@ def ms_to_s(t_ms: float) -> float:
 def s_to_ms(t: float) -> float:
     """Time [s] → [ms]."""
     return t * 1e3
+
+
+def W_to_kW(P: float) -> float:
+    """Power [W] → [kW]."""
+    return P * 1e-3
+
+
+def H_to_mH(L: float) -> float:
+    """Inductance [H] → [mH]."""
+    return L * 1e3
+
+
+def Hz_to_kHz(f: float) -> float:
+    """Frequency [Hz] → [kHz]."""
+    return f * 1e-3
+
+
+def rad_to_deg(x: float) -> float:
+    """Angle [rad] → [deg]."""
+    return math.degrees(x)
+
+
+def rad_to_rev(x: float) -> float:
+    """Angle [rad] → [rev]."""
+    return x / (2.0 * math.pi)
+
+
+def kgm2_to_kgcm2(J: float) -> float:
+    """Inertia [kg·m²] → [kg·cm²]."""
+    return J * 1e4
 
 
 def kHz_to_Hz(f_kHz: float) -> float:
@@ -90,37 +130,89 @@ class Alias:
     unit: str
 
 
-#: Unit-suffixed keys accepted per section, mapping to the SI field and its converter.
-ALIASES: dict[str, dict[str, Alias]] = {
-    "motor": {
-        "omega_b_rpm": Alias("omega_b", rpm_to_rad_s, "rpm"),
-        "P_r_kW": Alias("P_r", kW_to_W, "kW"),
-        "L_d_mH": Alias("L_d", mH_to_H, "mH"),
-        "L_q_mH": Alias("L_q", mH_to_H, "mH"),
-        "J_r_kgcm2": Alias("J_r", kgcm2_to_kgm2, "kg·cm²"),
-    },
-    "load": {"J_L_kgcm2": Alias("J_L", kgcm2_to_kgm2, "kg·cm²")},
-    "controller": {
-        "T_si_ms": Alias("T_si", ms_to_s, "ms"),
-        "T_salpha_ms": Alias("T_salpha", ms_to_s, "ms"),
-        "T_so_ms": Alias("T_so", ms_to_s, "ms"),
-        "f_s_kHz": Alias("f_s", kHz_to_Hz, "kHz"),
-    },
-    # BLDC speed-control mode (control/bldc/params.py); nested lists use the dotted path
-    "machine": {"L_s_minus_M_s_mH": Alias("L_s_minus_M_s", mH_to_H, "mH")},
-    "inverter": {"f_s_kHz": Alias("f_s", kHz_to_Hz, "kHz")},
-    "gains": {"eps_lambda_rpm": Alias("eps_lambda", rpm_to_rad_s, "rpm")},
-    "scenario.cases": {
-        "omega_0_rpm": Alias("omega_0", rpm_to_rad_s, "rpm"),
-        "omega_ref_rpm": Alias("omega_ref", rpm_to_rad_s, "rpm"),
-        "band_recovery_rpm": Alias("band_recovery", rpm_to_rad_s, "rpm"),
-        "t_window_ms": Alias("t_window", ms_to_s, "ms"),
-    },
-    "manoeuvre": {
-        "theta_dem_deg": Alias("theta_dem", deg_to_rad, "deg"),
-        "theta_dem_rev": Alias("theta_dem", rev_to_rad, "rev"),
-    },
+#: Non-SI unit → (to SI, from SI). Every display or loader unit a field spec names must be here.
+CONVERSIONS: dict[str, tuple[Callable[[float], float], Callable[[float], float]]] = {
+    "kW": (kW_to_W, W_to_kW),
+    "rpm": (rpm_to_rad_s, rad_s_to_rpm),
+    "mH": (mH_to_H, H_to_mH),
+    "ms": (ms_to_s, s_to_ms),
+    "kHz": (kHz_to_Hz, Hz_to_kHz),
+    "deg": (deg_to_rad, rad_to_deg),
+    "rev": (rev_to_rad, rad_to_rev),
+    "kg·cm²": (kgcm2_to_kgm2, kgm2_to_kgcm2),
 }
+#: Key suffix of a unit whose name is not an identifier (``J_r_kgcm2``).
+KEY_SUFFIX = {"kg·cm²": "kgcm2"}
+
+
+def to_si(x: float, unit: str) -> float:
+    """Convert a value in ``unit`` to SI (a unit without a conversion is the SI unit itself)."""
+    return CONVERSIONS[unit][0](x) if unit in CONVERSIONS else x
+
+
+def from_si(x: float, unit: str) -> float:
+    """Convert an SI value to ``unit`` (a unit without a conversion is the SI unit itself)."""
+    return CONVERSIONS[unit][1](x) if unit in CONVERSIONS else x
+
+
+def alias_key(name: str, unit: str) -> str:
+    """Return the loader key of field ``name`` given in ``unit``, e.g. ``L_d_mH``, ``J_r_kgcm2``."""
+    return f"{name}_{KEY_SUFFIX.get(unit, unit)}"
+
+
+def aliases_of(cls: type) -> dict[str, Alias]:
+    """Unit-suffixed keys of a parameter dataclass, from its field specs."""
+    return {alias_key(name, u): Alias(name, CONVERSIONS[u][0], u)
+            for name, spec in field_specs(cls).items() for u in spec.loader_units}
+
+
+def sections(cls: type, prefix: str = "") -> Iterator[tuple[str, type]]:
+    """(dotted section path, dataclass) of every nested parameter dataclass of ``cls``.
+
+    A dataclass field is a section (``motor``); a tuple of dataclasses is a list section
+    (``load.steps``, ``scenario.cases``), walked further (``scenario.cases.T_L_steps``).
+    """
+    hints = typing.get_type_hints(cls)
+    for f in dataclasses.fields(cls):
+        tp = hints[f.name]
+        if typing.get_origin(tp) is tuple:
+            tp = typing.get_args(tp)[0]
+        if dataclasses.is_dataclass(tp):
+            path = f"{prefix}{f.name}"
+            yield path, tp
+            yield from sections(tp, f"{path}.")
+
+
+#: Parameter dataclass of each mode (the preset loader's registry lives in app.io.presets).
+MODE_CLASSES: tuple[type, ...] = (DriveParams, BldcParams)
+#: Section path → parameter dataclass, both modes (section names are unique across modes).
+SECTION_CLASSES: dict[str, type] = {path: tp for cls in MODE_CLASSES for path, tp in sections(cls)}
+
+
+def spec_of(key: str) -> FieldSpec:
+    """Return the :class:`~control.common.checks.FieldSpec` of ``section.field``, e.g. ``"motor.L_d"``."""
+    section, _, name = key.rpartition(".")
+    return field_specs(SECTION_CLASSES[section])[name]
+
+
+def range_in(spec: FieldSpec, to_shown: Callable[[float], float], unit: str) -> str:
+    """Write the allowed range of ``spec`` in a shown unit; ``to_shown`` converts (linear, increasing).
+
+    E.g. L_d's range 1e-09 ≤ value ≤ 10 H shown in mH: ``"allowed 1e-06 ≤ value ≤ 10000 mH"``.
+    """
+    lo, hi = (None if b is None else to_shown(b) for b in (spec.low, spec.high))
+    return range_text(lo, hi, spec.low_open, unit, integer=spec.integer)
+
+
+def shown_range(spec: FieldSpec, unit: str | None = None) -> str:
+    """Write the allowed range of ``spec`` in ``unit`` (default its display unit), e.g. for a page hint."""
+    unit = unit or spec.shown_unit
+    return range_in(spec, lambda b: from_si(b, unit), unit)
+
+
+#: Unit-suffixed keys accepted per section, mapping to the SI field and its converter.
+ALIASES: dict[str, dict[str, Alias]] = {path: table for path, tp in SECTION_CLASSES.items()
+                                        if (table := aliases_of(tp))}
 
 #: Keys needing more than one field to convert (Ke needs the pole pairs).
 KE_KEY = "Ke_Vrms_krpm"
@@ -144,15 +236,22 @@ def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
     return psi_pm * p * rpm_to_rad_s(1000.0) / math.sqrt(2.0 / 3.0)
 
 
-#: SI unit of every input field of the position-drive parameter model (control/fdsmc/params.py), as
-#: written in exported parameter files (``units`` section).
+
+
+def _unit_text(cls: type, name: str) -> str:
+    """Return the exported SI unit of ``name``: its spec, a list section's fields, or ``-`` (a choice)."""
+    spec = field_specs(cls).get(name)
+    if spec is not None:
+        return spec.unit_text
+    nested = [tp for path, tp in sections(cls) if path == name]
+    if nested:
+        return ", ".join(f"{n}: {s.unit_text}" for n, s in field_specs(nested[0]).items())
+    return "-"
+
+
+#: SI unit of every input field of both modes' top-level sections, as written in exported
+#: parameter files (``units`` section); generated from the field specs.
 SI_UNITS: dict[str, dict[str, str]] = {
-    "motor": {"V_0": "V", "P_r": "W", "omega_b": "rad/s", "Gamma_max": "N·m", "psi_pm": "Wb", "L_d": "H",
-              "L_q": "H", "R_s": "Ω", "p": "-", "J_r": "kg·m²"},
-    "load": {"J_L": "kg·m²", "F_v": "N·m·s/rad", "Gamma_Le": "N·m", "steps": "t: s, Gamma_Le: N·m",
-             "Gamma_Le_ramp": "N·m/s"},
-    "controller": {"T_si": "s", "T_salpha": "s", "T_so": "s", "K": "s/rad", "T_c": "s or 'T_a'",
-                   "alpha_max_rule": "-", "f_s": "Hz or 'continuous'", "delay_samples": "samples",
-                   "V_dc": "V", "i_max": "A"},
-    "manoeuvre": {"theta_dem": "rad", "T_m": "s"},
+    path: {f.name: _unit_text(tp, f.name) for f in dataclasses.fields(tp)}
+    for path, tp in SECTION_CLASSES.items() if "." not in path
 }

@@ -27,36 +27,53 @@ from app.io.bldc_emf import read_measured, with_measured
 from app.io.bldc_view import metric_table
 from app.io.numbers import NumberFormatError
 from app.io.preset_modes import load_mode_preset
-from app.io.presets import dumps_preset, loads_preset
-from app.io.units import kHz_to_Hz, mH_to_H, rad_s_to_rpm, rpm_to_rad_s
+from app.io.presets import annotate_units, dumps_preset, loads_preset
+from app.io.units import from_si, shown_range, spec_of, to_si
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice, md_text
 from app.ui.worker import Cancelled, Worker
 from control.bldc.design import bldc_design
 from control.bldc.params import EMF_SHAPES, BldcParams
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 from sim.bldc.emf import machine_table
 from sim.bldc.engine import CONTROLLERS, LABELS, BldcComparison, compare_bldc
 
 PRESET = "bldc_smc_paper"
 ASPECT = 0.75
 
-#: (label, section, field, to-SI converter, from-SI converter, step) of the number inputs.
-FIELDS: tuple[tuple[str, str, str, Callable[[float], float], Callable[[float], float], float], ...] = (
-    ("R_s [Ω]", "machine", "R_s", float, float, 0.01),
-    ("L_s − M_s [mH]", "machine", "L_s_minus_M_s", mH_to_H, lambda x: x * 1e3, 0.1),
-    ("n_pp (pole pairs)", "machine", "n_pp", int, int, 1),
-    ("Φ_m [Wb]", "machine", "Phi_m", float, float, 0.001),
-    ("J [kg·m²]", "mechanics", "J", float, float, 1e-4),
-    ("B [N·m·s/rad]", "mechanics", "B", float, float, 1e-4),
-    ("V_dc [V]", "inverter", "V_dc", float, float, 1.0),
-    ("f_s [kHz]", "inverter", "f_s", kHz_to_Hz, lambda x: x * 1e-3, 1.0),
-    ("k_I [1/A]", "gains", "k_I", float, float, 0.1),
-    ("k_ω [s/rad]", "gains", "k_omega", float, float, 0.1),
-    ("T_max [N·m]", "gains", "T_max", float, float, 0.1),
-    ("λ₀ [1/s]", "gains", "lambda_0", float, float, 1.0),
-    ("ε_λ [rpm]", "gains", "eps_lambda", rpm_to_rad_s, rad_s_to_rpm, 0.1),
+#: The machine, load, inverter and gain inputs (``section.field``); label, display unit and allowed
+#: range come from each field's spec (:func:`app.io.units.spec_of`).
+FIELDS: tuple[str, ...] = (
+    "machine.R_s", "machine.L_s_minus_M_s", "machine.n_pp", "machine.Phi_m", "mechanics.J", "mechanics.B",
+    "inverter.V_dc", "inverter.f_s", "gains.k_I", "gains.k_omega", "gains.T_max", "gains.lambda_0",
+    "gains.eps_lambda",
 )
+#: The scenario inputs shown beside the scenario dropdown.
+SCENARIO_FIELDS: tuple[str, ...] = ("scenario.cases.omega_ref", "scenario.cases.t_end")
+
+
+def field_label(key: str) -> str:
+    """Return the page label of ``section.field``: spec label and display unit, e.g. ``"L_s − M_s [mH]"``."""
+    spec = spec_of(key)
+    return f"{spec.label} [{spec.shown_unit}]"
+
+
+def number_input(gui: viser.GuiApi, key: str) -> NumberInput:
+    """Add a number field for ``key`` with its label and its allowed range (display unit) as hint."""
+    return NumberInput(gui, field_label(key), hint=shown_range(spec_of(key)))
+
+
+def show_si(field: NumberInput, key: str, si: float) -> None:
+    """Show an SI value in the field's display unit; an untouched field reads back ``si`` exactly."""
+    spec = spec_of(key)
+    field.show(int(si) if spec.integer else from_si(si, spec.shown_unit), exact=si)
+
+
+def read_si(field: NumberInput, key: str) -> float | int:
+    """Read the field's value in SI units; NumberFormatError naming the field and its label."""
+    spec = spec_of(key)
+    return field.read(f"{key} ({field_label(key)})",
+                      lambda x: to_si(x, spec.shown_unit), integer=spec.integer)
 
 
 def _placeholder(fid: str, title: str) -> go.Figure:
@@ -110,16 +127,13 @@ class BldcTab:
                                        "the results panel's **BLDC figures** tab.")
         self.warnings = gui.add_markdown("")
         with gui.add_folder("Scenario", expand_by_default=False):
-            self.w_ref = NumberInput(gui, "ω* [rpm]")
-            self.w_ref.show(rad_s_to_rpm(p.case.omega_ref), exact=p.case.omega_ref)
-            self.t_end = NumberInput(gui, "t_end [s]")
-            self.t_end.show(p.case.t_end)
+            self.w_ref, self.t_end = (number_input(gui, key) for key in SCENARIO_FIELDS)
+            self._scenario_chosen()
         self.inputs: dict[str, NumberInput] = {}
         with gui.add_folder("Machine, load, inverter, gains", expand_by_default=False):
-            for label, sec, name, _, from_si, _step in FIELDS:
-                si = getattr(getattr(p, sec), name)
-                self.inputs[label] = NumberInput(gui, label)
-                self.inputs[label].show(from_si(si), exact=si)
+            for key in FIELDS:
+                self.inputs[key] = number_input(gui, key)
+            self._show_inputs(p)
         with self._figures_container or gui.add_folder("Figures", expand_by_default=True):
             with gui.add_folder("Metrics", expand_by_default=True):
                 self.metrics = gui.add_markdown("No run yet — press **Simulate BLDC**.")
@@ -142,12 +156,12 @@ class BldcTab:
         p = self.params
         sections: dict[str, dict[str, Any]] = {"machine": {}, "mechanics": {}, "inverter": {}, "gains": {}}
         try:
-            for label, sec, name, to_si, _from_si, _ in FIELDS:
+            for key in FIELDS:
                 # an untouched field keeps its exact SI value (export → import gives back the same inputs)
-                sections[sec][name] = self.inputs[label].read(f"{sec}.{name} ({label})", to_si,
-                                                              integer=to_si is int)
-            omega_ref = self.w_ref.read("scenario ω* [rpm]", rpm_to_rad_s)
-            t_end = self.t_end.read("scenario t_end [s]")
+                sec, name = key.split(".")
+                sections[sec][name] = read_si(self.inputs[key], key)
+            omega_ref, t_end = (read_si(f, key) for f, key in zip((self.w_ref, self.t_end), SCENARIO_FIELDS,
+                                                                     strict=True))
         except NumberFormatError as exc:
             raise ParameterError(str(exc)) from None
         sections["machine"]["emf"] = checked_choice(self.emf.value, EMF_SHAPES, "Machine back-EMF")
@@ -212,8 +226,13 @@ class BldcTab:
         """Show the chosen scenario's reference speed and duration."""
         case = next((c for c in self.params.scenario.cases if c.name == self.scenario.value), None)
         if case is not None:
-            self.w_ref.show(rad_s_to_rpm(case.omega_ref), exact=case.omega_ref)
-            self.t_end.show(case.t_end)
+            show_si(self.w_ref, SCENARIO_FIELDS[0], case.omega_ref)
+            show_si(self.t_end, SCENARIO_FIELDS[1], case.t_end)
+
+    def _show_inputs(self, params: BldcParams) -> None:
+        for key in FIELDS:
+            sec, name = key.split(".")
+            show_si(self.inputs[key], key, getattr(getattr(params, sec), name))
 
     def _emf_chosen(self, event: viser.GuiEvent) -> None:
         if event.client is None:
@@ -276,9 +295,7 @@ class BldcTab:
     def apply(self, params: BldcParams) -> None:
         """Show ``params`` in every widget of the tab and make them the tab's parameters."""
         self.params = params
-        for label, sec, name, _, from_si, _ in FIELDS:
-            si = getattr(getattr(params, sec), name)
-            self.inputs[label].show(from_si(si), exact=si)
+        self._show_inputs(params)
         self.scenario.options = [c.name for c in params.scenario.cases]
         self.scenario.value = params.scenario.active
         self._scenario_chosen()
@@ -291,7 +308,7 @@ class BldcTab:
         except (ParameterError, ValueError, TypeError) as exc:
             self.status.content = f"**Rejected:** {md_text(exc)}"
             return
-        self.client.send_file_download(f"{params.name}.yaml", dumps_preset(params).encode("utf-8"),
+        self.client.send_file_download(f"{params.name}.yaml", annotate_units(dumps_preset(params)).encode("utf-8"),
                                        save_immediately=True)
 
 

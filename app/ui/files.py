@@ -19,7 +19,8 @@ import viser
 
 from app.exports.model import export_download, safe_stem
 from app.io.presets import MAX_BYTES, PresetError, loads_preset, to_raw
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import Comparison
 
 #: Export label → format of :func:`app.exports.model.export_files`.

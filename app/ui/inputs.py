@@ -11,7 +11,6 @@ the same loader as the CLI and YAML files (:func:`app.io.presets.parse_preset`).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -23,7 +22,8 @@ from app.io.numbers import NumberFormatError
 from app.io.presets import parse_preset, to_raw
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import FieldSpec, ParameterError
+from control.fdsmc.params import DriveParams
 
 Conv = Callable[[float, int], float]  # (value, pole pairs) → value
 
@@ -41,21 +41,34 @@ class Unit:
     from_si: Conv = _same
 
 
-def _scale(label: str, k: float) -> Unit:
-    return Unit(label, lambda x, _p: x * k, lambda x, _p: x / k)
+def _named(unit: str) -> Unit:
+    """Make a display unit converted by :mod:`app.io.units` (``"kg·cm²"``, ``"deg"`` …; an SI unit as is)."""
+    return Unit(unit, lambda x, _p: units.to_si(x, unit), lambda x, _p: units.from_si(x, unit))
+
+
+def _choices(key: str) -> tuple[Unit, ...]:
+    """List the units a field's spec offers: its shown unit first, then the loader's other units."""
+    spec = units.spec_of(key)
+    return tuple(_named(u) for u in dict.fromkeys((spec.shown_unit, spec.unit, *spec.loader_units)))
+
+
+def _winding(label: str, k: float, key: str) -> Unit:
+    """Per phase (k = 1) or line-to-line (k = 2) in the spec's display unit of ``key``."""
+    unit = units.spec_of(key).shown_unit
+    return Unit(label, lambda x, _p: units.to_si(x, unit) / k, lambda x, _p: units.from_si(x, unit) * k)
 
 
 #: Unit choices per selector; the first is the default.
 UNIT_GROUPS: dict[str, tuple[Unit, ...]] = {
-    "inertia": (Unit("kg·m²"), _scale("kg·cm²", 1e-4)),
-    "angle": (Unit("rad"), _scale("deg", math.pi / 180.0), _scale("rev", 2.0 * math.pi)),
+    "inertia": _choices("motor.J_r"),
+    "angle": _choices("manoeuvre.theta_dem"),
     "flux": (Unit("Ψ_PM [Wb]"),
              Unit("Ke [V_rms LL/krpm]", lambda x, p: units.ke_vrms_krpm_to_psi_pm(x, p),
                   lambda x, p: units.psi_pm_to_ke_vrms_krpm(x, p)),
              Unit("Kt [N·m/A_rms]", lambda x, p: units.kt_nm_per_arms_to_psi_pm(x, p),
                   lambda x, p: units.psi_pm_to_kt_nm_per_arms(x, p))),
-    "resistance": (Unit("per phase"), _scale("line-to-line", 0.5)),
-    "inductance": (_scale("per phase", 1e-3), _scale("line-to-line", 0.5e-3)),
+    "resistance": (_winding("per phase", 1.0, "motor.R_s"), _winding("line-to-line", 2.0, "motor.R_s")),
+    "inductance": (_winding("per phase", 1.0, "motor.L_d"), _winding("line-to-line", 2.0, "motor.L_d")),
 }
 SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), ("inertia", "Inertia unit"),
              ("angle", "Move unit"))
@@ -65,26 +78,43 @@ SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), (
 class Field:
     """One numeric input: SI field ``section.name`` shown as ``label [unit]``.
 
-    ``unit`` is the fixed display unit, or ``group`` names the selector whose choice applies.
+    Label, display unit and allowed range come from the field's spec (:func:`app.io.units.spec_of`);
+    ``group`` names the selector whose unit choice applies instead of the spec's display unit.
     """
 
     section: str
     name: str
-    label: str
-    unit: str = ""
-    scale: float = 1.0  # SI value = shown value · scale (fixed units)
     group: str | None = None
-    integer: bool = False
 
     @property
     def key(self) -> str:
         """``section.name``."""
         return f"{self.section}.{self.name}"
 
+    @property
+    def spec(self) -> FieldSpec:
+        """The field's one declaration (unit, range, label)."""
+        return units.spec_of(self.key)
+
+    @property
+    def label(self) -> str:
+        """The page label without unit."""
+        return self.spec.label
+
+    @property
+    def unit(self) -> str:
+        """The fixed display unit (fields without a selector)."""
+        return self.spec.shown_unit
+
+    @property
+    def integer(self) -> bool:
+        """True for a whole-number field."""
+        return self.spec.integer
+
     def unit_of(self, choice: Unit | None) -> str:
         """Display unit text for the selector's ``choice``."""
         if self.group in ("resistance", "inductance") and choice is not None:
-            return f"{'Ω' if self.group == 'resistance' else 'mH'}, {choice.label}"
+            return f"{self.spec.shown_unit}, {choice.label}"
         return choice.label if choice is not None else self.unit
 
     def text(self, choice: Unit | None = None) -> str:
@@ -93,31 +123,25 @@ class Field:
             return choice.label
         return f"{self.label} [{self.unit_of(choice)}]"
 
+    def hint(self, choice: Unit | None, p: int) -> str:
+        """Write the allowed range in the shown unit, e.g. ``"allowed 1e-06 ≤ value ≤ 10000 mH"``."""
+        if choice is None:
+            return units.shown_range(self.spec)
+        unit = choice.label.partition("[")[2].rstrip("]") if self.group == "flux" else self.unit_of(choice)
+        return units.range_in(self.spec, lambda b: choice.from_si(b, p), unit)
+
 
 FIELDS: tuple[Field, ...] = (
-    Field("motor", "V_0", "V_0 rated (LL rms)", "V"),
-    Field("motor", "P_r", "P_r rated power", "kW", 1e3),
-    Field("motor", "omega_b", "n_b rated speed", "rpm", math.pi / 30.0),
-    Field("motor", "Gamma_max", "Γ_max peak torque", "N·m"),
-    Field("motor", "psi_pm", "Ψ_PM", group="flux"),
-    Field("motor", "p", "p pole pairs", "-", integer=True),
-    Field("motor", "R_s", "R_s", group="resistance"),
-    Field("motor", "L_d", "L_d", group="inductance"),
-    Field("motor", "L_q", "L_q", group="inductance"),
-    Field("motor", "J_r", "J_r rotor inertia", group="inertia"),
-    Field("load", "J_L", "J_L load inertia", group="inertia"),
-    Field("load", "F_v", "F_v viscous friction", "N·m·s/rad"),
-    Field("load", "Gamma_Le", "Γ_Le load torque at t=0", "N·m"),
-    Field("load", "Gamma_Le_ramp", "Γ_Le ramp", "N·m/s"),
-    Field("controller", "V_dc", "V_dc inverter DC link (0 = ideal)", "V"),
-    Field("controller", "i_max", "i_max inverter peak current (0 = none)", "A"),
-    Field("controller", "T_si", "T_si current settling", "ms", 1e-3),
-    Field("controller", "T_salpha", "T_sα accel. settling", "ms", 1e-3),
-    Field("controller", "T_so", "T_so observer settling", "ms", 1e-3),
-    Field("controller", "K", "K boundary-layer gain", "s/rad"),
-    Field("manoeuvre", "theta_dem", "θ_dem demanded angle", group="angle"),
-    Field("manoeuvre", "T_m", "T_m manoeuvre time", "s"),
+    Field("motor", "V_0"), Field("motor", "P_r"), Field("motor", "omega_b"), Field("motor", "Gamma_max"),
+    Field("motor", "psi_pm", "flux"), Field("motor", "p"), Field("motor", "R_s", "resistance"),
+    Field("motor", "L_d", "inductance"), Field("motor", "L_q", "inductance"), Field("motor", "J_r", "inertia"),
+    Field("load", "J_L", "inertia"), Field("load", "F_v"), Field("load", "Gamma_Le"), Field("load", "Gamma_Le_ramp"),
+    Field("controller", "V_dc"), Field("controller", "i_max"), Field("controller", "T_si"),
+    Field("controller", "T_salpha"), Field("controller", "T_so"), Field("controller", "K"),
+    Field("manoeuvre", "theta_dem", "angle"), Field("manoeuvre", "T_m"),
 )
+#: Inputs with a keyword alternative (a dropdown beside them): T_c ('T_a' rule) and f_s ('continuous').
+T_C, F_S = Field("controller", "T_c"), Field("controller", "f_s")
 FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("controller", "Inverter and controller"),
            ("manoeuvre", "Manoeuvre"))
 TC_RULES = ("T_c = T_a, eq. (59)", "T_c given below")
@@ -168,7 +192,8 @@ class InputsPanel:
             with gui.add_folder(title):
                 self._selectors(section)
                 for f in (f for f in FIELDS if f.section == section):
-                    self.numbers[f.key] = NumberInput(gui, f.text(self._unit(f)))
+                    self.numbers[f.key] = NumberInput(gui, f.text(self._unit(f)),
+                                                      hint=f.hint(self._unit(f), self._params.motor.p))
                 self._extra(section)
         self.populate(params)
 
@@ -190,12 +215,12 @@ class InputsPanel:
                                       hint="Later steps of the external load torque, e.g. 0.5:10, 1.2:0")
         elif section == "controller":
             self.tc_rule = gui.add_dropdown("T_c rule", TC_RULES)
-            self.tc_ms = NumberInput(gui, "T_c sliding time const. [ms]")
+            self.tc_ms = NumberInput(gui, T_C.text(), hint=T_C.hint(None, 0))
             self.alpha_rule = gui.add_dropdown("α_max rule", ALPHA_RULES,
                                                hint="torque_limit: largest α within Γ_max/i_max incl. friction, "
                                                     "load and inner-loop overshoot; paper: α_max = H·P_r/V_0")
             self.fs_mode = gui.add_dropdown("Controller", FS_MODES)
-            self.fs_khz = NumberInput(gui, "f_s sample rate [kHz]")
+            self.fs_khz = NumberInput(gui, F_S.text(), hint=F_S.hint(None, 0))
             self.delay = gui.add_dropdown("Computation delay [samples]", DELAYS)
 
     # ---- units --------------------------------------------------------------------------------
@@ -210,7 +235,7 @@ class InputsPanel:
 
     def _show(self, f: Field, si: float) -> None:
         u = self._unit(f)
-        shown = u.from_si(si, self._p()) if u is not None else (si if f.integer else si / f.scale)
+        shown = u.from_si(si, self._p()) if u is not None else (si if f.integer else units.from_si(si, f.unit))
         self.numbers[f.key].show(int(shown) if f.integer else float(shown), exact=si)
 
     def _unit_changed(self, group: str) -> None:
@@ -228,6 +253,7 @@ class InputsPanel:
             self._choice[g] = UNIT_GROUPS[g][idx]
         for f in fields:
             self.numbers[f.key].label = f.text(self._unit(f))
+            self.numbers[f.key].hint = f.hint(self._unit(f), self._p())
             if f.key in values:
                 self._show(f, values[f.key])
 
@@ -243,22 +269,22 @@ class InputsPanel:
         self.steps.value = format_steps(params.load.steps)
         self.tc_rule.value = TC_RULES[0] if c.T_c == "T_a" else TC_RULES[1]
         if c.T_c != "T_a":
-            self.tc_ms.show(float(c.T_c) * 1e3, exact=float(c.T_c))
+            self.tc_ms.show(units.from_si(float(c.T_c), T_C.unit), exact=float(c.T_c))
         self.alpha_rule.value = c.alpha_max_rule
         self.fs_mode.value = FS_MODES[1] if c.is_continuous else FS_MODES[0]
         if not c.is_continuous:
-            self.fs_khz.show(float(c.f_s) * 1e-3, exact=float(c.f_s))
+            self.fs_khz.show(units.from_si(float(c.f_s), F_S.unit), exact=float(c.f_s))
         self.delay.value = str(c.delay_samples)
 
     def show_T_c_in_force(self, T_c: float) -> None:
         """With the rule T_c = T_a, show the T_a in force [s] in the T_c field (read-only meaning)."""
         if self.tc_rule.value == TC_RULES[0]:
-            self.tc_ms.show(T_c * 1e3, exact=T_c)
+            self.tc_ms.show(units.from_si(T_c, T_C.unit), exact=T_c)
 
     def set_T_c(self, T_c: float) -> None:
         """Select "T_c given below" and show ``T_c`` [s] (e.g. "use T_c,min")."""
         self.tc_rule.value = TC_RULES[1]
-        self.tc_ms.show(units.s_to_ms(T_c), exact=T_c)
+        self.tc_ms.show(units.from_si(T_c, T_C.unit), exact=T_c)
 
     def set_value(self, key: str, value_si: float) -> None:
         """Set one numeric field from an SI value (e.g. "use recommended K")."""
@@ -269,7 +295,7 @@ class InputsPanel:
         try:
             if f.integer:
                 return self.numbers[f.key].read(page, integer=True)
-            conv = (lambda x: u.to_si(x, self._p())) if u is not None else (lambda x: x * f.scale)
+            conv = (lambda x: u.to_si(x, self._p())) if u is not None else (lambda x: units.to_si(x, f.unit))
             return self.numbers[f.key].read(page, conv)
         except NumberFormatError as exc:
             raise InputError(str(exc)) from None
@@ -306,9 +332,10 @@ class InputsPanel:
             c["delay_samples"] = int(checked_choice(self.delay.value, DELAYS, "Computation delay"))
             for group, _title in SELECTORS:
                 checked_choice(self.selectors[group].value, [u.label for u in UNIT_GROUPS[group]], _title)
-            c["T_c"] = "T_a" if tc_rule == TC_RULES[0] else self.tc_ms.read("Controller › T_c [ms]", units.ms_to_s)
+            c["T_c"] = "T_a" if tc_rule == TC_RULES[0] else self.tc_ms.read(
+                f"Controller › {T_C.text()}", lambda x: units.to_si(x, T_C.unit))
             c["f_s"] = "continuous" if fs_mode == FS_MODES[1] else self.fs_khz.read(
-                "Controller › f_s [kHz]", units.kHz_to_Hz)
+                f"Controller › {F_S.text()}", lambda x: units.to_si(x, F_S.unit))
         except (NumberFormatError, ParameterError) as exc:
             raise InputError(str(exc)) from None
         self.nameplate_checks()

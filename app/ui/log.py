@@ -16,8 +16,9 @@ import viser
 from app.figures.drive_log import make_log_overlay_figure
 from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
 from app.io.presets import load_preset
+from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.drivelog.overlay import Overlay, overlay
 
 EXAMPLE_LOG = Path(__file__).resolve().parents[2] / "tests" / "data" / "drive_log_dq.csv"

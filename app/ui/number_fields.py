@@ -39,6 +39,15 @@ class NumberInput:
     def label(self, text: str) -> None:
         self.handle.label = text
 
+    @property
+    def hint(self) -> str | None:
+        """The hover hint (e.g. the allowed range in the shown unit)."""
+        return self.handle.hint
+
+    @hint.setter
+    def hint(self, text: str | None) -> None:
+        self.handle.hint = text
+
     def show(self, value: float | int, exact: float | int | None = None) -> None:
         """Display ``value``; :meth:`read` returns ``exact`` (default ``value``) while untouched.
 

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from app.io.derived_view import derived_rows
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
-from control.fdsmc.params import ParameterError
 
 #: Joules per kilowatt-hour [J/kWh].
 J_PER_KWH = 3.6e6

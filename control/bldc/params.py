@@ -1,9 +1,9 @@
 """Parameters of the BLDC speed-control mode: frozen dataclasses in SI units.
 
 The second mode of the tool: sliding-mode vector speed control of a surface-mount PMSM with a
-trapezoidal (non-sinusoidal) back-EMF, after [2]. Every field carries its unit in the docstring;
-construction rejects impossible values with a :class:`~control.fdsmc.params.ParameterError` naming the
-field, the value and the allowed range.
+trapezoidal (non-sinusoidal) back-EMF, after [2]. Every input field is declared once with
+:func:`control.common.checks.spec_field`; construction rejects impossible values with a
+:class:`~control.common.checks.ParameterError` naming the field, the value and the allowed range.
 
 References
 ----------
@@ -13,24 +13,15 @@ References
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, fields
-from typing import Any
+from dataclasses import dataclass
 
-from control.fdsmc.params import ParameterError, check_range
+from control.common.checks import ParameterError, check_fields, spec_field
 
 #: Back-EMF shapes of the machine model: the ideal trapezoid of Fig. 2 in [2], the built-in
 #: smooth distorted example, or a measured table (``BldcMachine.emf_samples``).
 EMF_SHAPES = ("ideal", "distorted", "measured")
 #: Minimum / maximum number of samples of a measured back-EMF period.
 EMF_SAMPLES_MIN, EMF_SAMPLES_MAX = 24, 4096
-
-
-def _check(obj: Any, section: str, spec: dict[str, tuple[float | None, float | None, bool, str]]) -> None:
-    for f in fields(obj):
-        if f.name in spec:
-            low, high, low_open, unit = spec[f.name]
-            check_range(f"{section}.{f.name}", getattr(obj, f.name), low, high, low_open=low_open, unit=unit)
 
 
 @dataclass(frozen=True)
@@ -56,30 +47,19 @@ class BldcMachine:
         (used when ``emf == "measured"``; phases b, c lag by 120° and 240°).
     """
 
-    R_s: float
-    L_s_minus_M_s: float
-    n_pp: int
-    Phi_m: float
+    R_s: float = spec_field("Ω", 0.0, 1e3, low_open=False, label="R_s")
+    L_s_minus_M_s: float = spec_field("H", 0.0, 10.0, label="L_s − M_s", display="mH")
+    n_pp: int = spec_field("-", 1, 100, integer=True, label="n_pp (pole pairs)")
+    Phi_m: float = spec_field("Wb", 0.0, 100.0, label="Φ_m")
     emf: str = "distorted"
-    emf_samples: tuple[float, ...] = ()
+    emf_samples: tuple[float, ...] = spec_field("Wb", -1e3, 1e3, default=(), label="Φ'_ra samples")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        _check(self, "machine", {
-            "R_s": (0.0, 1e3, False, "Ω"), "L_s_minus_M_s": (0.0, 10.0, True, "H"),
-            "Phi_m": (0.0, 100.0, True, "Wb"),
-        })
-        p = self.n_pp
-        if isinstance(p, bool) or not isinstance(p, int | float) or not (
-            math.isfinite(p) and float(p).is_integer() and 1 <= p <= 100
-        ):
-            raise ParameterError(f"machine.n_pp = {p!r} is out of range: allowed an integer 1 … 100 pole pairs")
-        object.__setattr__(self, "n_pp", int(p))
+        check_fields(self, "machine")
         if self.emf not in EMF_SHAPES:
             raise ParameterError(f"machine.emf = {self.emf!r} is not allowed: one of {', '.join(EMF_SHAPES)}")
-        samples = tuple(float(check_range(f"machine.emf_samples[{i}]", v, -1e3, 1e3, unit="Wb"))
-                        for i, v in enumerate(self.emf_samples))
-        object.__setattr__(self, "emf_samples", samples)
+        samples = self.emf_samples
         if self.emf == "measured" and not EMF_SAMPLES_MIN <= len(samples) <= EMF_SAMPLES_MAX:
             raise ParameterError(
                 f"machine.emf_samples has {len(samples)} samples: allowed {EMF_SAMPLES_MIN} … "
@@ -100,12 +80,12 @@ class BldcMechanics:
         SI dimension).
     """
 
-    J: float
-    B: float
+    J: float = spec_field("kg·m²", 0.0, 1e4, label="J")
+    B: float = spec_field("N·m·s/rad", 0.0, 1e4, low_open=False, label="B")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        _check(self, "mechanics", {"J": (0.0, 1e4, True, "kg·m²"), "B": (0.0, 1e4, False, "N·m·s/rad")})
+        check_fields(self, "mechanics")
 
 
 @dataclass(frozen=True)
@@ -121,12 +101,12 @@ class BldcInverter:
         Controller sample rate = PWM frequency [Hz]; the voltage is held for 1/f_s.
     """
 
-    V_dc: float
-    f_s: float
+    V_dc: float = spec_field("V", 0.0, 1e5, label="V_dc")
+    f_s: float = spec_field("Hz", 1e3, 1e6, low_open=False, label="f_s", display="kHz")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        _check(self, "inverter", {"V_dc": (0.0, 1e5, True, "V"), "f_s": (1e3, 1e6, False, "Hz")})
+        check_fields(self, "inverter")
 
 
 @dataclass(frozen=True)
@@ -147,32 +127,27 @@ class BldcGains:
         Error at which λ has fallen to λ_0/2: λ(ε) = λ_0/(1 + (ε/ε_λ)²) [rad/s].
     """
 
-    k_I: float
-    k_omega: float
-    T_max: float
-    lambda_0: float
-    eps_lambda: float
+    k_I: float = spec_field("1/A", 0.0, 1e4, label="k_I")
+    k_omega: float = spec_field("s/rad", 0.0, 1e4, label="k_ω")
+    T_max: float = spec_field("N·m", 0.0, 1e5, label="T_max")
+    lambda_0: float = spec_field("1/s", 0.0, 1e5, low_open=False, label="λ₀")
+    eps_lambda: float = spec_field("rad/s", 0.0, 1e5, label="ε_λ", display="rpm")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        _check(self, "gains", {
-            "k_I": (0.0, 1e4, True, "1/A"), "k_omega": (0.0, 1e4, True, "s/rad"),
-            "T_max": (0.0, 1e5, True, "N·m"), "lambda_0": (0.0, 1e5, False, "1/s"),
-            "eps_lambda": (0.0, 1e5, True, "rad/s"),
-        })
+        check_fields(self, "gains")
 
 
 @dataclass(frozen=True)
 class TorqueStep:
     """From time ``t`` [s] on, the load torque is ``T_L`` [N·m] (positive opposes motion)."""
 
-    t: float
-    T_L: float
+    t: float = spec_field("s", 0.0, 100.0, low_open=False, label="t step time")
+    T_L: float = spec_field("N·m", -1e5, 1e5, label="T_L load torque")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        check_range("scenario.cases.T_L_steps.t", self.t, 0.0, 100.0, low_open=False, unit="s")
-        check_range("scenario.cases.T_L_steps.T_L", self.T_L, -1e5, 1e5, unit="N·m")
+        check_fields(self, "scenario.cases.T_L_steps")
 
 
 @dataclass(frozen=True)
@@ -201,21 +176,17 @@ class BldcScenario:
     """
 
     name: str
-    omega_0: float
-    omega_ref: float
-    t_end: float
-    T_L_0: float = 0.0
+    omega_0: float = spec_field("rad/s", -1e4, 1e4, label="ω_0", display="rpm")
+    omega_ref: float = spec_field("rad/s", -1e4, 1e4, label="ω*", display="rpm")
+    t_end: float = spec_field("s", 0.0, 100.0, label="t_end")
+    T_L_0: float = spec_field("N·m", -1e5, 1e5, default=0.0, label="T_L at t=0")
     T_L_steps: tuple[TorqueStep, ...] = ()
-    t_window: float = 0.02
-    band_recovery: float = 0.1
+    t_window: float = spec_field("s", 0.0, 10.0, default=0.02, label="t_window", aliases=("ms",))
+    band_recovery: float = spec_field("rad/s", 0.0, 1e4, default=0.1, label="recovery band", aliases=("rpm",))
 
     def __post_init__(self) -> None:
         """Check the fields' ranges, turn mapping load steps into :class:`TorqueStep`, check their times increase."""
-        _check(self, "scenario", {
-            "omega_0": (-1e4, 1e4, True, "rad/s"), "omega_ref": (-1e4, 1e4, True, "rad/s"),
-            "t_end": (0.0, 100.0, True, "s"), "T_L_0": (-1e5, 1e5, True, "N·m"),
-            "t_window": (0.0, 10.0, True, "s"), "band_recovery": (0.0, 1e4, True, "rad/s"),
-        })
+        check_fields(self, "scenario.cases")
         steps = tuple(s if isinstance(s, TorqueStep) else TorqueStep(**s) for s in self.T_L_steps)
         times = [s.t for s in steps]
         if times != sorted(times) or any(t >= self.t_end for t in times):

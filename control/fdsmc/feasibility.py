@@ -8,8 +8,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from control.common.checks import ParameterError
 from control.fdsmc.model import available_voltage, model_coefficients, torque_constant
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import peak_speed, shortest_manoeuvre_time
 
 #: Relative precision of the steady-state limit checks [-]: the model's torque and voltage estimates

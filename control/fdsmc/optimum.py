@@ -47,9 +47,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.model import torque_constant
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 
 #: Default number of QP intervals over [0, T_m] [-].
 N_INTERVALS = 2000

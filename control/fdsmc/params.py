@@ -1,7 +1,9 @@
 """Parameter model of the FDSMC position drive: frozen dataclasses in SI units.
 
-Every field carries its unit in the docstring. Construction rejects impossible values with a
-:class:`ParameterError` whose message names the field, the value and the allowed range.
+Every input field is declared once with :func:`control.common.checks.spec_field` (SI unit, allowed
+range, page label, display unit, loader units); construction rejects impossible values with a
+:class:`~control.common.checks.ParameterError` whose message names the field, the value and the
+allowed range.
 
 References
 ----------
@@ -11,74 +13,11 @@ References
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, fields
-from typing import Any
+from dataclasses import dataclass
+
+from control.common.checks import ParameterError, check_fields, spec_field
 
 ALPHA_MAX_RULES = ("paper", "torque_limit")
-
-
-class ParameterError(ValueError):
-    """An input value outside its allowed range; the message names field, value and range."""
-
-
-def check_range(
-    name: str,
-    value: Any,
-    low: float | None = None,
-    high: float | None = None,
-    *,
-    low_open: bool = True,
-    unit: str = "",
-) -> float:
-    """Return ``value`` as float or raise :class:`ParameterError` naming the allowed range.
-
-    Parameters
-    ----------
-    name : str
-        Dotted field name shown to the user, e.g. ``"motor.L_d"``.
-    value : Any
-        The value to check.
-    low, high : float or None
-        Bounds (``None`` = unbounded). ``low`` is exclusive when ``low_open`` else inclusive;
-        ``high`` is inclusive.
-    unit : str
-        Unit shown in the message.
-
-    Returns
-    -------
-    float
-        The checked value.
-    """
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ParameterError(f"{name} = {value!r} is not a number{_range_text(low, high, low_open, unit)}")
-    x = float(value)
-    bad = not math.isfinite(x)
-    bad = bad or (low is not None and (x <= low if low_open else x < low))
-    bad = bad or (high is not None and x > high)
-    if bad:
-        shown = f"{name} = {value!r} {unit}".rstrip()
-        raise ParameterError(f"{shown} is out of range{_range_text(low, high, low_open, unit)}")
-    return x
-
-
-def _range_text(low: float | None, high: float | None, low_open: bool, unit: str) -> str:
-    u = f" {unit}" if unit else ""
-    if low is not None and high is not None:
-        op = "<" if low_open else "≤"
-        return f": allowed {low:g} {op} value ≤ {high:g}{u}"
-    if low is not None:
-        return f": allowed {'>' if low_open else '≥'} {low:g}{u}"
-    if high is not None:
-        return f": allowed ≤ {high:g}{u}"
-    return ": allowed any finite number"
-
-
-def _check_fields(obj: Any, section: str, spec: dict[str, tuple[float | None, float | None, bool, str]]) -> None:
-    for f in fields(obj):
-        if f.name in spec:
-            low, high, low_open, unit = spec[f.name]
-            check_range(f"{section}.{f.name}", getattr(obj, f.name), low, high, low_open=low_open, unit=unit)
 
 
 #: Shortest settling time of the inner loops and the observer [s]. With T_so ≥ 1 µs the observer
@@ -118,44 +57,32 @@ class Motor:
         Rotor moment of inertia [kg·m²].
     """
 
-    V_0: float
-    P_r: float
-    omega_b: float
-    Gamma_max: float
-    psi_pm: float
-    L_d: float
-    L_q: float
-    R_s: float
-    p: int
-    J_r: float
+    V_0: float = spec_field("V", 1.0, 1e5, low_open=False, label="V_0 rated (LL rms)")
+    P_r: float = spec_field("W", 1e-3, 1e8, low_open=False, label="P_r rated power", display="kW")
+    omega_b: float = spec_field("rad/s", 0.0, 1e5, label="n_b rated speed", display="rpm")
+    Gamma_max: float = spec_field("N·m", 1e-6, 1e6, low_open=False, label="Γ_max peak torque")
+    psi_pm: float = spec_field("Wb", 1e-6, 100.0, low_open=False, label="Ψ_PM")
+    L_d: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_d", display="mH")
+    L_q: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_q", display="mH")
+    R_s: float = spec_field("Ω", 0.0, 1e4, label="R_s")
+    p: int = spec_field("-", 1, 100, integer=True, label="p pole pairs")
+    J_r: float = spec_field("kg·m²", 1e-9, 1e4, low_open=False, label="J_r rotor inertia", aliases=("kg·cm²",))
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        spec = {
-            "V_0": (1.0, 1e5, False, "V"), "P_r": (1e-3, 1e8, False, "W"), "omega_b": (0.0, 1e5, True, "rad/s"),
-            "Gamma_max": (1e-6, 1e6, False, "N·m"), "psi_pm": (1e-6, 100.0, False, "Wb"),
-            "L_d": (1e-9, 10.0, False, "H"), "L_q": (1e-9, 10.0, False, "H"), "R_s": (0.0, 1e4, True, "Ω"),
-            "J_r": (1e-9, 1e4, False, "kg·m²"),
-        }
-        _check_fields(self, "motor", spec)
-        if isinstance(self.p, bool) or not isinstance(self.p, int | float) or not (
-            math.isfinite(self.p) and float(self.p).is_integer() and 1 <= self.p <= 100
-        ):
-            raise ParameterError(f"motor.p = {self.p!r} is out of range: allowed an integer 1 … 100 pole pairs")
-        object.__setattr__(self, "p", int(self.p))
+        check_fields(self, "motor")
 
 
 @dataclass(frozen=True)
 class LoadStep:
     """A step of the external load torque: from time ``t`` [s] on, Γ_Le = ``Gamma_Le`` [N·m]."""
 
-    t: float
-    Gamma_Le: float
+    t: float = spec_field("s", 0.0, None, low_open=False, label="t step time")
+    Gamma_Le: float = spec_field("N·m", -1e6, 1e6, label="Γ_Le load torque")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        check_range("load.steps.t", self.t, 0.0, None, low_open=False, unit="s")
-        check_range("load.steps.Gamma_Le", self.Gamma_Le, -1e6, 1e6, unit="N·m")
+        check_fields(self, "load.steps")
 
 
 @dataclass(frozen=True)
@@ -176,18 +103,15 @@ class Load:
         Ramp rate added to the external load torque from t = 0 [N·m/s].
     """
 
-    J_L: float
-    F_v: float
-    Gamma_Le: float = 0.0
+    J_L: float = spec_field("kg·m²", 0.0, 1e4, low_open=False, label="J_L load inertia", aliases=("kg·cm²",))
+    F_v: float = spec_field("N·m·s/rad", 0.0, 1e4, low_open=False, label="F_v viscous friction")
+    Gamma_Le: float = spec_field("N·m", -1e6, 1e6, default=0.0, label="Γ_Le load torque at t=0")
     steps: tuple[LoadStep, ...] = ()
-    Gamma_Le_ramp: float = 0.0
+    Gamma_Le_ramp: float = spec_field("N·m/s", -1e6, 1e6, default=0.0, label="Γ_Le ramp")
 
     def __post_init__(self) -> None:
         """Check the fields' ranges, turn mapping load steps into :class:`LoadStep`, check their times increase."""
-        _check_fields(self, "load", {
-            "J_L": (0.0, 1e4, False, "kg·m²"), "F_v": (0.0, 1e4, False, "N·m·s/rad"),
-            "Gamma_Le": (-1e6, 1e6, True, "N·m"), "Gamma_Le_ramp": (-1e6, 1e6, True, "N·m/s"),
-        })
+        check_fields(self, "load")
         steps = tuple(s if isinstance(s, LoadStep) else LoadStep(**s) for s in self.steps)
         times = [s.t for s in steps]
         if times != sorted(times):
@@ -225,40 +149,32 @@ class Controller:
         Inverter current limit on |i_q| [A]. 0 = none (the paper).
     """
 
-    T_si: float
-    T_salpha: float
-    T_so: float
-    K: float
-    T_c: float | str = "T_a"
+    T_si: float = spec_field("s", T_MIN_S, 10.0, low_open=False, label="T_si current settling", display="ms")
+    T_salpha: float = spec_field("s", T_MIN_S, 10.0, low_open=False, label="T_sα accel. settling", display="ms")
+    T_so: float = spec_field("s", T_MIN_S, 10.0, low_open=False, label="T_so observer settling", display="ms")
+    K: float = spec_field("s/rad", 0.0, 1e9, label="K boundary-layer gain")
+    T_c: float | str = spec_field("s", 0.0, 100.0, default="T_a", keywords=("T_a",),
+                                label="T_c sliding time const.", display="ms")
     alpha_max_rule: str = "paper"
-    f_s: float | str = 20000.0
-    delay_samples: int = 0
-    V_dc: float = 0.0
-    i_max: float = 0.0
+    f_s: float | str = spec_field("Hz", 100.0, 1e7, default=20000.0, low_open=False, keywords=("continuous",),
+                                  label="f_s sample rate", display="kHz")
+    delay_samples: int = spec_field("samples", 0, 1, default=0, integer=True, label="Computation delay")
+    V_dc: float = spec_field("V", 0.0, 1e5, default=0.0, low_open=False, label="V_dc inverter DC link (0 = ideal)")
+    i_max: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False,
+                              label="i_max inverter peak current (0 = none)")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        _check_fields(self, "controller", {
-            "T_si": (T_MIN_S, 10.0, False, "s"), "T_salpha": (T_MIN_S, 10.0, False, "s"),
-            "T_so": (T_MIN_S, 10.0, False, "s"), "K": (0.0, 1e9, True, "s/rad"),
-            "V_dc": (0.0, 1e5, False, "V"), "i_max": (0.0, 1e6, False, "A"),
-        })
-        if self.T_c != "T_a":
-            if isinstance(self.T_c, str):
-                raise ParameterError(f"controller.T_c = {self.T_c!r} is not allowed: a time > 0 s or 'T_a'")
-            check_range("controller.T_c", self.T_c, 0.0, 100.0, unit="s")
+        if isinstance(self.T_c, str) and self.T_c != "T_a":
+            raise ParameterError(f"controller.T_c = {self.T_c!r} is not allowed: a time > 0 s or 'T_a'")
+        if isinstance(self.f_s, str) and self.f_s != "continuous":
+            raise ParameterError(f"controller.f_s = {self.f_s!r} is not allowed: a rate in Hz or 'continuous'")
+        check_fields(self, "controller")
         if self.alpha_max_rule not in ALPHA_MAX_RULES:
             raise ParameterError(
                 f"controller.alpha_max_rule = {self.alpha_max_rule!r} is not allowed: "
                 f"one of {', '.join(ALPHA_MAX_RULES)}"
             )
-        if self.f_s != "continuous":
-            if isinstance(self.f_s, str):
-                raise ParameterError(f"controller.f_s = {self.f_s!r} is not allowed: a rate in Hz or 'continuous'")
-            check_range("controller.f_s", self.f_s, 100.0, 1e7, low_open=False, unit="Hz")
-        if self.delay_samples not in (0, 1) or isinstance(self.delay_samples, bool):
-            raise ParameterError(f"controller.delay_samples = {self.delay_samples!r} is out of range: allowed 0 or 1")
-        object.__setattr__(self, "delay_samples", int(self.delay_samples))  # 1.0 → 1: the kernel needs an int
 
     @property
     def is_continuous(self) -> bool:
@@ -278,16 +194,19 @@ class Manoeuvre:
         Demanded manoeuvre time [s].
     """
 
-    theta_dem: float
-    T_m: float
+    theta_dem: float = spec_field("rad", -1e6, 1e6, label="θ_dem demanded angle", aliases=("deg", "rev"))
+    T_m: float = spec_field("s", 1e-4, 1e4, low_open=False, label="T_m manoeuvre time")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
-        check_range("manoeuvre.theta_dem", self.theta_dem, -1e6, 1e6, unit="rad")
+        check_fields(self, "manoeuvre")
         if abs(self.theta_dem) < THETA_DEM_MIN:
             raise ParameterError(f"manoeuvre.theta_dem = {self.theta_dem!r} rad is out of range: allowed "
                                  f"{THETA_DEM_MIN:g} ≤ |value| ≤ 1e+06 rad")
-        check_range("manoeuvre.T_m", self.T_m, 1e-4, 1e4, low_open=False, unit="s")
+
+
+__all__ = ["ALPHA_MAX_RULES", "Controller", "DriveParams", "Load", "LoadStep", "Manoeuvre", "Motor",
+           "ParameterError", "T_MIN_S", "THETA_DEM_MIN"]
 
 
 @dataclass(frozen=True)

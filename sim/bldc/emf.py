@@ -23,7 +23,7 @@ import numpy as np
 
 from control.bldc.dqx import trapezoid_unit
 from control.bldc.params import EMF_SAMPLES_MIN, BldcMachine
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 
 N_TABLE = 720  # 0.5° electrical per sample; a multiple of 12 keeps the trapezoid corners exact
 HANN_WIDTH = math.radians(30.0)

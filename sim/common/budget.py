@@ -19,7 +19,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 
 #: Most RK4 integration steps of one request, sub-steps and all controllers included [-].
 #: About 2–3 s of CPU for either kernel on one core (``python -m app bench`` prints the rates).

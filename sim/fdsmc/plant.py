@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.engine import _grid, _load_steps, pack_parameters
 
