@@ -179,7 +179,7 @@ def test_3d_view_folds_by_default_and_hides_in_the_bldc_tab(browser, server_3d):
         folded_width = session.fit.layout.results_width
         page.get_by_text("3D view", exact=True).click()
         page.get_by_text("Show 3D rotors").click()
-        page.wait_for_function("() => document.querySelector('canvas').getBoundingClientRect().width > 300")
+        page.wait_for_function("() => document.querySelector('canvas').getBoundingClientRect().width > 250")
         assert scene.visible and session.fit.layout.results_width < folded_width
         assert page.evaluate(CANVAS_JS) == "visible"
         page.get_by_role("tab", name="BLDC speed SMC").click()
