@@ -116,14 +116,19 @@ def load_step_times(comparison: Comparison) -> list[float]:
 
 
 def _phase_marks(comparison: Comparison, key: str, run: RunResult) -> list[dict[str, Any]]:
-    """Boundary-layer entry and load-step markers of one trajectory."""
+    """Return the sliding phase (FDSMC, from the layer entry on), layer entry and load steps of a trajectory."""
     tr, th = run.trace, comparison.derived.params.manoeuvre.theta_dem
     out = []
     k = layer_entry_index(comparison, run) if key != "optimum" else None  # the optimum does not slide
+    if k is not None and key == "fdsmc":
+        i = k + decimate_index(len(tr.t) - k)
+        out.append({"type": "scatter", "x": f32(tr.theta_r[i] - th), "y": f32(tr.omega_r[i]), "mode": "lines",
+                    "name": "FDSMC sliding phase (in the layer)", "hoverinfo": "skip", "opacity": 0.3,
+                    "line": {"color": COLOURS[key], "width": 9}})
     if k is not None:
         out.append({"type": "scatter", "x": [float(tr.theta_r[k] - th)], "y": [float(tr.omega_r[k])],
-                    "mode": "markers+text", "text": ["sliding from here"] if key == "fdsmc" else [""],
-                    "textposition": "top right", "name": f"{LABELS[key]} enters boundary layer",
+                    "mode": "markers+text", "text": ["reaching → sliding"] if key == "fdsmc" else [""],
+                    "textposition": "top left", "name": f"{LABELS[key]} enters boundary layer",
                     "marker": {"symbol": "diamond", "size": 11, "color": COLOURS[key],
                                "line": {"color": BOUNDARY_COLOUR, "width": 1.5}},
                     "hovertemplate": f"t = {tr.t[k]:.4f} s: reaching → sliding<extra>{LABELS[key]}</extra>"})

@@ -1,10 +1,11 @@
-"""The phase-plane replay, animated by the browser: Plotly buttons and a slider with inline frames.
+"""The replay, animated by the browser: Plotly buttons and a slider with inline frames.
 
 Viser hands Plotly only ``data``/``layout``/``config`` (``fig.frames`` are dropped), but
 ``Plotly.animate`` also takes a list of frame *objects*, and a layout ``updatemenus`` button
 passes its ``args`` straight to it. So each speed's button carries its own short list of
-frames, each moving only the "now" markers (a few numbers per frame); the figure goes out once
-per Simulate and the replay then costs no server traffic at all.
+frames, each moving only the phase-plane "now" markers and the time cursors of the overview
+figure (:mod:`app.figures.overview`; a few numbers per frame); the figure goes out once per
+Simulate and the replay then costs no server traffic at all.
 """
 
 from __future__ import annotations
@@ -26,8 +27,11 @@ FRAME_RATE, MAX_FRAMES = 30.0, 600
 SLIDER_STEPS = 100
 
 
-def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray) -> str:
-    """JSON list of frames: per time of ``t_grid`` [s] the x/y of each "now" marker (and a time label).
+def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = ()) -> str:
+    """Write the JSON list of frames at the times ``t_grid`` [s].
+
+    Per time t: the x/y of each "now" marker (and a time label) and ``x = [t, t]`` of each
+    time-cursor trace (indices ``cursors``).
 
     Written as text directly: a few thousand small frames are ~10× faster this way than as dicts.
     """
@@ -38,11 +42,12 @@ def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray) -> 
         x = np.interp(t_grid, tr.t, tr.theta_r) - th
         y = np.interp(t_grid, tr.t, tr.omega_r)
         cols.append(([f"{v:.5g}" for v in x.tolist()], [f"{v:.5g}" for v in y.tolist()]))
-    traces = ",".join(map(str, now))
+    traces = ",".join(map(str, [*now, *cursors]))
     frames = []
     for k, t in enumerate(t_grid.tolist()):
         parts = [f'{{"x":[{x[k]}],"y":[{y[k]}]' + (f',"text":["t = {t:.3f} s"]}}' if j == 0 else "}")
                  for j, (x, y) in enumerate(cols)]
+        parts += [f'{{"x":[{t:.6g},{t:.6g}]}}'] * len(cursors)
         frames.append(f'{{"data":[{",".join(parts)}],"traces":[{traces}]}}')
     return "[" + ",".join(frames) + "]"
 
@@ -52,14 +57,15 @@ def _n_frames(t_end: float, speed: float) -> int:
     return int(min(MAX_FRAMES, max(2, math.ceil(t_end / speed * FRAME_RATE) + 1)))
 
 
-def replay_layout(comparison: Comparison, trace_names: list[str]) -> tuple[dict[str, Any], dict[str, str]]:
+def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[dict[str, Any], dict[str, str]]:
     """Layout entries (``updatemenus``, ``sliders``) that replay ``comparison`` in the browser.
 
     Parameters
     ----------
     comparison : sim.fdsmc.engine.Comparison
-    trace_names : list of str
-        Names of the figure's traces in order; the ``"<name> now"`` markers are the ones moved.
+    data : list of dict
+        The figure's traces in order; the ``"<name> now"`` markers and the ``"time cursor …"``
+        lines (vertical, ``x = [t, t]``) are the ones moved.
 
     Returns
     -------
@@ -70,28 +76,32 @@ def replay_layout(comparison: Comparison, trace_names: list[str]) -> tuple[dict[
     rs = runs(comparison)
     if not rs:
         return {}, {}
-    now = [trace_names.index(n) for n in trace_names if n.endswith(" now")]
+    names = [t.get("name", "") for t in data]
+    now = [i for i, n in enumerate(names) if n.endswith(" now")]
+    cursors = tuple(i for i, n in enumerate(names) if n.startswith("time cursor"))
     t_end = max(float(run.trace.t[-1]) for _, run in rs)
     buttons, raw = [], {}
     for k, (label, speed) in enumerate(SPEEDS.items()):
         n = _n_frames(t_end, speed)
-        raw[f"__frames_{k}__"] = _frames_json(comparison, now, np.linspace(0.0, t_end, n))
+        raw[f"__frames_{k}__"] = _frames_json(comparison, now, np.linspace(0.0, t_end, n), cursors)
         buttons.append({"label": f"▶ {label}", "method": "animate", "args": [f"__frames_{k}__", {
             "mode": "immediate", "frame": {"duration": 1e3 * t_end / speed / (n - 1), "redraw": False},
             "transition": {"duration": 0}}]})
     buttons.append({"label": "Pause", "method": "animate", "args": [[None], {
         "mode": "immediate", "frame": {"duration": 0, "redraw": False}, "transition": {"duration": 0}}]})
     t_grid = np.linspace(0.0, t_end, SLIDER_STEPS + 1)
-    marks = json.loads(_frames_json(comparison, now, t_grid))
+    marks = json.loads(_frames_json(comparison, now, t_grid, cursors))
+    cursor_y = [list(data[i]["y"]) for i in cursors]
     steps = [{"label": f"{t:.3g}", "method": "restyle",
-              "args": [{"x": [d["x"] for d in m["data"]], "y": [d["y"] for d in m["data"]],
-                        "text": [m["data"][0]["text"]] + [[""]] * (len(now) - 1)}, now]}
+              "args": [{"x": [d["x"] for d in m["data"]], "y": [d["y"] for d in m["data"][:len(now)]] + cursor_y,
+                        "text": [m["data"][0]["text"]] + [[""]] * (len(now) + len(cursors) - 1)},
+                       [*now, *cursors]]}
              for t, m in zip(t_grid, marks, strict=True)]
     return {
-        "updatemenus": [{"type": "buttons", "direction": "left", "showactive": False, "x": 1.0, "y": 1.0,
-                         "xanchor": "right", "yanchor": "bottom", "pad": {"t": 0, "b": 2},
+        "updatemenus": [{"type": "buttons", "direction": "left", "showactive": False, "x": 1.0, "y": -0.1,
+                         "xanchor": "right", "yanchor": "top", "pad": {"t": 0, "b": 2},
                          "font": {"size": 11}, "buttons": buttons}],
-        "sliders": [{"active": SLIDER_STEPS, "steps": steps, "x": 0.0, "len": 1.0, "y": -0.3,
+        "sliders": [{"active": SLIDER_STEPS, "steps": steps, "x": 0.0, "len": 0.52, "y": -0.1, "yanchor": "top",
                      "currentvalue": {"prefix": "replay t = ", "suffix": " s", "font": {"size": 11}},
                      "pad": {"t": 0, "b": 0}, "tickwidth": 0, "ticklen": 0, "font": {"size": 1},
                      "minorticklen": 0}],

@@ -1,22 +1,25 @@
-"""Replay of a comparison: the browser animates the phase plane, the server turns the 3D rotors.
+"""Replay of a comparison: the browser animates the overview figure, the server turns the 3D rotors.
 
-The phase-plane figure carries its own play buttons (one per speed), pause and time slider
-(:mod:`app.figures.replay`): it is sent once per Simulate and animated by Plotly in the browser,
-with no server traffic per frame. The 3D rotors are scene nodes; their replay (Play/Pause and
-a time slider in the "3D replay" folder) sends one small orientation update per rotor per tick
-and runs only while playing.
+The overview figure (phase plane and compact time plot, :mod:`app.figures.overview`) carries its
+own play buttons (one per speed), pause and time slider (:mod:`app.figures.replay`): it is sent
+once per Simulate and animated by Plotly in the browser — the phase-plane markers and the time
+cursors move together — with no server traffic per frame. The 3D rotors are scene nodes, folded
+away by default ("Show 3D rotors"); their replay (Play/Pause and a time slider in the "3D view"
+folder) sends one small orientation update per rotor per tick and runs only while playing.
 """
 
 from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import viser
 
-from app.figures.comparison import phase_plane_spec, runs, time_plots_spec
+from app.figures.comparison import runs, time_plots_spec
+from app.figures.overview import overview_spec
 from app.figures.plain import figure_json
 from app.figures.replay import SPEEDS, replay_layout
 from app.ui.scene import RotorScene
@@ -33,9 +36,9 @@ def set_figure_json(handle: viser.GuiPlotlyHandle, json_str: str) -> None:
 
 
 def phase_plane_json(comparison: Any) -> str:
-    """JSON of the phase plane with its in-browser replay (buttons per speed, slider)."""
-    spec = phase_plane_spec(comparison)
-    layout, raw = replay_layout(comparison, [t["name"] for t in spec["data"]])
+    """JSON of the overview figure (phase plane + compact time plot) with its in-browser replay."""
+    spec = overview_spec(comparison)
+    layout, raw = replay_layout(comparison, spec["data"])
     spec["layout"].update(layout)
     return figure_json(spec, raw)
 
@@ -50,21 +53,34 @@ class Replay:
 
     def __init__(self, gui: viser.GuiApi, phase: viser.GuiPlotlyHandle,
                  time_plots: viser.GuiPlotlyHandle | None, scene: RotorScene | None,
-                 flush: Any = lambda: None) -> None:
+                 flush: Any = lambda: None, on_3d: Callable[[bool], None] = lambda _: None) -> None:
         self._phase, self._time_plots, self._scene, self._flush = phase, time_plots, scene, flush
+        self._on_3d = on_3d
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._comparison: Any = None
         self._t_end = 1.0
         self._t_now = 0.0
-        self.folder = gui.add_folder("3D replay", expand_by_default=False, visible=scene is not None)
+        self.folder = gui.add_folder("3D view", expand_by_default=False, visible=scene is not None)
         with self.folder:
+            self.show_3d = gui.add_checkbox("Show 3D rotors", False,
+                                            hint="FDSMC (blue, left) and conventional (orange, right) rotors "
+                                                 "turning with θ_r; hidden in the BLDC tabs")
             self.buttons = gui.add_button_group("3D rotors", ("Play", "Pause", "Replay"))
             self.slider = gui.add_slider("t [s]", min=0.0, max=1.0, step=0.001, initial_value=0.0)
             self.speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.25×")
         self.buttons.on_click(self._on_button)
         self.slider.on_update(self._on_slider)
+        self.show_3d.on_update(lambda _: self._toggle_3d())
+
+    def _toggle_3d(self) -> None:
+        shown = bool(self.show_3d.value)
+        if self._scene is not None:
+            self._scene.visible = shown
+        if not shown:
+            self.pause()
+        self._on_3d(shown)
 
     def load(self, comparison: Any, autoplay: bool = True) -> None:
         """Show a new comparison: the phase plane first, then the time plots; rotors to the end."""
@@ -79,7 +95,7 @@ class Replay:
             self._t_end = max((float(run.trace.t[-1]) for _, run in rs), default=1.0)
         self.slider.max = self._t_end
         self.slider.step = self._t_end / 1000.0
-        if autoplay and self._scene is not None and rs:
+        if autoplay and self._scene is not None and self._scene.visible and rs:
             self.play(restart=True)
         else:
             self.seek(self._t_end)

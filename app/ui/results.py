@@ -1,4 +1,7 @@
-"""The results panel (docked right, most of the window): phase plane, time plots, energy, Table 1.
+"""The results panel (docked right, the rest of the window): overview, time plots, energy, Table 1.
+
+The *Overview* tab is what a projector shows: one line of key numbers above one figure holding
+the phase plane and a compact time plot (ω_r and Γ vs t), replayed together in the browser.
 
 Only builds widgets and pushes figures made by the pure ``make_*_figure`` functions; the
 simulations themselves run on the session's worker.
@@ -15,9 +18,10 @@ import viser
 from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.figures.plain import figure_json
 from app.io.numbers import parse_T_m_list
+from app.ui.layout import PanelLayout
 from app.ui.replay import Replay, set_figure_json
 from app.ui.scene import RotorScene
-from app.ui.text import annual_savings, savings_markdown
+from app.ui.text import annual_savings, key_numbers_html, savings_markdown
 from sim.fdsmc.engine import TABLE1_T_M
 
 #: Plot height / width per figure [-].
@@ -28,19 +32,21 @@ class ResultsPanel:
     """Right-hand panel with the result tabs of one client."""
 
     def __init__(self, client: viser.ClientHandle, comparison: Any, scene: RotorScene | None,
-                 on_sweep: Callable[[list[float]], None]) -> None:
+                 on_sweep: Callable[[list[float]], None],
+                 on_3d: Callable[[bool], None] = lambda _: None) -> None:
         gui = client.gui
         self._on_sweep = on_sweep
         self._comparison = comparison
         self.panel = gui.add_panel()
-        phase_tab = self.panel.add_tab("Phase plane", viser.Icon.CHART_DOTS)
+        phase_tab = self.panel.add_tab("Overview", viser.Icon.CHART_DOTS)
         time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
         with phase_tab:
+            self.key_numbers = gui.add_html(key_numbers_html(comparison))
             self.phase = gui.add_plotly(go.Figure(), aspect=ASPECT_PHASE)
         with time_tab:
             self.time_plots = gui.add_plotly(go.Figure(), aspect=ASPECT_TIME)
         with phase_tab:
-            self.replay = Replay(gui, self.phase, self.time_plots, scene, flush=client.flush)
+            self.replay = Replay(gui, self.phase, self.time_plots, scene, flush=client.flush, on_3d=on_3d)
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
             self.energy = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
             self.bars = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
@@ -70,13 +76,24 @@ class ResultsPanel:
             return
         self.savings.content = savings_markdown(annual_savings(self._comparison, *values))
 
+    def fit(self, layout: PanelLayout) -> None:
+        """Size the panel and the overview plot for the window (see :mod:`app.ui.layout`)."""
+        self.panel.set_width(layout.results_width)
+        self.phase.aspect = layout.plot_aspect
+
     def show(self, comparison: Any, autoplay: bool = True) -> None:
-        """Draw a new comparison: phase plane first (it is what the user waits for), then the rest."""
+        """Draw a new comparison: key numbers and overview first (what the user waits for), then the rest."""
         self._comparison = comparison
+        self.key_numbers.content = key_numbers_html(comparison)
         self.replay.load(comparison, autoplay=autoplay)
         set_figure_json(self.energy, figure_json(energy_spec(comparison)))
         set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))
         self._update_savings()
+
+    def show_derived_only(self, comparison: Any) -> None:
+        """Show an infeasible case (no runs): the key numbers say so, the overview shows the boundary."""
+        self.key_numbers.content = key_numbers_html(comparison)
+        self.replay.load(comparison, autoplay=False)
 
     def _sweep_clicked(self, client: viser.ClientHandle) -> None:
         try:

@@ -21,9 +21,10 @@ from app.io.preset_modes import list_presets_of, load_mode_preset, require_mode
 from app.threads import limit_blas_threads
 from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
+from app.ui.layout import PanelLayout, WindowFit
 from app.ui.log import LogPanel
 from app.ui.results import ResultsPanel
-from app.ui.scene import RotorScene
+from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import OptimumToggle, StudiesSection
 from app.ui.text import checked_choice, derived_markdown, design_markdown, md_text, warnings_html
 from app.ui.tuning import LiveTuning
@@ -36,8 +37,10 @@ from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
 from sim.fdsmc.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
 
-#: Widths of the control panel (left) and the results panel (right) [px].
-CONTROL_WIDTH, RESULTS_WIDTH = 430, 780
+#: Page-wide CSS: the 3D canvas is hidden while a BLDC tab is shown (viser mounts only the active
+#: tab, and marks it ``aria-selected``; the BLDC tabs' titles start with "BLDC").
+PAGE_STYLE = ('<style>body:has([role="tab"][aria-selected="true"][title^="BLDC"]) canvas '
+              '{visibility: hidden}</style>')
 
 
 def comparison_or_derived(params: DriveParams, optimum: bool = False) -> Comparison:
@@ -90,18 +93,30 @@ class Session:
 
     # ---- layout -------------------------------------------------------------------------------
     def _layout(self, scene: RotorScene | None) -> None:
+        """Dock the control panel left, the results panel right, the 3D canvas between them.
+
+        The widths follow the window the browser reports (:mod:`app.ui.layout`).
+        """
         gui = self.gui
         gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
+        gui.add_html(PAGE_STYLE)
         gui.main_panel.dock_left()
-        gui.main_panel.set_width(CONTROL_WIDTH)
         tabs = gui.add_tab_group()
         with tabs.add_tab("Position drive (FDSMC)"):
             self._controls()
-        self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep)
+        self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep,
+                                    on_3d=lambda shown: self.fit.set_3d(shown))
         self.studies = StudiesSection(self)
         _add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
         self.results.panel.dock_right()
-        self.results.panel.set_width(RESULTS_WIDTH)
+        self.fit = WindowFit(self._apply_layout)
+        if scene is not None:
+            aim_camera(self.client.camera)
+        self.client.camera.on_update(lambda cam: self.fit.canvas_reported(cam.image_width, cam.image_height))
+
+    def _apply_layout(self, layout: PanelLayout) -> None:
+        self.gui.main_panel.set_width(layout.control_width)
+        self.results.fit(layout)
 
     def _controls(self) -> None:
         gui = self.gui
@@ -222,7 +237,7 @@ class Session:
         if comparison.fdsmc is not None:
             self.results.show(comparison, autoplay=autoplay)
         else:
-            self.results.replay.load(comparison, autoplay=False)
+            self.results.show_derived_only(comparison)
         self._show_text()
 
     def sweep(self, T_m_values: list[float]) -> None:

@@ -14,6 +14,7 @@ from typing import Any
 from app.io.derived_view import derived_rows
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
+from control.fdsmc.feasibility import torque_limit
 
 #: Joules per kilowatt-hour [J/kWh].
 J_PER_KWH = 3.6e6
@@ -60,7 +61,9 @@ def derived_markdown(derived: Derived) -> str:
 def warnings_html(items: list[str], error: str | None = None, notes: list[str] | None = None) -> str:
     """Render the input error and the warnings in a red box, or a green line when there are none.
 
-    The ``notes`` (e.g. about the comparator) go in a grey box below.
+    The ``notes`` (e.g. about the comparator) go in a grey box below. The warnings are an HTML
+    ``<details>`` list, open at first: a click on its summary line ("⚠ 6 warning(s) — first
+    warning…") folds it to that one line in the browser, and a second click opens it again.
     """
     extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
                     f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html.escape(n)}</div>'
@@ -74,10 +77,49 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
                      f'simulated: {html.escape(error)}</div>')
     if items:
         lis = "".join(f"<li>{html.escape(w)}</li>" for w in items)
-        parts.append(f'<div style="font-weight:600">⚠ {len(items)} warning(s)</div>'
-                     f'<ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul>')
+        parts.append('<details open data-role="warnings-list"><summary data-role="warnings-summary" '
+                     'style="cursor:pointer;white-space:nowrap;overflow:hidden;text-overflow:ellipsis">'
+                     f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html.escape(items[0])}'
+                     f'</span></summary><ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul></details>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
             'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>" + extra)
+
+
+def _saves(pct: float | None) -> str:
+    """Word a saving [%]: "saves 25.2 %", "costs 3.1 % more" or "saving –" (not both runs stable)."""
+    if pct is None:
+        return "saving –"
+    return f"saves {pct:.1f} %" if pct >= 0 else f"costs {-pct:.1f} % more"
+
+
+def key_numbers_html(comparison: Any) -> str:
+    """Render one line of key numbers above the overview figure.
+
+    Savings [%], friction and electrical input energies [J] of both controllers, peak torques
+    [N·m] vs the drive's limit Γ_max (red when above).
+    """
+    f, c = comparison.fdsmc, comparison.conventional
+    if f is None:
+        return '<div data-role="key-numbers" style="font-size:0.9em">Not simulated (infeasible manoeuvre).</div>'
+    g_max = torque_limit(comparison.derived.params)
+
+    def energy(key: str) -> str:
+        return " / ".join("–" if r is None or not isinstance(r.metrics.get(key), float)
+                          else f"{r.metrics[key]:.4g}" for r in (f, c))
+
+    def peak(r: Any) -> str:
+        v = r.metrics.get("torque_peak_Nm") if r is not None else None
+        if not isinstance(v, float):
+            return "–"
+        return f'<b style="color:#c92a2a">{v:.4g} ⚠</b>' if v > g_max * 1.001 else f"{v:.4g}"
+
+    parts = [f"<b>FDSMC {_saves(comparison.saving_friction_pct)}</b> friction, "
+             f"{_saves(comparison.saving_electrical_pct)} electrical input",
+             f"friction to T_m FDSMC / conv. {energy('friction_J')} J",
+             f"electrical in {energy('electrical_in_total_J')} J",
+             f"peak Γ {peak(f)} / {peak(c)} N·m vs Γ_max {g_max:.4g} N·m"]
+    return ('<div data-role="key-numbers" style="font-size:0.88em;line-height:1.35;padding:2px 2px 4px 2px">'
+            + " · ".join(parts) + "</div>")
 
 
 @dataclass(frozen=True)
@@ -140,5 +182,6 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
             "(negative = the conventional controller is cheaper).")
 
 
-__all__ = ["AnnualSavings", "design_markdown", "annual_savings", "checked_choice", "derived_markdown", "md_text",
+__all__ = ["AnnualSavings", "design_markdown", "annual_savings", "checked_choice", "derived_markdown",
+           "key_numbers_html", "md_text",
            "savings_markdown", "warnings_html"]

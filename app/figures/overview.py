@@ -1,0 +1,149 @@
+"""The overview figure: phase plane and a compact time plot (ω_r and Γ vs t) in ONE Plotly figure.
+
+One figure, so that each in-browser replay frame (:mod:`app.figures.replay`) moves the phase-plane
+markers *and* the time cursors together, with no server traffic per frame. The phase plane keeps
+its trace names and order (:func:`app.figures.comparison.phase_plane_spec`); the compact time plot
+adds, per controller, ω_r [rad/s] and the motor torque Γ [N·m] (eq. (5) in [1]), the true load
+torque Γ_L dotted, the references ω_p and ±Γ_max dashed, the load steps as red dotted lines, and
+one ``"time cursor …"`` trace per row that the replay moves.
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from app.figures.comparison import (
+    COLOURS,
+    LABELS,
+    MAX_POINTS_TIME,
+    f32,
+    load_step_times,
+    phase_plane_spec,
+    runs,
+    stride_index,
+    time_axis,
+)
+from control.fdsmc.feasibility import torque_limit
+
+#: Horizontal domains [-] of the phase plane and of the compact time plot.
+PHASE_X, TIME_X = (0.0, 0.55), (0.66, 1.0)
+#: Vertical domains [-] of the two time rows: ω_r on top, Γ below.
+ROW_Y = ((0.56, 1.0), (0.0, 0.44))
+#: Names of the two cursor traces the replay moves (one per time row).
+CURSORS = ("time cursor ω_r", "time cursor Γ")
+LOAD_STEP_COLOUR = "#c92a2a"
+REF_LINE = {"color": "#555", "width": 1.2, "dash": "dash"}
+
+
+def motor_torque(motor: Any, i_d: np.ndarray, i_q: np.ndarray) -> np.ndarray:
+    """Electromagnetic torque Γ = (3/2)·p·(Ψ_PM·i_q + (L_d − L_q)·i_d·i_q), eq. (5) in [1] [N·m]."""
+    return 1.5 * motor.p * (motor.psi_pm * i_q + (motor.L_d - motor.L_q) * i_d * i_q)
+
+
+def _padded(lo: float, hi: float, pad: float = 0.08) -> list[float]:
+    span = hi - lo if hi > lo else max(abs(hi), 1.0)
+    return [lo - pad * span, hi + pad * span]
+
+
+def _row_traces(comparison: Any) -> tuple[list[dict[str, Any]], list[list[float]], float]:
+    """ω_r and Γ traces of both controllers, the y ranges of the two rows and t_end [s]."""
+    d = comparison.derived
+    motor, g_max, w_p = d.params.motor, torque_limit(d.params), d.profile.omega_p
+    data: list[dict[str, Any]] = []
+    ys: list[list[float]] = [[-w_p, w_p, 0.0], [-g_max, g_max]]
+    t_end = 0.0
+    for key, run in runs(comparison):
+        tr = run.trace
+        i = stride_index(len(tr.t), MAX_POINTS_TIME // 2)
+        t, t_end = time_axis(tr.t[i]), max(t_end, float(tr.t[-1]))
+        gamma = motor_torque(motor, tr.i_d[i], tr.i_q[i])
+        style = {"type": "scatter", "mode": "lines", "showlegend": False, **t}
+        for row, y, name, unit, line in (
+                (0, tr.omega_r[i], "ω_r", "rad/s", {"width": 1.6}),
+                (1, gamma, "Γ", "N·m", {"width": 1.6}),
+                (1, tr.Gamma_L[i], "Γ_L", "N·m", {"width": 1.2, "dash": "dot"})):
+            data.append({**style, "y": f32(y), "name": f"{name} {LABELS[key]}", "xaxis": f"x{row + 2}",
+                         "yaxis": f"y{row + 2}", "line": {"color": COLOURS[key], **line},
+                         "hovertemplate": f"t = %{{x:.4f}} s: %{{y:.4g}} {unit}<extra>{LABELS[key]}</extra>"})
+            ys[row] += [float(np.min(y)), float(np.max(y))]
+    return data, [_padded(min(y), max(y)) for y in ys], t_end
+
+
+def _reference_traces(comparison: Any, t_end: float, ranges: list[list[float]]) -> list[dict[str, Any]]:
+    """ω_p (eq. (60)) and ±Γ_max references, and the two time cursors (at t_end, moved by the replay)."""
+    d = comparison.derived
+    w_p, g_max = d.profile.omega_p, torque_limit(d.params)
+    sign = 1.0 if d.params.manoeuvre.theta_dem >= 0 else -1.0
+    ref = {"type": "scatter", "mode": "lines", "line": REF_LINE, "hoverinfo": "skip", "showlegend": False}
+    out = [{**ref, "x": [0.0, t_end], "y": [sign * w_p] * 2, "name": "ω_p reference", "xaxis": "x2", "yaxis": "y2"},
+           {**ref, "x": [0.0, t_end, None, 0.0, t_end], "y": [g_max, g_max, None, -g_max, -g_max],
+            "name": "±Γ_max limit", "xaxis": "x3", "yaxis": "y3"}]
+    for row, name in enumerate(CURSORS):
+        out.append({"type": "scatter", "mode": "lines", "x": [t_end, t_end], "y": ranges[row], "name": name,
+                    "showlegend": False, "hoverinfo": "skip", "xaxis": f"x{row + 2}", "yaxis": f"y{row + 2}",
+                    "line": {"color": "#212529", "width": 1.5}})
+    return out
+
+
+def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> dict[str, Any]:
+    """Axes, row titles and load-step lines of the compact time plot."""
+    g_max = torque_limit(comparison.derived.params)
+    axes: dict[str, Any] = {}
+    for row, (y_dom, title) in enumerate(zip(ROW_Y, ("ω_r [rad/s]", "Γ [N·m]"), strict=True)):
+        n = row + 2
+        axes[f"xaxis{n}"] = {"domain": list(TIME_X), "anchor": f"y{n}", "range": [0.0, t_end],
+                             "showticklabels": row == 1, **({"matches": "x2"} if row else {})}
+        axes[f"yaxis{n}"] = {"domain": list(y_dom), "anchor": f"x{n}", "range": ranges[row],
+                             "title": {"text": title, "standoff": 4}}
+    axes["xaxis3"]["title"] = {"text": "t [s]", "standoff": 4}
+    notes = [{"text": f"motor Γ, load Γ_L dotted, ±Γ_max = {g_max:.4g} N·m dashed", "x": TIME_X[0],
+              "y": ROW_Y[1][1], "xref": "paper", "yref": "paper", "xanchor": "left", "yanchor": "bottom",
+              "showarrow": False, "font": {"size": 10, "color": "#555"}}]
+    shapes = []
+    for t in load_step_times(comparison):
+        for row in (2, 3):
+            shapes.append({"type": "line", "xref": f"x{row}", "yref": f"y{row} domain", "x0": t, "x1": t,
+                           "y0": 0.0, "y1": 1.0, "line": {"color": LOAD_STEP_COLOUR, "width": 2, "dash": "dot"}})
+        notes.append({"text": f"load step {t:.3g} s", "x": t, "y": 1.0, "xref": "x2", "yref": "y2 domain",
+                      "xanchor": "left", "yanchor": "top", "showarrow": False,
+                      "font": {"size": 10, "color": LOAD_STEP_COLOUR}})
+    return {**axes, "annotations": notes, "shapes": shapes}
+
+
+def overview_spec(comparison: Any) -> dict[str, Any]:
+    """Build the phase plane (left) and the compact time plot (right) as one plain-dict figure.
+
+    ``layout.meta.id`` stays ``"phase_plane"`` (the page and its tests find the figure by it);
+    ``layout.meta.overview`` is True.
+
+    Parameters
+    ----------
+    comparison : sim.fdsmc.engine.Comparison
+
+    Returns
+    -------
+    dict
+        ``{"data": [...], "layout": {...}}`` for :func:`app.figures.plain.figure_json`.
+    """
+    spec = phase_plane_spec(comparison)
+    layout = spec["layout"]
+    layout["xaxis"] = {**layout["xaxis"], "domain": list(PHASE_X)}
+    layout["meta"] = {**layout["meta"], "overview": True}
+    layout["title"] = {**layout["title"], "font": {"size": 15}, "y": 0.995, "yref": "container", "yanchor": "top"}
+    layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": 10},
+                        "entrywidth": 0.36, "entrywidthmode": "fraction"}
+    layout["margin"] = {"l": 56, "r": 12, "t": 96, "b": 84, "autoexpand": False}
+    if not runs(comparison):
+        return spec
+    traces, ranges, t_end = _row_traces(comparison)
+    phase_notes = layout.get("annotations", [])
+    layout.update(_time_layout(comparison, t_end, ranges))
+    layout["annotations"] = phase_notes + layout["annotations"]
+    return {"data": spec["data"] + traces + _reference_traces(comparison, t_end, ranges), "layout": layout}
+
+
+__all__ = ["CURSORS", "motor_torque", "overview_spec"]
