@@ -8,6 +8,11 @@ depends only on (params, spreads, samples, seed) — not on the executor, the nu
 or the chunking. Work is handed to any executor with ``submit(fn, *args) -> future`` and
 ``future.result()`` (``concurrent.futures.ProcessPoolExecutor`` locally, a
 ``dask.distributed.Client`` on a cluster), chunk by chunk; results are collected in order.
+
+The controller's model is the nominal one, so its design ``derive(params)`` is computed once and
+handed to every task; a task simulates its samples one after the other (no thread per sample).
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
 
 from __future__ import annotations
@@ -24,13 +29,16 @@ import numpy as np
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
 from control.fdsmc.params import DriveParams, ParameterError
-from sim.fdsmc.engine import CONTROLLERS, compare
+from sim.fdsmc.engine import CONTROLLERS, RunResult, reached_target, simulate
 
 #: Metrics summarised per controller; the worst case is the largest value (errors as |·|).
 METRICS = ("friction_J", "copper_J", "electrical_in_total_J", "torque_peak_Nm",
            "theta_error_abs_at_Tm_rad", "t_2pct_settle_s")
 #: Each task should compute for at least this long [s] (scheduling overhead stays small).
 MIN_TASK_S = 0.1
+#: Tasks per worker a run is cut into at most [-]: enough for progress, cancelling and balancing
+#: the load, few enough that handing out tasks (and pickling their arguments) costs nothing.
+TASKS_PER_WORKER = 16
 #: Trace points kept per run (metrics only; the 2 % settling time is read from this trace).
 TRACE_POINTS = 2000
 #: Largest σ of a normal spread, relative to the nominal value [-] (kept well away from ≤ 0).
@@ -88,21 +96,36 @@ def plant_for(params: DriveParams, values: dict[str, float]) -> DriveParams:
                                load=dataclasses.replace(params.load, **changes["load"]))
 
 
+def _friction_saving(f: RunResult, c: RunResult) -> float | None:
+    """FDSMC's friction saving vs the conventional controller [%]: eq. (47) in [1] over [0, T_m];
+    None unless both runs are stable and reached the 2 % band."""
+    if not (reached_target(f) and reached_target(c)):
+        return None
+    wf, wc = f.metrics["friction_J"], c.metrics["friction_J"]
+    if not isinstance(wf, float) or not isinstance(wc, float) or wc == 0.0:
+        return None
+    return 100.0 * (1.0 - wf / wc)
+
+
 def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None) -> dict[str, dict[str, Any]]:
     """Both controllers' metrics on one plant, plus ``infeasible`` (unstable, or the peak torque
-    beyond the plant's torque limit) and ``saving_friction_pct``; ``d`` = derive(params)."""
-    cmp = compare(params, CONTROLLERS, d, plant=plant, max_points=TRACE_POINTS)
+    beyond the plant's torque limit) and ``saving_friction_pct``; ``d`` = derive(params).
+
+    The two runs are simulated one after the other in the calling thread: the parallelism of a
+    sweep is across samples (processes), and a thread pool per sample would only add overhead.
+    """
+    d = derive(params) if d is None else d
+    runs = [simulate(params, c, d, plant=plant, max_points=TRACE_POINTS) for c in CONTROLLERS]
     lim = torque_limit(plant)
     out: dict[str, dict[str, Any]] = {}
-    for run in (cmp.fdsmc, cmp.conventional):
-        assert run is not None
+    for run in runs:
         m = dict(run.metrics)
         err = m["theta_error_at_Tm_rad"]
         m["theta_error_abs_at_Tm_rad"] = abs(err) if isinstance(err, float) else None
         peak = m["torque_peak_Nm"]
         m["infeasible"] = not m["stable"] or (isinstance(peak, float) and peak > lim * (1.0 + LIMIT_TOLERANCE))
         out[run.controller] = {k: m[k] for k in (*METRICS, "chatter", "stable", "infeasible")}
-    out["fdsmc"]["saving_friction_pct"] = cmp.saving_friction_pct
+    out["fdsmc"]["saving_friction_pct"] = _friction_saving(runs[0], runs[1])
     return out
 
 
@@ -115,8 +138,10 @@ def simulate_chunk(params: DriveParams, rows: list[dict[str, float]],
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
-    """Samples per task [-]: each task ≥ MIN_TASK_S, unless that leaves a worker idle."""
-    size = max(1, math.ceil(MIN_TASK_S / max(seconds_per_sample, 1e-6)))
+    """Samples per task [-]: each task ≥ MIN_TASK_S and at most TASKS_PER_WORKER tasks per
+    worker, unless that leaves a worker idle."""
+    size = max(1, math.ceil(MIN_TASK_S / max(seconds_per_sample, 1e-6)),
+               math.ceil(n / (TASKS_PER_WORKER * max(1, workers))))
     if n > 0 and math.ceil(n / size) < workers:
         size = max(1, math.ceil(n / workers))  # every worker gets work, even if tasks are short
     return size
