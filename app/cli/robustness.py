@@ -2,7 +2,8 @@
 
 Spreads (comma-separated or repeated), each on a plant value (see :mod:`app.io.plant_overrides`), in SI:
 ``plant.J_L=0:0.3`` uniform between 0 and 0.3; ``plant.R_s=±20%`` (or ``+-20%``) uniform within
-±20 % of the preset's value; ``plant.psi_pm=~5%`` normal with σ = 5 % of it (truncated at ±3σ).
+±20 % of the nominal plant's value (the preset's plant section and ``--set plant.*``, else its
+motor and load); ``plant.psi_pm=~5%`` normal with σ = 5 % of it (truncated at ±3σ).
 Runs on a local process pool (all cores) or, with ``--scheduler tcp://HOST:PORT`` or the
 environment variable ``PMSM_DASK_SCHEDULER``, on a Dask distributed cluster.
 """
@@ -122,20 +123,17 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--samples = {args.samples} is not allowed: 1 … {MAX_SAMPLES}")
     if args.workers < 1:
         raise ParameterError(f"--workers = {args.workers} is not allowed: ≥ 1")
-    params, plant = load_model_and_plant(args.preset, args.overrides)
-    if plant is not None:
-        raise ParameterError("plant.* --set overrides are not allowed here: give the plant's "
-                             "distribution with --spread (the preset is the nominal plant)")
+    params, plant = load_model_and_plant(args.preset, args.overrides)  # plant: the nominal plant
     spreads = parse_spreads(args.spread)
     if args.scheduler:
         from dask.distributed import Client
 
         with Client(args.scheduler) as client:
             workers = max(1, len(client.scheduler_info().get("workers", {})))
-            res = robustness(params, spreads, args.samples, args.seed, client, workers, _progress)
+            res = robustness(params, spreads, args.samples, args.seed, client, workers, _progress, plant=plant)
     else:
         with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
-            res = robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress)
+            res = robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant)
     if args.csv:
         write_csv(args.csv, res)
     if args.json:

@@ -129,12 +129,14 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
     return out
 
 
-def simulate_chunk(params: DriveParams, rows: list[dict[str, float]],
-                   d: Derived | None = None) -> list[dict[str, dict[str, Any]]]:
+def simulate_chunk(params: DriveParams, rows: list[dict[str, float]], d: Derived | None = None,
+                   plant: DriveParams | None = None) -> list[dict[str, dict[str, Any]]]:
     """Metrics of several samples (one task); module-level so that it pickles. ``d`` =
-    derive(params), the controller's design (the same for every sample; computed if None)."""
+    derive(params), the controller's design (the same for every sample; computed if None);
+    ``plant`` the nominal plant the rows' values replace values of (None: the model)."""
     d = derive(params) if d is None else d
-    return [sample_metrics(params, plant_for(params, r), d) for r in rows]
+    base = params if plant is None else plant
+    return [sample_metrics(params, plant_for(base, r), d) for r in rows]
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
@@ -176,7 +178,7 @@ def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str
 def robustness(
     params: DriveParams, spreads: Sequence[Spread], samples: int, seed: int = 0, executor: Any = None,
     workers: int = 1, progress: Callable[[int, int], None] | None = None,
-    cancelled: Callable[[], bool] | None = None,
+    cancelled: Callable[[], bool] | None = None, plant: DriveParams | None = None,
 ) -> RobustnessResult:
     """Run the Monte-Carlo analysis (see the module docstring).
 
@@ -190,28 +192,30 @@ def robustness(
     workers : int                 Workers behind the executor (for the chunk size) [-].
     progress : callable or None   ``progress(done, total)`` as samples complete, in order.
     cancelled : callable or None  Polled between chunks; True stops (ParameterError raised).
+    plant : DriveParams or None   The nominal plant (a preset's plant section) the spreads are
+                                  drawn around and applied to; None: the controller's model.
     """
     if samples < 1:
         raise ParameterError(f"samples = {samples} is not allowed: ≥ 1")
     t0 = time.perf_counter()
-    values = draw(params, spreads, samples, seed)
+    values = draw(params if plant is None else plant, spreads, samples, seed)
     rows = [{k: float(v[i]) for k, v in values.items()} for i in range(samples)]
     d = derive(params)
-    runs = simulate_chunk(params, rows[:1], d)  # warm-up (compiled kernel loaded) …
+    runs = simulate_chunk(params, rows[:1], d, plant)  # warm-up (compiled kernel loaded) …
     t1 = time.perf_counter()
-    runs += simulate_chunk(params, rows[1:2], d)  # … and one timed sample
+    runs += simulate_chunk(params, rows[1:2], d, plant)  # … and one timed sample
     done = len(runs)
     size = chunk_size(time.perf_counter() - t1, samples - done, workers)
     chunks = [rows[i: i + size] for i in range(done, samples, size)]
     if progress is not None:
         progress(done, samples)
-    futures = [executor.submit(simulate_chunk, params, c, d) for c in chunks] if executor is not None else None
+    futures = [executor.submit(simulate_chunk, params, c, d, plant) for c in chunks] if executor is not None else None
     for j, c in enumerate(chunks):
         if cancelled is not None and cancelled():
             for f in futures or []:
                 f.cancel()
             raise ParameterError(f"robustness run cancelled after {len(runs)} of {samples} samples")
-        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d))
+        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d, plant))
         if progress is not None:
             progress(len(runs), samples)
     return RobustnessResult(values, runs, summarise(runs, time.perf_counter() - t0))
