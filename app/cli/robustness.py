@@ -11,7 +11,6 @@ environment variable ``PMSM_DASK_SCHEDULER``, on a Dask distributed cluster.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
 import sys
@@ -19,11 +18,12 @@ from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from typing import Any
 
-from app.cli.main import add_preset_arguments
+from app.cli.main import add_preset_arguments, check_writable
 from app.cli.simulate import finite_or_none
 from app.io.plant_overrides import load_model_and_plant, plant_section
+from app.io.sample_table import write_csv, write_parquet
 from control.fdsmc.params import ParameterError
-from sim.studies.robustness import MAX_NORMAL_SIGMA, METRICS, RobustnessResult, Spread, robustness
+from sim.studies.robustness import MAX_NORMAL_SIGMA, METRICS, Spread, robustness
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
 MAX_SAMPLES = 1_000_000
@@ -43,6 +43,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"Dask scheduler address tcp://HOST:PORT (or ${SCHEDULER_ENV})")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--csv", metavar="FILE", help="write one row per sample (drawn values and metrics)")
+    p.add_argument("--parquet", metavar="FILE",
+                   help="write the same rows as Parquet, with each column's unit in the schema metadata")
 
 
 def _number(text: str, item: str) -> float:
@@ -93,17 +95,6 @@ def _progress(done: int, total: int) -> None:
     sys.stderr.flush()
 
 
-def write_csv(path: str, res: RobustnessResult) -> None:
-    """One row per sample: the drawn plant values, then each controller's metrics."""
-    keys = list(res.values)
-    cols = [(c, m) for c in ("fdsmc", "conventional") for m in (*METRICS, "chatter", "infeasible")]
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(keys + [f"{c}.{m}" for c, m in cols])
-        for i, r in enumerate(res.runs):
-            w.writerow([f"{res.values[k][i]:.9g}" for k in keys] + [r[c][m] for c, m in cols])
-
-
 def _print_table(summary: dict[str, Any]) -> None:
     print(f"{summary['samples']} samples in {summary['seconds']:.1f} s")
     for ctrl in ("fdsmc", "conventional"):
@@ -123,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--samples = {args.samples} is not allowed: 1 … {MAX_SAMPLES}")
     if args.workers < 1:
         raise ParameterError(f"--workers = {args.workers} is not allowed: ≥ 1")
+    for opt, path in (("--csv", args.csv), ("--parquet", args.parquet)):
+        if path:
+            check_writable(path, opt)  # before hours of simulation, not after
     params, plant = load_model_and_plant(args.preset, args.overrides)  # plant: the nominal plant
     spreads = parse_spreads(args.spread)
     if args.scheduler:
@@ -136,6 +130,10 @@ def run(args: argparse.Namespace) -> int:
             res = robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant)
     if args.csv:
         write_csv(args.csv, res)
+    if args.parquet:
+        write_parquet(args.parquet, res, {"preset": args.preset, "overrides": list(args.overrides),
+                                          "spreads": list(args.spread), "seed": args.seed,
+                                          "samples": args.samples})
     if args.json:
         print(json.dumps(finite_or_none(res.summary), indent=2, ensure_ascii=False))
     else:
