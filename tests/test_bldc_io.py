@@ -53,7 +53,8 @@ def test_bad_parameters_name_field_value_range(override, words):
 
 def test_measured_csv_with_three_phases_and_header_round_trips():
     """A measured file made from the built-in distorted waveform gives the same table and
-    the same simulation as the built-in example (resampling is faithful)."""
+    the same simulation as the built-in example (resampling is faithful).
+    """
     th, vals = _three_phase()
     m = read_measured(_csv(th, vals))
     assert m.n_phases == 3 and m.shifts_deg == pytest.approx((120.0, 240.0), abs=0.5)

@@ -24,7 +24,8 @@ def params():
 @pytest.mark.parametrize("controller", CONTROLLERS)
 def test_energy_balance_closes(params, controller):
     """∫Σv_x·i_x dt = copper + friction + load work + ΔE_kin + E_mag (eq. (1) with eq. (2)–(3),
-    (17)): closes to 1e-8 of the input; the load and copper terms are a sizeable share."""
+    (17)): closes to 1e-8 of the input; the load and copper terms are a sizeable share.
+    """
     m = simulate_bldc(params, controller).metrics
     assert m["stable"]
     assert abs(m["energy_balance_residual_J"]) < 1e-8 * m["electrical_in_total_J"]
@@ -57,7 +58,8 @@ def test_emf_power_equals_mechanical_power_eq2_eq3(params):
 def test_ideal_table_is_the_trapezoid_and_distorted_is_smooth():
     """Ideal table: Fig. 2 values (flat ±Φ_M, 0 at 0° and 180°). Distorted example: odd
     half-wave symmetry f(θ + π) = −f(θ), no jumps in the slope (smooth), fundamental within 5 %
-    of the trapezoid's (4/π)·(sin 30°/30°)·Φ_M."""
+    of the trapezoid's (4/π)·(sin 30°/30°)·Φ_M.
+    """
     ideal = bldc_emf.ideal_table(0.12)
     th = bldc_emf.grid()
     assert np.allclose(ideal, [0.12 * trapezoid_unit(t) for t in th])
@@ -74,7 +76,8 @@ def test_ideal_table_is_the_trapezoid_and_distorted_is_smooth():
 
 def test_reachability_hyperbola_eq24():
     """Eq. (24): bound = B/J + (T_max − T_L − B·ω*)/(J·ε) for ε > 0; → B/J as |ε| → ∞; the
-    preset's λ(ε) stays inside; a too large λ_0 is reported with the violated interval."""
+    preset's λ(ε) stays inside; a too large λ_0 is reported with the violated interval.
+    """
     J, B, w, Tm, TL = 0.0042, 0.003032, 104.72, 5.0, 2.2
     b = reachability_bound(np.array([1.0, 1e9]), w, J, B, Tm, TL)
     assert b[0] == pytest.approx(B / J + (Tm - TL - B * w) / J)

@@ -1,4 +1,4 @@
-"""Section IV of [2] on the paper preset: the comparisons of issue 5 (physics, not snapshots)."""
+"""Section IV of [2] on the paper preset: the dq_x SMC against its comparators (physics, not snapshots)."""
 
 from __future__ import annotations
 
@@ -33,7 +33,8 @@ def test_integral_surface_removes_steady_state_error_plain_tanh_does_not(name, r
     predicted by eq. (21), i.e. several rpm under the 2.2 N·m load. The prediction assumes
     T_EL = T*; the tanh current law has a steady current error of its own (larger at 2000 rpm,
     where the back-EMF takes more of the voltage), which adds to the speed error — hence the
-    one-sided 25 % band."""
+    one-sided 25 % band.
+    """
     comp = request.getfixturevalue(name)
     p = comp.params
     integral, plain = comp.run("smc_integral").metrics, comp.run("smc_plain").metrics
@@ -47,7 +48,8 @@ def test_integral_surface_removes_steady_state_error_plain_tanh_does_not(name, r
 @pytest.mark.parametrize("name", ["run1000", "run2000"])
 def test_speed_recovers_after_each_load_step(name, request):
     """Paper's drive: back within ±1 rpm of ω* after every load step, each within 60 ms
-    (the paper reports ≈ 50 ms at 2000 rpm); the plain law never returns under load."""
+    (the paper reports ≈ 50 ms at 2000 rpm); the plain law never returns under load.
+    """
     comp = request.getfixturevalue(name)
     rec = comp.run("smc_integral").metrics["recovery_times_s"]
     assert len(rec) == len(comp.params.case.T_L_steps)
@@ -58,7 +60,8 @@ def test_speed_recovers_after_each_load_step(name, request):
 @pytest.mark.parametrize("name", ["run1000", "run2000"])
 def test_dqx_has_clearly_lower_torque_ripple_than_sinusoidal_dq(name, request):
     """Same trapezoidal (distorted) machine: dq_x with ideal a_x, θ_x vs sinusoidal Park + PI —
-    at least 1.8× less peak-to-peak torque ripple in the loaded steady window."""
+    at least 1.8× less peak-to-peak torque ripple in the loaded steady window.
+    """
     comp = request.getfixturevalue(name)
     r_x = comp.run("smc_integral").metrics["torque_ripple_pct"]
     r_s = comp.run("pi_sinusoidal").metrics["torque_ripple_pct"]
@@ -71,7 +74,8 @@ def test_six_step_ripple_is_clearly_higher_than_dqx_on_the_distorted_machine(nam
     speed error (< 0.5 rpm) and recovery after every load step, like the paper's drive, but more
     torque ripple — commutation excursions plus the rounded, dipped flat tops. Measured 3.2× the
     dq_x ripple at 1000 rpm; 1.6× at 2000 rpm, where V_dc ≈ 4·E_phase and the commutation
-    excursions nearly cancel (the classical six-step result). dq_x has the least ripple of all."""
+    excursions nearly cancel (the classical six-step result). dq_x has the least ripple of all.
+    """
     comp = request.getfixturevalue(name)
     six = comp.run("six_step").metrics
     ripple = {r.controller: r.metrics["torque_ripple_pct"] for r in comp.runs}
@@ -92,14 +96,15 @@ def test_equivalent_control_eq21_in_steady_state(run1000):
 
 def test_anti_windup_keeps_overshoot_small(run1000):
     """λ(ε) fades out for large errors: the 0 → 1000 rpm step (torque-limited for ≈ 90 ms)
-    overshoots by less than 1 % of ω*; torque never exceeds T_max by more than the ripple."""
+    overshoots by less than 1 % of ω*; torque never exceeds T_max by more than the ripple.
+    """
     m = run1000.run("smc_integral").metrics
     assert m["overshoot_rpm"] < 10.0
     assert m["torque_peak_Nm"] < 1.1 * run1000.params.gains.T_max
 
 
-def test_cli_json_has_the_issue_keys(capsys):
-    """``python -m app bldc PRESET --json``: per controller the four keys of issue 5."""
+def test_cli_json_has_the_contract_keys(capsys):
+    """``python -m app bldc PRESET --json``: each controller has the four comparison keys."""
     assert main(["bldc", "bldc_smc_paper", "--json", "--set", "scenario.active=2000rpm"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert set(data["controllers"]) == {"smc_integral", "smc_plain", "pi_sinusoidal", "six_step"}

@@ -1,4 +1,4 @@
-"""Comparator 4 of issue 5: six-step (120° square-wave current) commutation, Fig. 1 of [2].
+"""The fourth BLDC comparator: six-step (120° square-wave current) commutation, Fig. 1 of [2].
 
 Commutation table against the ideal trapezoid, the current law's voltage range, and the
 physics of a run on the ideal trapezoid: T_EL = K_T·I with K_T = 2·n_pp·Φ_M, flat torque
@@ -27,7 +27,8 @@ SHIFTS = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)
 def test_commutation_conducts_on_the_flat_tops(theta):
     """At every θ_e: one phase at +1, one at −1, one open (currents sum to zero); the two
     conducting phases sit on a flat top of the ideal Φ' (slope 0) with the current's sign, the
-    open one is on its ramp; ±I then gives T = 2·n_pp·Φ_M·I (Fig. 7's K_T) exactly."""
+    open one is on its ramp; ±I then gives T = 2·n_pp·Φ_M·I (Fig. 7's K_T) exactly.
+    """
     edge = (theta + math.pi / 6.0) / (math.pi / 3.0)
     assume(abs(edge - round(edge)) > 1e-9)  # not exactly on a corner of the trapezoid
     signs = six.commutation_signs(theta)
@@ -45,7 +46,8 @@ def test_commutation_conducts_on_the_flat_tops(theta):
 
 def test_each_phase_conducts_120_degrees_each_way_in_six_60_degree_sectors():
     """Over one period on a 0.5° grid: every phase is +1, −1 and open for 120° each; the state
-    changes only at θ_e = 30° + k·60° (the trapezoid's corners), six states in order."""
+    changes only at θ_e = 30° + k·60° (the trapezoid's corners), six states in order.
+    """
     th = np.radians(np.arange(720) * 0.5)
     signs = np.array([six.commutation_signs(t) for t in th])
     for col in signs.T:
@@ -60,7 +62,8 @@ def test_each_phase_conducts_120_degrees_each_way_in_six_60_degree_sectors():
 def test_voltage_law_stays_inside_the_inverter(i_ref, i_a, i_b, v_ff, sector):
     """The phase voltages sum to zero, the pair sees at most the DC link (|v_p − v_n| ≤ V_dc) and
     the open phase stays between the rails (|v_o − (v_p + v_n)/2| ≤ V_dc/2): always inside the
-    hexagon (max − min ≤ V_dc); i_line and i_open are the pair's and the open phase's currents."""
+    hexagon (max − min ≤ V_dc); i_line and i_open are the pair's and the open phase's currents.
+    """
     V = 300.0
     s = six.commutation_signs(sector * math.pi / 3.0)
     i = (i_a, i_b, -i_a - i_b)
@@ -74,7 +77,8 @@ def test_voltage_law_stays_inside_the_inverter(i_ref, i_a, i_b, v_ff, sector):
 def test_small_signal_gains_match_the_dqx_current_loop():
     """Near zero error both loops have the αβ gain k_I·V_dc/√2 of the dq_x tanh law: a pair
     error δ gives v_line = 2·(k_I·V_dc/√2)·δ (αβ current √2·δ, voltage v_line/√2); an open-phase
-    error δ with v_ff = 0 gives v_o − v_mid = 1.5·(k_I·V_dc/√2)·δ."""
+    error δ with v_ff = 0 gives v_o − v_mid = 1.5·(k_I·V_dc/√2)·δ.
+    """
     k_I, V, d = 1.0, 300.0, 1e-6
     gain = k_I * V / math.sqrt(2.0)
     s = six.commutation_signs(0.0)  # b +, c −, a open
@@ -100,7 +104,8 @@ def _loaded_window(run):
 def test_torque_is_kt_times_line_current_on_the_ideal_trapezoid(ideal_run):
     """Loaded steady window (2.2 N·m): wherever the open phase carries < 1 % of I (all but the
     commutations) T_EL = 2·n_pp·Φ_M·I to 0.5 %; the window mean within 4 % (the commutations,
-    where the outgoing phase still conducts, add a little); zero speed error (< 0.5 rpm)."""
+    where the outgoing phase still conducts, add a little); zero speed error (< 0.5 rpm).
+    """
     p, run = ideal_run
     tr, m = _loaded_window(run)
     K_T = torque_constant_fig7(p.machine.n_pp, p.machine.Phi_m)
@@ -115,7 +120,8 @@ def test_torque_is_kt_times_line_current_on_the_ideal_trapezoid(ideal_run):
 
 def test_ideal_trapezoid_torque_is_flat_except_at_commutations(ideal_run):
     """More than 15° after each commutation the torque is flat to < 3 % peak-to-peak; the
-    window's ripple metric is at least 4× that — set by the commutation excursions."""
+    window's ripple metric is at least 4× that — set by the commutation excursions.
+    """
     _, run = ideal_run
     tr, m = _loaded_window(run)
     since = np.degrees(tr.theta_e[m] + math.pi / 6.0) % 60.0  # electrical degrees since commutation
@@ -131,7 +137,8 @@ def test_commutation_bump_turns_into_a_dip_as_the_dc_link_falls(ideal_run):
     """While both loops are saturated after a commutation the torque-carrying current moves at
     (V_dc − 4E)/(3L), E = ω_e·Φ_M (4E = 151 V at 1000 rpm): with V_dc = 300 V ≈ 8E the torque
     bumps up (> +5 %) in the first 10° after a commutation, with V_dc = 120 V ≈ 3.2E it dips
-    (< −15 %); both runs still hold 1000 rpm under load (the classical six-step result)."""
+    (< −15 %); both runs still hold 1000 rpm under load (the classical six-step result).
+    """
     _, run = ideal_run
     low = load_preset("bldc_smc_paper", ["machine.emf=ideal", "inverter.V_dc=120"])
     excursions = []

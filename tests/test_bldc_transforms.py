@@ -1,5 +1,6 @@
 """dq_x transformation of [2] (eqs. (4)–(12)): round trips, torque eq. (3) = eq. (9), eq. (10),
-and the paper's typos (eq. (12) θ_r, single-argument tan⁻¹ in eq. (8), K_T of Fig. 7)."""
+and the paper's typos (eq. (12) θ_r, single-argument tan⁻¹ in eq. (8), K_T of Fig. 7).
+"""
 
 from __future__ import annotations
 
@@ -56,7 +57,8 @@ def test_power_invariance():
 @given(angles, values, values)
 def test_torque_eq3_equals_eq9_for_ideal_waveform(theta_e, i_d, i_q):
     """Currents set in dq_x (zero-sequence free) on the ideal machine: eq. (3) in abc equals
-    eq. (9), T = n_pp·√(3/2)·Φ_m·i_qx, at any θ_e; i_dx gives no torque."""
+    eq. (9), T = n_pp·√(3/2)·Φ_m·i_qx, at any θ_e; i_dx gives no torque.
+    """
     a_x, phi, phases = _ideal_gain_angle(theta_e)
     i_abc = dqx.abc_from_alpha_beta(*dqx.from_dqx(i_d, i_q, a_x, phi), 0.0)
     T3 = NPP * sum(f * i for f, i in zip(phases, i_abc, strict=True))
@@ -77,7 +79,8 @@ def test_sinusoidal_machine_reduces_to_dq():
 
 def test_ideal_trapezoid_a_x_range_and_period():
     """Ideal trapezoid: |Φ'_αβ|² = Φ_m²·(2 + 2s²/3) with s the ramping phase ⇒ a_x runs from
-    √(3/2)/√(8/3) = 0.75 (corners) to √(3/2)/√2 = 0.866 (mid-ramp), with a 60° period (Fig. 5)."""
+    √(3/2)/√(8/3) = 0.75 (corners) to √(3/2)/√2 = 0.866 (mid-ramp), with a 60° period (Fig. 5).
+    """
     th = np.linspace(0, 2 * np.pi, 721)
     c = dqx.ideal_coefficients(th, PHI_M)
     assert math.isclose(c.a_x.min(), 0.75, rel_tol=1e-9)
@@ -97,7 +100,8 @@ def _smooth_phases(theta: float) -> tuple[np.ndarray, np.ndarray]:
 
 def test_electrical_equation_eq10_matches_abc_model():
     """Eq. (10) equals eq. (1) transformed with eq. (4) (a_x, θ_x from the same waveform),
-    including the a'_x/a_x and (1 + θ'_x) terms and e_qx = √(3/2)·Φ_m·ω_e/a_x²."""
+    including the a'_x/a_x and (1 + θ'_x) terms and e_qx = √(3/2)·Φ_m·ω_e/a_x².
+    """
     R, L, w_e = 2.3, 0.0125, 300.0
     i_d_f = lambda t: 1.0 + 0.5 * np.sin(40 * t)  # noqa: E731
     i_q_f = lambda t: 4.0 + np.cos(25 * t)  # noqa: E731
@@ -129,7 +133,8 @@ def test_electrical_equation_eq10_matches_abc_model():
 def test_eq12_typo_theta_r_instead_of_theta_e():
     """Eq. (12) repeats eq. (8) with θ_r (mechanical). For a sinusoidal machine with n_pp = 3
     that would give θ_x = θ_e − θ_r = (2/3)·θ_e ≠ 0, i.e. a rotating, wrong frame; eq. (8) with
-    θ_e gives θ_x ≡ 0, which is physically right (dq_x must reduce to dq)."""
+    θ_e gives θ_x ≡ 0, which is physically right (dq_x must reduce to dq).
+    """
     th = np.linspace(0.1, 2.0, 9)
     f = np.array([-np.sin(th - k * 2 * np.pi / 3) for k in range(3)])
     fa, fb = dqx.alpha_beta(*f)
@@ -152,7 +157,8 @@ def test_eq12_typo_theta_r_instead_of_theta_e():
 
 def test_single_argument_arctan_of_eq8_flips_the_axes():
     """tan⁻¹(−Φ'_α/Φ'_β) as printed loses the quadrant: on half the period the dq_x axes are
-    reversed and eq. (9) would give the wrong torque sign. atan2 (used) does not."""
+    reversed and eq. (9) would give the wrong torque sign. atan2 (used) does not.
+    """
     th = np.linspace(0.0, 2 * np.pi, 361)[:-1]
     phi_abc, _ = dqx.ideal_phases(th, PHI_M)
     fa, fb = dqx.alpha_beta(*phi_abc)
@@ -166,7 +172,8 @@ def test_single_argument_arctan_of_eq8_flips_the_axes():
 def test_fig7_torque_constant_is_the_six_step_line_current_constant():
     """120° square currents ±I on the ideal trapezoid's flat tops give T = 2·n_pp·Φ_M·I (K_T of
     Fig. 7), while eq. (9) needs n_pp·√(3/2)·Φ_m per ampere of i_qx: K_T(Fig. 7) used for i*_qx
-    would deliver only √(3/2)/2 ≈ 0.61 of the demanded torque."""
+    would deliver only √(3/2)/2 ≈ 0.61 of the demanded torque.
+    """
     I = 3.0
     for th in np.radians([40.0, 60.0, 85.0]):  # a and b on flat tops, c ramping (off)
         phases = [PHI_M * dqx.trapezoid_unit(th - k * 2 * np.pi / 3) for k in range(3)]

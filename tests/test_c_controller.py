@@ -89,7 +89,8 @@ def test_float32_build_within_tolerance(tmp_path):
 def test_float32_build_in_the_papers_limit_cycle(tmp_path):
     """At the paper's K = 1000 the sampled loop limit-cycles (see docs/paper_reproduction.md):
     the cycle's phase is chaotic, so float32 rounding shifts i_q within it, but the trajectory
-    and the friction energy — what the manoeuvre is designed for — still agree to 1e-3."""
+    and the friction energy — what the manoeuvre is designed for — still agree to 1e-3.
+    """
     params = load_preset("paper_12kw_pmsm")
     _write(tmp_path, params)
     err = agreement(params, closed_loop(build(tmp_path, True), True, params))
@@ -152,7 +153,8 @@ def test_every_real_motor_preset_runs_as_simulated(tmp_path, preset):
 
 def test_a_new_position_demand_leaves_the_estimates_unchanged(tmp_path):
     """The observer does not depend on θ_dem (eq. (15)); its z0 = θ̂ − θ_dem is shifted exactly
-    when the demand changes, so θ̂ and ω̂ are the same whatever demand sequence the drive sends."""
+    when the demand changes, so θ̂ and ω̂ are the same whatever demand sequence the drive sends.
+    """
     from app.exports.c_verify import _types
 
     params = load_preset("paper_12kw_pmsm", PAPER_K_REC)

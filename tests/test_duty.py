@@ -33,7 +33,8 @@ def test_cycle_energy_is_the_sum_of_the_moves_and_yearly_figures_follow(tmp_path
 def test_moves_energies_add_up_to_the_runs_closed_energy_balance():
     """Back to back, the moves' energies (differences of the one run's electrical-input integral)
     sum to the run's input, and that input equals copper + friction + load work + the kinetic and
-    magnetic energy stored at the end (the balance of the whole continuous run)."""
+    magnetic energy stored at the end (the balance of the whole continuous run).
+    """
     p = load_preset(PRESET, ["load.Gamma_Le=0.5"])
     res = duty_cycle(p, [Move(40.0, 0.6, 0.1), Move(20.0, 0.4, 0.0), Move(-30.0, 0.5, 0.2)])
     for c, run in res.runs.items():
@@ -54,7 +55,8 @@ def test_cycle_returning_to_its_start_ends_there():
 
 def test_one_move_with_the_tail_as_dwell_is_the_single_move_run():
     """A cycle of one move whose dwell is the single-move simulation's tail (0.3·T_m) is that
-    simulation: the same kernel steps from rest, the same energy."""
+    simulation: the same kernel steps from rest, the same energy.
+    """
     p = load_preset(PRESET, ["manoeuvre.theta_dem=31.4", "manoeuvre.T_m=0.5"])
     single = compare(p, ("fdsmc", "conventional", "optimum"))
     res = duty_cycle(p, [Move(31.4, 0.5, 0.3 * 0.5)])
@@ -64,7 +66,8 @@ def test_one_move_with_the_tail_as_dwell_is_the_single_move_run():
 
 def test_back_to_back_differs_from_moves_started_at_rest():
     """Without dwell the second move starts while the first has not settled: its energy differs
-    from the same move started from rest (the former independent-move estimate)."""
+    from the same move started from rest (the former independent-move estimate).
+    """
     p = load_preset(PRESET)
     b2b = duty_cycle(p, [Move(40.0, 0.5, 0.0), Move(40.0, 0.5, 0.15)])
     alone = duty_cycle(p, [Move(40.0, 0.5, 0.15)])

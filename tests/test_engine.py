@@ -1,4 +1,4 @@
-"""Physics of the closed-loop engine (issue 3): convergence, energy balance, paper values.
+"""Physics of the closed-loop engine: convergence, energy balance, paper values.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper (section 5 preset).
 """
@@ -174,11 +174,11 @@ def test_chatter_flagged_for_paper_K_not_for_recommended(mode):
     assert not cmp.fdsmc.metrics["chatter"]
     assert not cmp.conventional.metrics["chatter"]
     assert cmp.fdsmc.metrics["copper_total_J"] < 0.1 * hot["copper_total_J"]
-    assert 20.0 < cmp.saving_electrical_pct < 26.0  # issue 3: ≈ 23 % without chatter
+    assert 20.0 < cmp.saving_electrical_pct < 26.0  # ≈ 23 % reported for a chatter-free K
 
 
 def test_paper_K_limit_cycle_matches_reported_amplitude_and_frequency(continuous_cmp):
-    """Issue 3: ω_r oscillates ~2.6 rad/s peak-to-peak at roughly 400 Hz during the cruise."""
+    """At the paper's K = 1000 the loop limit-cycles: ω_r swings ~2.6 rad/s peak-to-peak at ≈ 400 Hz in the cruise."""
     m = continuous_cmp.fdsmc.metrics
     assert 2.0 < m["cruise_omega_ptp_rad_s"] < 3.2
     assert 300.0 < m["chatter_frequency_Hz"] < 500.0
@@ -249,7 +249,8 @@ def test_hysteretic_sign_changes_counts_half_cycles_and_ignores_small_noise():
 
 def test_chatter_verdict_does_not_depend_on_trace_decimation(paper_params):
     """The limit cycle (≈ 270 Hz at 20 kHz, paper K) is found from full-resolution samples even
-    when the stored trace is decimated far below its frequency (here 200 points over 1.3 s)."""
+    when the stored trace is decimated far below its frequency (here 200 points over 1.3 s).
+    """
     fine = simulate(paper_params, "fdsmc").metrics
     coarse = simulate(paper_params, "fdsmc", max_points=200).metrics
     assert fine["chatter"] and coarse["chatter"]
@@ -260,7 +261,8 @@ def test_chatter_verdict_does_not_depend_on_trace_decimation(paper_params):
 def test_continuous_step_follows_the_fastest_designed_pole(continuous_paper):
     """5 µs at the paper's T_so = 0.2 ms (q = 37 500 1/s, h·q = 0.1875); T_so = 20 µs (q ten times
     larger) would make that RK4 step diverge (h·q = 1.9 per stage on a four-fold pole), so the
-    step shrinks tenfold and the run still reproduces eq. (52)."""
+    step shrinks tenfold and the run still reproduces eq. (52).
+    """
     from sim.fdsmc.engine import continuous_step
 
     assert continuous_step(continuous_paper) == pytest.approx(5e-6, rel=1e-12)
@@ -273,7 +275,8 @@ def test_continuous_step_follows_the_fastest_designed_pole(continuous_paper):
 
 def test_slow_digital_controller_plant_substeps_converged():
     """A 2 kHz controller (T_so = 2 ms, T_sα = 10 ms, stable by the sample-rate check) gets 10 RK4
-    plant substeps of 50 µs per sample; doubling them changes the friction by < 0.05 %."""
+    plant substeps of 50 µs per sample; doubling them changes the friction by < 0.05 %.
+    """
     from sim.fdsmc.engine import plant_substeps
 
     base = ["controller.T_so=0.002", "controller.T_salpha=0.01", "controller.f_s=2000"]
@@ -289,7 +292,8 @@ def test_slow_digital_controller_plant_substeps_converged():
 
 def test_divergence_near_the_sample_rate_limit_names_the_K_limit(paper_params):
     """Just above f_s,min = 10.69 kHz the inner loops are stable (ρ < 1) but the FDSMC loop
-    tolerates only K ≈ 0.018 s/rad: K = 0.2 diverges and the reason says why; K_rec is stable."""
+    tolerates only K ≈ 0.018 s/rad: K = 0.2 diverges and the reason says why; K_rec is stable.
+    """
     p = _with(paper_params, "controller", f_s=10700.0, K=0.2)
     d = derive(p)
     assert d.sample_rate.stable and not d.gain.K_ok

@@ -52,7 +52,8 @@ def test_simulate_unstable_reports_reason_not_numbers(capsys):
 
 def test_simulate_csv_is_the_export_format(tmp_path, capsys):
     """One CSV format: a controller column, one column per signal, units in the header names,
-    numbers from the second row on (no units row, so pandas/Excel read typed columns)."""
+    numbers from the second row on (no units row, so pandas/Excel read typed columns).
+    """
     path = tmp_path / "run.csv"
     assert main(["simulate", "paper_12kw_pmsm", "--controller", "fdsmc", "--csv", str(path)]) == 0
     text = capsys.readouterr().out

@@ -1,5 +1,6 @@
 """Exports: one model for page and CLI; YAML/JSON round trip (schema 2, schema 1 still read),
-units and verdicts carried, one CSV format, the offline HTML report with its metrics table."""
+units and verdicts carried, one CSV format, the offline HTML report with its metrics table.
+"""
 
 from __future__ import annotations
 

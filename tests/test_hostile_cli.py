@@ -1,5 +1,6 @@
 """Hostile and extreme input at the CLI and the loader: every case answers with exit 2 and one line
-naming the field, the value and the allowed range — before any simulation work starts."""
+naming the field, the value and the allowed range — before any simulation work starts.
+"""
 
 from __future__ import annotations
 

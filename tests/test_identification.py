@@ -41,7 +41,8 @@ def test_noise_free_log_gives_the_true_plant_exactly(case):
     """Without noise the window-integrated electrical equations are the plant's own (errors
     < 0.05 %); the mechanical fit only carries the Savitzky–Golay speed's smoothing (< 0.5 %
     on J and F_v, < 2 % on the small constant load torque);
-    the one-sample computation delay of the drive is found."""
+    the one-sample computation delay of the drive is found.
+    """
     _, true, truth, clean = case
     log = {k: v for k, v in clean.items() if k != "omega_r"}
     r = identify(log, true.motor.p)
@@ -53,7 +54,8 @@ def test_noise_free_log_gives_the_true_plant_exactly(case):
 
 def test_fifty_noisy_logs_recover_the_plant_within_tolerance_and_intervals_cover(case):
     """50 seeded noise draws: every estimate within its tolerance; the true value inside the
-    reported 95 % interval in ≥ 90 % of the trials for each parameter."""
+    reported 95 % interval in ≥ 90 % of the trials for each parameter.
+    """
     _, true, truth, clean = case
     covered = dict.fromkeys(truth, 0)
     worst = dict.fromkeys(truth, 0.0)
@@ -98,7 +100,8 @@ def test_standstill_log_refuses_psi_and_inertia(case):
 
 def test_without_voltages_mechanics_use_the_given_flux(case):
     """No u_d, u_q: the electrical parameters are refused (naming the missing signals) and
-    J, F_v come from eq. (4a) with the Ψ_PM given; a 2 % flux error scales J by 2 %."""
+    J, F_v come from eq. (4a) with the Ψ_PM given; a 2 % flux error scales J by 2 %.
+    """
     _, true, truth, clean = case
     log = {k: v for k, v in add_noise(clean, LogNoise(), 3).items() if k not in ("u_d", "u_q")}
     r = identify(log, true.motor.p, psi_pm_prior=TRUE_MOTOR["psi_pm"] * 1.02,

@@ -1,5 +1,6 @@
 """Layers: control/ and sim/ (every sub-package) import neither viser, plotly nor yaml; only app/io/presets.py
-uses yaml; the page (app/ui) never imports the command line (app/cli)."""
+uses yaml; the page (app/ui) never imports the command line (app/cli).
+"""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 def test_control_and_sim_do_not_import_ui_or_yaml():
     """Importing every module of control/ and sim/ imports no viser or plotly, and no project
     module of theirs imports yaml. (numba itself imports yaml to read an optional
-    .numba_config.yaml file, so the yaml check records *who* imports it.)"""
+    .numba_config.yaml file, so the yaml check records *who* imports it.)
+    """
     code = (
         "import sys, pkgutil, importlib\n"
         "culprits = []\n"

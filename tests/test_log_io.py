@@ -31,7 +31,8 @@ def _truth() -> dict[str, float]:
                                            ("drive_log_phases.csv", "drive_log_phases.map.yaml")])
 def test_shipped_logs_identify_the_true_plant(name, mapping):
     """Through the same import path as a real log: R_s, L, Ψ_PM within 2 %, J within 3 %,
-    F_v within 10 %, and every true value inside its 95 % interval."""
+    F_v within 10 %, and every true value inside its 95 % interval.
+    """
     mp = loads_log_mapping((DATA / mapping).read_text(encoding="utf-8")) if mapping else None
     log = read_log(DATA / name, mapping=mp, p=5)
     assert (DATA / name).stat().st_size < 300_000
@@ -71,7 +72,8 @@ def test_units_in_header_are_converted_to_si():
 
 def test_own_simulate_csv_is_accepted_without_mapping(tmp_path):
     """``simulate --csv`` output (both runs in one file) is a log: --run picks one, and its
-    signals equal the simulated trace."""
+    signals equal the simulated trace.
+    """
     params = load_preset("paper_12kw_pmsm", ["manoeuvre.theta_dem=3", "manoeuvre.T_m=0.6",
                                              "controller.f_s=5000", "controller.T_so=0.002",
                                              "controller.T_salpha=0.005"])
@@ -139,7 +141,8 @@ def test_mapping_names_columns_and_unknown_mapped_column_is_an_error():
 
 def test_cli_log_json_overlay_of_own_export_is_exact_and_identifies_the_shipped_log(tmp_path, capsys):
     """A log that is this tool's own simulation of the same preset overlays with zero error
-    and equal input energy; a rest period before the move is found as the move start."""
+    and equal input energy; a rest period before the move is found as the move start.
+    """
     import json
 
     from app.cli.main import main
@@ -219,7 +222,8 @@ def test_page_csv_export_with_unit_suffixes_and_run_column_is_accepted():
 
 def test_given_move_start_shifts_the_overlay_and_a_wrong_one_shows_in_the_errors():
     """The own simulation behind 50 ms of rest: detected t0 = 50 ms with zero error; a t0 given
-    10 ms late leaves a position error of about ω·10 ms."""
+    10 ms late leaves a position error of about ω·10 ms.
+    """
     from sim.drivelog.overlay import overlay
 
     run = simulate(load_preset("example_log_drive"), "fdsmc")
@@ -240,7 +244,8 @@ def test_given_move_start_shifts_the_overlay_and_a_wrong_one_shows_in_the_errors
                                  "{sig} ({run}) [{unit}]"])
 def test_wide_csv_with_units_in_header_and_two_runs_picks_the_run(fmt):
     """A wide export with both runs side by side and units in the names (any of the usual
-    spellings of the run) is a log; ``run`` picks one."""
+    spellings of the run) is a log; ``run`` picks one.
+    """
     heads = ["t [s]"] + [fmt.format(run=r, sig=s, unit=u) for r in RUNS_ for s, u in (("theta_r", "rad"),
                                                                                       ("i_q", "A"))]
     rows = [f"{k * 1e-3},{k * 0.01},{k * 0.1},{-k * 0.01},{-k * 0.1}" for k in range(30)]

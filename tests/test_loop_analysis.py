@@ -32,7 +32,8 @@ def _params(*overrides: str):
 def test_ideal_plant_closed_loop_poles_are_closed_form():
     """J_L = 0, F_v = 0 (model exact): separation principle — the cruise loop has the poles of
     s² + (3/T_sα)·s + (3/T_sα)·α_max·K (eqs. 13, 46 of [1]) plus the observer's four at −q
-    (eq. 17)."""
+    (eq. 17).
+    """
     d = derive(_params("load.J_L=0", "load.F_v=0", "controller.f_s=continuous"))
     K = 0.5
     ev = np.linalg.eigvals(reduce_shift_mode(continuous_loop(d, "cruise", K)))
@@ -44,8 +45,8 @@ def test_ideal_plant_closed_loop_poles_are_closed_form():
     assert np.allclose(got, exp, rtol=5e-3, atol=5e-3 * d.observer.q)
 
 
-def test_paper_K_limit_continuous_near_issue_value():
-    """Issue 3 reports K_limit ≈ 0.9 s/rad for J_L = 4·J_r; this linearisation gives ≈ 0.96."""
+def test_paper_K_limit_continuous_near_reported_value():
+    """The reported chatter bound is K_limit ≈ 0.9 s/rad for J_L = 4·J_r; this linearisation gives ≈ 0.96."""
     g = recommend_K(derive(_params("controller.f_s=continuous")))
     assert 0.85 < g.K_limit < 1.05
     assert g.K_recommended == pytest.approx(g.K_limit / 2.0)
@@ -76,8 +77,9 @@ def test_K_limit_predicts_nonlinear_chatter_onset():
 
 
 def test_sample_rate_limits_with_and_without_delay():
-    """Issue 3: 10 kHz unstable with T_so = 0.2 ms, ≈ 15 kHz needed — the 15 kHz figure is the
-    limit with a one-sample computation delay; without delay this discretisation needs ≈ 10.7 kHz."""
+    """Reported: 10 kHz unstable with T_so = 0.2 ms, ≈ 15 kHz needed — the 15 kHz figure is the
+    limit with a one-sample computation delay; without delay this discretisation needs ≈ 10.7 kHz.
+    """
     d0 = derive(_params())
     assert 10.0e3 < minimum_sample_rate(d0, 0) < 11.5e3
     assert 14.0e3 < minimum_sample_rate(d0, 1) < 16.0e3
@@ -132,7 +134,8 @@ def test_slope_damping_matches_ideal_loop_eigenvalues():
 def test_slow_manoeuvre_sloped_segment_needs_larger_T_c():
     """T_m = 60 s: ω_p = α_max·T_a ≈ 1 rad/s, so with T_c = T_a (eq. 59) the sloped segment is
     poorly damped for every K below the limit cycle bound. The analysis still recommends K from
-    the cruise limit, warns, and its T_c advice removes the oscillation in the simulation."""
+    the cruise limit, warns, and its T_c advice removes the oscillation in the simulation.
+    """
     d = derive(_params("manoeuvre.T_m=60"))
     g = d.gain
     assert g.K_limit == g.K_limit_cruise > 0.1  # not "no K helps"

@@ -1,5 +1,6 @@
 """The minimum-energy move: closed form vs Hamiltonian vs QP, limits, and the tracked optimum
-never drawing more energy than the FDSMC or the conventional controller on the same move."""
+never drawing more energy than the FDSMC or the conventional controller on the same move.
+"""
 
 from __future__ import annotations
 
@@ -37,7 +38,8 @@ def test_closed_form_meets_the_boundary_conditions():
 
 def test_closed_form_equals_the_hamiltonian_two_point_solution():
     """Where e^(M·T) is well conditioned, shooting with the Hamiltonian's matrix exponential gives
-    the same ω(t) and Γ(t) = −λ2/(2·a·J) as the stable closed form."""
+    the same ω(t) and Γ(t) = −λ2/(2·a·J) as the stable closed form.
+    """
     mm = MoveModel(J=1.0, F_v=0.5, a=0.2, delta_theta=2.0, T_m=1.5)
     cf = closed_form(mm, 300)
     M = hamiltonian_matrix(mm)
@@ -131,7 +133,8 @@ def test_simulate_json_has_optimum_and_gap(capsys):
 
 def _exact_voltage_peak(mm, mv) -> float:
     """max |u_dq| [V] at i_d = 0, eqs. (1)–(2) of the FDSMC paper in the steady state of each interval
-    (u_d = −p·ω·L_q·i_q, u_q = R_s·i_q + p·Ψ_PM·ω), with the speed at both ends of each interval."""
+    (u_d = −p·ω·L_q·i_q, u_q = R_s·i_q + p·Ψ_PM·ω), with the speed at both ends of each interval.
+    """
     i_q = mv.Gamma_em[:-1] / (1.5 * mm.p * mm.psi_pm)
     peaks = []
     for w in (mv.omega[:-1], mv.omega[1:]):
@@ -142,7 +145,8 @@ def _exact_voltage_peak(mm, mv) -> float:
 def test_voltage_limit_binds_and_is_respected():
     """Siemens servo with a 95 V DC link (u_max = 54.8 V): the unconstrained optimum needs 69 V
     (its back-EMF alone reaches 69 V at the peak speed); the voltage-limited optimum stays within
-    u_max, still arrives, and costs more."""
+    u_max, still arrives, and costs more.
+    """
     from control.fdsmc.optimum import optimal_move, voltage_peak
 
     p = load_preset("siemens_1ft7044_ak7", ["controller.V_dc=95"])
@@ -162,7 +166,8 @@ def test_voltage_limit_binds_and_is_respected():
 def test_voltage_cone_that_does_not_bind_changes_nothing():
     """With u_max 20 % above what the unconstrained optimum needs, the cone is in the problem but
     inactive: the same energy and trajectory as the problem without it; and a drive whose DC link
-    never binds gets the closed form, exactly as without a DC link."""
+    never binds gets the closed form, exactly as without a DC link.
+    """
     from control.fdsmc.optimum import _problem, _solve, optimal_move, voltage_peak
 
     free = dataclasses.replace(move_model(load_preset("siemens_1ft7044_ak7")), u_max=math.inf)

@@ -52,7 +52,8 @@ def test_set_plant_goes_on_top_of_the_section():
 
 def test_simulate_uses_the_plant_section():
     """The controller's design is the model's; the heavier plant needs more torque, and the energy
-    balance closes with the plant's inertia."""
+    balance closes with the plant's inertia.
+    """
     params, plant = load_preset_and_plant(MISMATCH, ["controller.K=0.3"])
     nominal, mismatch = compare(params), compare(params, plant=plant)
     assert mismatch.derived.alpha.alpha_max == nominal.derived.alpha.alpha_max

@@ -32,7 +32,8 @@ def test_plant_equal_to_model_changes_nothing():
 
 def test_plant_override_changes_the_drive_not_the_controller():
     """A heavier true load than the controller assumes: the same design, more torque and energy;
-    the energy balance closes with the plant's inertia."""
+    the energy balance closes with the plant's inertia.
+    """
     params, plant = load_model_and_plant(PRESET, ["plant.J_L=0.004"])
     assert pytest.approx(2.172e-3) == params.load.J_L and plant.load.J_L == 0.004
     nominal, heavy = compare(params), compare(params, plant=plant)
@@ -130,7 +131,8 @@ def test_robustness_cli_json(capsys):
 
 def test_parquet_and_csv_tables_hold_the_same_numbers_with_units(tmp_path):
     """Write the per-sample results as Parquet and CSV through the CLI; read both back: equal
-    values (floats exactly), each column's SI unit in the Parquet schema metadata."""
+    values (floats exactly), each column's SI unit in the Parquet schema metadata.
+    """
     import csv
 
     from app.io.sample_table import read_parquet

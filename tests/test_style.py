@@ -1,4 +1,4 @@
-"""House rule 7: ruff clean."""
+"""Ruff clean: app, sim, control, tests and scripts pass the pinned ruff with the rules of pyproject.toml."""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """The page against hostile clients (no browser): a raw websocket client, foreign origins and hosts,
-the access token, dropdown values never offered, markup in user text, cancel."""
+the access token, dropdown values never offered, markup in user text, cancel.
+"""
 
 from __future__ import annotations
 
@@ -126,7 +127,8 @@ CAMERA = {"type": "ViewerCameraMessage", "wxyz": [1.0, 0.0, 0.0, 0.0], "position
 
 def _send_update(hostport: str, config: object, handle_of: str, value: str, wait_error: bool = True) -> object:
     """Connect as a hand-written client, set a GUI value by uuid (``handle_of`` a dotted attribute path of
-    the session), return the session."""
+    the session), return the session.
+    """
     known = set(config.sessions)
     done = threading.Event()
     session_box: list[object] = []

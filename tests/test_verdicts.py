@@ -44,7 +44,8 @@ def test_a_drive_big_enough_gets_no_limit_warning(quiet_paper):
 def test_target_missed_is_reported_not_hidden_behind_a_saving(paper_params, quiet_paper):
     """T_c = 5 s (≫ T_m) makes the FDSMC decelerate far too slowly: it is still 49 rad short at
     T_m, so its low friction is no 'saving'. The comparator (2.44 % short by design) is not
-    flagged; the quiet paper case flags nothing."""
+    flagged; the quiet paper case flags nothing.
+    """
     assert not any("Target missed" in w for w in run_warnings(quiet_paper))
     slow = dataclasses.replace(paper_params, controller=dataclasses.replace(
         paper_params.controller, K=quiet_paper.derived.gain.K_recommended, T_c=5.0))
@@ -56,7 +57,8 @@ def test_target_missed_is_reported_not_hidden_behind_a_saving(paper_params, quie
 
 def test_slow_manoeuvre_gets_T_c_advice_that_removes_the_limit_cycle(paper_params):
     """T_m = 60 s: T_c = T_a ≈ 0.38 ms gives ζ ≈ 0.28 on the −1/T_c line even with the
-    recommended K, and the run limit-cycles about θ_dem; T_c,min = 4/(α_max·K_rec) cures it."""
+    recommended K, and the run limit-cycles about θ_dem; T_c,min = 4/(α_max·K_rec) cures it.
+    """
     from control.fdsmc.derivations import derive
 
     slow = dataclasses.replace(paper_params, manoeuvre=dataclasses.replace(paper_params.manoeuvre, T_m=60.0))

@@ -28,7 +28,7 @@ def _finite(x: Any) -> Any:
 
 
 def design_json(dd: DriveDesign) -> dict[str, Any]:
-    """The JSON contract of ``design --json``."""
+    """Return the JSON contract of ``design --json``."""
     c, cmp = dd.params.controller, dd.comparison
     verified: dict[str, Any] = {}
     for name in ("fdsmc", "conventional"):

@@ -43,7 +43,7 @@ def _field(item: dict[str, Any], key: str, where: str, default: float | None = N
 
 
 def parse_moves(raw: Any, origin: str) -> list[Move]:
-    """The YAML list → moves, with a clear message for a bad entry."""
+    """Parse the YAML list into moves, with a clear message for a bad entry."""
     if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_MOVES:
         raise ParameterError(f"{origin}: expected a YAML list of 1 … {MAX_MOVES} moves")
     moves = []

@@ -35,7 +35,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def load(args: argparse.Namespace) -> tuple[DriveParams, DriveLog]:
-    """The preset and the imported log of the command line."""
+    """Return the preset and the imported log of the command line."""
     params = load_preset(args.preset, args.overrides)
     if not isinstance(params, DriveParams):
         raise ParameterError(f"--preset {args.preset!r} is not a position-drive preset")
@@ -60,7 +60,7 @@ def overlay_json(ov: Overlay) -> dict[str, Any]:
 
 
 def identified_json(r: Identification) -> dict[str, Any]:
-    """``identified``: per parameter value, stderr, ci95, unit — or refused with the reason."""
+    """Return ``identified``: per parameter value, stderr, ci95, unit — or refused with the reason."""
     out: dict[str, Any] = {}
     for e in r.estimates:
         if e.refused is not None:

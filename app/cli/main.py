@@ -36,7 +36,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every available sub-command."""
+    """Build the argument parser with every available sub-command."""
     parser = _Parser(prog="python -m app", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for name, (module, help_text) in COMMANDS.items():
@@ -53,7 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None) -> None:
-    """The PRESET positional and repeatable ``--set section.field=value`` options."""
+    """Add the PRESET positional and repeatable ``--set section.field=value`` options."""
     if default is None:
         p.add_argument("preset", metavar="PRESET", help="preset name (presets/NAME.yaml) or a YAML/JSON file path")
     else:

@@ -31,7 +31,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def parse_axes(raw: Any, origin: str) -> list[tuple[str, DriveParams]]:
-    """The YAML list → (name, params) per axis, with clear messages for a bad entry."""
+    """Parse the YAML list into (name, params) per axis, with clear messages for a bad entry."""
     if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_AXES:
         raise ParameterError(f"{origin}: expected a YAML list of 1 … {MAX_AXES} axes")
     axes = []

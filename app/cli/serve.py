@@ -31,7 +31,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def is_loopback(host: str) -> bool:
-    """True for localhost / 127.x / ::1."""
+    """Return True for localhost / 127.x / ::1."""
     if host.lower() == "localhost":
         return True
     try:

@@ -65,8 +65,10 @@ OPTIMUM_BASIS = "electrical_in_total_J"
 
 
 def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float | None:
-    """100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save
-    (W = net electrical input over the whole horizon); None unless both runs are stable."""
+    """Return 100·(1 − W_opt/W) [%]: the share of ``run``'s energy the tracked optimum would save.
+
+    W is the net electrical input over the whole horizon; None unless both runs are stable.
+    """
     if run is None or optimum is None or not (run.metrics["stable"] and optimum.metrics["stable"]):
         return None
     w, w_opt = run.metrics[OPTIMUM_BASIS], optimum.metrics[OPTIMUM_BASIS]
@@ -76,7 +78,7 @@ def saving_vs_optimum(run: RunResult | None, optimum: RunResult | None) -> float
 
 
 def comparison_json(cmp: Comparison) -> dict[str, Any]:
-    """The stable JSON contract of ``simulate --json``.
+    """Return the stable JSON contract of ``simulate --json``.
 
     Each run's entry holds its metrics; with the optimum run, the ``fdsmc`` and ``conventional``
     entries gain ``saving_vs_optimum_pct`` (see :func:`saving_vs_optimum`).

@@ -57,8 +57,10 @@ class ScaledObserver:
 
 
 def scaled_observer(d: Derived) -> ScaledObserver:
-    """The derived discrete observer (prediction form, :func:`control.fdsmc.observer.discrete_observer`)
-    in coordinates where each state is the angle it moves in one sample [rad].
+    """Return the derived discrete observer in coordinates where each state is the angle it moves in one sample.
+
+    The observer is the prediction form of :func:`control.fdsmc.observer.discrete_observer`; each state is
+    scaled to the angle [rad] it moves in one sample.
 
     Raises
     ------
@@ -133,7 +135,7 @@ def controller_constants(params: DriveParams, d: Derived) -> list[CConstant]:
 
 
 def c_literal(x: float) -> str:
-    """A C double literal that reads back exactly (17 significant digits), e.g. ``1.5e-05``."""
+    """Format a C double literal that reads back exactly (17 significant digits), e.g. ``1.5e-05``."""
     text = repr(float(x))
     if not math.isfinite(float(x)):
         raise ParameterError(f"constant {x!r} is not finite: a C module needs finite values")

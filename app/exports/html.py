@@ -96,7 +96,7 @@ def _table(rows: list[tuple[str, ...]], head: tuple[str, ...]) -> str:
 
 
 def report_figures(cmp: Comparison) -> list[go.Figure]:
-    """The report's figures, each with its height set for print/offline reading."""
+    """Return the report's figures, each with its height set for print/offline reading."""
     figs = [make_phase_plane_figure(cmp).update_layout(height=FIGURE_HEIGHT_PX)]
     if cmp.fdsmc is not None:
         figs.append(make_time_plots_figure(cmp).update_layout(height=ROW_HEIGHT_PX * len(TIME_ROWS)))

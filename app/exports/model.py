@@ -104,7 +104,7 @@ def verdicts(cmp: Comparison) -> dict[str, Any]:
 
 
 def parameter_data(cmp: Comparison) -> dict[str, Any]:
-    """The drive parameter file as plain data (schema 2): preset + units, gains, verdicts, results."""
+    """Return the drive parameter file as plain data (schema 2): preset + units, gains, verdicts, results."""
     params = cmp.derived.params
     raw = to_raw(params)
     raw["units"] = {sec: dict(SI_UNITS[sec]) for sec in ("motor", "load", "controller", "manoeuvre")}
@@ -165,7 +165,7 @@ def trace_csv(cmp: Comparison) -> str:
 
 
 def safe_stem(name: str) -> str:
-    """A file-name stem from a preset/motor name (letters, digits, ``_-.`` only)."""
+    """Make a file-name stem from a preset/motor name (letters, digits, ``_-.`` only)."""
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "drive"
 
 
@@ -192,8 +192,10 @@ def export_files(fmt: str, cmp: Comparison) -> dict[str, bytes]:
 
 
 def export_download(fmt: str, cmp: Comparison) -> tuple[str, bytes]:
-    """One downloadable file: the single export file, or a zip (``<name>_fdsmc_controller.zip``)
-    holding the C module's header and source."""
+    """Return one downloadable file: the single export file, or a zip of the C module's header and source.
+
+    The zip is named ``<name>_fdsmc_controller.zip``.
+    """
     files = export_files(fmt, cmp)
     if len(files) == 1:
         return next(iter(files.items()))

@@ -1,0 +1,1 @@
+"""Pure ``make_*_figure(result)`` functions that turn results into plotly figure dicts."""

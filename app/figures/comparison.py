@@ -31,7 +31,7 @@ _MARGIN = {"l": 60, "r": 16, "t": 40, "b": 44}
 
 
 def decimate_index(n: int, n_max: int = MAX_POINTS) -> np.ndarray:
-    """Indices of at most ``n_max`` evenly spread samples of ``n``, always keeping the last one."""
+    """Return the indices of at most ``n_max`` evenly spread samples of ``n``, always keeping the last one."""
     if n <= n_max:
         return np.arange(n)
     idx = np.linspace(0, n - 1, n_max).round().astype(int)
@@ -53,7 +53,7 @@ def time_axis(t: np.ndarray) -> dict[str, Any]:
 
 
 def f32(a: np.ndarray) -> np.ndarray:
-    """``a`` as float32: halves the figure JSON (base64 typed arrays) at ample drawing precision."""
+    """Return ``a`` as float32: halves the figure JSON (base64 typed arrays) at ample drawing precision."""
     return np.asarray(a, dtype=np.float32)
 
 
@@ -78,7 +78,7 @@ def phase_plane_extent(comparison: Any) -> tuple[float, float]:
 
 
 def boundary_xy(comparison: Any, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
-    """The switching boundary of eq. (41) in [1] over the phase-plane extent: (θ_re [rad], ω_r [rad/s])."""
+    """Return the switching boundary of eq. (41) in [1] over the phase-plane extent: (θ_re [rad], ω_r [rad/s])."""
     lo, hi = phase_plane_extent(comparison)
     prof = comparison.derived.profile
     knee = prof.T_c * prof.omega_p
@@ -111,7 +111,7 @@ def layer_entry_index(comparison: Any, run: Any) -> int | None:
 
 
 def load_step_times(comparison: Any) -> list[float]:
-    """Times [s] of the external load-torque steps of the manoeuvre."""
+    """Return the times [s] of the external load-torque steps of the manoeuvre."""
     return [float(s.t) for s in comparison.derived.params.load.steps]
 
 

@@ -21,7 +21,7 @@ ENERGIES = (
 
 
 def _styled(fig: go.Figure, fid: str, title: str, legend_y: float, **layout: Any) -> go.Figure:
-    """The common layout of the energy figures: id in ``meta``, title, margins, legend below."""
+    """Return the common layout of the energy figures: id in ``meta``, title, margins, legend below."""
     fig.update_layout(_layout(fid, title, legend_y, **layout))
     return fig
 

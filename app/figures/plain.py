@@ -41,7 +41,7 @@ _TEMPLATE_MARK = '"__template__"'
 
 
 def figure_json(spec: dict[str, Any], raw: dict[str, str] | None = None) -> str:
-    """The Plotly JSON of a plain-dict figure ``spec`` (not modified).
+    """Return the Plotly JSON of a plain-dict figure ``spec`` (not modified).
 
     ``raw`` maps placeholder strings used as values in ``spec`` to ready-made JSON put in their place.
     """
@@ -56,7 +56,7 @@ def figure_json(spec: dict[str, Any], raw: dict[str, str] | None = None) -> str:
 
 
 def to_figure(spec: dict[str, Any]) -> go.Figure:
-    """A validated ``go.Figure`` of a plain-dict figure (for exports and tests; slower)."""
+    """Return a validated ``go.Figure`` of a plain-dict figure (for exports and tests; slower)."""
     return go.Figure(spec)
 
 

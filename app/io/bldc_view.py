@@ -28,7 +28,7 @@ METRIC_ROWS: tuple[tuple[str, str, str, str], ...] = (
 
 
 def format_value(value: Any, fmt: str) -> str:
-    """A metric as text ('—' for None / not finite)."""
+    """Format a metric as text ('—' for None / not finite)."""
     if isinstance(value, bool) or value is None:
         return "—" if value is None else str(value)
     if isinstance(value, float) and not math.isfinite(value):
@@ -54,7 +54,7 @@ def _plain(value: Any) -> Any:
 
 
 def design_json(d: BldcDesign) -> dict[str, Any]:
-    """Derived values of a case as plain JSON data (SI units)."""
+    """Return the derived values of a case as plain JSON data (SI units)."""
     return {
         "K_Tx_Nm_per_A": d.K_Tx, "K_T_fig7_Nm_per_A": d.K_T_fig7, "i_qx_max_A": d.i_qx_max,
         "current_loop_gain_V_per_A": d.current.gain, "current_loop_bandwidth_rad_s": d.current.bandwidth,
@@ -68,7 +68,7 @@ def design_json(d: BldcDesign) -> dict[str, Any]:
 
 
 def comparison_json(comp: BldcComparison) -> dict[str, Any]:
-    """The stable JSON form: scenario, design, per-controller metrics, warnings."""
+    """Return the stable JSON form: scenario, design, per-controller metrics, warnings."""
     case = comp.params.case
     return {
         "preset": comp.params.name,

@@ -23,12 +23,12 @@ class Row:
     ref: str
 
     def text(self) -> str:
-        """The value formatted to 5 significant digits."""
+        """Return the value formatted to 5 significant digits."""
         return f"{self.value:.5g}"
 
 
 def derived_rows(d: Derived) -> list[Row]:
-    """Derived values with units and equation references, in reading order."""
+    """Return the derived values with units and equation references, in reading order."""
     o, pr, e, c = d.observer, d.profile, d.energy, d.conventional
     rows = [
         Row("Torque gain of acceleration", "H", d.coefficients.H, "rad/s²/A", "eq. (4)"),
@@ -82,7 +82,7 @@ def _loop_rows(d: Derived) -> list[Row]:
 
 
 def derived_json(d: Derived) -> dict[str, Any]:
-    """The stable JSON contract of ``derive --json`` (keys listed in the README)."""
+    """Return the stable JSON contract of ``derive --json`` (keys listed in the README)."""
     o, pr, e = d.observer, d.profile, d.energy
     out: dict[str, Any] = {
         "alpha_max": d.alpha.alpha_max,

@@ -117,8 +117,10 @@ def _split_unit(head: str) -> tuple[str, str | None]:
 
 
 def _split_run(head: str) -> tuple[str, str | None]:
-    """(header without the run, run) of e.g. ``fdsmc.theta_r [rad]``, ``i_q [A] (conventional)``,
-    ``omega_r_fdsmc [rad/s]``."""
+    """Split a header name into (header without the run, run).
+
+    E.g. ``fdsmc.theta_r [rad]``, ``i_q [A] (conventional)``, ``omega_r_fdsmc [rad/s]``.
+    """
     m = _RUN_RE.search(head)
     if not m:
         return head.strip(), None
@@ -126,7 +128,7 @@ def _split_run(head: str) -> tuple[str, str | None]:
 
 
 def _signal_name(name: str) -> str:
-    """The signal a header name stands for (aliases such as ``iq``, ``ω_r`` resolved)."""
+    """Return the signal a header name stands for (aliases such as ``iq``, ``ω_r`` resolved)."""
     key = name.strip().lower().replace("ω", "omega").replace("θ", "theta")
     key = _ALIASES.get(key, key)
     return key if key in SIGNALS else name.strip()
@@ -170,7 +172,7 @@ def _columns_from_mapping(header: list[str], mapping: dict[str, str]) -> list[_C
 
 
 def _select(cols: list[_Column], run: str | None, mapped: bool) -> tuple[list[_Column], list[str]]:
-    """The signal columns of the chosen run; unknown columns are an error unless mapped."""
+    """Return the signal columns of the chosen run; unknown columns are an error unless mapped."""
     unknown = [c.header for c in cols if c.signal not in SIGNALS and c.signal not in TOOL_COLUMNS]
     if unknown and not mapped:
         raise LogError(f"unknown column(s) {', '.join(map(repr, unknown))}: allowed signals "
@@ -218,7 +220,7 @@ def _body(text: str) -> tuple[list[str], list[str], str, list[int]]:
 
 
 def _parse_rows(lines: list[str], line_no: list[int], delim: str, width: int, used: list[_Column]) -> np.ndarray:
-    """The used columns as floats: numpy's fast reader, or a row-by-row scan naming the bad cell."""
+    """Read the used columns as floats: numpy's fast reader, or a row-by-row scan naming the bad cell."""
     if all(ln.count(delim) == width - 1 for ln in lines):
         try:
             return np.loadtxt(lines, delimiter=delim, usecols=[c.index for c in used], ndmin=2, dtype=float)

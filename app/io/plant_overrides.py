@@ -33,7 +33,7 @@ def plant_section(field: str) -> str:
 
 
 def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
-    """(the model's overrides, the plant's overrides mapped to ``motor.``/``load.`` fields)."""
+    """Split into (the model's overrides, the plant's overrides mapped to ``motor.``/``load.`` fields)."""
     model, plant = [], []
     for item in overrides:
         if not item.startswith(PREFIX):
@@ -47,8 +47,11 @@ def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
 
 
 def load_model_and_plant(preset: str, overrides: Iterable[str]) -> tuple[DriveParams, DriveParams | None]:
-    """The controller's model and the plant: the preset's ``plant`` section with the ``plant.``
-    overrides on top (None when neither gives a value that differs from the model)."""
+    """Return the controller's model and the plant.
+
+    The plant is the preset's ``plant`` section with the ``plant.`` overrides on top (None when
+    neither gives a value that differs from the model).
+    """
     overrides = list(overrides)
     split_overrides(overrides)  # names a bad plant field before anything is loaded
     params, plant = load_preset_and_plant(preset, overrides)

@@ -14,7 +14,7 @@ from app.io.presets import MODES, PresetError, list_presets, load_preset, load_r
 
 
 def mode_of(params: Any) -> str:
-    """The preset mode of a parameter object (``"position"``, ``"bldc"`` …)."""
+    """Return the preset mode of a parameter object (``"position"``, ``"bldc"`` …)."""
     return next(m for m, cls in MODES.items() if isinstance(params, cls))
 
 

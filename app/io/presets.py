@@ -77,8 +77,11 @@ def _describe(tp: Any) -> str:
 
 
 def _number(name: str, value: Any, tp: type) -> Any:
-    """A number field's value: text is parsed by :mod:`app.io.numbers` (decimal or scientific notation
-    only; an integer field takes whole numbers only), a number from JSON/Python data is kept."""
+    """Return a number field's value: text is parsed, a number from JSON/Python data is kept.
+
+    Text is parsed by :mod:`app.io.numbers` (decimal or scientific notation only; an integer field takes whole
+    numbers only).
+    """
     try:
         if isinstance(value, str):
             return parse_integer(value, name) if tp is int else parse_number(value, name)
@@ -217,13 +220,15 @@ def plant_fields() -> dict[str, str]:
 
 
 def _plant_error(exc: Exception, section: str) -> PresetError:
-    """The message of a motor/load error, naming the field as ``plant.FIELD``."""
+    """Return the message of a motor/load error, naming the field as ``plant.FIELD``."""
     return PresetError(str(exc).replace(f"{section}.", f"{PLANT}.", 1))
 
 
 def parse_plant(raw: Any, params: DriveParams) -> DriveParams | None:
-    """The plant of a raw preset: ``params`` with the motor and load values of its ``plant``
-    mapping; None without one (or when it equals the controller's model).
+    """Return the plant of a raw preset.
+
+    That is ``params`` with the motor and load values of its ``plant`` mapping; None without one
+    (or when it equals the controller's model).
 
     Raises
     ------
@@ -261,8 +266,11 @@ def parse_plant(raw: Any, params: DriveParams) -> DriveParams | None:
 
 
 def plant_raw(params: DriveParams, plant: DriveParams | None) -> dict[str, Any]:
-    """The ``plant`` mapping of a preset: the plant's motor and load values (SI) that differ from
-    the controller's model ``params``; empty when there is no plant."""
+    """Return the ``plant`` mapping of a preset.
+
+    That is the plant's motor and load values (SI) that differ from the controller's model
+    ``params``; empty when there is no plant.
+    """
     if plant is None:
         return {}
     out: dict[str, Any] = {}
@@ -275,7 +283,7 @@ def plant_raw(params: DriveParams, plant: DriveParams | None) -> dict[str, Any]:
 
 
 def migrate(raw: dict[str, Any]) -> dict[str, Any]:
-    """A schema-1 mapping → schema 2 (a copy); schema 2 unchanged; other schemas refused.
+    """Upgrade a schema-1 mapping to schema 2 (a copy); schema 2 unchanged; other schemas refused.
 
     Schema 1 holds the inputs only; its drive parameter exports added ``exported_from`` and a flat
     ``drive_gains`` (YAML) or wrapped the inputs as ``{"tool", "preset", "inputs", "gains",
@@ -295,7 +303,7 @@ def migrate(raw: dict[str, Any]) -> dict[str, Any]:
 
 
 def _check_units(table: Any, sections: list[str]) -> None:
-    """An exported file's ``units`` section must state the SI unit of each value it names."""
+    """Check that an exported file's ``units`` section states the SI unit of each value it names."""
     if table is None:
         return
     if not isinstance(table, dict):
@@ -318,9 +326,12 @@ MAX_INDENT = 128
 
 
 class _TextLoader(yaml.SafeLoader):
-    """Safe YAML loader that keeps every scalar as text: no YAML 1.1 implicit typing (``1:30`` →
-    90, ``017`` → 15, ``0x10``, ``1_000``, ``yes`` → True …). Numbers are parsed afterwards by
-    :mod:`app.io.numbers` against the field types; duplicate keys and explicit tags are errors."""
+    """Safe YAML loader that keeps every scalar as text: no YAML 1.1 implicit typing.
+
+    Without it ``1:30`` → 90, ``017`` → 15, and ``0x10``, ``1_000``, ``yes`` → True … would be converted.
+    Numbers are parsed afterwards by :mod:`app.io.numbers` against the field types; duplicate keys and
+    explicit tags are errors.
+    """
 
 
 _TextLoader.yaml_implicit_resolvers = {}
@@ -390,8 +401,10 @@ def _check_no_aliases(text: str) -> None:
 
 
 def loads_raw(text: str, origin: str = "<text>") -> Any:
-    """Parse YAML text safely (size-limited, shallow, no aliases, no duplicate keys) into plain data
-    whose scalars are all text (see :class:`_TextLoader`)."""
+    """Parse YAML text safely into plain data whose scalars are all text (see :class:`_TextLoader`).
+
+    Size-limited, shallow, no aliases, no duplicate keys.
+    """
     if len(text) > MAX_BYTES or len(text.encode("utf-8", "replace")) > MAX_BYTES:
         raise PresetError(f"{origin} is too large: allowed ≤ {MAX_BYTES // 1024} KiB")
     check_structure(text, origin)
@@ -410,7 +423,7 @@ def loads_raw(text: str, origin: str = "<text>") -> Any:
 
 
 def _schema(value: Any) -> int | None:
-    """The schema number of a preset (text or int), None if it is not a whole number."""
+    """Return the schema number of a preset (text or int), None if it is not a whole number."""
     try:
         return _number("schema", value, int)
     except PresetError:
@@ -558,8 +571,11 @@ def _plain(value: Any) -> Any:
 
 
 def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
-    """Parameter object → preset mapping (schema, name, source, mode, sections, and the
-    ``plant`` section when a plant that differs from the model is given)."""
+    """Convert a parameter object to a preset mapping.
+
+    Schema, name, source, mode, sections, and the ``plant`` section when a plant that differs
+    from the model is given.
+    """
     mode = next(m for m, cls in MODES.items() if isinstance(params, cls))
     body = _plain(params)
     raw: dict[str, Any] = {"schema": SCHEMA, "name": body.pop("name"), "source": body.pop("source")}
@@ -594,7 +610,7 @@ __all__ = [
 
 
 def loads_log_mapping(text: str, origin: str = "<mapping>") -> dict[str, str]:
-    """A drive-log column mapping (YAML ``column: signal [unit]``) as a dict of strings."""
+    """Parse a drive-log column mapping (YAML ``column: signal [unit]``) into a dict of strings."""
     raw = loads_raw(text, origin)
     if not isinstance(raw, dict) or not raw:
         raise PresetError(f"{origin}: a mapping file needs lines 'column: signal [unit]', e.g. 'Iq: i_q [A]'")

@@ -35,7 +35,7 @@ def columns(res: RobustnessResult) -> list[tuple[str, str]]:
 
 
 def rows(res: RobustnessResult) -> list[list[Any]]:
-    """The table's values, one list per sample (floats, booleans or None)."""
+    """Return the table's values, one list per sample (floats, booleans or None)."""
     out = []
     for i, r in enumerate(res.runs):
         drawn = [float(res.values[k][i]) for k in res.values]
@@ -54,8 +54,11 @@ def write_csv(path: str | Path, res: RobustnessResult) -> None:
 
 
 def write_parquet(path: str | Path, res: RobustnessResult, meta: dict[str, Any] | None = None) -> None:
-    """The table as Parquet: float64/bool columns, each with ``unit`` in its field metadata;
-    ``meta`` (e.g. seed, samples, spreads) as JSON in the file's ``robustness`` metadata."""
+    """Write the table as Parquet.
+
+    Float64/bool columns, each with ``unit`` in its field metadata; ``meta`` (e.g. seed, samples,
+    spreads) as JSON in the file's ``robustness`` metadata.
+    """
     import pyarrow as pa
     import pyarrow.parquet as pq
 

@@ -67,7 +67,7 @@ def _placeholder(fid: str, title: str) -> go.Figure:
 
 
 def metrics_markdown(comp: BldcComparison) -> str:
-    """The side-by-side metrics as a Markdown table (shared rows with the CLI)."""
+    """Return the side-by-side metrics as a Markdown table (shared rows with the CLI)."""
     rows = metric_table(comp)
     head = "| " + " | ".join(rows[0]) + " |"
     lines = [head, "|" + "---|" * len(rows[0])] + ["| " + " | ".join(r) + " |" for r in rows[1:]]

@@ -46,8 +46,10 @@ def _flat(params: DriveParams) -> dict[str, Any]:
 
 
 def uncommitted(shown: DriveParams, committed: DriveParams) -> list[str]:
-    """``field = shown (simulated: value)`` for every input that differs (SI units); name and
-    source are not simulated inputs (the Export folder sets them)."""
+    """List ``field = shown (simulated: value)`` for every input that differs (SI units).
+
+    Name and source are not simulated inputs (the Export folder sets them).
+    """
     a, b = _flat(shown), _flat(committed)
     return [f"{k} = {a[k]!r} (simulated: {b.get(k)!r})" for k in a if a[k] != b.get(k)]
 
@@ -67,7 +69,7 @@ def parse_upload(name: str, content: bytes) -> DriveParams:
 
 
 def renamed(cmp: Comparison, name: str, source: str) -> Comparison:
-    """The case with the name and source written into the exports (both must be non-blank)."""
+    """Return the case with the name and source written into the exports (both must be non-blank)."""
     for field, text in (("name", name), ("source", source)):
         if not text.strip():
             raise ExportRefusedError(f"Export › {field} = {text!r} is empty: allowed any non-blank text "

@@ -275,7 +275,7 @@ class InputsPanel:
             raise InputError(str(exc)) from None
 
     def nameplate_checks(self) -> dict[str, float]:
-        """The optional datasheet values typed for the cross-check (empty fields left out)."""
+        """Return the optional datasheet values typed for the cross-check (empty fields left out)."""
         out: dict[str, float] = {}
         for label, key in CHECKS:
             field = self.checks[key]

@@ -55,7 +55,7 @@ class NumberInput:
         return self.handle.value != self._shown
 
     def read(self, field: str, convert: Callable[[float], float] | None = None, integer: bool = False) -> float | int:
-        """The exact value if untouched, else the typed text parsed (and converted by ``convert``).
+        """Return the exact value if untouched, else the typed text parsed (and converted by ``convert``).
 
         Raises
         ------

@@ -60,7 +60,7 @@ class AppConfig:
     guard: Guard | None = None
 
     def initial(self) -> Comparison:
-        """The comparison of the start-up preset (computed on first use)."""
+        """Return the comparison of the start-up preset (computed on first use)."""
         with self._lock:
             if self._initial is None:
                 self._initial = comparison_or_derived(self.params)
@@ -339,7 +339,7 @@ class Session:
             self.status.content = "Working…"
 
     def _export_state(self) -> Comparison:
-        """The simulated case, if it is what the page shows; else ExportRefusedError saying what differs."""
+        """Return the simulated case if the page shows it; else raise ExportRefusedError saying what differs."""
         try:
             shown = self.inputs.collect()
         except ValueError as exc:

@@ -23,18 +23,20 @@ _MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
 
 
 def md_text(text: object) -> str:
-    """User-provided text (preset name/source, file names, messages quoting them) made safe to put
-    in Markdown or HTML: shown literally, never as markup, links, images or code.
+    """Make user-provided text safe to put in Markdown or HTML: shown literally, never as markup.
 
-    HTML special characters become entities, Markdown punctuation is backslash-escaped and line
-    breaks become spaces (a name cannot start a heading or a table row).
+    User-provided text is a preset name/source, a file name or a message quoting them; it never becomes
+    markup, links, images or code.
+
+    HTML special characters become entities, Markdown punctuation is backslash-escaped and line breaks become
+    spaces (a name cannot start a heading or a table row).
     """
     flat = " ".join(str(text).split())
     return _MARKDOWN_SPECIAL.sub(r"\\\1", html.escape(flat, quote=False))
 
 
 def checked_choice(value: object, options: tuple[str, ...] | list[str], label: str) -> str:
-    """A dropdown value the server received, checked against the options it offered.
+    """Check a dropdown value the server received against the options it offered.
 
     Raises
     ------
@@ -56,8 +58,10 @@ def derived_markdown(derived: Derived) -> str:
 
 
 def warnings_html(items: list[str], error: str | None = None, notes: list[str] | None = None) -> str:
-    """A red box listing the input error and the warnings, a green line when there are none, and the
-    ``notes`` (e.g. about the comparator) in a grey box below."""
+    """Render the input error and the warnings in a red box, or a green line when there are none.
+
+    The ``notes`` (e.g. about the comparator) go in a grey box below.
+    """
     extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
                     f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html.escape(n)}</div>'
                     for n in notes or [])
@@ -106,7 +110,7 @@ def design_markdown(dd: Any) -> str:
 
 def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
                    price_per_kWh: float) -> AnnualSavings | None:
-    """Savings on the net electrical input energy over the simulated horizon; None without both runs.
+    """Return the savings on the net electrical input energy over the simulated horizon; None without both runs.
 
     Parameters
     ----------

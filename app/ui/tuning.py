@@ -43,7 +43,7 @@ KNOBS = (
 
 
 def _si_values(params: DriveParams, T_c: float) -> dict[str, float]:
-    """Current SI values of the knobs (T_c [s] is the one in force)."""
+    """Return the current SI values of the knobs (T_c [s] is the one in force)."""
     return {"controller.K": params.controller.K, "controller.T_c": T_c,
             "manoeuvre.T_m": params.manoeuvre.T_m, "load.J_L": params.load.J_L}
 

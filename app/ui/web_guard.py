@@ -35,7 +35,7 @@ _patch_lock = threading.Lock()
 
 
 def new_token() -> str:
-    """A random URL-safe access token (128 bits)."""
+    """Return a random URL-safe access token (128 bits)."""
     return secrets.token_urlsafe(16)
 
 

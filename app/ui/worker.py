@@ -70,7 +70,7 @@ class Worker:
             return True
 
     def checkpoint(self) -> None:
-        """Called by jobs between pieces of work: raises :class:`Cancelled` after :meth:`cancel`."""
+        """Raise :class:`Cancelled` after :meth:`cancel`; jobs call this between pieces of work."""
         if self._cancel.is_set():
             raise Cancelled("cancelled by the user")
 

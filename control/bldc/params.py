@@ -64,6 +64,7 @@ class BldcMachine:
     emf_samples: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         _check(self, "machine", {
             "R_s": (0.0, 1e3, False, "Ω"), "L_s_minus_M_s": (0.0, 10.0, True, "H"),
             "Phi_m": (0.0, 100.0, True, "Wb"),
@@ -103,6 +104,7 @@ class BldcMechanics:
     B: float
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         _check(self, "mechanics", {"J": (0.0, 1e4, True, "kg·m²"), "B": (0.0, 1e4, False, "N·m·s/rad")})
 
 
@@ -123,6 +125,7 @@ class BldcInverter:
     f_s: float
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         _check(self, "inverter", {"V_dc": (0.0, 1e5, True, "V"), "f_s": (1e3, 1e6, False, "Hz")})
 
 
@@ -151,6 +154,7 @@ class BldcGains:
     eps_lambda: float
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         _check(self, "gains", {
             "k_I": (0.0, 1e4, True, "1/A"), "k_omega": (0.0, 1e4, True, "s/rad"),
             "T_max": (0.0, 1e5, True, "N·m"), "lambda_0": (0.0, 1e5, False, "1/s"),
@@ -166,6 +170,7 @@ class TorqueStep:
     T_L: float
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_range("scenario.cases.T_L_steps.t", self.t, 0.0, 100.0, low_open=False, unit="s")
         check_range("scenario.cases.T_L_steps.T_L", self.T_L, -1e5, 1e5, unit="N·m")
 
@@ -205,6 +210,7 @@ class BldcScenario:
     band_recovery: float = 0.1
 
     def __post_init__(self) -> None:
+        """Check the fields' ranges, turn mapping load steps into :class:`TorqueStep`, check their times increase."""
         _check(self, "scenario", {
             "omega_0": (-1e4, 1e4, True, "rad/s"), "omega_ref": (-1e4, 1e4, True, "rad/s"),
             "t_end": (0.0, 100.0, True, "s"), "T_L_0": (-1e5, 1e5, True, "N·m"),
@@ -242,6 +248,7 @@ class BldcScenarios:
     cases: tuple[BldcScenario, ...]
 
     def __post_init__(self) -> None:
+        """Turn mapping cases into :class:`BldcScenario` and check that ``active`` names one of them."""
         cases = tuple(c if isinstance(c, BldcScenario) else BldcScenario(**c) for c in self.cases)
         if not cases:
             raise ParameterError("scenario.cases is empty: allowed one or more scenarios")

@@ -23,7 +23,7 @@ from control.bldc.params import BldcParams
 
 
 def pi_output(integ: float, err: float, K_p: float, u_lim: float) -> float:
-    """u = clamp(K_p·err + integ, ±u_lim) (units of u).
+    """Return u = clamp(K_p·err + integ, ±u_lim) (units of u).
 
     Parameters
     ----------

@@ -63,7 +63,7 @@ def commutation_sector(theta_e: float) -> int:
 
 
 def commutation_signs(theta_e: float) -> tuple[float, float, float]:
-    """Current signs (s_a, s_b, s_c) of six-step at θ_e: one +1, one −1, one 0 (open phase) [-].
+    """Return the current signs (s_a, s_b, s_c) of six-step at θ_e: one +1, one −1, one 0 (open phase) [-].
 
     The ideal 120° square-wave currents are i_x = s_x·I (they sum to zero).
 

@@ -66,8 +66,10 @@ def conventional_demand(theta_dem: float, theta_hat: float, omega_hat: float, g1
 @jitable
 def tracking_demand(theta_ref: float, omega_ref: float, alpha_ref: float, theta_hat: float, omega_hat: float,
                     g1: float, g2: float) -> float:
-    """α_ref + g1·(θ_ref − θ̂_r) + g2·(ω_ref − ω̂_r) [rad/s²]: eq. (62) sign-corrected acting on the
-    error from a time-varying reference move, its acceleration fed forward (numba-compilable).
+    """Return α_ref + g1·(θ_ref − θ̂_r) + g2·(ω_ref − ω̂_r) [rad/s²]: eq. (62) tracking a reference move.
+
+    Eq. (62) sign-corrected, acting on the error from a time-varying reference move, its acceleration fed
+    forward (numba-compilable).
 
     With θ_ref = θ_rdem constant and ω_ref = α_ref = 0 it is :func:`conventional_demand`.
     """

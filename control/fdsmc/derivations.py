@@ -118,7 +118,7 @@ def derive(params: DriveParams) -> Derived:
 
 
 def _layer_warning(K: float, gain: GainRecommendation, prof: VelocityProfile) -> tuple[str, ...]:
-    """The boundary layer |S| < 1/K of eq. (45) in [1] wider than ω_p: the outer loop never slides.
+    """Warn when the boundary layer |S| < 1/K of eq. (45) in [1] is wider than ω_p: the outer loop never slides.
 
     Warned only when a K within the chatter limit would slide (K_recommended·ω_p > 1); otherwise the
     linear outer loop is the best this sample rate allows, which the design reports as a note.

@@ -18,7 +18,7 @@ LIMIT_TOLERANCE = 0.005
 
 
 def exceeds(value: float, limit: float) -> bool:
-    """True when ``value`` exceeds ``limit`` by more than :data:`LIMIT_TOLERANCE` (relative)."""
+    """Return True when ``value`` exceeds ``limit`` by more than :data:`LIMIT_TOLERANCE` (relative)."""
     return value > limit * (1.0 + LIMIT_TOLERANCE)
 
 

@@ -87,7 +87,7 @@ class Identification:
     windows_mechanical: int
 
     def get(self, name: str) -> Estimate:
-        """The estimate called ``name``."""
+        """Return the estimate called ``name``."""
         return next(e for e in self.estimates if e.name == name)
 
 
@@ -105,9 +105,12 @@ MECHANICAL = (("J_total", "kg·m²"), ("F_v", "N·m·s/rad"), ("Gamma_Le", "N·m
 
 
 def _ols(A: np.ndarray, y: np.ndarray, Z: np.ndarray | None = None) -> _Fit:
-    """Least squares with the classical standard errors σ̂²·(AᵀA)⁻¹; with instruments ``Z``
-    (same shape as ``A``) the instrumental-variable estimate (ZᵀA)⁻¹Zᵀy and its covariance
-    σ̂²·(ZᵀA)⁻¹ZᵀZ(AᵀZ)⁻¹, which stays unbiased when a regressor carries noise."""
+    """Solve by least squares, or by instrumental variables when instruments ``Z`` are given.
+
+    Least squares comes with the classical standard errors σ̂²·(AᵀA)⁻¹; with instruments ``Z`` (same shape as
+    ``A``) the instrumental-variable estimate (ZᵀA)⁻¹Zᵀy and its covariance σ̂²·(ZᵀA)⁻¹ZᵀZ(AᵀZ)⁻¹, which stays
+    unbiased when a regressor carries noise.
+    """
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0.0] = 1.0
     As = A / scale

@@ -160,7 +160,7 @@ class LoopModel:
 
 
 def loop_model(d: Derived) -> LoopModel:
-    """The :class:`LoopModel` of a derived case."""
+    """Return the :class:`LoopModel` of a derived case."""
     return LoopModel(d.coefficients, d.params, d.observer)
 
 

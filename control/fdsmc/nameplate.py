@@ -1,4 +1,4 @@
-"""Consistency of a motor's nameplate: do Ψ_PM, Kt, rated torque, power, speed and voltage agree?
+"""Consistency of a motor's nameplate: check that Ψ_PM, Kt, rated torque, power, speed and voltage agree.
 
 A typing slip in one nameplate value (Ke = 300 V/krpm on an 18 N·m servo) otherwise passes
 silently into every derivation. Each check compares two routes to the same quantity, in the

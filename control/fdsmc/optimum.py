@@ -68,9 +68,12 @@ N_INTERVALS = 2000
 
 @dataclass(frozen=True)
 class MoveModel:
-    """The move's data. J [kg·m²]; F_v [N·m·s/rad]; a [W/(N·m)²] copper coefficient; delta_theta
-    [rad]; T_m [s]; Gamma_lim [N·m] torque limit (inf = none); Gamma_Le [N·m] constant load;
-    u_max [V] limit of |u_dq| (inf = none) with the motor's R_s [Ω], L_q [H], p [-], psi_pm [Wb]."""
+    """The move's data.
+
+    J [kg·m²]; F_v [N·m·s/rad]; a [W/(N·m)²] copper coefficient; delta_theta [rad]; T_m [s];
+    Gamma_lim [N·m] torque limit (inf = none); Gamma_Le [N·m] constant load; u_max [V] limit of
+    |u_dq| (inf = none) with the motor's R_s [Ω], L_q [H], p [-], psi_pm [Wb].
+    """
 
     J: float
     F_v: float
@@ -93,9 +96,11 @@ class MoveModel:
 
 @dataclass(frozen=True)
 class OptimalMove:
-    """An optimal move on the grid t [s] (N + 1 nodes): theta [rad], omega [rad/s], alpha
-    [rad/s²] (dω/dt), Gamma_em [N·m]; energies over [0, T_m] [J]; torque_peak [N·m];
-    limited (a torque limit is active); method ("closed form" or the solver's name)."""
+    """An optimal move on the grid t [s] (N + 1 nodes).
+
+    theta [rad], omega [rad/s], alpha [rad/s²] (dω/dt), Gamma_em [N·m]; energies over [0, T_m]
+    [J]; torque_peak [N·m]; limited (a limit is active); method ("closed form" or the solver's name).
+    """
 
     t: np.ndarray
     theta: np.ndarray
@@ -116,8 +121,10 @@ class OptimalMove:
 
 
 def move_model(params: DriveParams, margin: float = 1.0) -> MoveModel:
-    """The move of ``params`` with the torque limit divided by ``margin`` ≥ 1 [-] (room for the
-    inner loops' overshoot when the optimum is tracked)."""
+    """Return the move of ``params`` with the torque limit divided by ``margin`` ≥ 1 [-].
+
+    The margin leaves room for the inner loops' overshoot when the optimum is tracked.
+    """
     from control.fdsmc.feasibility import torque_limit  # local: feasibility imports the profile
 
     m, ld, mv = params.motor, params.load, params.manoeuvre
@@ -129,8 +136,10 @@ def move_model(params: DriveParams, margin: float = 1.0) -> MoveModel:
 
 
 def voltage_peak(mm: MoveModel, mv: OptimalMove) -> float:
-    """Largest steady-state |u_dq| [V] of a move at i_d = 0 (module docstring), over the
-    nodes (each interval's torque with the speed at both of its ends)."""
+    """Return the largest steady-state |u_dq| [V] of a move at i_d = 0 (module docstring).
+
+    Over the nodes: each interval's torque with the speed at both of its ends.
+    """
     i_q = mv.Gamma_em / mm.k_t
     u = 0.0
     for w in (mv.omega, np.append(mv.omega[1:], mv.omega[-1])):
@@ -154,7 +163,7 @@ def mu(mm: MoveModel) -> float:
 
 
 def closed_form(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
-    """The unconstrained optimum of the module docstring on n + 1 nodes (Γ_Le constant)."""
+    """Return the unconstrained optimum of the module docstring on n + 1 nodes (Γ_Le constant)."""
     T, dth, m_ = mm.T_m, mm.delta_theta, mu(mm)
     t = np.linspace(0.0, T, n + 1)
     s = t - 0.5 * T
@@ -200,9 +209,12 @@ VOLTAGE_ITERATION_TOL = 1e-6
 
 
 def _problem(mm: MoveModel, n: int, voltage: bool) -> tuple:
-    """The convex problem on n intervals: the QP of the module docstring, plus (``voltage``) the
-    voltage cone with u_d's speed a parameter (n + 1 nodes, [rad/s]) so that re-solving with a
-    new speed reuses the compiled problem. Returns (problem, g, v, speed parameter, G_s, w_s)."""
+    """Build the convex problem on n intervals.
+
+    The QP of the module docstring, plus (``voltage``) the voltage cone with u_d's speed a
+    parameter (n + 1 nodes, [rad/s]) so that re-solving with a new speed reuses the compiled
+    problem. Returns (problem, g, v, speed parameter, G_s, w_s).
+    """
     import cvxpy as cp  # heavy import, only when an optimum is asked for
 
     dth, h = mm.delta_theta, mm.T_m / n
@@ -243,7 +255,7 @@ def _solve(mm: MoveModel, n: int, problem: tuple) -> OptimalMove:
 
 
 def _move(mm: MoveModel, n: int, G: np.ndarray, omega: np.ndarray) -> OptimalMove:
-    """The OptimalMove of the solved torques G [N·m] (n) and speeds omega [rad/s] (n + 1)."""
+    """Return the OptimalMove of the solved torques G [N·m] (n) and speeds omega [rad/s] (n + 1)."""
     h = mm.T_m / n
     e, b, c, d = _zoh(mm, h)
     omega[0] = omega[-1] = 0.0
@@ -258,8 +270,10 @@ def _move(mm: MoveModel, n: int, G: np.ndarray, omega: np.ndarray) -> OptimalMov
 
 
 def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
-    """The optimum with |Γ_em| ≤ Γ_lim (a QP) and, if u_max is finite, |u_dq| ≤ u_max (a
-    sequence of SOCPs, module docstring), on n intervals (Clarabel via cvxpy).
+    """Solve for the optimum within the torque and voltage limits on n intervals.
+
+    |Γ_em| ≤ Γ_lim (a QP) and, if u_max is finite, |u_dq| ≤ u_max (a sequence of SOCPs, module
+    docstring), solved by Clarabel via cvxpy.
 
     Raises
     ------
@@ -284,13 +298,15 @@ def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
 
 
 def optimal_move(params: DriveParams, margin: float = 1.0, n: int = N_INTERVALS) -> OptimalMove:
-    """The minimum-energy move of ``params`` within the torque limit / ``margin`` (see
-    :func:`move_model`): the closed form where no limit is active, else the QP."""
+    """Return the minimum-energy move of ``params`` within the limits (torque limit / ``margin``).
+
+    See :func:`move_model`: the closed form where no limit is active, else the QP/SOCP.
+    """
     return _optimum(move_model(params, margin), n)
 
 
 def _optimum(mm: MoveModel, n: int) -> OptimalMove:
-    """The closed form where it respects the torque and voltage limits, else the numerical one."""
+    """Return the closed form where it respects the torque and voltage limits, else the numerical one."""
     cf = closed_form(mm, n)
     if cf.torque_peak <= mm.Gamma_lim and (not math.isfinite(mm.u_max) or voltage_peak(mm, cf) <= mm.u_max):
         return cf
@@ -298,7 +314,7 @@ def _optimum(mm: MoveModel, n: int) -> OptimalMove:
 
 
 def tracked_move(d: Derived, n: int = N_INTERVALS) -> OptimalMove:
-    """The optimum the closed-loop simulation tracks for the derived case ``d``.
+    """Return the optimum the closed-loop simulation tracks for the derived case ``d``.
 
     Its torque limit is the drive's (Γ_max or i_max's torque), or the FDSMC's own planned peak
     torque when that is larger (the paper's section-5 drive plans beyond Γ_max: the optimum is

@@ -130,6 +130,7 @@ class Motor:
     J_r: float
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         spec = {
             "V_0": (1.0, 1e5, False, "V"), "P_r": (1e-3, 1e8, False, "W"), "omega_b": (0.0, 1e5, True, "rad/s"),
             "Gamma_max": (1e-6, 1e6, False, "N·m"), "psi_pm": (1e-6, 100.0, False, "Wb"),
@@ -152,6 +153,7 @@ class LoadStep:
     Gamma_Le: float
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_range("load.steps.t", self.t, 0.0, None, low_open=False, unit="s")
         check_range("load.steps.Gamma_Le", self.Gamma_Le, -1e6, 1e6, unit="N·m")
 
@@ -181,6 +183,7 @@ class Load:
     Gamma_Le_ramp: float = 0.0
 
     def __post_init__(self) -> None:
+        """Check the fields' ranges, turn mapping load steps into :class:`LoadStep`, check their times increase."""
         _check_fields(self, "load", {
             "J_L": (0.0, 1e4, False, "kg·m²"), "F_v": (0.0, 1e4, False, "N·m·s/rad"),
             "Gamma_Le": (-1e6, 1e6, True, "N·m"), "Gamma_Le_ramp": (-1e6, 1e6, True, "N·m/s"),
@@ -234,6 +237,7 @@ class Controller:
     i_max: float = 0.0
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         _check_fields(self, "controller", {
             "T_si": (T_MIN_S, 10.0, False, "s"), "T_salpha": (T_MIN_S, 10.0, False, "s"),
             "T_so": (T_MIN_S, 10.0, False, "s"), "K": (0.0, 1e9, True, "s/rad"),
@@ -278,6 +282,7 @@ class Manoeuvre:
     T_m: float
 
     def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
         check_range("manoeuvre.theta_dem", self.theta_dem, -1e6, 1e6, unit="rad")
         if abs(self.theta_dem) < THETA_DEM_MIN:
             raise ParameterError(f"manoeuvre.theta_dem = {self.theta_dem!r} rad is out of range: allowed "

@@ -55,7 +55,7 @@ def distorted_table(Phi_m: float, n: int = N_TABLE) -> np.ndarray:
 
 
 def machine_table(machine: BldcMachine, n: int = N_TABLE) -> np.ndarray:
-    """The machine's Φ'_ra table [Wb] for its ``emf`` choice."""
+    """Return the machine's Φ'_ra table [Wb] for its ``emf`` choice."""
     if machine.emf == "ideal":
         return ideal_table(machine.Phi_m, n)
     if machine.emf == "distorted":

@@ -1,4 +1,4 @@
-"""BLDC speed-drive simulation: one run, and the comparison of the drives of issue 5.
+"""BLDC speed-drive simulation: one run, and the comparison of the speed drives of [2] and their comparators.
 
 Mirrors :mod:`sim.fdsmc.engine` (Trace / RunResult / Comparison shapes): :func:`simulate_bldc`
 returns a :class:`BldcRunResult` (controller, trace, metrics); :func:`compare_bldc` a
@@ -111,12 +111,12 @@ class BldcComparison:
     wall_s: float
 
     def run(self, controller: str) -> BldcRunResult:
-        """The run of ``controller``."""
+        """Return the run of ``controller``."""
         return next(r for r in self.runs if r.controller == controller)
 
 
 def pack_parameters(params: BldcParams, design: BldcDesign, controller: str) -> np.ndarray:
-    """The kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.bldc.kernel`)."""
+    """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.bldc.kernel`)."""
     m, mech, g, inv, case = params.machine, params.mechanics, params.gains, params.inverter, params.case
     prm = np.zeros(kn.N_PRM)
     prm[[kn.P_R, kn.P_L, kn.P_NPP, kn.P_PHIM, kn.P_J, kn.P_B]] = (

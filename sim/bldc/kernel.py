@@ -144,7 +144,7 @@ def speed_law(ctrl: int, eps: float, z: np.ndarray, prm: np.ndarray) -> tuple[fl
 @njit(cache=True)
 def vector_current_step(ctrl: int, y: np.ndarray, z: np.ndarray, i_q_ref: float, prm: np.ndarray
                         ) -> tuple[float, float, float, float]:
-    """Current loop of the vector drives: (v_α, v_β) [V] and (i_dx, i_qx) [A]; updates z[1:3]."""
+    """Run the current loop of the vector drives: return (v_α, v_β) [V] and (i_dx, i_qx) [A]; update z[1:3]."""
     T_s = prm[P_TS]
     i_al, i_be = _ab(y[0], y[1], -y[0] - y[1])
     th = prm[P_NPP] * y[3]

@@ -1,4 +1,4 @@
-"""Metrics of one BLDC speed-control run (issue 5), computed with :mod:`sim.common.signals`.
+"""Metrics of one BLDC speed-control run, computed with :mod:`sim.common.signals`.
 
 Definitions (all on the run's sample grid):
 
@@ -13,7 +13,7 @@ Definitions (all on the run's sample grid):
   some step never recovers);
 * current / voltage peaks: max |i_x|, max |v_x − v_n| over the run; copper loss ∫R_s·Σi_x² dt.
 
-The ``_rpm`` keys are output-edge values (the issue's JSON keys); everything else is SI.
+The ``_rpm`` keys are output-edge values (keys of the ``bldc --json`` contract); everything else is SI.
 """
 
 from __future__ import annotations
@@ -100,7 +100,7 @@ def energy_metrics(tr: Any) -> dict[str, float]:
 
 
 def run_metrics(params: BldcParams, tr: Any, diverged: bool = False) -> dict[str, Any]:
-    """The metrics of one run (module docstring); ``stable``/``reason`` say if it diverged."""
+    """Return the metrics of one run (module docstring); ``stable``/``reason`` say if it diverged."""
     case = params.case
     t_reach = signals.first_entry_time(tr.t, tr.omega, case.omega_ref, case.band_recovery)
     err_ss, ripple, window = _window_stats(params, tr, t_reach)

@@ -46,6 +46,7 @@ class Cost:
     trace_bytes: int
 
     def __add__(self, other: Cost) -> Cost:
+        """Add two costs field by field."""
         return Cost(self.steps + other.steps, self.trace_bytes + other.trace_bytes)
 
     @property
@@ -84,7 +85,7 @@ def _fits(driver: Driver, v: float) -> bool:
 
 
 def best_value(driver: Driver) -> float | None:
-    """The value nearest the user's that fits the budget, the other fields kept.
+    """Return the value nearest the user's that fits the budget, the other fields kept.
 
     Searches between the field's permitted extreme ``driver.limit`` (where the cost is lowest)
     and the user's value (over budget) by bisection in log space; None when even the extreme is

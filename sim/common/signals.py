@@ -44,7 +44,7 @@ def overshoot(y: np.ndarray, start: float, target: float) -> float:
 
 
 def peak_abs(y: np.ndarray) -> float:
-    """max |y| (0 for an empty array)."""
+    """Return max |y| (0 for an empty array)."""
     return float(np.max(np.abs(y))) if y.size else 0.0
 
 
@@ -57,5 +57,5 @@ def ripple_pct(y: np.ndarray) -> float:
 
 
 def is_finite_and_bounded(*arrays: np.ndarray, limit: float = 1e9) -> bool:
-    """True when every array is finite and within ±limit (a run that did not diverge)."""
+    """Return True when every array is finite and within ±limit (a run that did not diverge)."""
     return all(np.all(np.isfinite(a)) and np.all(np.abs(a) < limit) for a in arrays)

@@ -72,7 +72,7 @@ LOG_DURATION = 0.68
 
 def perturbed(nominal: DriveParams, motor: dict[str, float] = TRUE_MOTOR,
               load: dict[str, float] = TRUE_LOAD) -> DriveParams:
-    """The true plant: ``nominal`` with the motor and load fields replaced."""
+    """Return the true plant: ``nominal`` with the motor and load fields replaced."""
     return dataclasses.replace(nominal, motor=dataclasses.replace(nominal.motor, **motor),
                                load=dataclasses.replace(nominal.load, **load), source="synthetic plant")
 
@@ -122,7 +122,7 @@ def clean_log(true: DriveParams, d_nominal: Derived, t_end: float, injection: In
 
 
 def add_noise(clean: dict[str, np.ndarray], noise: LogNoise, seed: int) -> dict[str, np.ndarray]:
-    """The measured log: noisy, quantised currents; encoder θ_r; ω_r by the drive's difference.
+    """Return the measured log: noisy, quantised currents; encoder θ_r; ω_r by the drive's difference.
 
     ω_r is the drive's speed signal: the encoder difference averaged over 1 ms (lagging and
     noisy, as logged by drives); identification uses θ_r when both are present.

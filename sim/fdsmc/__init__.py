@@ -1,0 +1,1 @@
+"""Position-drive simulation of [1]: compiled kernel, plain-Python reference, engine, metrics, verdicts."""

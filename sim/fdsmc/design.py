@@ -102,7 +102,7 @@ def _fits(params: DriveParams, eta: float, T_m: float) -> bool:
 
 
 def shortest_fitting_T_m(params: DriveParams, eta: float) -> float | None:
-    """The requested T_m if it fits (:func:`_fits`), else the shortest that does [s]; None if none ≤ 1e4 s."""
+    """Return the requested T_m if it fits (:func:`_fits`), else the shortest that does [s]; None if none ≤ 1e4 s."""
     lo = params.manoeuvre.T_m
     if _fits(params, eta, lo):
         return lo
@@ -214,7 +214,7 @@ def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
 
 
 def run_checks(p: DriveParams, run: RunResult) -> list[Constraint]:
-    """The simulated run's violations of the drive's limits, the arrival band and chatter."""
+    """Return the simulated run's violations of the drive's limits, the arrival band and chatter."""
     m = run.metrics
     if m.get("stable") is False:
         return [Constraint("stable", 1.0, 0.0, "-", True, f"Unstable run: {m.get('reason')}.")]

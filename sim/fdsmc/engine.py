@@ -2,7 +2,7 @@
 
 The model (plant, FDC inner loops, observer, outer loop, energies) is integrated by the
 compiled kernel :func:`sim.fdsmc.kernel.run_kernel`; this module packs the parameters, chooses the
-time grid, and turns the raw arrays into frozen results with the metrics of issue 3.
+time grid, and turns the raw arrays into frozen results with their metrics (:mod:`sim.fdsmc.metrics`).
 
 Rest-to-rest manoeuvre from θ_r = 0 to θ_dem, simulated over [0, (1 + TAIL_FRACTION)·T_m].
 Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) in [1]); the
@@ -145,9 +145,11 @@ def continuous_step(params: DriveParams, h_max: float = CONTINUOUS_STEP_S) -> fl
 
 
 def plant_substeps(params: DriveParams) -> int:
-    """RK4 substeps per sample [-] so that the plant step is ≤ PLANT_STEP_MAX_S and ≤ 0.2 rad
-    of the fastest electrical angle p·max(ω_b, 2.1·|θ_dem|/T_m) (the comparator peaks at
-    Δθ·5.6/(e·T_m)); 1 at 20 kHz for the paper's motor."""
+    """Return the RK4 substeps per sample [-] that keep the plant step short enough.
+
+    The plant step is ≤ PLANT_STEP_MAX_S and ≤ 0.2 rad of the fastest electrical angle
+    p·max(ω_b, 2.1·|θ_dem|/T_m) (the comparator peaks at Δθ·5.6/(e·T_m)); 1 at 20 kHz for the paper's motor.
+    """
     m = params.motor
     w_e = m.p * max(m.omega_b, 2.1 * abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
     h_max = min(PLANT_STEP_MAX_S, 0.2 / w_e)
@@ -187,7 +189,7 @@ def _with(params: DriveParams, field: str, value: float) -> DriveParams:
 
 
 def _cost_drivers(params: DriveParams, request: Callable[[DriveParams], budget.Cost]) -> list[budget.Driver]:
-    """The fields that set the step count and trace size, with the end of their range that is cheapest."""
+    """Return the fields that set the step count and trace size, with the end of their range that is cheapest."""
     ctrl, m = params.controller, params.motor
     fields: list[tuple[str, float, str, float, bool]] = [("manoeuvre.T_m", params.manoeuvre.T_m, "s", 1e-4, False)]
     if ctrl.is_continuous:
@@ -222,7 +224,7 @@ def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budg
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
                     plant: DriveParams | None = None) -> np.ndarray:
-    """The kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.kernel`).
+    """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.kernel`).
 
     ``params``/``d`` are the controller's model; ``plant`` (default: the same) gives the true
     motor and load values the simulated drive has (R_s, L_d, L_q, Ψ_PM, p, J_r, J_L, F_v, Γ_Le).
@@ -274,7 +276,7 @@ def _check_controller(controller: str) -> None:
 
 
 def _reference(d: Derived, controller: str) -> np.ndarray:
-    """The kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
+    """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
     if controller != "optimum":
         return np.zeros((3, 2))
     from control.fdsmc.optimum import tracked_move  # imports cvxpy only when limits are active
@@ -392,8 +394,10 @@ def _trace(chans: np.ndarray) -> Trace:
 
 
 def reached_target(run: RunResult) -> bool:
-    """True when the run is stable and θ_r entered the 2 % band around θ_dem (a run that never
-    gets there — e.g. a rotor that never moves — has no energy figure worth comparing)."""
+    """Return True when the run is stable and θ_r entered the 2 % band around θ_dem.
+
+    A run that never gets there (e.g. a rotor that never moves) has no energy figure worth comparing.
+    """
     return bool(run.metrics["stable"]) and run.metrics.get("t_2pct_first_s") is not None
 
 

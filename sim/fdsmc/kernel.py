@@ -70,8 +70,10 @@ def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) 
 
 @_helper
 def reference_at(t: float, ref: np.ndarray, T_m: float) -> tuple[float, float, float]:
-    """θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] at t [s], linear between the rows of ``ref``
-    (equally spaced nodes over [0, T_m]); the final node's θ at rest after T_m."""
+    """Return θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] at t [s], linear between the rows of ``ref``.
+
+    The rows are equally spaced nodes over [0, T_m]; after T_m the final node's θ at rest.
+    """
     n = ref.shape[1]
     if t >= T_m:
         return ref[0, n - 1], 0.0, 0.0
@@ -85,8 +87,11 @@ def reference_at(t: float, ref: np.ndarray, T_m: float) -> tuple[float, float, f
 @_helper
 def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
               ref: np.ndarray) -> tuple[float, float]:
-    """Demanded acceleration [rad/s²] and S [rad/s]: eqs. (44)–(46), (62), or the reference tracking
-    law :func:`control.fdsmc.conventional.tracking_demand` (``P_CTRL`` = 2), all of :mod:`control`."""
+    """Return the outer loop's demanded acceleration [rad/s²] and S [rad/s].
+
+    Eqs. (44)–(46), (62), or the reference tracking law :func:`control.fdsmc.conventional.tracking_demand`
+    (``P_CTRL`` = 2), all of :mod:`control`.
+    """
     if prm[P_CTRL] == 2.0:
         th_r, w_r, a_r = reference_at(t, ref, prm[P_TM])
         return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
@@ -106,7 +111,7 @@ def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0:
 @_helper
 def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
                   prm: np.ndarray) -> tuple[float, float, bool]:
-    """Optional inverter limits of :func:`control.fdsmc.inverter.limit_voltage`. Returns the flag."""
+    """Apply the optional inverter limits of :func:`control.fdsmc.inverter.limit_voltage`; return u_d, u_q, flag."""
     return inverter.limit_voltage(u_d, u_q, i_d, i_q, omega_hat, prm[P_IMAX], prm[P_UMAX], prm[P_C], prm[P_D],
                                   prm[P_E], prm[P_G])
 
@@ -130,7 +135,7 @@ def electromagnetic_torque(i_d: float, i_q: float, prm: np.ndarray) -> float:
 @_helper
 def plant_rhs(t: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray, step_t: np.ndarray,
               step_v: np.ndarray) -> tuple:
-    """Derivatives of the plant and energy states p (eqs. 1–3, 4b, 5) [SI/s]."""
+    """Return the derivatives of the plant and energy states p (eqs. 1–3, 4b, 5) [SI/s]."""
     i_d, i_q, w = p[X_ID], p[X_IQ], p[X_W]
     g_le = gamma_le(t, prm, step_t, step_v)
     T_em = electromagnetic_torque(i_d, i_q, prm)
@@ -157,26 +162,26 @@ def observer_rhs(p: tuple, o: tuple, prm: np.ndarray) -> tuple[float, float, flo
 
 @_helper
 def axpy9(x: tuple, a: float, k: tuple) -> tuple:
-    """x + a·k for 9-tuples."""
+    """Return x + a·k for 9-tuples."""
     return (x[0] + a * k[0], x[1] + a * k[1], x[2] + a * k[2], x[3] + a * k[3], x[4] + a * k[4],
             x[5] + a * k[5], x[6] + a * k[6], x[7] + a * k[7], x[8] + a * k[8])
 
 
 @_helper
 def axpy4(x: tuple, a: float, k: tuple) -> tuple:
-    """x + a·k for 4-tuples."""
+    """Return x + a·k for 4-tuples."""
     return (x[0] + a * k[0], x[1] + a * k[1], x[2] + a * k[2], x[3] + a * k[3])
 
 
 @_helper
 def rk4_sum9(x: tuple, h: float, k1: tuple, k2: tuple, k3: tuple, k4: tuple) -> tuple:
-    """x + h/6·(k1 + 2k2 + 2k3 + k4) for 9-tuples."""
+    """Return x + h/6·(k1 + 2k2 + 2k3 + k4) for 9-tuples."""
     return axpy9(x, h / 6.0, axpy9(axpy9(k1, 2.0, axpy9(k2, 1.0, k3)), 1.0, k4))
 
 
 @_helper
 def rk4_sum4(x: tuple, h: float, k1: tuple, k2: tuple, k3: tuple, k4: tuple) -> tuple:
-    """x + h/6·(k1 + 2k2 + 2k3 + k4) for 4-tuples."""
+    """Return x + h/6·(k1 + 2k2 + 2k3 + k4) for 4-tuples."""
     return axpy4(x, h / 6.0, axpy4(axpy4(k1, 2.0, axpy4(k2, 1.0, k3)), 1.0, k4))
 
 
@@ -243,7 +248,7 @@ def record(row: np.ndarray, t: float, p: tuple, o: tuple, u: tuple, prm: np.ndar
 
 @_helper
 def peaks(pk: tuple, p: tuple, u_d: float, u_q: float, prm: np.ndarray) -> tuple:
-    """Running peaks (|ω_r|, |i_q|, |u_dq|, |Γ_em|, |i_d|)."""
+    """Return the running peaks updated with this step (|ω_r|, |i_q|, |u_dq|, |Γ_em|, |i_d|)."""
     return (max(pk[0], abs(p[X_W])), max(pk[1], abs(p[X_IQ])),
             max(pk[2], math.sqrt(u_d * u_d + u_q * u_q)),
             max(pk[3], abs(electromagnetic_torque(p[X_ID], p[X_IQ], prm))),
@@ -252,7 +257,7 @@ def peaks(pk: tuple, p: tuple, u_d: float, u_q: float, prm: np.ndarray) -> tuple
 
 @_helper
 def diverged(p: tuple, o: tuple, prm: np.ndarray) -> bool:
-    """True when a state is not finite or beyond the divergence limits."""
+    """Return True when a state is not finite or beyond the divergence limits."""
     total = 0.0
     for v in p:
         total += v
@@ -275,7 +280,7 @@ def store_state(info: np.ndarray, at: int, p: tuple, o: tuple, w: float, p0: tup
 @_helper
 def step_sample(t: float, p: tuple, o: tuple, hold: tuple, continuous: bool, delay: int,
                 prm: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray, ref: np.ndarray):
-    """Controller (and, digital, the observer update) at one sample or continuous step.
+    """Run the controller (and, digital, the observer update) at one sample or continuous step.
 
     Returns (voltages applied over the step, new observer state, new held voltages, the
     recorded outputs (u_d, u_q, α_dem, α̂, S), saturated flag).

@@ -65,7 +65,7 @@ class ChatterVerdict:
 
 
 def hysteretic_sign_changes(r: np.ndarray, hyst: float) -> int:
-    """Number of sign changes of ``r`` counting only swings beyond ±``hyst``.
+    """Count the sign changes of ``r``, counting only swings beyond ±``hyst``.
 
     Samples inside ±hyst are ignored; every change between consecutive remaining signs counts.
     """
@@ -203,8 +203,10 @@ def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
     samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None,
 ) -> dict[str, float | bool | str | None]:
-    """All metrics of one run from the (decimated) trace, the full-resolution chatter-window
-    ``samples`` and the kernel's ``info`` vector.
+    """Return all metrics of one run.
+
+    They come from the (decimated) trace, the full-resolution chatter-window ``samples`` and the kernel's
+    ``info`` vector.
 
     Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
     every number becomes None, ``stable`` False and ``reason`` says why. Stored energies use the

@@ -90,7 +90,7 @@ class ReferenceDrive:
         return u_d, u_q
 
     def plant(self, t: float, x: np.ndarray, u_d: float, u_q: float) -> np.ndarray:
-        """Derivatives of [i_d, i_q, θ, ω, E_f, E_cu, E_el], eqs. (1)–(3), (4b), (5)."""
+        """Return the derivatives of [i_d, i_q, θ, ω, E_f, E_cu, E_el], eqs. (1)–(3), (4b), (5)."""
         c, m, ld = self.plant_c, self.p.motor, self.p.load
         i_d, i_q, _, w = x[:4]
         T_em = 1.5 * m.p * (m.psi_pm + (m.L_d - m.L_q) * i_d) * i_q
@@ -147,7 +147,7 @@ class ReferenceDrive:
             self.x, self.t = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4), t + h
 
     def state(self) -> ReferenceState:
-        """The current state as a frozen record."""
+        """Return the current state as a frozen record."""
         x, xh = self.x, self.xh
         return ReferenceState(self.t, *(float(v) for v in x[:4]), *(float(v) for v in xh),
                               *(float(v) for v in x[4:7]))

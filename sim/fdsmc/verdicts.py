@@ -24,7 +24,7 @@ def recommended_K(derived: Derived) -> float | None:
 
 
 def _chatter_hint(derived: Derived) -> str:
-    """What to change: K above its limit, or a poorly damped sloped segment (T_c too small)."""
+    """Say what to change: K above its limit, or a poorly damped sloped segment (T_c too small)."""
     g = derived.gain
     if g is None or g.K_limit <= 0.0:
         return " Reduce K, eq. (45)."
@@ -60,7 +60,7 @@ def _chatter(run: RunResult, derived: Derived) -> str:
 
 
 def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
-    """Simulated peaks that the real drive cannot deliver (Γ_max, available voltage, ω_b).
+    """List the simulated peaks that the real drive cannot deliver (Γ_max, available voltage, ω_b).
 
     Parameters
     ----------
@@ -108,9 +108,12 @@ def _target_missed(run: RunResult) -> str | None:
 
 
 def run_warnings(comparison: Comparison) -> list[str]:
-    """Warnings from the simulated runs: unstable, chatter, target missed, the FDSMC's saturation and
-    drive limits, and savings that are not comparable. The comparator's own limit violations are
-    :func:`comparator_notes` (they do not concern the drive being commissioned)."""
+    """Return the warnings from the simulated runs.
+
+    Unstable, chatter, target missed, the FDSMC's saturation and drive limits, and savings that are not
+    comparable. The comparator's own limit violations are :func:`comparator_notes` (they do not concern the
+    drive being commissioned).
+    """
     out: list[str] = []
     for run in (comparison.fdsmc, comparison.conventional):
         if run is None:
@@ -137,8 +140,10 @@ def _saturation(run: RunResult) -> list[str]:
 
 
 def comparator_notes(comparison: Comparison) -> list[str]:
-    """Where the conventional comparator (eq. (61) gains) itself exceeds the drive's limits: its
-    energy is then not a fair baseline for the saving."""
+    """Note where the conventional comparator (eq. (61) gains) itself exceeds the drive's limits.
+
+    Its energy is then not a fair baseline for the saving.
+    """
     run = comparison.conventional
     if run is None or run.metrics.get("stable") is False:
         return []
@@ -149,8 +154,11 @@ def comparator_notes(comparison: Comparison) -> list[str]:
 
 
 def _saving_verdicts(comparison: Comparison) -> list[str]:
-    """A friction saving above the theoretical bound 1 − 4/5.6 of eq. (53), or from a run that missed
-    its target, is not a saving: say so."""
+    """Say so when a friction saving is not a saving.
+
+    A friction saving above the theoretical bound 1 − 4/5.6 of eq. (53), or from a run that missed its target,
+    is not a saving.
+    """
     saving, bound = comparison.saving_friction_pct, comparison.derived.energy.bound_pct
     if saving is None:
         never = [r for r in (comparison.fdsmc, comparison.conventional)

@@ -25,8 +25,10 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
               step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray,
               continuous: bool, h: float, n_sub: int, delay: int, decim: int, out: np.ndarray,
               seg_info: np.ndarray) -> int:
-    """Integrate the whole cycle from rest; returns the number of trace points written to ``out``
-    (N_CH × points, every ``decim``-th step), or −(points + 1) when the run diverged.
+    """Integrate the whole cycle from rest.
+
+    Returns the number of trace points written to ``out`` (N_CH × points, every ``decim``-th
+    step), or −(points + 1) when the run diverged.
 
     Segment j lasts ``seg_steps[j]`` samples (digital; RK4 steps in continuous mode) with the
     parameters ``prm_all[j]`` and the reference ``ref_all[:, ref_off[j]:ref_off[j + 1]]``.

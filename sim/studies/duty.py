@@ -47,10 +47,13 @@ class Move:
 
 @dataclass(frozen=True)
 class CycleRun:
-    """One comparator's cycle: per-move net electrical input [J], the run's totals [J] (electrical
-    in, copper, friction, load work, stored kinetic + magnetic at the end), the final position
-    error against the last target [rad], a trace (t [s], theta_r [rad], omega_r [rad/s],
-    E_electrical [J]) and ``stable`` (False: diverged; then the energies are None)."""
+    """One comparator's cycle.
+
+    Per-move net electrical input [J], the run's totals [J] (electrical in, copper, friction, load
+    work, stored kinetic + magnetic at the end), the final position error against the last target
+    [rad], a trace (t [s], theta_r [rad], omega_r [rad/s], E_electrical [J]) and ``stable``
+    (False: diverged; then the energies are None).
+    """
 
     moves_J: tuple[float, ...] | None
     electrical_in_J: float | None
@@ -73,8 +76,11 @@ class CycleRun:
 
 @dataclass(frozen=True)
 class DutyResult:
-    """Energy per cycle [J] per comparator (None if its run diverged), the cycle time [s], the
-    per-move energies ``moves[i][comparator]`` [J] and each comparator's run."""
+    """A duty cycle's energies.
+
+    Energy per cycle [J] per comparator (None if its run diverged), the cycle time [s], the
+    per-move energies ``moves[i][comparator]`` [J] and each comparator's run.
+    """
 
     cycle_J: dict[str, float | None]
     cycle_s: float

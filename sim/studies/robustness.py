@@ -47,9 +47,12 @@ MAX_NORMAL_SIGMA = 0.3
 
 @dataclass(frozen=True)
 class Spread:
-    """Distribution of one plant value. section "motor"/"load"; field the parameter's name;
-    kind "uniform" (absolute lo…hi in SI), "relative" (uniform nominal·(1 + lo…hi)) or "normal"
-    (nominal·(1 + σ·N(0, 1)) with σ = hi, truncated at ±3σ by redrawing)."""
+    """Distribution of one plant value.
+
+    section "motor"/"load"; field the parameter's name; kind "uniform" (absolute lo…hi in SI),
+    "relative" (uniform nominal·(1 + lo…hi)) or "normal" (nominal·(1 + σ·N(0, 1)) with σ = hi,
+    truncated at ±3σ by redrawing).
+    """
 
     section: str
     field: str
@@ -68,7 +71,7 @@ class RobustnessResult:
 
 
 def draw(params: DriveParams, spreads: Sequence[Spread], n: int, seed: int) -> dict[str, np.ndarray]:
-    """n values [SI] of each spread's field, keyed ``section.field``, from one seeded generator."""
+    """N values [SI] of each spread's field, keyed ``section.field``, from one seeded generator."""
     rng = np.random.default_rng(seed)
     out: dict[str, np.ndarray] = {}
     for s in spreads:
@@ -97,8 +100,10 @@ def plant_for(params: DriveParams, values: dict[str, float]) -> DriveParams:
 
 
 def _friction_saving(f: RunResult, c: RunResult) -> float | None:
-    """FDSMC's friction saving vs the conventional controller [%]: eq. (47) in [1] over [0, T_m];
-    None unless both runs are stable and reached the 2 % band."""
+    """Return FDSMC's friction saving vs the conventional controller [%].
+
+    Eq. (47) in [1] over [0, T_m]; None unless both runs are stable and reached the 2 % band.
+    """
     if not (reached_target(f) and reached_target(c)):
         return None
     wf, wc = f.metrics["friction_J"], c.metrics["friction_J"]
@@ -108,8 +113,9 @@ def _friction_saving(f: RunResult, c: RunResult) -> float | None:
 
 
 def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None) -> dict[str, dict[str, Any]]:
-    """Both controllers' metrics on one plant, plus ``infeasible`` (unstable, or the peak torque
-    beyond the plant's torque limit) and ``saving_friction_pct``; ``d`` = derive(params).
+    """Return both controllers' metrics on one plant, plus ``infeasible`` and ``saving_friction_pct``.
+
+    ``infeasible``: unstable, or the peak torque beyond the plant's torque limit; ``d`` = derive(params).
 
     The two runs are simulated one after the other in the calling thread: the parallelism of a
     sweep is across samples (processes), and a thread pool per sample would only add overhead.
@@ -131,17 +137,22 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
 
 def simulate_chunk(params: DriveParams, rows: list[dict[str, float]], d: Derived | None = None,
                    plant: DriveParams | None = None) -> list[dict[str, dict[str, Any]]]:
-    """Metrics of several samples (one task); module-level so that it pickles. ``d`` =
-    derive(params), the controller's design (the same for every sample; computed if None);
-    ``plant`` the nominal plant the rows' values replace values of (None: the model)."""
+    """Return the metrics of several samples (one task); module-level so that it pickles.
+
+    ``d`` = derive(params), the controller's design (the same for every sample; computed if None);
+    ``plant`` the nominal plant the rows' values replace values of (None: the model).
+    """
     d = derive(params) if d is None else d
     base = params if plant is None else plant
     return [sample_metrics(params, plant_for(base, r), d) for r in rows]
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
-    """Samples per task [-]: each task ≥ MIN_TASK_S and at most TASKS_PER_WORKER tasks per
-    worker, unless that leaves a worker idle."""
+    """Return the samples per task [-].
+
+    Each task ≥ MIN_TASK_S and at most TASKS_PER_WORKER tasks per worker, unless that leaves a
+    worker idle.
+    """
     size = max(1, math.ceil(MIN_TASK_S / max(seconds_per_sample, 1e-6)),
                math.ceil(n / (TASKS_PER_WORKER * max(1, workers))))
     if n > 0 and math.ceil(n / size) < workers:
@@ -158,8 +169,11 @@ def _stats(x: np.ndarray, worst: str) -> dict[str, float | None]:
 
 
 def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str, Any]:
-    """Per controller, per metric mean/p05/p50/p95/worst over the stable samples, chatter and
-    infeasible probabilities; the friction saving's distribution (worst = smallest)."""
+    """Summarise the runs.
+
+    Per controller, per metric mean/p05/p50/p95/worst over the stable samples, chatter and
+    infeasible probabilities; the friction saving's distribution (worst = smallest).
+    """
     out: dict[str, Any] = {"samples": len(runs), "seconds": seconds}
     for ctrl in CONTROLLERS:
         rs = [r[ctrl] for r in runs]

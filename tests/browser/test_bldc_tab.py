@@ -1,6 +1,7 @@
-"""Browser test of the "BLDC speed SMC" tab (issue 5): open it, run the paper scenario, read the
+"""Browser test of the "BLDC speed SMC" tab: open it, run the paper scenario, read the
 metrics table and a figure. Uses the UI fixtures of ``tests/browser/conftest.py`` (fails, not
-skips, under CI=true when Chromium is missing)."""
+skips, under CI=true when Chromium is missing).
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """The page in a real Chromium against hostile input: a foreign web page cannot open the tool's
-websocket, and markup in user text (file names, preset names) is shown as text."""
+websocket, and markup in user text (file names, preset names) is shown as text.
+"""
 
 from __future__ import annotations
 

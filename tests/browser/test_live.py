@@ -55,7 +55,8 @@ def _slider(page, label: str):
 
 def test_dragging_the_K_slider_resimulates_with_the_latest_value(page):
     """Key presses on the K slider (each a move, faster than a run): the last value is what runs,
-    it is the value the K field shows, and the trajectory changes (the band ±1/K of eq. (45) too)."""
+    it is the value the K field shows, and the trajectory changes (the band ±1/K of eq. (45) too).
+    """
     from tests.browser.conftest import field
 
     before_band, before_y = page.evaluate(BAND_JS), page.evaluate(FDSMC_Y_JS)

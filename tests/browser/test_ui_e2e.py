@@ -1,4 +1,4 @@
-"""End-to-end tests of the web UI in a real Chromium (issue 4)."""
+"""End-to-end tests of the web UI in a real Chromium."""
 
 from __future__ import annotations
 
@@ -117,7 +117,8 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
 
 def test_export_of_edited_but_unsimulated_inputs_is_refused(page):
     """An export describes the inputs shown: after an edit without Simulate it is refused with a
-    message naming the uncommitted field, and nothing is downloaded."""
+    message naming the uncommitted field, and nothing is downloaded.
+    """
     set_number(page, "T_m manoeuvre time [s]", 1.4)
     page.get_by_text("Export", exact=True).click()
     downloads: list[object] = []
@@ -176,7 +177,8 @@ def _click_and_wait_for_run(page, button) -> None:
 
 def test_recommended_K_then_T_c_min_one_click_fixes(page):
     """Slow manoeuvre (T_m = 60 s): K = 1000 chatters → "Use recommended K"; the approach to θ_dem
-    is then poorly damped with T_c = T_a → "Use T_c = …" selects T_c,min and the chatter is gone."""
+    is then poorly damped with T_c = T_a → "Use T_c = …" selects T_c,min and the chatter is gone.
+    """
     from sim.fdsmc.verdicts import T_c_advice
 
     params = load_preset(PAPER_PRESET)
