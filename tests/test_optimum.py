@@ -16,6 +16,7 @@ from app.cli.main import main
 from app.io.presets import load_preset
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
 from control.fdsmc.optimum import MoveModel, closed_form, hamiltonian_matrix, move_model, numerical_optimum
+from control.fdsmc.params import ParameterError
 from sim.fdsmc.engine import compare
 
 PAPER_TM = (1.0, 1.4, 1.8, 2.2, 2.6)  # Table 1 of the FDSMC paper
@@ -128,3 +129,64 @@ def test_simulate_json_has_optimum_and_gap(capsys):
         w, w_opt = out[ctrl]["electrical_in_total_J"], out["optimum"]["electrical_in_total_J"]
         assert out[ctrl]["saving_vs_optimum_pct"] == pytest.approx(100.0 * (1.0 - w_opt / w))
         assert out[ctrl]["saving_vs_optimum_pct"] >= 0.0
+
+
+def _exact_voltage_peak(mm, mv) -> float:
+    """max |u_dq| [V] at i_d = 0, eqs. (1)–(2) of the FDSMC paper in the steady state of each interval
+    (u_d = −p·ω·L_q·i_q, u_q = R_s·i_q + p·Ψ_PM·ω), with the speed at both ends of each interval.
+    """
+    i_q = mv.Gamma_em[:-1] / (1.5 * mm.p * mm.psi_pm)
+    peaks = []
+    for w in (mv.omega[:-1], mv.omega[1:]):
+        peaks.append(np.max(np.hypot(mm.p * w * mm.L_q * i_q, mm.R_s * i_q + mm.p * mm.psi_pm * w)))
+    return float(max(peaks))
+
+
+def test_voltage_limit_binds_and_is_respected():
+    """Siemens servo with a 95 V DC link (u_max = 54.8 V): the unconstrained optimum needs 69 V
+    (its back-EMF alone reaches 69 V at the peak speed); the voltage-limited optimum stays within
+    u_max, still arrives, and costs more.
+    """
+    from control.fdsmc.optimum import optimal_move, voltage_peak
+
+    p = load_preset("siemens_1ft7044_ak7", ["controller.V_dc=95"])
+    mm = move_model(p)
+    assert mm.u_max == pytest.approx(95.0 / math.sqrt(3.0))
+    cf = closed_form(mm, 400)
+    assert _exact_voltage_peak(mm, cf) > 1.2 * mm.u_max
+    mv = optimal_move(p, n=400)
+    assert mv.method == "clarabel" and mv.limited
+    assert _exact_voltage_peak(mm, mv) <= mm.u_max * (1.0 + 1e-6)
+    assert _exact_voltage_peak(mm, mv) >= mm.u_max * (1.0 - 1e-4)  # it binds
+    assert voltage_peak(mm, mv) == pytest.approx(_exact_voltage_peak(mm, mv), rel=1e-12)
+    assert mv.theta[-1] == pytest.approx(mm.delta_theta, rel=1e-6) and abs(mv.omega[-1]) < 1e-12
+    assert mv.energy_J > 1.1 * cf.energy_J
+
+
+def test_voltage_cone_that_does_not_bind_changes_nothing():
+    """With u_max 20 % above what the unconstrained optimum needs, the cone is in the problem but
+    inactive: the same energy and trajectory as the problem without it; and a drive whose DC link
+    never binds gets the closed form, exactly as without a DC link.
+    """
+    from control.fdsmc.optimum import _problem, _solve, optimal_move, voltage_peak
+
+    free = dataclasses.replace(move_model(load_preset("siemens_1ft7044_ak7")), u_max=math.inf)
+    ref = numerical_optimum(free, 400)
+    mm = dataclasses.replace(free, u_max=1.2 * voltage_peak(free, ref))
+    problem = _problem(mm, 400, True)
+    problem[3].value = mm.p * mm.L_q * ref.omega / mm.u_max * problem[4] / mm.k_t
+    with_cone = _solve(mm, 400, problem)
+    assert with_cone.energy_J == pytest.approx(ref.energy_J, rel=1e-6)
+    np.testing.assert_allclose(with_cone.omega, ref.omega, atol=1e-5 * float(np.max(ref.omega)))
+    a = optimal_move(load_preset("siemens_1ft7044_ak7"))  # V_dc = 540 V in the preset
+    b = optimal_move(load_preset("siemens_1ft7044_ak7", ["controller.V_dc=0"]))
+    assert a.method == b.method == "closed form" and a.energy_J == b.energy_J
+
+
+def test_voltage_limit_below_the_back_emf_is_refused_naming_v_dc():
+    """Δθ/T_m needs at least p·Ψ_PM·Δθ/T_m of back-EMF: below it no move exists."""
+    p = load_preset("siemens_1ft7044_ak7", ["controller.V_dc=40"])
+    mm = move_model(p)
+    assert mm.p * mm.psi_pm * mm.delta_theta / mm.T_m > mm.u_max
+    with pytest.raises(ParameterError, match=r"V_dc"):
+        numerical_optimum(mm, 200)

@@ -127,3 +127,37 @@ def test_robustness_cli_json(capsys):
         for key in METRICS:
             s = e[key]
             assert s["p05"] <= s["p50"] <= s["p95"] <= s["worst"]
+
+
+def test_parquet_and_csv_tables_hold_the_same_numbers_with_units(tmp_path):
+    """Write the per-sample results as Parquet and CSV through the CLI; read both back: equal
+    values (floats exactly), each column's SI unit in the Parquet schema metadata.
+    """
+    import csv
+
+    from app.io.sample_table import read_parquet
+
+    pq_path, csv_path = tmp_path / "r.parquet", tmp_path / "r.csv"
+    assert main(["robustness", PRESET, "--samples", "3", "--workers", "1", "--seed", "4",
+                 "--spread", "plant.R_s=±10%,plant.J_L=0.001:0.003", "--parquet", str(pq_path),
+                 "--csv", str(csv_path), "--json"]) == 0
+    cols, units, meta = read_parquet(pq_path)
+    params = load_preset(PRESET)
+    again = robustness(params, parse_spreads(["plant.R_s=±10%,plant.J_L=0.001:0.003"]), 3, seed=4)
+    assert cols["motor.R_s"] == list(again.values["motor.R_s"])
+    assert cols["fdsmc.friction_J"] == [r["fdsmc"]["friction_J"] for r in again.runs]
+    assert cols["conventional.chatter"] == [r["conventional"]["chatter"] for r in again.runs]
+    assert units["motor.R_s"] == "Ω" and units["load.J_L"] == "kg·m²" and units["fdsmc.friction_J"] == "J"
+    assert units["fdsmc.t_2pct_settle_s"] == "s" and units["fdsmc.saving_friction_pct"] == "%"
+    assert meta["seed"] == 4 and meta["samples"] == 3
+    with open(csv_path, newline="", encoding="utf-8") as fh:
+        table = list(csv.DictReader(fh))
+    assert list(table[0]) == list(cols)
+    assert [float(r["fdsmc.copper_J"]) for r in table] == cols["fdsmc.copper_J"]
+
+
+def test_parquet_to_an_unwritable_path_is_refused_before_the_run(tmp_path, capsys):
+    bad = tmp_path / "no" / "dir" / "r.parquet"
+    assert main(["robustness", PRESET, "--samples", "2", "--parquet", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "--parquet" in err and "does not exist or is not writable" in err and "samples" not in err

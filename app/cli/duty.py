@@ -1,7 +1,8 @@
 """``python -m app dutycycle PRESET FILE [--cycles-per-hour N] [--hours-per-year H] [--price P] [--json]``.
 
 FILE is a YAML list of moves ``{theta_dem: RAD, T_m: S, dwell: S}`` (dwell optional, default 0),
-simulated with the FDSMC, the conventional controller and the tracked minimum-energy optimum.
+simulated back to back (one continuous run per comparator, :mod:`sim.studies.duty`) with the FDSMC,
+the conventional controller and the tracked minimum-energy optimum.
 """
 
 from __future__ import annotations
@@ -76,11 +77,15 @@ def run(args: argparse.Namespace) -> int:
     year = res.per_year(args.cycles_per_hour, args.hours_per_year, args.price)
     out = {"cycle_s": res.cycle_s, "cycle_J": res.cycle_J, "moves_J": list(res.moves),
            "kWh_per_year": {c: (v[0] if v else None) for c, v in year.items()},
-           "cost_per_year": {c: (v[1] if v else None) for c, v in year.items()}}
+           "cost_per_year": {c: (v[1] if v else None) for c, v in year.items()},
+           "runs": {c: {"stable": r.stable, "electrical_in_J": r.electrical_in_J, "copper_J": r.copper_J,
+                        "friction_J": r.friction_J, "load_work_J": r.load_work_J,
+                        "stored_end_J": r.stored_end_J, "balance_residual_J": r.balance_residual_J,
+                        "theta_error_end_rad": r.theta_error_end_rad} for c, r in res.runs.items()}}
     if args.json:
         print(json.dumps(to_json(out), indent=2, ensure_ascii=False))
         return 0
-    print(f"Cycle of {len(res.moves)} moves, {res.cycle_s:.4g} s")
+    print(f"Cycle of {len(res.moves)} moves, {res.cycle_s:.4g} s, simulated back to back")
     for c, w in res.cycle_J.items():
         y = year[c]
         print(f"  {c:13s} {w if w is not None else float('nan'):10.4g} J per cycle"

@@ -2,7 +2,8 @@
 
 Spreads (comma-separated or repeated), each on a plant value (see :mod:`app.io.plant_overrides`), in SI:
 ``plant.J_L=0:0.3`` uniform between 0 and 0.3; ``plant.R_s=±20%`` (or ``+-20%``) uniform within
-±20 % of the preset's value; ``plant.psi_pm=~5%`` normal with σ = 5 % of it (truncated at ±3σ).
+±20 % of the nominal plant's value (the preset's plant section and ``--set plant.*``, else its
+motor and load); ``plant.psi_pm=~5%`` normal with σ = 5 % of it (truncated at ±3σ).
 Runs on a local process pool (all cores) or, with ``--scheduler tcp://HOST:PORT`` or the
 environment variable ``PMSM_DASK_SCHEDULER``, on a Dask distributed cluster.
 """
@@ -10,7 +11,6 @@ environment variable ``PMSM_DASK_SCHEDULER``, on a Dask distributed cluster.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
 import sys
@@ -18,12 +18,13 @@ from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from typing import Any
 
-from app.cli.main import add_preset_arguments
+from app.cli.main import add_preset_arguments, check_writable
 from app.io.json_data import to_json
 from app.io.plant_overrides import load_model_and_plant
+from app.io.sample_table import write_csv, write_parquet
 from app.io.study_inputs import parse_spread, parse_spreads
 from control.common.checks import ParameterError
-from sim.studies.robustness import METRICS, RobustnessResult, robustness
+from sim.studies.robustness import METRICS, robustness
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
 MAX_SAMPLES = 1_000_000
@@ -44,6 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"Dask scheduler address tcp://HOST:PORT (or ${SCHEDULER_ENV})")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--csv", metavar="FILE", help="write one row per sample (drawn values and metrics)")
+    p.add_argument("--parquet", metavar="FILE",
+                   help="write the same rows as Parquet, with each column's unit in the schema metadata")
 
 
 def _progress(done: int, total: int) -> None:
@@ -51,17 +54,6 @@ def _progress(done: int, total: int) -> None:
     if done == total:
         sys.stderr.write("\n")
     sys.stderr.flush()
-
-
-def write_csv(path: str, res: RobustnessResult) -> None:
-    """One row per sample: the drawn plant values, then each controller's metrics."""
-    keys = list(res.values)
-    cols = [(c, m) for c in ("fdsmc", "conventional") for m in (*METRICS, "chatter", "infeasible")]
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(keys + [f"{c}.{m}" for c, m in cols])
-        for i, r in enumerate(res.runs):
-            w.writerow([f"{res.values[k][i]:.9g}" for k in keys] + [r[c][m] for c, m in cols])
 
 
 def _print_table(summary: dict[str, Any]) -> None:
@@ -83,22 +75,26 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--samples = {args.samples} is not allowed: 1 … {MAX_SAMPLES}")
     if args.workers < 1:
         raise ParameterError(f"--workers = {args.workers} is not allowed: ≥ 1")
-    params, plant = load_model_and_plant(args.preset, args.overrides)
-    if plant is not None:
-        raise ParameterError("plant.* --set overrides are not allowed here: give the plant's "
-                             "distribution with --spread (the preset is the nominal plant)")
+    for opt, path in (("--csv", args.csv), ("--parquet", args.parquet)):
+        if path:
+            check_writable(path, opt)  # before hours of simulation, not after
+    params, plant = load_model_and_plant(args.preset, args.overrides)  # plant: the nominal plant
     spreads = parse_spreads(args.spread)
     if args.scheduler:
         from dask.distributed import Client
 
         with Client(args.scheduler) as client:
             workers = max(1, len(client.scheduler_info().get("workers", {})))
-            res = robustness(params, spreads, args.samples, args.seed, client, workers, _progress)
+            res = robustness(params, spreads, args.samples, args.seed, client, workers, _progress, plant=plant)
     else:
         with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
-            res = robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress)
+            res = robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant)
     if args.csv:
         write_csv(args.csv, res)
+    if args.parquet:
+        write_parquet(args.parquet, res, {"preset": args.preset, "overrides": list(args.overrides),
+                                          "spreads": list(args.spread), "seed": args.seed,
+                                          "samples": args.samples})
     if args.json:
         print(json.dumps(to_json(res.summary), indent=2, ensure_ascii=False))
     else:

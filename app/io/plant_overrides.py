@@ -3,6 +3,7 @@
 A ``plant.`` override changes the simulated drive only; the controller keeps designing with the
 preset's (and the other overrides') values. FIELD is a motor or load field of the preset, with the
 same unit suffixes as ``motor.`` / ``load.`` overrides (``plant.L_d_mH=6``, ``plant.J_L=0.3``).
+The overrides go on top of the preset's own ``plant`` section (:func:`app.io.presets.parse_plant`).
 """
 
 from __future__ import annotations
@@ -10,7 +11,8 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable
 
-from app.io.preset_modes import load_mode_preset
+from app.io.preset_modes import require_mode
+from app.io.presets import load_preset_and_plant
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams, Load, Motor
 
@@ -32,7 +34,7 @@ def plant_section(field: str) -> str:
 
 
 def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
-    """Split the overrides into (the model's overrides, the plant's overrides mapped to ``motor.``/``load.`` fields)."""
+    """Split into (the model's overrides, the plant's overrides mapped to ``motor.``/``load.`` fields)."""
     model, plant = [], []
     for item in overrides:
         if not item.startswith(PREFIX):
@@ -46,9 +48,12 @@ def split_overrides(overrides: Iterable[str]) -> tuple[list[str], list[str]]:
 
 
 def load_model_and_plant(preset: str, overrides: Iterable[str]) -> tuple[DriveParams, DriveParams | None]:
-    """Return the controller's model and the plant (None when no ``plant.`` override is given)."""
-    model_ov, plant_ov = split_overrides(overrides)
-    params = load_mode_preset(preset, model_ov, mode="position")
-    if not plant_ov:
-        return params, None
-    return params, load_mode_preset(preset, model_ov + plant_ov, mode="position")
+    """Return the controller's model and the plant.
+
+    The plant is the preset's ``plant`` section with the ``plant.`` overrides on top (None when
+    neither gives a value that differs from the model).
+    """
+    overrides = list(overrides)
+    split_overrides(overrides)  # names a bad plant field before anything is loaded
+    params, plant = load_preset_and_plant(preset, overrides)
+    return require_mode(params, "position", preset), plant

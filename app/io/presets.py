@@ -6,6 +6,11 @@ mode's parameter dataclass. Loading is safe (``yaml.safe_load``, no aliases, siz
 rejects unknown keys with a "did you mean" hint, missing keys and wrong types, and converts
 unit-suffixed keys (``L_d_mH``, ``omega_b_rpm``, ``Ke_Vrms_krpm`` …) through :mod:`app.io.units`.
 Saving writes SI field names only, so load → save → load gives equal objects.
+
+A position preset may carry an optional ``plant`` mapping: the true motor and load values of the
+simulated drive where they differ from the controller's model (the ``motor`` and ``load``
+sections), with the same keys and unit suffixes as those sections (``plant: {J_L: 0.3,
+R_s: 0.12}``); see :func:`parse_plant`.
 """
 
 from __future__ import annotations
@@ -38,6 +43,10 @@ DEFAULT_PRESET = "siemens_1ft7044_ak7"
 #: The FDSMC paper's drive (section 5 of [1]), for reproduction.
 PAPER_PRESET = "paper_12kw_pmsm"
 _TOP_KEYS = ("schema", "name", "source", "mode")
+#: Optional top-level section of a position preset: the plant's true values (see parse_plant).
+PLANT = "plant"
+#: The sections whose fields a plant section may give.
+PLANT_SECTIONS = ("motor", "load")
 #: Top-level keys an exported drive parameter file adds; informational, ignored on import (the
 #: gains are recomputed from the inputs).
 _EXPORT_KEYS = ("exported_by", "units", "drive_gains", "verdicts", "results")
@@ -178,7 +187,7 @@ def parse_preset(raw: Any) -> Any:
         raise PresetError(f"mode = {mode!r} is not known{_hint(str(mode), list(MODES))}")
     cls = MODES[mode]
     sections = [f.name for f in dataclasses.fields(cls) if f.name not in ("name", "source")]
-    allowed = list(_TOP_KEYS) + list(_EXPORT_KEYS) + list(sections)
+    allowed = list(_TOP_KEYS) + list(_EXPORT_KEYS) + list(sections) + ([PLANT] if cls is DriveParams else [])
     for key in raw:
         if key not in allowed:
             raise PresetError(f"unknown top-level key {key!r}{_hint(str(key), allowed)}")
@@ -193,7 +202,84 @@ def parse_preset(raw: Any) -> Any:
             raise PresetError(f"missing key {key!r}: every preset names itself and its source")
         kwargs[key] = _coerce(key, raw[key], str)
     _check_units(raw.get("units"), sections)
-    return cls(**kwargs)
+    params = cls(**kwargs)
+    if cls is DriveParams:
+        parse_plant(raw, params)  # validated with the rest of the file, even where only the model is used
+    return params
+
+
+def plant_fields() -> dict[str, str]:
+    """Every key a plant section accepts (SI names, unit-suffixed aliases, Ke) → ``motor``/``load``."""
+    out: dict[str, str] = {}
+    hints = typing.get_type_hints(DriveParams)
+    for section in PLANT_SECTIONS:
+        names = [f.name for f in dataclasses.fields(hints[section]) if f.name != "steps"]
+        out.update(dict.fromkeys(names + list(units.ALIASES.get(section, {})), section))
+    out[units.KE_KEY] = "motor"
+    return out
+
+
+def _plant_error(exc: Exception, section: str) -> PresetError:
+    """Return the message of a motor/load error, naming the field as ``plant.FIELD``."""
+    return PresetError(str(exc).replace(f"{section}.", f"{PLANT}.", 1))
+
+
+def parse_plant(raw: Any, params: DriveParams) -> DriveParams | None:
+    """Return the plant of a raw preset.
+
+    That is ``params`` with the motor and load values of its ``plant`` mapping; None without one
+    (or when it equals the controller's model).
+
+    Raises
+    ------
+    PresetError
+        For a key that is not a motor or load field, a wrong type or a value out of range; the
+        message names ``plant.FIELD``, the value and what is allowed.
+    """
+    block = raw.get(PLANT) if isinstance(raw, dict) else None
+    if block is None or block == {}:
+        return None
+    if not isinstance(block, dict):
+        raise PresetError(f"plant must be a mapping of FIELD: value (motor and load fields), got {block!r}")
+    known = plant_fields()
+    split: dict[str, dict[str, Any]] = {s: {} for s in PLANT_SECTIONS}
+    for key, value in block.items():
+        if str(key) not in known:
+            raise PresetError(f"unknown key plant.{key}{_hint(str(key), list(known))}")
+        split[known[str(key)]][str(key)] = value
+    hints = typing.get_type_hints(DriveParams)
+    parts: dict[str, Any] = {}
+    for section in PLANT_SECTIONS:
+        base = getattr(params, section)
+        aliases = units.ALIASES.get(section, {})
+        given = {_field_of(k, aliases, [units.KE_KEY]) for k in split[section]}
+        if len(given) < len(split[section]):
+            raise PresetError(f"plant gives a {section} field more than once (SI and unit-suffixed forms): "
+                              f"{', '.join(split[section])}")
+        merged = {k: v for k, v in _plain(base).items() if k not in given} | split[section]
+        try:
+            parts[section] = _parse_section(hints[section], merged, section)
+        except (PresetError, ParameterError) as exc:
+            raise _plant_error(exc, section) from None
+    plant = dataclasses.replace(params, **parts)
+    return None if plant == params else plant
+
+
+def plant_raw(params: DriveParams, plant: DriveParams | None) -> dict[str, Any]:
+    """Return the ``plant`` mapping of a preset.
+
+    That is the plant's motor and load values (SI) that differ from the controller's model
+    ``params``; empty when there is no plant.
+    """
+    if plant is None:
+        return {}
+    out: dict[str, Any] = {}
+    for section in PLANT_SECTIONS:
+        model, true = _plain(getattr(params, section)), _plain(getattr(plant, section))
+        if true.get("steps", []) != model.get("steps", []):
+            raise PresetError("plant.steps is not allowed: the load steps are the load section's")
+        out.update({k: v for k, v in true.items() if k != "steps" and v != model[k]})
+    return out
 
 
 def migrate(raw: dict[str, Any]) -> dict[str, Any]:
@@ -353,13 +439,16 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
         section, dot, name = key.strip().partition(".")
         if not sep or not dot or not name:
             raise PresetError(f"--set {item!r} is malformed: allowed form section.field=value")
+        if section == PLANT and raw.get(PLANT) is None and raw.get("mode", "position") == "position":
+            raw[PLANT] = {}
         if not isinstance(raw.get(section), dict):
             known = [k for k, v in raw.items() if isinstance(v, dict)]
             raise PresetError(f"--set {item!r}: unknown section {section!r}{_hint(section, known)}")
         value = loads_raw(text, f"--set {key}") if text.strip() else None
         if value is None:
             raise PresetError(f"--set {item!r} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
-        aliases = units.ALIASES.get(section, {})
+        aliases = units.ALIASES.get(section, {}) if section != PLANT else (
+            units.ALIASES["motor"] | units.ALIASES["load"])
         target = _field_of(name, aliases, [units.KE_KEY])
         for other in [k for k in raw[section] if _field_of(str(k), aliases, [units.KE_KEY]) == target]:
             del raw[section][other]  # an override replaces the value in any unit form
@@ -409,6 +498,26 @@ def load_raw(name_or_path: str) -> Any:
 def load_preset(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()) -> Any:
     """Load, override and validate a preset; returns its parameter object."""
     return parse_preset(apply_overrides(load_raw(name_or_path), overrides))
+
+
+def load_preset_and_plant(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()
+                          ) -> tuple[Any, DriveParams | None]:
+    """Load, override and validate a preset: (the controller's model, the plant or None).
+
+    ``overrides`` may include ``plant.FIELD=VALUE`` (on top of the file's plant section); a
+    ``motor.``/``load.`` override changes the model and, where the plant section does not give
+    that field, the plant too.
+    """
+    raw = apply_overrides(load_raw(name_or_path), overrides)
+    params = parse_preset(raw)
+    return params, (parse_plant(raw, params) if isinstance(params, DriveParams) else None)
+
+
+def loads_preset_and_plant(text: str, origin: str = "<upload>") -> tuple[Any, DriveParams | None]:
+    """:func:`loads_preset` returning (the controller's model, the plant or None)."""
+    raw = loads_any_raw(text, origin)
+    params = parse_preset(raw)
+    return params, (parse_plant(raw, params) if isinstance(params, DriveParams) else None)
 
 
 def loads_preset(text: str, origin: str = "<upload>") -> Any:
@@ -461,14 +570,20 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def to_raw(params: Any) -> dict[str, Any]:
-    """Parameter object → preset mapping (schema, name, source, mode, sections)."""
+def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
+    """Convert a parameter object to a preset mapping.
+
+    Schema, name, source, mode, sections, and the ``plant`` section when a plant that differs
+    from the model is given.
+    """
     mode = next(m for m, cls in MODES.items() if isinstance(params, cls))
     body = _plain(params)
     raw: dict[str, Any] = {"schema": SCHEMA, "name": body.pop("name"), "source": body.pop("source")}
     if mode != "position":
         raw["mode"] = mode
     raw.update(body)
+    if plant is not None and (true := plant_raw(params, plant)):
+        raw[PLANT] = true
     return raw
 
 
@@ -477,9 +592,9 @@ def dumps(data: Any) -> str:
     return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=False)
 
 
-def dumps_preset(params: Any) -> str:
-    """Parameter object → preset YAML text in SI field names."""
-    return dumps(to_raw(params))
+def dumps_preset(params: Any, plant: DriveParams | None = None) -> str:
+    """Parameter object (and optional plant) → preset YAML text in SI field names."""
+    return dumps(to_raw(params, plant))
 
 
 _KEY_LINE = re.compile(r"^( *)(- )?(\w+):(.*)$")
@@ -510,16 +625,16 @@ def annotate_units(text: str) -> str:
     return "\n".join(out) + "\n"
 
 
-def save_preset(params: Any, path: str | Path) -> None:
-    """Write a parameter object as a preset file."""
-    Path(path).write_text(dumps_preset(params), encoding="utf-8")
+def save_preset(params: Any, path: str | Path, plant: DriveParams | None = None) -> None:
+    """Write a parameter object (and optional plant) as a preset file."""
+    Path(path).write_text(dumps_preset(params, plant), encoding="utf-8")
 
 
 __all__ = [
-    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "ParameterError", "PresetError", "annotate_units", "apply_overrides",
-    "dumps",
-    "dumps_preset", "list_presets", "load_preset", "loads_preset", "parse_preset", "save_preset",
-    "to_raw",
+    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "PLANT", "ParameterError", "PresetError", "annotate_units",
+    "apply_overrides", "dumps", "dumps_preset", "list_presets", "load_preset", "load_preset_and_plant",
+    "loads_preset", "loads_preset_and_plant", "parse_plant", "parse_preset", "plant_fields", "plant_raw",
+    "save_preset", "to_raw",
 ]
 
 

@@ -104,12 +104,12 @@ def key_numbers_html(comparison: Any) -> str:
     g_max = torque_limit(comparison.derived.params)
 
     def energy(key: str) -> str:
-        return " / ".join("–" if r is None or not isinstance(r.metrics.get(key), float)
-                          else f"{r.metrics[key]:.4g}" for r in (f, c))
+        values = [None if r is None else getattr(r.metrics, key) for r in (f, c)]
+        return " / ".join("–" if v is None else f"{v:.4g}" for v in values)
 
     def peak(r: Any) -> str:
-        v = r.metrics.get("torque_peak_Nm") if r is not None else None
-        if not isinstance(v, float):
+        v = r.metrics.torque_peak_Nm if r is not None else None
+        if v is None:
             return "–"
         return f'<b style="color:#c92a2a">{v:.4g} ⚠</b>' if v > g_max * 1.001 else f"{v:.4g}"
 

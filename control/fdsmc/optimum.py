@@ -33,8 +33,19 @@ with ω(0) = ω(T) = 0 is
 
 Numerical optimum (limits). Γ_em piecewise constant on N intervals, the mechanics discretised
 exactly (zero-order hold), |Γ_em| ≤ Γ_lim (the drive's torque limit including the inverter's
-i_max), solved as a QP by Clarabel through cvxpy. The voltage limit is **not** a constraint
-(dropped, not linearised): the tracked optimum's simulated peak |u_dq| shows whether it holds.
+i_max), solved as a QP by Clarabel through cvxpy.
+
+Voltage limit. With a DC link (controller.V_dc > 0) the inverter applies |u_dq| ≤ u_max = V_dc/√3.
+At i_d = 0 in the steady state of each interval, eqs. (1)–(2) in [1] give
+
+    u_d = −p·ω·L_q·i_q,   u_q = R_s·i_q + p·Ψ_PM·ω,   i_q = Γ_em/k_t,
+
+so ‖(u_d, u_q)‖ ≤ u_max is a second-order cone once the product ω·i_q of u_d is taken with ω
+fixed: the problem is solved as a sequence of SOCPs (Clarabel), u_d's ω taken from the previous
+solution (the first from the problem without the voltage limit), until the speed changes by less
+than 1e-6 of its peak; the result is then checked against the exact |u_dq| ≤ u_max (both
+interval ends' speeds). L_q·di_q/dt is not in the limit (the inner loops shape the current
+within T_si ≪ T_m), nor is any voltage the inner loops need for tracking.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -60,8 +71,9 @@ N_INTERVALS = 2000
 class MoveModel:
     """The move's data.
 
-    J [kg·m²]; F_v [N·m·s/rad]; a [W/(N·m)²] copper coefficient; delta_theta [rad]; T_m [s]; Gamma_lim [N·m]
-    torque limit (inf = none); Gamma_Le [N·m] constant load.
+    J [kg·m²]; F_v [N·m·s/rad]; a [W/(N·m)²] copper coefficient; delta_theta [rad]; T_m [s];
+    Gamma_lim [N·m] torque limit (inf = none); Gamma_Le [N·m] constant load; u_max [V] limit of
+    |u_dq| (inf = none) with the motor's R_s [Ω], L_q [H], p [-], psi_pm [Wb].
     """
 
     J: float
@@ -71,14 +83,24 @@ class MoveModel:
     T_m: float
     Gamma_lim: float = math.inf
     Gamma_Le: float = 0.0
+    u_max: float = math.inf
+    R_s: float = 0.0
+    L_q: float = 0.0
+    p: int = 1
+    psi_pm: float = 1.0
+
+    @property
+    def k_t(self) -> float:
+        """Torque constant (3/2)·p·Ψ_PM [N·m/A] (eq. (5) in [1] at i_d = 0)."""
+        return 1.5 * self.p * self.psi_pm
 
 
 @dataclass(frozen=True)
 class OptimalMove:
     """An optimal move on the grid t [s] (N + 1 nodes).
 
-    theta [rad], omega [rad/s], alpha [rad/s²] (dω/dt), Gamma_em [N·m]; energies over [0, T_m] [J];
-    torque_peak [N·m]; limited (a torque limit is active); method ("closed form" or the solver's name).
+    theta [rad], omega [rad/s], alpha [rad/s²] (dω/dt), Gamma_em [N·m]; energies over [0, T_m]
+    [J]; torque_peak [N·m]; limited (a limit is active); method ("closed form" or the solver's name).
     """
 
     t: np.ndarray
@@ -108,8 +130,23 @@ def move_model(params: DriveParams, margin: float = 1.0) -> MoveModel:
 
     m, ld, mv = params.motor, params.load, params.manoeuvre
     k_t = torque_constant(m)
+    V_dc = params.controller.V_dc
+    u_max = V_dc / math.sqrt(3.0) if V_dc > 0.0 else math.inf
     return MoveModel(params.J_total, ld.F_v, 1.5 * m.R_s / k_t**2, mv.theta_dem, mv.T_m,
-                     torque_limit(params) / max(1.0, margin), ld.Gamma_Le)
+                     torque_limit(params) / max(1.0, margin), ld.Gamma_Le, u_max, m.R_s, m.L_q, m.p, m.psi_pm)
+
+
+def voltage_peak(mm: MoveModel, mv: OptimalMove) -> float:
+    """Return the largest steady-state |u_dq| [V] of a move at i_d = 0 (module docstring).
+
+    Over the nodes: each interval's torque with the speed at both of its ends.
+    """
+    i_q = mv.Gamma_em / mm.k_t
+    u = 0.0
+    for w in (mv.omega, np.append(mv.omega[1:], mv.omega[-1])):
+        u_d, u_q = mm.p * w * mm.L_q * i_q, mm.R_s * i_q + mm.p * mm.psi_pm * w
+        u = max(u, float(np.max(np.hypot(u_d, u_q))))
+    return u
 
 
 def hamiltonian_matrix(mm: MoveModel) -> np.ndarray:
@@ -166,17 +203,22 @@ def _zoh(mm: MoveModel, h: float) -> tuple[float, float, float, float]:
     return e, (1.0 - e) / F, c, (h - c) / F
 
 
-def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
-    """Solve for the optimum with |Γ_em| ≤ Γ_lim as a QP on n intervals (Clarabel via cvxpy).
+#: Most SOCP solves of the voltage-limited optimum (sequential convex programming) [-].
+MAX_VOLTAGE_ITERATIONS = 12
+#: Converged when no node's speed changes by more than this share of the peak speed [-].
+VOLTAGE_ITERATION_TOL = 1e-6
 
-    Raises
-    ------
-    ParameterError
-        When no move within the torque limit reaches Δθ in T_m, naming the limit.
+
+def _problem(mm: MoveModel, n: int, voltage: bool) -> tuple:
+    """Build the convex problem on n intervals.
+
+    The QP of the module docstring, plus (``voltage``) the voltage cone with u_d's speed a
+    parameter (n + 1 nodes, [rad/s]) so that re-solving with a new speed reuses the compiled
+    problem. Returns (problem, g, v, speed parameter, G_s, w_s).
     """
     import cvxpy as cp  # heavy import, only when an optimum is asked for
 
-    T, dth, h = mm.T_m, mm.delta_theta, mm.T_m / n
+    dth, h = mm.delta_theta, mm.T_m / n
     e, b, c, d = _zoh(mm, h)
     ref = closed_form(mm, 200)
     G_s, w_s = max(ref.torque_peak, 1e-12), max(float(np.max(np.abs(ref.omega))), 1e-12)
@@ -187,35 +229,87 @@ def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
             cp.sum(c * w_s * v[:-1] + d * u) == dth]
     if math.isfinite(mm.Gamma_lim):
         cons.append(cp.abs(g) <= mm.Gamma_lim / G_s)
+    w_ud = cp.Parameter(n + 1)  # p·L_q·ω/u_max·(G_s/k_t) of u_d: ω from the previous solve
+    if voltage:
+        i_q = (G_s / mm.k_t / mm.u_max) * g  # per unit of u_max below
+        for ends in (slice(0, n), slice(1, n + 1)):  # both ends of each interval
+            u_q = mm.R_s * i_q + (mm.p * mm.psi_pm * w_s / mm.u_max) * v[ends]
+            cons.append(cp.norm(cp.vstack([cp.multiply(w_ud[ends], g), u_q]), 2, axis=0) <= 1.0)
     scale = max(ref.energy_J - ref.load_J, 1e-12)
     cost = (mm.a * h * G_s**2 * cp.sum_squares(g) + mm.F_v * h * w_s**2 * cp.sum_squares(v)) / scale
-    prob = cp.Problem(cp.Minimize(cost), cons)
+    return cp.Problem(cp.Minimize(cost), cons), g, v, w_ud, G_s, w_s
+
+
+def _solve(mm: MoveModel, n: int, problem: tuple) -> OptimalMove:
+    """Solve ``problem`` of :func:`_problem` (Clarabel), naming the limits if it is infeasible."""
+    import cvxpy as cp
+
+    prob, g, v, _, G_s, w_s = problem
     prob.solve(solver=cp.CLARABEL)
     if prob.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+        volt = f" and |u_dq| ≤ V_dc/√3 = {mm.u_max:.4g} V" if math.isfinite(mm.u_max) else ""
         raise ParameterError(
-            f"manoeuvre.T_m = {T:g} s: no move of Δθ = {dth:g} rad stays within the torque limit "
-            f"{mm.Gamma_lim:.4g} N·m (solver status {prob.status}); allowed: a longer T_m")
-    G = G_s * np.asarray(g.value)
-    omega = w_s * np.asarray(v.value)
+            f"manoeuvre.T_m = {mm.T_m:g} s: no move of Δθ = {mm.delta_theta:g} rad stays within the torque limit "
+            f"{mm.Gamma_lim:.4g} N·m{volt} (solver status {prob.status}); allowed: a longer T_m"
+            + (" or a larger controller.V_dc" if volt else ""))
+    return _move(mm, n, G_s * np.asarray(g.value), w_s * np.asarray(v.value))
+
+
+def _move(mm: MoveModel, n: int, G: np.ndarray, omega: np.ndarray) -> OptimalMove:
+    """Return the OptimalMove of the solved torques G [N·m] (n) and speeds omega [rad/s] (n + 1)."""
+    h = mm.T_m / n
+    e, b, c, d = _zoh(mm, h)
     omega[0] = omega[-1] = 0.0
     dtheta = c * omega[:-1] + d * (G - mm.Gamma_Le)
     theta = np.concatenate(([0.0], np.cumsum(dtheta)))
     alpha = (np.append(G, G[-1]) - mm.F_v * omega - mm.Gamma_Le) / mm.J
     peak = float(np.max(np.abs(G)))
-    return OptimalMove(np.linspace(0.0, T, n + 1), theta, omega, alpha, np.append(G, G[-1]),
+    return OptimalMove(np.linspace(0.0, mm.T_m, n + 1), theta, omega, alpha, np.append(G, G[-1]),
                        float(mm.a * h * np.sum(G**2)), float(mm.F_v * h * np.sum(omega**2)),
                        float(mm.Gamma_Le * np.sum(dtheta)),
                        peak, peak >= mm.Gamma_lim * (1.0 - 1e-6), "clarabel")
 
 
-def optimal_move(params: DriveParams, margin: float = 1.0, n: int = N_INTERVALS) -> OptimalMove:
-    """Return the minimum-energy move of ``params`` within the torque limit / ``margin``.
+def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
+    """Solve for the optimum within the torque and voltage limits on n intervals.
 
-    See :func:`move_model`: the closed form where no limit is active, else the QP.
+    |Γ_em| ≤ Γ_lim (a QP) and, if u_max is finite, |u_dq| ≤ u_max (a sequence of SOCPs, module
+    docstring), solved by Clarabel via cvxpy.
+
+    Raises
+    ------
+    ParameterError
+        When no move within the limits reaches Δθ in T_m (naming the limits), or when the
+        voltage iteration does not converge.
     """
-    mm = move_model(params, margin)
+    mv = _solve(mm, n, _problem(mm, n, False))
+    if not math.isfinite(mm.u_max) or voltage_peak(mm, mv) <= mm.u_max:
+        return mv
+    problem = _problem(mm, n, True)
+    for _ in range(MAX_VOLTAGE_ITERATIONS):
+        problem[3].value = mm.p * mm.L_q * mv.omega / mm.u_max * problem[4] / mm.k_t
+        new = _solve(mm, n, problem)
+        step = float(np.max(np.abs(new.omega - mv.omega)))
+        mv = dataclasses.replace(new, limited=True)
+        if step <= VOLTAGE_ITERATION_TOL * float(np.max(np.abs(mv.omega))):
+            return mv
+    raise ParameterError(
+        f"controller.V_dc = {mm.u_max * math.sqrt(3.0):g} V: the voltage-limited optimum of manoeuvre.T_m = "
+        f"{mm.T_m:g} s did not converge in {MAX_VOLTAGE_ITERATIONS} iterations; allowed: a longer T_m")
+
+
+def optimal_move(params: DriveParams, margin: float = 1.0, n: int = N_INTERVALS) -> OptimalMove:
+    """Return the minimum-energy move of ``params`` within the limits (torque limit / ``margin``).
+
+    See :func:`move_model`: the closed form where no limit is active, else the QP/SOCP.
+    """
+    return _optimum(move_model(params, margin), n)
+
+
+def _optimum(mm: MoveModel, n: int) -> OptimalMove:
+    """Return the closed form where it respects the torque and voltage limits, else the numerical one."""
     cf = closed_form(mm, n)
-    if cf.torque_peak <= mm.Gamma_lim:
+    if cf.torque_peak <= mm.Gamma_lim and (not math.isfinite(mm.u_max) or voltage_peak(mm, cf) <= mm.u_max):
         return cf
     return numerical_optimum(mm, n)
 
@@ -233,5 +327,4 @@ def tracked_move(d: Derived, n: int = N_INTERVALS) -> OptimalMove:
     p = d.params
     lim = max(torque_limit(p), d.feasibility.torque_needed)
     mm = dataclasses.replace(move_model(p), Gamma_lim=lim / max(1.0, d.alpha.overshoot))
-    cf = closed_form(mm, n)
-    return cf if cf.torque_peak <= mm.Gamma_lim else numerical_optimum(mm, n)
+    return _optimum(mm, n)

@@ -1,31 +1,44 @@
-"""Duty cycles: a sequence of rest-to-rest moves with dwell times, energy per cycle and per year.
+"""Duty cycles: a sequence of moves with dwell times, simulated back to back as one run.
 
-Every move of the cycle starts and ends at rest (the simulated horizon 1.3·T_m includes the
-settling tail), so the cycle's energy is the sum of the moves' net electrical inputs over their
-whole runs plus the dwell: holding a constant external load Γ_Le at rest costs the copper loss
-a·Γ_Le²·t_hold (a = (3/2)·R_s/k_t²; t_hold = the dwell less the simulated tail 0.3·T_m, which the
-run already contains), nothing without a load. The cycle lasts Σ(T_m + dwell). A move's position change is its
-own θ_dem (relative moves; the absolute position does not change the energy).
+Each comparator (FDSMC, conventional, the tracked minimum-energy optimum) drives the whole cycle
+in one continuous simulation (:func:`sim.studies.cycle_kernel.run_cycle`): a move starts where
+the previous move and its dwell left the drive — position, speed, currents, the observer's
+estimates — not from rest. Move i lasts T_m,i + dwell_i; its θ_dem is relative (the target is
+the previous target plus θ_dem,i) and its design (profile, gains, reference) is that of a single
+move of θ_dem,i in T_m,i on the preset's drive. The energy of a move is the net electrical input
+over its segment; the cycle's energy is their sum, which is the run's own integral, and the
+run's energy balance (input = copper + friction + load work + the stored kinetic and magnetic
+energy at the end) is reported. A constant external load held during a dwell costs what the
+simulation says (the copper loss of the holding current).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from control.fdsmc.optimum import move_model
+import numpy as np
+
+from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.params import DriveParams, ParameterError
-from sim.fdsmc.engine import TAIL_FRACTION, compare
+from sim.fdsmc import kernel as kn
+from sim.fdsmc.engine import continuous_step, pack_parameters, plant_substeps
+from sim.studies.cycle_kernel import run_cycle
 
 #: Joules per kilowatt-hour [J/kWh].
 J_PER_KWH = 3.6e6
 COMPARATORS = ("fdsmc", "conventional", "optimum")
+#: Most trace points kept per comparator's run [-].
+TRACE_POINTS = 4000
+#: Most integration steps of one comparator's cycle [-] (≈ 20 s of CPU).
+MAX_CYCLE_STEPS = 40_000_000
 
 
 @dataclass(frozen=True)
 class Move:
-    """One move of the cycle: theta_dem [rad], T_m [s], dwell after it [s]."""
+    """One move of the cycle: theta_dem [rad] (relative), T_m [s], dwell after it [s]."""
 
     theta_dem: float
     T_m: float
@@ -33,15 +46,46 @@ class Move:
 
 
 @dataclass(frozen=True)
-class DutyResult:
-    """Return the energy per cycle [J] per comparator (None if a run was unstable) and the cycle time [s].
+class CycleRun:
+    """One comparator's cycle.
 
-    Also the per-move energies ``moves[i][comparator]`` [J].
+    Per-move net electrical input [J], the run's totals [J] (electrical in, copper, friction, load
+    work, stored kinetic + magnetic at the end), the final position error against the last target
+    [rad], a trace (t [s], theta_r [rad], omega_r [rad/s], E_electrical [J]) and ``stable``
+    (False: diverged; then the energies are None).
+    """
+
+    moves_J: tuple[float, ...] | None
+    electrical_in_J: float | None
+    copper_J: float | None
+    friction_J: float | None
+    load_work_J: float | None
+    stored_end_J: float | None
+    theta_error_end_rad: float | None
+    trace: dict[str, np.ndarray]
+    stable: bool
+
+    @property
+    def balance_residual_J(self) -> float | None:
+        """Electrical input − (copper + friction + load work + stored at the end) [J]."""
+        if not self.stable:
+            return None
+        return self.electrical_in_J - (self.copper_J + self.friction_J + self.load_work_J  # type: ignore[operator]
+                                       + self.stored_end_J)
+
+
+@dataclass(frozen=True)
+class DutyResult:
+    """A duty cycle's energies.
+
+    Energy per cycle [J] per comparator (None if its run diverged), the cycle time [s], the
+    per-move energies ``moves[i][comparator]`` [J] and each comparator's run.
     """
 
     cycle_J: dict[str, float | None]
     cycle_s: float
     moves: tuple[dict[str, float | None], ...]
+    runs: dict[str, CycleRun]
 
     def per_year(self, cycles_per_hour: float, hours_per_year: float, price_per_kWh: float
                  ) -> dict[str, tuple[float, float] | None]:
@@ -53,32 +97,104 @@ class DutyResult:
         return out
 
 
+def _designs(params: DriveParams, moves: Sequence[Move]) -> list[tuple[DriveParams, Derived]]:
+    """Each move's case (the preset with its θ_dem and T_m) and design; bad moves named."""
+    if not moves:
+        raise ParameterError("moves: allowed at least one move")
+    out = []
+    for i, mv in enumerate(moves):
+        if not (math.isfinite(mv.dwell) and mv.dwell >= 0.0):
+            raise ParameterError(f"move {i + 1}: dwell = {mv.dwell:g} s is not allowed: ≥ 0 s")
+        p = dataclasses.replace(params, manoeuvre=dataclasses.replace(
+            params.manoeuvre, theta_dem=float(mv.theta_dem), T_m=float(mv.T_m)))
+        d = derive(p)
+        if not d.profile.feasible:
+            raise ParameterError(f"move {i + 1}: T_m = {mv.T_m:g} s is infeasible: allowed ≥ T_m,min = "
+                                 f"{d.profile.T_m_min:.4g} s for Δθ = {mv.theta_dem:g} rad")
+        out.append((p, d))
+    return out
+
+
+def _segments(params: DriveParams, moves: Sequence[Move]) -> tuple[bool, float, int, np.ndarray]:
+    """(continuous, RK4 step h [s], substeps per sample, steps per segment) of the cycle."""
+    ctrl = params.controller
+    if ctrl.is_continuous:
+        if params.load.steps or params.load.Gamma_Le_ramp != 0.0:
+            raise ParameterError("load.steps / load.Gamma_Le_ramp with controller.f_s = continuous are not "
+                                 "allowed in a duty cycle: allowed a digital f_s, or a constant Γ_Le")
+        h, sub, T_step = continuous_step(params), 1, continuous_step(params)
+    else:
+        T_s = 1.0 / float(ctrl.f_s)
+        sub = max(plant_substeps(dataclasses.replace(params, manoeuvre=dataclasses.replace(
+            params.manoeuvre, theta_dem=float(m.theta_dem), T_m=float(m.T_m)))) for m in moves)
+        h, T_step = T_s / sub, T_s
+    steps = np.array([max(1, round((m.T_m + m.dwell) / T_step)) for m in moves], dtype=np.int64)
+    if int(steps.sum()) * sub > MAX_CYCLE_STEPS:
+        raise ParameterError(f"the cycle of {sum(m.T_m + m.dwell for m in moves):g} s needs "
+                             f"{int(steps.sum()) * sub:.3g} integration steps: allowed ≤ {MAX_CYCLE_STEPS:.3g} "
+                             "(shorter dwells or fewer moves, or a lower controller.f_s)")
+    return ctrl.is_continuous, h, sub, steps
+
+
+def _pack(cases: list[tuple[DriveParams, Derived]], moves: Sequence[Move], controller: str
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per-segment parameters (absolute targets) and the concatenated references with offsets."""
+    from control.fdsmc.optimum import tracked_move  # cvxpy only where a limit is active
+
+    prm_all, refs, start = [], [], 0.0
+    for (p, d), mv in zip(cases, moves, strict=True):
+        prm = pack_parameters(p, d, controller)
+        prm[kn.P_THDEM] = start + mv.theta_dem
+        if controller == "optimum":
+            tm = tracked_move(d)
+            refs.append(np.vstack((start + tm.theta, tm.omega, tm.alpha)))
+        else:
+            refs.append(np.zeros((3, 2)))
+        prm_all.append(prm)
+        start += mv.theta_dem
+    off = np.cumsum([0] + [r.shape[1] for r in refs]).astype(np.int64)
+    return np.ascontiguousarray(prm_all), np.ascontiguousarray(np.hstack(refs)), off
+
+
+def cycle_run(params: DriveParams, moves: Sequence[Move], controller: str) -> CycleRun:
+    """One comparator's back-to-back run of the cycle (module docstring)."""
+    cases = _designs(params, moves)
+    continuous, h, sub, steps = _segments(params, moves)
+    prm_all, ref_all, off = _pack(cases, moves, controller)
+    od = cases[0][1].observer_discrete
+    Phi, Gam, Lo = ((np.ascontiguousarray(od.Phi), np.ascontiguousarray(od.Gamma), np.ascontiguousarray(od.L))
+                    if od is not None else (np.zeros((4, 4)), np.zeros(4), np.zeros(4)))
+    step_t = np.array([s.t for s in params.load.steps], dtype=float)
+    step_v = np.array([s.Gamma_Le for s in params.load.steps], dtype=float)
+    total = int(steps.sum())
+    decim = max(1, math.ceil(total / TRACE_POINTS))
+    out = np.zeros((kn.N_CH, total // decim + 1))
+    seg = np.zeros((len(moves), kn.N_X))
+    n = run_cycle(prm_all, steps, ref_all, off, step_t, step_v, Phi, Gam, Lo, continuous, h, sub,
+                  params.controller.delay_samples, decim, out, seg)
+    chans = {name: out[kn.CHANNELS.index(name), : abs(n) - (1 if n < 0 else 0)]
+             for name in ("t", "theta_r", "omega_r", "E_electrical")}
+    if n < 0:
+        return CycleRun(None, None, None, None, None, None, None, chans, False)
+    e_el = np.concatenate(([0.0], seg[:, kn.X_EEL]))
+    end, m = seg[-1], params.motor
+    stored = 0.5 * params.J_total * end[kn.X_W] ** 2 + 0.75 * (m.L_d * end[kn.X_ID] ** 2 + m.L_q * end[kn.X_IQ] ** 2)
+    return CycleRun(tuple(float(x) for x in np.diff(e_el)), float(end[kn.X_EEL]), float(end[kn.X_ECU]),
+                    float(end[kn.X_EF]), float(end[kn.X_ELOAD]), float(stored),
+                    float(end[kn.X_TH] - sum(mv.theta_dem for mv in moves)), chans, True)
+
+
 def duty_cycle(params: DriveParams, moves: Sequence[Move]) -> DutyResult:
-    """Simulate each move with the three comparators and add the dwell losses (module docstring).
+    """Simulate the cycle back to back with each comparator (module docstring).
 
     Raises
     ------
     ParameterError
-        For an empty cycle or a negative dwell (naming the move).
+        For an empty cycle, a negative dwell or an infeasible move (naming the move), or a
+        cycle beyond the step budget.
     """
-    if not moves:
-        raise ParameterError("moves: allowed at least one move")
-    per_move: list[dict[str, float | None]] = []
-    for i, mv in enumerate(moves):
-        if not mv.dwell >= 0.0:
-            raise ParameterError(f"move {i + 1}: dwell = {mv.dwell:g} s is not allowed: ≥ 0 s")
-        p = dataclasses.replace(params, manoeuvre=dataclasses.replace(
-            params.manoeuvre, theta_dem=float(mv.theta_dem), T_m=float(mv.T_m)))
-        cmp = compare(p, COMPARATORS)
-        mm = move_model(p)
-        hold = mm.a * mm.Gamma_Le**2 * max(0.0, mv.dwell - TAIL_FRACTION * mv.T_m)
-        row: dict[str, float | None] = {}
-        for c in COMPARATORS:
-            run = getattr(cmp, c)
-            w = run.metrics.electrical_in_total_J if run is not None and run.metrics.stable else None
-            row[c] = float(w) + hold if isinstance(w, float) else None
-        per_move.append(row)
-    total = {c: (None if any(r[c] is None for r in per_move) else float(sum(r[c] for r in per_move)))  # type: ignore[misc]
-             for c in COMPARATORS}
-    t_cycle = sum(m.T_m + m.dwell for m in moves)
-    return DutyResult(total, t_cycle, tuple(per_move))
+    runs = {c: cycle_run(params, moves, c) for c in COMPARATORS}
+    per_move = tuple({c: (r.moves_J[i] if r.moves_J is not None else None) for c, r in runs.items()}
+                     for i in range(len(moves)))
+    total = {c: r.electrical_in_J for c, r in runs.items()}
+    return DutyResult(total, float(sum(m.T_m + m.dwell for m in moves)), per_move, runs)

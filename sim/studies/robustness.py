@@ -8,6 +8,11 @@ depends only on (params, spreads, samples, seed) — not on the executor, the nu
 or the chunking. Work is handed to any executor with ``submit(fn, *args) -> future`` and
 ``future.result()`` (``concurrent.futures.ProcessPoolExecutor`` locally, a
 ``dask.distributed.Client`` on a cluster), chunk by chunk; results are collected in order.
+
+The controller's model is the nominal one, so its design ``derive(params)`` is computed once and
+handed to every task; a task simulates its samples one after the other (no thread per sample).
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
 
 from __future__ import annotations
@@ -24,13 +29,16 @@ import numpy as np
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
 from control.fdsmc.params import DriveParams, ParameterError
-from sim.fdsmc.engine import CONTROLLERS, compare
+from sim.fdsmc.engine import CONTROLLERS, RunResult, reached_target, simulate
 
 #: Metrics summarised per controller; the worst case is the largest value (errors as |·|).
 METRICS = ("friction_J", "copper_J", "electrical_in_total_J", "torque_peak_Nm",
            "theta_error_abs_at_Tm_rad", "t_2pct_settle_s")
 #: Each task should compute for at least this long [s] (scheduling overhead stays small).
 MIN_TASK_S = 0.1
+#: Tasks per worker a run is cut into at most [-]: enough for progress, cancelling and balancing
+#: the load, few enough that handing out tasks (and pickling their arguments) costs nothing.
+TASKS_PER_WORKER = 16
 #: Trace points kept per run (metrics only; the 2 % settling time is read from this trace).
 TRACE_POINTS = 2000
 #: Largest σ of a normal spread, relative to the nominal value [-] (kept well away from ≤ 0).
@@ -41,9 +49,9 @@ MAX_NORMAL_SIGMA = 0.3
 class Spread:
     """Distribution of one plant value.
 
-    section "motor"/"load"; field the parameter's name; kind "uniform" (absolute lo…hi in SI), "relative"
-    (uniform nominal·(1 + lo…hi)) or "normal" (nominal·(1 + σ·N(0, 1)) with σ = hi, truncated at ±3σ by
-    redrawing).
+    section "motor"/"load"; field the parameter's name; kind "uniform" (absolute lo…hi in SI),
+    "relative" (uniform nominal·(1 + lo…hi)) or "normal" (nominal·(1 + σ·N(0, 1)) with σ = hi,
+    truncated at ±3σ by redrawing).
     """
 
     section: str
@@ -63,7 +71,7 @@ class RobustnessResult:
 
 
 def draw(params: DriveParams, spreads: Sequence[Spread], n: int, seed: int) -> dict[str, np.ndarray]:
-    """Draw n values [SI] of each spread's field, keyed ``section.field``, from one seeded generator."""
+    """N values [SI] of each spread's field, keyed ``section.field``, from one seeded generator."""
     rng = np.random.default_rng(seed)
     out: dict[str, np.ndarray] = {}
     for s in spreads:
@@ -91,38 +99,61 @@ def plant_for(params: DriveParams, values: dict[str, float]) -> DriveParams:
                                load=dataclasses.replace(params.load, **changes["load"]))
 
 
+def _friction_saving(f: RunResult, c: RunResult) -> float | None:
+    """Return FDSMC's friction saving vs the conventional controller [%].
+
+    Eq. (47) in [1] over [0, T_m]; None unless both runs are stable and reached the 2 % band.
+    """
+    if not (reached_target(f) and reached_target(c)):
+        return None
+    wf, wc = f.metrics.friction_J, c.metrics.friction_J
+    if wf is None or wc is None or wc == 0.0:
+        return None
+    return 100.0 * (1.0 - wf / wc)
+
+
 def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None) -> dict[str, dict[str, Any]]:
     """Return both controllers' metrics on one plant, plus ``infeasible`` and ``saving_friction_pct``.
 
     ``infeasible``: unstable, or the peak torque beyond the plant's torque limit; ``d`` = derive(params).
+
+    The two runs are simulated one after the other in the calling thread: the parallelism of a
+    sweep is across samples (processes), and a thread pool per sample would only add overhead.
     """
-    cmp = compare(params, CONTROLLERS, d, plant=plant, max_points=TRACE_POINTS)
+    d = derive(params) if d is None else d
+    runs = [simulate(params, c, d, plant=plant, max_points=TRACE_POINTS) for c in CONTROLLERS]
     lim = torque_limit(plant)
     out: dict[str, dict[str, Any]] = {}
-    for run in (cmp.fdsmc, cmp.conventional):
-        assert run is not None
+    for run in runs:
         m: dict[str, Any] = dataclasses.asdict(run.metrics)
         err, peak = run.metrics.theta_error_at_Tm_rad, run.metrics.torque_peak_Nm
         m["theta_error_abs_at_Tm_rad"] = None if err is None else abs(err)
         m["infeasible"] = not run.metrics.stable or (peak is not None and peak > lim * (1.0 + LIMIT_TOLERANCE))
         out[run.controller] = {k: m[k] for k in (*METRICS, "chatter", "stable", "infeasible")}
-    out["fdsmc"]["saving_friction_pct"] = cmp.saving_friction_pct
+    out["fdsmc"]["saving_friction_pct"] = _friction_saving(runs[0], runs[1])
     return out
 
 
-def simulate_chunk(params: DriveParams, rows: list[dict[str, float]],
-                   d: Derived | None = None) -> list[dict[str, dict[str, Any]]]:
+def simulate_chunk(params: DriveParams, rows: list[dict[str, float]], d: Derived | None = None,
+                   plant: DriveParams | None = None) -> list[dict[str, dict[str, Any]]]:
     """Return the metrics of several samples (one task); module-level so that it pickles.
 
-    ``d`` = derive(params), the controller's design (the same for every sample; computed if None).
+    ``d`` = derive(params), the controller's design (the same for every sample; computed if None);
+    ``plant`` the nominal plant the rows' values replace values of (None: the model).
     """
     d = derive(params) if d is None else d
-    return [sample_metrics(params, plant_for(params, r), d) for r in rows]
+    base = params if plant is None else plant
+    return [sample_metrics(params, plant_for(base, r), d) for r in rows]
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
-    """Return the samples per task [-]: each task ≥ MIN_TASK_S, unless that leaves a worker idle."""
-    size = max(1, math.ceil(MIN_TASK_S / max(seconds_per_sample, 1e-6)))
+    """Return the samples per task [-].
+
+    Each task ≥ MIN_TASK_S and at most TASKS_PER_WORKER tasks per worker, unless that leaves a
+    worker idle.
+    """
+    size = max(1, math.ceil(MIN_TASK_S / max(seconds_per_sample, 1e-6)),
+               math.ceil(n / (TASKS_PER_WORKER * max(1, workers))))
     if n > 0 and math.ceil(n / size) < workers:
         size = max(1, math.ceil(n / workers))  # every worker gets work, even if tasks are short
     return size
@@ -137,9 +168,10 @@ def _stats(x: np.ndarray, worst: str) -> dict[str, float | None]:
 
 
 def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str, Any]:
-    """Summarise the samples per controller: mean/p05/p50/p95/worst of each metric over the stable ones.
+    """Summarise the runs.
 
-    Also the chatter and infeasible probabilities and the friction saving's distribution (worst = smallest).
+    Per controller, per metric mean/p05/p50/p95/worst over the stable samples, chatter and
+    infeasible probabilities; the friction saving's distribution (worst = smallest).
     """
     out: dict[str, Any] = {"samples": len(runs), "seconds": seconds}
     for ctrl in CONTROLLERS:
@@ -159,7 +191,7 @@ def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str
 def robustness(
     params: DriveParams, spreads: Sequence[Spread], samples: int, seed: int = 0, executor: Any = None,
     workers: int = 1, progress: Callable[[int, int], None] | None = None,
-    cancelled: Callable[[], bool] | None = None,
+    cancelled: Callable[[], bool] | None = None, plant: DriveParams | None = None,
 ) -> RobustnessResult:
     """Run the Monte-Carlo analysis (see the module docstring).
 
@@ -173,28 +205,30 @@ def robustness(
     workers : int                 Workers behind the executor (for the chunk size) [-].
     progress : callable or None   ``progress(done, total)`` as samples complete, in order.
     cancelled : callable or None  Polled between chunks; True stops (ParameterError raised).
+    plant : DriveParams or None   The nominal plant (a preset's plant section) the spreads are
+                                  drawn around and applied to; None: the controller's model.
     """
     if samples < 1:
         raise ParameterError(f"samples = {samples} is not allowed: ≥ 1")
     t0 = time.perf_counter()
-    values = draw(params, spreads, samples, seed)
+    values = draw(params if plant is None else plant, spreads, samples, seed)
     rows = [{k: float(v[i]) for k, v in values.items()} for i in range(samples)]
     d = derive(params)
-    runs = simulate_chunk(params, rows[:1], d)  # warm-up (compiled kernel loaded) …
+    runs = simulate_chunk(params, rows[:1], d, plant)  # warm-up (compiled kernel loaded) …
     t1 = time.perf_counter()
-    runs += simulate_chunk(params, rows[1:2], d)  # … and one timed sample
+    runs += simulate_chunk(params, rows[1:2], d, plant)  # … and one timed sample
     done = len(runs)
     size = chunk_size(time.perf_counter() - t1, samples - done, workers)
     chunks = [rows[i: i + size] for i in range(done, samples, size)]
     if progress is not None:
         progress(done, samples)
-    futures = [executor.submit(simulate_chunk, params, c, d) for c in chunks] if executor is not None else None
+    futures = [executor.submit(simulate_chunk, params, c, d, plant) for c in chunks] if executor is not None else None
     for j, c in enumerate(chunks):
         if cancelled is not None and cancelled():
             for f in futures or []:
                 f.cancel()
             raise ParameterError(f"robustness run cancelled after {len(runs)} of {samples} samples")
-        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d))
+        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d, plant))
         if progress is not None:
             progress(len(runs), samples)
     return RobustnessResult(values, runs, summarise(runs, time.perf_counter() - t0))
