@@ -20,8 +20,8 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 
-from app.cli.robustness import parse_spreads
 from app.io.presets import load_preset
+from app.io.study_inputs import parse_spreads
 from sim.studies.robustness import robustness, simulate_chunk
 
 

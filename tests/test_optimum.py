@@ -14,9 +14,9 @@ from scipy.linalg import expm
 
 from app.cli.main import main
 from app.io.presets import load_preset
+from control.common.checks import ParameterError
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
 from control.fdsmc.optimum import MoveModel, closed_form, hamiltonian_matrix, move_model, numerical_optimum
-from control.fdsmc.params import ParameterError
 from sim.fdsmc.engine import compare
 
 PAPER_TM = (1.0, 1.4, 1.8, 2.2, 2.6)  # Table 1 of the FDSMC paper

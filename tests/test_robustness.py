@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from app.cli.main import main
-from app.cli.robustness import parse_spread, parse_spreads
 from app.io.plant_overrides import load_model_and_plant
 from app.io.presets import load_preset
+from app.io.study_inputs import parse_spread, parse_spreads
 from control.common.checks import ParameterError
 from sim.fdsmc.engine import compare
 from sim.studies.robustness import METRICS, TRACE_POINTS, Spread, draw, robustness
@@ -91,7 +91,7 @@ def test_zero_spread_reproduces_the_nominal_run_exactly():
 _DASK_SCRIPT = """
 import json
 from dask.distributed import Client, LocalCluster
-from app.cli.robustness import parse_spreads
+from app.io.study_inputs import parse_spreads
 from app.io.presets import load_preset
 from sim.studies.robustness import robustness
 params = load_preset("siemens_1ft7044_ak7")

@@ -23,8 +23,8 @@ from app.ui.studies import optimum_markdown
 from app.ui.studies_multiaxis import axis_line, check_axes, default_axes, parse_page_axes
 from app.ui.studies_robustness import STUDY_MAX_STEPS, check_study, parse_page_spreads
 from app.ui.text import md_text
+from control.common.checks import ParameterError
 from control.fdsmc.feasibility import torque_limit
-from control.fdsmc.params import ParameterError
 from sim.common.budget import BudgetError
 from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, check_budget, compare
 from sim.fdsmc.optimum_gap import saving_vs_optimum

@@ -41,16 +41,8 @@ def chosen_command(argv: list[str]) -> str | None:
     return next((a for a in argv if not a.startswith("-")), None)
 
 
-def _available(module: str) -> bool:
-    """Tell whether the sub-command's module exists (found without importing it)."""
-    try:
-        return importlib.util.find_spec(module) is not None
-    except ModuleNotFoundError:
-        return False
-
-
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """Build the argument parser with every available sub-command.
+    """Build the argument parser with every sub-command.
 
     Only the module of ``command`` is imported (and its arguments added): a sub-command's module
     imports what it needs (numba kernels, scipy, plotly …), so importing all of them would make
@@ -60,8 +52,6 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m app", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for name, (module, help_text) in COMMANDS.items():
-        if not _available(module):
-            continue
         p = sub.add_parser(name, help=help_text, description=help_text)
         if command is None or command == name:
             mod = importlib.import_module(module)

@@ -16,11 +16,9 @@ from typing import Any
 
 from app.io.json_data import to_json
 from app.io.presets import loads_raw
-from app.io.study_inputs import MAX_AXES, parse_axes
+from app.io.study_inputs import parse_axes
 from control.common.checks import ParameterError
 from sim.studies.multiaxis import MultiAxisResult, coordinate
-
-__all__ = ["MAX_AXES", "add_arguments", "multiaxis_json", "parse_axes", "run"]
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

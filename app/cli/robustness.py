@@ -22,13 +22,12 @@ from app.cli.main import add_preset_arguments, check_writable
 from app.io.json_data import to_json
 from app.io.plant_overrides import load_model_and_plant
 from app.io.sample_table import write_csv, write_parquet
-from app.io.study_inputs import parse_spread, parse_spreads
+from app.io.study_inputs import parse_spreads
 from control.common.checks import ParameterError
 from sim.studies.robustness import METRICS, robustness
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
 MAX_SAMPLES = 1_000_000
-__all__ = ["add_arguments", "parse_spread", "parse_spreads", "run", "write_csv"]
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

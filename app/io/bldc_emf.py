@@ -10,7 +10,7 @@ Accepted forms (one electrical period, angles in electrical degrees):
 Values are Φ'_r = e/ω_e [Wb = V·s/rad]. A waveform recorded in volts at a known speed can be
 given with ``n_rpm`` and ``n_pp``: Φ' = e/(n_pp·n_rpm·2π/60). The checks (period, NaN,
 periodicity, 120° shifts) are those of :func:`sim.bldc.emf.resample_measured`; every problem
-raises :class:`~control.fdsmc.params.ParameterError` naming row, value and what is allowed.
+raises :class:`~control.common.checks.ParameterError` naming row, value and what is allowed.
 """
 
 from __future__ import annotations

@@ -14,7 +14,8 @@ from typing import Any
 
 from app.io.plant_overrides import plant_section
 from app.io.presets import load_preset
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 from sim.studies.robustness import MAX_NORMAL_SIGMA, Spread
 
 #: Most axes of one multi-axis set [-].

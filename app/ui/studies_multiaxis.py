@@ -19,7 +19,8 @@ from app.io.presets import MAX_BYTES, loads_raw
 from app.io.study_inputs import parse_axes
 from app.ui.replay import set_figure_json
 from app.ui.text import md_text
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import check_budget
 from sim.studies.multiaxis import MultiAxisResult, coordinate
 

@@ -24,8 +24,9 @@ from app.io.study_inputs import parse_spread
 from app.ui.replay import set_figure_json
 from app.ui.text import md_text
 from app.ui.worker import Cancelled
+from control.common.checks import ParameterError
 from control.fdsmc.feasibility import torque_limit
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.common.budget import MAX_STEPS, BudgetError
 from sim.fdsmc.engine import check_budget
 from sim.studies.robustness import TRACE_POINTS, RobustnessResult, Spread, robustness

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from control.fdsmc.params import ParameterError
+from control.common.checks import ParameterError
 
 
 def check_controller(controller: str, allowed: Sequence[str]) -> None:
-    """Raise :class:`~control.fdsmc.params.ParameterError` unless ``controller`` is one of ``allowed``.
+    """Raise :class:`~control.common.checks.ParameterError` unless ``controller`` is one of ``allowed``.
 
     Parameters
     ----------

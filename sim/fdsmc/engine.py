@@ -21,9 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.model import model_coefficients, torque_constant
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.common import budget
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn

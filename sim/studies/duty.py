@@ -21,8 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.engine import continuous_step, pack_parameters, plant_substeps
 from sim.studies.cycle_kernel import run_cycle

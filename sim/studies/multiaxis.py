@@ -12,7 +12,8 @@ import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from control.fdsmc.params import DriveParams, ParameterError
+from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc.design import DriveDesign, design_drive
 from sim.fdsmc.verdicts import TARGET_BAND
 

@@ -26,9 +26,10 @@ from typing import Any
 
 import numpy as np
 
+from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
-from control.fdsmc.params import DriveParams, ParameterError
+from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import CONTROLLERS, RunResult, reached_target, simulate
 
 #: Metrics summarised per controller; the worst case is the largest value (errors as |·|).
