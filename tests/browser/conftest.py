@@ -2,7 +2,8 @@
 
 * ``ui_server`` (session): the web UI on a free loopback port, 3D view and HDRI off.
 * ``browser`` (session): Debian's Chromium driven by Playwright (never ``playwright install``).
-* ``page`` (function): a fresh 1400×900 context + page, connected and showing the phase plane.
+* ``page`` (function): a fresh 1400×900 context + page, connected, showing the phase plane, fitted.
+* :func:`click_tab` selects a tab once its box is steady (the tab row moves while a page opens).
 * :func:`figure` reads a Plotly figure out of the page by its ``layout.meta.id``.
 
 Missing Chromium or Playwright: a failure when ``CI=true``, a skip otherwise.
@@ -81,22 +82,104 @@ def browser() -> Iterator[Any]:
             b.close()
 
 
-def open_page(browser: Any, url: str) -> tuple[Any, Any]:
-    """A new context + page at ``url``, waited until the phase plane is drawn. Returns (context, page)."""
-    context = browser.new_context(viewport=VIEWPORT, accept_downloads=True)
+def open_page(browser: Any, ui: UiServer, viewport: dict[str, int] | None = None) -> tuple[Any, Any]:
+    """A new context + page of ``ui``, waited until the phase plane is drawn and the panels are
+    fitted to the window (:func:`wait_for_layout`). Returns (context, page).
+    """
+    context = browser.new_context(viewport=viewport or VIEWPORT, accept_downloads=True)
     page = context.new_page()
     page.set_default_timeout(TIMEOUT_MS)
-    page.goto(url)
-    page.get_by_role("button", name="Simulate").wait_for()
+    before = set(ui.config.sessions)
+    page.goto(ui.url)
+    # first draw of the page: allowed 3× the usual wait (a loaded 2-core machine needs > 30 s)
+    page.get_by_role("button", name="Simulate").wait_for(timeout=3 * TIMEOUT_MS)
     page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')]"
-                           ".some(e => e.layout && e.layout.meta && e.layout.meta.id === 'phase_plane')")
+                           ".some(e => e.layout && e.layout.meta && e.layout.meta.id === 'phase_plane')",
+                           timeout=3 * TIMEOUT_MS)
+    wait_for_layout(page, session_of(page, ui, before))
     return context, page
+
+
+def session_of(page: Any, ui: UiServer, before: set[int]) -> Any:
+    """The server-side session that ``page`` opened (the one not in ``before``).
+
+    The server registers a session once it is built, which may be just after its first figures
+    reached the page: polled until it is there.
+    """
+    for _ in range(TIMEOUT_MS // 20):
+        new = [cid for cid in list(ui.config.sessions) if cid not in before]
+        if new:
+            assert len(new) == 1, f"expected exactly one new session for the page, found {new}"
+            return ui.config.sessions[new[0]]
+        page.wait_for_timeout(20)  # poll the server's state again (a positive condition)
+    raise AssertionError(f"the page opened no session on the server within {TIMEOUT_MS} ms")
+
+
+# Widths of the results panel (the dock group holding the "Overview" tab) [px], recorded once per
+# animation frame; true once it showed ``want`` in three frames running (stable over two frames).
+PANEL_FITTED_JS = """(want) => {
+  const tab = [...document.querySelectorAll('[role="tab"]')].find(t => t.title === 'Overview');
+  const w = tab ? tab.closest('[data-dock-tab]').parentElement.getBoundingClientRect().width : -1;
+  const seen = window.__panelWidths = (window.__panelWidths || []).concat([w]).slice(-3);
+  return seen.length === 3 && seen.every(v => Math.abs(v - want) <= 1);
+}"""
+
+
+def wait_for_layout(page: Any, session: Any) -> None:
+    """Wait until the panels are fitted to the page's window and the server agrees.
+
+    The server sizes the panels from the canvas size each camera message reports
+    (``app/ui/layout.py``), so while a page opens the results panel changes width several times
+    and its tab row moves. Fitted means: the browser shows the results width
+    ``layout_for_window(viewport)`` in three animation frames running, the server holds that
+    layout, and the last canvas size the server received is the one that layout leaves (so no
+    earlier report is still to be answered with another width).
+    """
+    from app.ui.layout import BORDERS, layout_for_window
+
+    vp = page.viewport_size
+    for _ in range(TIMEOUT_MS // 50):
+        want = layout_for_window(vp["width"], vp["height"], session.fit.show_3d)
+        canvas = vp["width"] - want.control_width - want.results_width - BORDERS
+        page.wait_for_function(PANEL_FITTED_JS, arg=want.results_width, polling="raf")
+        if session.fit.layout == want and abs(session.client.camera.image_width - canvas) <= 2:
+            return
+        page.wait_for_timeout(50)  # poll the server's state again (a positive condition)
+    raise AssertionError(f"panels not fitted to the {vp} window: server layout {session.fit.layout}")
+
+
+# A tab's bounding box, recorded once per animation frame; true once it stayed the same in three
+# frames running and the tab itself (not a neighbour) is the element under its centre.
+TAB_STEADY_JS = """(tab) => {
+  const r = tab.getBoundingClientRect();
+  const key = [r.x, r.y, r.width, r.height].join();
+  const seen = tab.__boxes = (tab.__boxes || []).concat([key]).slice(-3);
+  if (r.width === 0 || seen.length < 3 || seen.some(k => k !== key)) return false;
+  const hit = document.elementFromPoint(r.x + r.width / 2, r.y + r.height / 2);
+  return hit !== null && tab.contains(hit);
+}"""
+
+
+def click_tab(page: Any, name: str) -> None:
+    """Select the tab ``name`` (results panel or control panel) and wait until it is selected.
+
+    Clicks only once the tab's box has been steady over two animation frames and nothing covers
+    it, so a tab row re-laid out under the pointer cannot take the click. Viser's "software WebGL"
+    notice, shown in headless Chromium, may lie over the tab row: notifications let clicks through.
+    """
+    page.add_style_tag(content=".mantine-Notifications-root, .mantine-Notifications-root * "
+                               "{ pointer-events: none !important; }")
+    tab = page.get_by_role("tab", name=name, exact=True)
+    tab.wait_for()
+    page.wait_for_function(TAB_STEADY_JS, arg=tab.element_handle(), polling="raf")
+    tab.click()
+    page.wait_for_function("(t) => t.getAttribute('aria-selected') === 'true'", arg=tab.element_handle())
 
 
 @pytest.fixture
 def page(browser: Any, ui_server: UiServer) -> Iterator[Any]:
-    """A connected page of the web UI (own browser context = own session)."""
-    context, pg = open_page(browser, ui_server.url)
+    """A connected page of the web UI (own browser context = own session), fitted to its window."""
+    context, pg = open_page(browser, ui_server)
     try:
         yield pg
     finally:

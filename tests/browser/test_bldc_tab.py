@@ -5,21 +5,21 @@ skips, under CI=true when Chromium is missing).
 
 from __future__ import annotations
 
-from tests.browser.conftest import field, figure
+from tests.browser.conftest import click_tab, field, figure
 
 FIG_JS = ("(id) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"
           " && e.layout.meta.id === id && e.data.length >= 4)")
 
 
 def _open_tab(page) -> None:
-    page.get_by_role("tab", name="BLDC speed SMC").click()
+    click_tab(page, "BLDC speed SMC")
     page.get_by_role("button", name="Simulate BLDC").wait_for()
 
 
 def test_bldc_tab_runs_paper_scenario_and_shows_metrics_and_speed_figure(page):
     _open_tab(page)
     page.get_by_role("button", name="Simulate BLDC").click()
-    page.get_by_role("tab", name="BLDC figures").click()  # the figures live in the wide results panel
+    click_tab(page, "BLDC figures")  # the figures live in the wide results panel
     page.wait_for_function(FIG_JS, arg="bldc_speed", timeout=60_000)
     page.get_by_text("Steady-state speed error").first.wait_for()
     # metrics table: one row per metric, one column per drive

@@ -30,7 +30,7 @@ def default_server() -> Iterator[UiServer]:
 
 @pytest.fixture
 def page(browser: Any, default_server: UiServer) -> Iterator[Any]:
-    context, pg = open_page(browser, default_server.url)
+    context, pg = open_page(browser, default_server)
     try:
         yield pg
     finally:

@@ -12,6 +12,7 @@ import pytest
 import viser
 
 from app.io.presets import PRESET_DIR, loads_preset
+from tests.browser.conftest import click_tab
 
 OPEN_WS_JS = """async ([url, protocol]) => await new Promise((resolve) => {
   const ws = new WebSocket(url, [protocol]);
@@ -66,7 +67,7 @@ def test_markup_in_file_and_preset_names_is_shown_as_text(page):
         "name: bldc_smc_paper", f"name: '{MARKUP}'")
     assert loads_preset(text).name == MARKUP
     file_name = "`<img src=x onerror=alert(1)>`.yaml"
-    page.get_by_role("tab", name="BLDC speed SMC").click()
+    click_tab(page, "BLDC speed SMC")
     with page.expect_file_chooser() as chooser:
         page.get_by_role("button", name="Import BLDC preset (YAML)").click()
     chooser.value.set_files(files=[{"name": file_name, "mimeType": "text/yaml", "buffer": text.encode()}])

@@ -7,7 +7,7 @@ import shutil
 
 from app.ui.log import EXAMPLE_LOG
 from sim.drivelog.synthetic import TRUE_MOTOR
-from tests.browser.conftest import figure
+from tests.browser.conftest import click_tab, figure
 
 
 def _session(ui_server, page):
@@ -26,7 +26,7 @@ def test_upload_log_overlay_identify_apply_and_simulate_again(page, ui_server, t
     page.get_by_text("Drive log (measured)").click()
     page.get_by_role("button", name="Load example log").click()
     page.get_by_text(re.compile(r"drive_log_dq\.csv: 6800 samples at 10000 Hz")).wait_for()
-    page.get_by_role("tab", name="Drive log").click()
+    click_tab(page, "Drive log")
     page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')]"
                            ".some(e => e.layout && e.layout.meta && e.layout.meta.id === 'log-overlay')")
     _runs_text(page, runs + 1)

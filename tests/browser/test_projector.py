@@ -13,7 +13,7 @@ import pytest
 
 from app.figures.overview import CURSORS
 from app.figures.replay import SPEEDS
-from tests.browser.conftest import ARTIFACTS, TIMEOUT_MS
+from tests.browser.conftest import ARTIFACTS, TIMEOUT_MS, UiServer, click_tab, session_of, wait_for_layout
 
 DOCS = ARTIFACTS.parent / "docs"
 
@@ -49,24 +49,27 @@ FRAMES_JS = """() => {
 }""".replace("CURSOR", json.dumps(CURSORS[0]))
 
 
-def _open(browser: Any, url: str, width: int, height: int) -> tuple[Any, Any]:
+def _open(browser: Any, ui: UiServer, width: int, height: int) -> tuple[Any, Any]:
+    """A page of ``ui`` in a ``width`` × ``height`` window, drawn and fitted (:func:`wait_for_layout`)."""
     context = browser.new_context(viewport={"width": width, "height": height})
     page = context.new_page()
     page.set_default_timeout(TIMEOUT_MS)
-    page.goto(url)
+    before = set(ui.config.sessions)
+    page.goto(ui.url)
     # first draw of the page: allowed 3× the usual wait (a loaded 2-core machine needs > 30 s)
     page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')]"
                            ".some(e => e.layout && e.layout.meta && e.layout.meta.overview"
                            " && e._fullLayout && e._fullLayout.xaxis2)", timeout=3 * TIMEOUT_MS)
     for close in page.locator(".mantine-Notification-closeButton").all():
         close.click()  # e.g. viser's "software WebGL" notice
+    wait_for_layout(page, session_of(page, ui, before))
     return context, page
 
 
 @pytest.fixture
 def projector(browser: Any, ui_server: Any) -> Iterator[Any]:
     """A page in a 1280×720 window, fitted (the results panel reached its width for this window)."""
-    context, page = _open(browser, ui_server.url, 1280, 720)
+    context, page = _open(browser, ui_server, 1280, 720)
     try:
         yield page
     finally:
@@ -98,7 +101,7 @@ def test_1280x720_shows_phase_plane_time_plot_and_numbers_without_scrolling(proj
 
 
 def test_wide_screen_gives_the_results_more_than_half_the_width(browser, ui_server):
-    context, page = _open(browser, ui_server.url, 1920, 1080)
+    context, page = _open(browser, ui_server, 1920, 1080)
     try:
         page.wait_for_function(f"() => {{ const b = ({BOXES_JS})(); return b.results > 960 && b.phase.width > 600; }}")
         boxes = page.evaluate(BOXES_JS)
@@ -171,7 +174,7 @@ CANVAS_JS = "() => getComputedStyle(document.querySelector('canvas')).visibility
 
 
 def test_3d_view_folds_by_default_and_hides_in_the_bldc_tab(browser, server_3d):
-    context, page = _open(browser, server_3d.url, 1280, 720)
+    context, page = _open(browser, server_3d, 1280, 720)
     try:
         session = max(server_3d.config.sessions.values(), key=lambda s: s.client.client_id)
         scene = session.results.replay._scene
@@ -182,9 +185,9 @@ def test_3d_view_folds_by_default_and_hides_in_the_bldc_tab(browser, server_3d):
         page.wait_for_function("() => document.querySelector('canvas').getBoundingClientRect().width > 250")
         assert scene.visible and session.fit.layout.results_width < folded_width
         assert page.evaluate(CANVAS_JS) == "visible"
-        page.get_by_role("tab", name="BLDC speed SMC").click()
+        click_tab(page, "BLDC speed SMC")
         page.wait_for_function(f"() => ({CANVAS_JS})() === 'hidden'")
-        page.get_by_role("tab", name="Position drive (FDSMC)").click()
+        click_tab(page, "Position drive (FDSMC)")
         page.wait_for_function(f"() => ({CANVAS_JS})() === 'visible'")
     finally:
         context.close()

@@ -8,7 +8,7 @@ from typing import Any
 
 from app.figures.comparison import LABELS
 from sim.fdsmc.verdicts import TARGET_BAND
-from tests.browser.conftest import figure, set_number
+from tests.browser.conftest import click_tab, figure, set_number
 
 PROGRESS_JS = """() => {
   const bars = [...document.querySelectorAll('[role=progressbar]')].filter(e => e.offsetParent !== null);
@@ -39,13 +39,9 @@ ARRIVAL_JS = """() => {
 
 
 def _open_tab(page: Any, name: str) -> None:
-    """Select a results tab (the studies' tabs sit inside "Studies"). Viser's "software WebGL" notice,
-    shown in headless Chromium, may cover the tab row: notifications let clicks through first.
-    """
-    page.add_style_tag(content=".mantine-Notifications-root, .mantine-Notifications-root * "
-                               "{ pointer-events: none !important; }")
+    """Select a results tab (the studies' tabs sit inside "Studies")."""
     for label in (("Studies", name) if name in ("Robustness", "Multi-axis") else (name,)):
-        page.get_by_role("tab", name=label).click()
+        click_tab(page, label)
 
 
 def _session(ui_server: Any, page: Any) -> Any:

@@ -130,8 +130,8 @@ def test_export_of_edited_but_unsimulated_inputs_is_refused(page):
 
 
 def test_two_browser_contexts_keep_separate_values(browser, ui_server):
-    ctx_a, page_a = open_page(browser, ui_server.url)
-    ctx_b, page_b = open_page(browser, ui_server.url)
+    ctx_a, page_a = open_page(browser, ui_server)
+    ctx_b, page_b = open_page(browser, ui_server)
     try:
         params = load_preset(PAPER_PRESET)
         new = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=2.2))
