@@ -14,13 +14,12 @@ from control.fdsmc.conventional import ConventionalGains, conventional_gains, fr
 from control.fdsmc.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
 from control.fdsmc.loop_analysis import (
     GainRecommendation,
-    LoopCase,
-    LoopModel,
     SampleRateCheck,
     loop_warnings,
     recommend_K,
     sample_rate_check,
 )
+from control.fdsmc.loop_model import LoopCase, LoopModel
 from control.fdsmc.model import ModelCoefficients, model_coefficients
 from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer, observer_gains
@@ -73,8 +72,8 @@ class Derived:
     @property
     def loop(self) -> LoopCase:
         """The linearised loop of this case (model, observer and outer laws)."""
-        return LoopCase(self.coefficients, self.params, self.observer, self.alpha.alpha_max, self.profile.T_c,
-                        self.conventional.g1, self.conventional.g2)
+        return LoopCase.of_case(LoopModel.of(self.coefficients, self.params, self.observer), self.params,
+                                self.alpha.alpha_max, self.profile.T_c, self.conventional.g1, self.conventional.g2)
 
 
 def predicted_energy(params: DriveParams, profile: VelocityProfile) -> EnergyPrediction:
@@ -105,13 +104,14 @@ def derive(params: DriveParams) -> Derived:
     obs = observer_gains(params.controller.T_so, coeff.M)
     ctrl = params.controller
     f_s = None if ctrl.is_continuous else float(ctrl.f_s)
-    eta = acceleration_overshoot(LoopModel(coeff, params, obs), f_s, ctrl.delay_samples)
+    lm = LoopModel.of(coeff, params, obs)
+    eta = acceleration_overshoot(lm, f_s, ctrl.delay_samples)
     alpha = alpha_max(params, eta)
     obs_d = None if ctrl.is_continuous else discrete_observer(obs, coeff.M, float(ctrl.f_s))
     prof = velocity_profile(params.manoeuvre.theta_dem, alpha.alpha_max, params.manoeuvre.T_m, ctrl.T_c)
     feas = feasibility(params, alpha, prof.omega_p)
     conv = conventional_gains(params.manoeuvre.T_m)
-    loop = LoopCase(coeff, params, obs, alpha.alpha_max, prof.T_c, conv.g1, conv.g2)
+    loop = LoopCase.of_case(lm, params, alpha.alpha_max, prof.T_c, conv.g1, conv.g2)
     gain, rate = recommend_K(loop), sample_rate_check(loop)
     return Derived(
         params=params,
