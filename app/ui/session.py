@@ -210,6 +210,7 @@ class Session:
             self.worker.submit(self._tune_loop)
 
     def _tune_loop(self) -> None:
+        """Re-simulate the latest values while a slider moves; the overview only, the rest once it stops."""
         while self._tune_pending:
             self._tune_pending = False
             try:
@@ -217,7 +218,9 @@ class Session:
             except InputError as exc:
                 self._reject(str(exc))
                 return
-            self._run(params, autoplay=False)
+            self._run(params, autoplay=False, overview_only=True)
+        if self.comparison is not None and self.comparison.fdsmc is not None:
+            self.results.show_rest()
 
     def _apply_knob(self, key: str, value_si: float) -> None:
         """Write a live-tuning slider's value into the inputs panel, as if typed."""
@@ -226,7 +229,7 @@ class Session:
         else:
             self.inputs.set_value(key, value_si)
 
-    def _run(self, params: DriveParams, autoplay: bool = True) -> None:
+    def _run(self, params: DriveParams, autoplay: bool = True, overview_only: bool = False) -> None:
         self.status.content = "Simulating…"
         self.design_note.content = ""
         self.worker.checkpoint()
@@ -235,7 +238,7 @@ class Session:
         self.params, self.comparison, self.error = params, comparison, None
         self.runs += 1
         if comparison.fdsmc is not None:
-            self.results.show(comparison, autoplay=autoplay)
+            self.results.show(comparison, autoplay=autoplay, overview_only=overview_only)
         else:
             self.results.show_derived_only(comparison)
         self._show_text()
