@@ -138,6 +138,11 @@ class Session:
         self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
         self.cancel_button.on_click(lambda _: self.cancel())
         self.status = gui.add_markdown("Ready.")
+        self.fold_warnings = gui.add_checkbox("Fold warnings to one line", False,
+                                              hint="Keeps the warnings box folded over new runs; a click on "
+                                                   "its first line still opens it once")
+        self.fold_warnings.on_update(lambda _: self._render_warnings())
+        self._warning_parts: tuple[list[str], str | None, list[str]] = ([], None, [])
         self.warnings = gui.add_html("")
         self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
         self.use_k.on_click(lambda _: self._use_recommended_k())
@@ -307,7 +312,7 @@ class Session:
         items = list(d.warnings) + run_warnings(self.comparison) + self._nameplate_warnings()
         if self.comparison.fdsmc is None:
             items.append("Not simulated: the manoeuvre is infeasible (see above).")
-        self.warnings.content = warnings_html(items, self.error, comparator_notes(self.comparison))
+        self._render_warnings((items, self.error, comparator_notes(self.comparison)))
         chatter = any(r is not None and r.metrics.chatter
                       for r in (self.comparison.fdsmc, self.comparison.conventional))
         k_rec = recommended_K(d)
@@ -332,9 +337,16 @@ class Session:
         return [f"Nameplate: {x.text}" for x in nameplate_consistency(self.params.motor, **extra)
                 if x.text not in general]
 
+    def _render_warnings(self, parts: tuple[list[str], str | None, list[str]] | None = None) -> None:
+        """Show the warnings (new ``parts``, or the last ones), folded to one line if the user asked."""
+        if parts is not None:
+            self._warning_parts = parts
+        items, error, notes = self._warning_parts
+        self.warnings.content = warnings_html(items, error, notes, folded=bool(self.fold_warnings.value))
+
     def _reject(self, message: str) -> None:
         self.error = message
-        self.warnings.content = warnings_html([], message)
+        self._render_warnings(([], message, []))
         self.client.add_notification("Input rejected — nothing simulated", message, color="red",
                                      auto_close_seconds=12.0)
 
