@@ -199,13 +199,13 @@ LAST_CLICK: list[float] = []
 def split(ws: WsCounter) -> tuple[float, float] | None:
     """(click → the overview's message arrived, arrived → drawn) [s] of the last click of ``ws``'s page.
 
-    The overview is the biggest message between the click and the drawn trajectory.
+    The overview is the first message of ≥ 20 kB after the click (it goes out first, then the time plots).
     """
     t0, t1 = LAST_CLICK
-    within = [(n, t) for t, n in ws.arrivals if t0 <= t <= t1]
+    within = [t for t, n in ws.arrivals if t0 <= t <= t1 and n >= 20_000]
     if not within or t1 != t1:
         return None
-    t_arrived = max(within)[1]
+    t_arrived = within[0]
     return (t_arrived - t0) / 1e3, (t1 - t_arrived) / 1e3
 
 

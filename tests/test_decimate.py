@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from app.figures.comparison import TIME_ROWS, time_plots_spec
-from app.figures.decimate import BINS_PHASE, envelope, minmax_index
+from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, minmax_index
 from app.figures.overview import motor_torque, overview_spec
 from app.figures.plain import figure_json
 from sim.fdsmc.engine import LABELS, compare
@@ -81,7 +81,7 @@ def test_drawn_time_plots_span_the_runs_range_and_end_at_its_ends(comparison):
                 d = traces[f"{label} {LABELS[key]}"]
                 y = np.frombuffer(__import__("base64").b64decode(d["y"]["bdata"]), dtype=np.float32)
                 full = np.asarray(getattr(tr, attr), dtype=np.float32)
-                assert len(y) <= 2 * 640 + 2
+                assert len(y) <= 2 * BINS_TIME_PLOTS + 2
                 assert y.max() == full.max() and y.min() == full.min(), (key, attr)
                 assert y[0] == full[0] and y[-1] == full[-1]
                 assert d["x0"] == pytest.approx(tr.t[0]) and d["x0"] + d["dx"] * (len(y) - 1) == pytest.approx(tr.t[-1])

@@ -32,7 +32,7 @@ from sim.fdsmc.engine import Comparison
 #: Replay speeds: button label → simulated seconds per wall-clock second.
 SPEEDS = {"1×": 1.0, "0.25×": 0.25, "0.1×": 0.1, "0.01×": 0.01}
 #: Key frames per wall-clock second, and the most key frames per speed (bounds the figure size).
-KEY_RATE, MAX_FRAMES = 15.0, 150
+KEY_RATE, MAX_FRAMES = 10.0, 150
 #: Positions on the scrub slider.
 SLIDER_STEPS = 100
 

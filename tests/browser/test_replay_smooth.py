@@ -45,7 +45,7 @@ SLOWEST = f"▶ {list(SPEEDS)[-1]}"
 def _assert_smooth(samples: list[list[float]], share: float = 0.8, jumps: bool = True) -> None:
     """Marker and cursor move in ≥ ``share`` of the animation frames, the cursor rightwards, no big jump.
 
-    A replay without glides moves only at its key frames (every 1/15 s at best, ≈0.5 s at 0.01×), so
+    A replay without glides moves only at its key frames (every 1/10 s at best, ≈0.5 s at 0.01×), so
     most animation frames would show no motion and each key frame a jump.
     """
     pairs = [(a, b) for a, b in zip(samples, samples[1:], strict=False) if a[3] == b[3]]  # same plot size
@@ -59,7 +59,7 @@ def _assert_smooth(samples: list[list[float]], share: float = 0.8, jumps: bool =
 
 
 def test_slowest_replay_glides_the_marker_and_the_cursor_in_the_page(page):
-    # 0.01×: one key frame per 1/15 s of wall time at most; skip the first key frame (a jump to t = 0)
+    # 0.01×: one key frame per 1/10 s of wall time at most; skip the first key frame (a jump to t = 0)
     samples = page.evaluate(SAMPLE_JS, [SLOWEST, 40, 800])
     # the page's panels may be re-fitted to the window meanwhile: frames across a resize are left out,
     # a few frames right after one read positions not yet redrawn, and the page's animation frames
