@@ -40,6 +40,12 @@ def template_json(name: str) -> str:
     return json.dumps(slim, separators=(",", ":"))
 
 
+@functools.cache
+def slim_template(name: str = "plotly_white") -> go.layout.Template:
+    """The cut template of :func:`template_json` as a ``go.layout.Template`` (for ``go.Figure`` figures)."""
+    return go.layout.Template(json.loads(template_json(name)))
+
+
 def _default(obj: Any) -> Any:
     if isinstance(obj, np.ndarray):
         if obj.dtype.kind == "f":
@@ -74,4 +80,4 @@ def to_figure(spec: dict[str, Any]) -> go.Figure:
     return go.Figure(spec)
 
 
-__all__ = ["figure_json", "template_json", "to_figure"]
+__all__ = ["figure_json", "slim_template", "template_json", "to_figure"]
