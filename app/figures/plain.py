@@ -42,7 +42,7 @@ def template_json(name: str) -> str:
 
 @functools.cache
 def slim_template(name: str = "plotly_white") -> go.layout.Template:
-    """The cut template of :func:`template_json` as a ``go.layout.Template`` (for ``go.Figure`` figures)."""
+    """Return the cut template of :func:`template_json` as a ``go.layout.Template`` (for ``go.Figure``)."""
     return go.layout.Template(json.loads(template_json(name)))
 
 
