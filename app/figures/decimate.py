@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 #: Bins (two points each) of the page's figures: about one per pixel of the plot's drawing width.
-BINS_TIME_PLOTS, BINS_OVERVIEW_ROWS, BINS_PHASE = 400, 300, 700
+BINS_TIME_PLOTS, BINS_OVERVIEW_ROWS, BINS_PHASE = 400, 300, 500
 
 
 def f32(a: np.ndarray) -> np.ndarray:

@@ -34,7 +34,7 @@ SPEEDS = {"1×": 1.0, "0.25×": 0.25, "0.1×": 0.1, "0.01×": 0.01}
 #: Key frames per wall-clock second, and the most key frames per speed (bounds the figure size).
 KEY_RATE, MAX_FRAMES = 10.0, 150
 #: Positions on the scrub slider.
-SLIDER_STEPS = 100
+SLIDER_STEPS = 50
 
 
 def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = ()) -> str:
