@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from app.io.bldc_emf import read_measured, with_measured
-from app.io.presets import PresetError, dumps_preset, load_preset, loads_preset
+from app.io.preset_schema import PresetError
+from app.io.presets import dumps_preset, load_preset, loads_preset
 from app.io.units import rad_s_to_rpm
 from control.common.checks import ParameterError
 from sim.bldc import emf as bldc_emf

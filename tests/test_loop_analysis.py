@@ -14,14 +14,13 @@ import pytest
 from app.io.presets import load_preset
 from control.fdsmc.derivations import derive
 from control.fdsmc.loop_analysis import (
-    continuous_loop,
     gain_limit,
     minimum_sample_rate,
     recommend_K,
-    reduce_shift_mode,
     sample_rate_check,
     stability_measure,
 )
+from control.fdsmc.loop_model import continuous_loop, reduce_shift_mode
 from sim.fdsmc.engine import simulate
 
 

@@ -9,8 +9,8 @@ import pytest
 
 from app.cli.main import main
 from app.io.plant_overrides import load_model_and_plant
+from app.io.preset_schema import PresetError
 from app.io.presets import (
-    PresetError,
     dumps_preset,
     load_preset,
     load_preset_and_plant,

@@ -10,7 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from app.io import presets
-from app.io.presets import PresetError, dumps_preset, load_preset, loads_preset, to_raw
+from app.io.preset_schema import PresetError, parse_preset
+from app.io.presets import dumps_preset, load_preset, loads_preset, to_raw
 from control.common.checks import ParameterError
 
 RAW_OK = dict  # alias for readability
@@ -45,25 +46,25 @@ def test_unknown_key_did_you_mean():
     raw = _raw()
     raw["motor"]["Ld"] = raw["motor"].pop("L_d")
     with pytest.raises(PresetError, match=r"unknown key motor.Ld — did you mean 'L_d'"):
-        presets.parse_preset(raw)
+        parse_preset(raw)
 
 
 def test_missing_key_and_section():
     raw = _raw()
     del raw["motor"]["R_s"]
     with pytest.raises(PresetError, match="missing key.*R_s"):
-        presets.parse_preset(raw)
+        parse_preset(raw)
     raw = _raw()
     del raw["load"]
     with pytest.raises(PresetError, match="missing section 'load'"):
-        presets.parse_preset(raw)
+        parse_preset(raw)
 
 
 def test_wrong_type():
     raw = _raw()
     raw["motor"]["L_d"] = "five"
     with pytest.raises(PresetError, match=r"motor.L_d = 'five' is not a number: allowed decimal or scientific"):
-        presets.parse_preset(raw)
+        parse_preset(raw)
 
 
 @pytest.mark.parametrize(
@@ -83,7 +84,7 @@ def test_impossible_values_named(section, key, value, match):
     raw = _raw()
     raw[section][key] = value
     with pytest.raises(ParameterError, match=match):
-        presets.parse_preset(raw)
+        parse_preset(raw)
 
 
 def test_unit_aliases_convert_at_the_edge():
@@ -94,7 +95,7 @@ def test_unit_aliases_convert_at_the_edge():
     del raw["motor"]["P_r"]
     raw["motor"]["omega_b_rpm"] = 150 * 60 / (2 * math.pi)
     del raw["motor"]["omega_b"]
-    p = presets.parse_preset(raw)
+    p = parse_preset(raw)
     assert p.motor.L_d == pytest.approx(5.4e-3)
     assert p.motor.P_r == pytest.approx(12000.0)
     assert p.motor.omega_b == pytest.approx(150.0)
@@ -104,7 +105,7 @@ def test_si_and_alias_both_given_is_an_error():
     raw = _raw()
     raw["motor"]["L_d_mH"] = 5.4
     with pytest.raises(PresetError, match="more than once"):
-        presets.parse_preset(raw)
+        parse_preset(raw)
 
 
 def test_overrides():
@@ -122,10 +123,10 @@ def test_exponent_numbers_without_a_dot_are_numbers():
     assert p.controller.T_so == 2e-4 and p.motor.J_r == 0.03
     raw = _raw()
     raw["controller"]["T_so"] = "2e-4"
-    assert presets.parse_preset(raw).controller.T_so == 2e-4
+    assert parse_preset(raw).controller.T_so == 2e-4
     raw["controller"]["T_so"] = "2e-4 s"
     with pytest.raises(PresetError, match=r"controller.T_so = '2e-4 s' is not a number: allowed decimal"):
-        presets.parse_preset(raw)
+        parse_preset(raw)
 
 
 def test_yaml_safety_and_size():
@@ -144,12 +145,12 @@ def test_yaml_safety_and_size():
 def test_load_steps_parse():
     raw = _raw()
     raw["load"]["steps"] = [{"t": 0.5, "Gamma_Le": 3.0}, {"t": 0.8, "Gamma_Le": -1.0}]
-    p = presets.parse_preset(raw)
+    p = parse_preset(raw)
     assert p.load.steps[1].Gamma_Le == -1.0
     assert loads_preset(dumps_preset(p)) == p
     raw["load"]["steps"] = [{"t": 0.8, "Gamma_Le": 3.0}, {"t": 0.5, "Gamma_Le": -1.0}]
     with pytest.raises(ParameterError, match="increasing"):
-        presets.parse_preset(raw)
+        parse_preset(raw)
 
 
 _scalars = st.one_of(
@@ -166,7 +167,7 @@ def test_garbage_in_a_section_gives_clear_error_only(section, key, value):
     raw = _raw()
     raw[section][key] = value
     try:
-        presets.parse_preset(raw)
+        parse_preset(raw)
     except ValueError as exc:  # PresetError or ParameterError, with a message
         assert str(exc)
 

@@ -33,7 +33,8 @@ def test_ke_to_psi_pm_hand_calculation():
 
 
 def test_ke_in_preset(paper_params):
-    from app.io.presets import parse_preset, to_raw
+    from app.io.preset_schema import parse_preset
+    from app.io.presets import to_raw
 
     raw = to_raw(paper_params)
     del raw["motor"]["psi_pm"]

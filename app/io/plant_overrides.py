@@ -3,7 +3,7 @@
 A ``plant.`` override changes the simulated drive only; the controller keeps designing with the
 preset's (and the other overrides') values. FIELD is a motor or load field of the preset, with the
 same unit suffixes as ``motor.`` / ``load.`` overrides (``plant.L_d_mH=6``, ``plant.J_L=0.3``).
-The overrides go on top of the preset's own ``plant`` section (:func:`app.io.presets.parse_plant`).
+The overrides go on top of the preset's own ``plant`` section (:func:`app.io.preset_schema.parse_plant`).
 """
 
 from __future__ import annotations

@@ -10,7 +10,8 @@ from __future__ import annotations
 import typing
 from typing import Any
 
-from app.io.presets import MODES, PresetError, list_presets, load_preset, load_raw
+from app.io.preset_schema import MODES, PresetError
+from app.io.presets import list_presets, load_preset, load_raw
 
 
 def mode_of(params: Any) -> str:

@@ -2,25 +2,22 @@
 
 A preset is a YAML mapping with ``schema: 1``, ``name``, ``source``, an optional ``mode``
 (``position``, the default, or another registered mode) and one mapping per section of the
-mode's parameter dataclass. Loading is safe (``yaml.safe_load``, no aliases, size-limited),
-rejects unknown keys with a "did you mean" hint, missing keys and wrong types, and converts
-unit-suffixed keys (``L_d_mH``, ``omega_b_rpm``, ``Ke_Vrms_krpm`` …) through :mod:`app.io.units`.
-Saving writes SI field names only, so load → save → load gives equal objects.
+mode's parameter dataclass. Loading is safe (``yaml.safe_load``, no aliases, size-limited) and
+every scalar is kept as text; :mod:`app.io.preset_schema` then rejects unknown keys with a "did
+you mean" hint, missing keys and wrong types, and converts unit-suffixed keys (``L_d_mH``,
+``omega_b_rpm``, ``Ke_Vrms_krpm`` …) through :mod:`app.io.units`. Saving writes SI field names
+only, so load → save → load gives equal objects.
 
 A position preset may carry an optional ``plant`` mapping: the true motor and load values of the
 simulated drive where they differ from the controller's model (the ``motor`` and ``load``
 sections), with the same keys and unit suffixes as those sections (``plant: {J_L: 0.3,
-R_s: 0.12}``); see :func:`parse_plant`.
+R_s: 0.12}``); see :func:`app.io.preset_schema.parse_plant`.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import difflib
 import json
-import math
 import re
-import types
 import typing
 from pathlib import Path
 from typing import Any
@@ -28,294 +25,27 @@ from typing import Any
 import yaml
 
 from app.io import units
-from app.io.numbers import NumberFormatError, parse_integer, parse_number
-from control.bldc.params import BldcParams
-from control.common.checks import ParameterError, field_specs
+from app.io.preset_schema import (
+    MODES,
+    PLANT,
+    SCHEMA,
+    PresetError,
+    field_of,
+    hint,
+    parse_plant,
+    parse_preset,
+    plain,
+    plant_raw,
+)
+from control.common.checks import field_specs
 from control.fdsmc.params import DriveParams
 
-SCHEMA = 2
-#: Schemas read: 1 (inputs only) is migrated to 2 (adds the informational export sections).
-SCHEMAS_READ = (1, 2)
 PRESET_DIR = Path(__file__).resolve().parents[2] / "presets"
 MAX_BYTES = 256 * 1024
 #: The page's start-up preset: a real catalogue servo with a verified clean design.
 DEFAULT_PRESET = "siemens_1ft7044_ak7"
 #: The FDSMC paper's drive (section 5 of [1]), for reproduction.
 PAPER_PRESET = "paper_12kw_pmsm"
-_TOP_KEYS = ("schema", "name", "source", "mode")
-#: Optional top-level section of a position preset: the plant's true values (see parse_plant).
-PLANT = "plant"
-#: The sections whose fields a plant section may give.
-PLANT_SECTIONS = ("motor", "load")
-#: Top-level keys an exported drive parameter file adds; informational, ignored on import (the
-#: gains are recomputed from the inputs).
-_EXPORT_KEYS = ("exported_by", "units", "drive_gains", "verdicts", "results")
-
-#: Parameter dataclass per preset mode. Other modes register themselves here.
-MODES: dict[str, type] = {"position": DriveParams}
-MODES["bldc"] = BldcParams
-
-
-class PresetError(ValueError):
-    """A preset file or override that cannot be loaded; the message says what and where."""
-
-
-def _hint(key: str, allowed: list[str]) -> str:
-    close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.5)
-    return f" — did you mean '{close[0]}'?" if close else f" (allowed: {', '.join(allowed)})"
-
-
-def _describe(tp: Any) -> str:
-    if tp is float:
-        return "a number"
-    if tp is int:
-        return "an integer"
-    if tp is str:
-        return "a text"
-    if isinstance(tp, types.UnionType):
-        return " or ".join(_describe(a) for a in typing.get_args(tp))
-    return "a list of mappings"
-
-
-def _number(name: str, value: Any, tp: type) -> Any:
-    """Return a number field's value: text is parsed, a number from JSON/Python data is kept.
-
-    Text is parsed by :mod:`app.io.numbers` (decimal or scientific notation only; an integer field takes whole
-    numbers only).
-    """
-    try:
-        if isinstance(value, str):
-            return parse_integer(value, name) if tp is int else parse_number(value, name)
-    except NumberFormatError as exc:
-        raise PresetError(str(exc)) from None
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
-    if tp is int:  # 4.0 → 4; 2.5, nan … go to the dataclass, which names the allowed range
-        return int(value) if math.isfinite(value) and float(value).is_integer() else value
-    return float(value)
-
-
-def _coerce(name: str, value: Any, tp: Any) -> Any:
-    """Check ``value`` against the annotation ``tp``; parse nested dataclasses."""
-    if tp in (float, int):
-        return _number(name, value, tp)
-    if tp is str and isinstance(value, str):
-        return value
-    if isinstance(tp, types.UnionType):  # e.g. float | str: a number, else the keyword text
-        args = typing.get_args(tp)
-        if float in args and isinstance(value, str) and str in args:
-            try:
-                return _number(name, value, float)
-            except PresetError:
-                return value
-        for arg in args:
-            try:
-                return _coerce(name, value, arg)
-            except PresetError:
-                continue
-    if typing.get_origin(tp) is tuple and isinstance(value, list):
-        item = typing.get_args(tp)[0]
-        if item is float:  # a list of numbers, e.g. a sampled back-EMF period
-            return tuple(_coerce(f"{name}[{i}]", v, float) for i, v in enumerate(value))
-        return tuple(_parse_section(item, v, f"{name}[{i}]") for i, v in enumerate(value))
-    raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
-
-
-def _parse_section(cls: type, raw: Any, section: str) -> Any:
-    """Build dataclass ``cls`` from mapping ``raw``; ``section`` names it in messages."""
-    if not isinstance(raw, dict):
-        raise PresetError(f"{section} must be a mapping of field: value, got {raw!r}")
-    hints = typing.get_type_hints(cls)
-    names = [f.name for f in dataclasses.fields(cls)]
-    aliases = units.aliases_of(cls)  # the unit-suffixed keys declared by the field specs
-    extra = [units.KE_KEY] if "psi_pm" in names else []
-    allowed = names + list(aliases) + extra
-    values: dict[str, Any] = {}
-    for key, value in raw.items():
-        key = str(key)
-        if key in names:
-            target = key
-            values[key] = _coerce(f"{section}.{key}", value, hints[key])
-        elif key in aliases:
-            target = aliases[key].field
-            number = _coerce(f"{section}.{key}", value, float)
-            values[target] = aliases[key].convert(number)
-        elif key in extra:
-            target = "psi_pm"
-            ke = _coerce(f"{section}.{key}", value, float)
-            try:
-                p = _number(f"{section}.p", raw.get("p"), int)
-            except PresetError:
-                p = 0
-            if p < 1:
-                raise PresetError(f"{section}.{key} needs a valid {section}.p (pole pairs) beside it")
-            values[target] = units.ke_vrms_krpm_to_psi_pm(ke, p)
-        else:
-            raise PresetError(f"unknown key {section}.{key}{_hint(key, allowed)}")
-        if sum(1 for k in raw if _field_of(str(k), aliases, extra) == target) > 1:
-            raise PresetError(f"{section}.{target} is given more than once (SI and unit-suffixed forms)")
-    missing = [
-        f.name for f in dataclasses.fields(cls)
-        if f.name not in values and f.default is dataclasses.MISSING
-        and f.default_factory is dataclasses.MISSING
-    ]
-    if missing:
-        raise PresetError(f"missing key(s) in {section}: {', '.join(missing)}")
-    return cls(**values)
-
-
-def _field_of(key: str, aliases: dict[str, units.Alias], extra: list[str]) -> str:
-    if key in aliases:
-        return aliases[key].field
-    return "psi_pm" if key in extra else key
-
-
-def parse_preset(raw: Any) -> Any:
-    """Validate a preset mapping and return its parameter object (e.g. :class:`DriveParams`).
-
-    Raises
-    ------
-    PresetError, ParameterError
-        With a message naming the field, the value and the allowed range or type.
-    """
-    if not isinstance(raw, dict):
-        raise PresetError("a preset must be a mapping: allowed a YAML or JSON mapping with schema, name, "
-                          "source and sections")
-    raw = migrate(raw)
-    mode = raw.get("mode", "position")
-    if mode not in MODES:
-        raise PresetError(f"mode = {mode!r} is not known{_hint(str(mode), list(MODES))}")
-    cls = MODES[mode]
-    sections = [f.name for f in dataclasses.fields(cls) if f.name not in ("name", "source")]
-    allowed = list(_TOP_KEYS) + list(_EXPORT_KEYS) + list(sections) + ([PLANT] if cls is DriveParams else [])
-    for key in raw:
-        if key not in allowed:
-            raise PresetError(f"unknown top-level key {key!r}{_hint(str(key), allowed)}")
-    hints = typing.get_type_hints(cls)
-    kwargs: dict[str, Any] = {}
-    for name in sections:
-        if name not in raw:
-            raise PresetError(f"missing section {name!r} (allowed sections: {', '.join(sections)})")
-        kwargs[name] = _parse_section(hints[name], raw[name], name)
-    for key in ("name", "source"):
-        if key not in raw:
-            raise PresetError(f"missing key {key!r}: every preset names itself and its source")
-        kwargs[key] = _coerce(key, raw[key], str)
-    _check_units(raw.get("units"), sections)
-    params = cls(**kwargs)
-    if cls is DriveParams:
-        parse_plant(raw, params)  # validated with the rest of the file, even where only the model is used
-    return params
-
-
-def plant_fields() -> dict[str, str]:
-    """Every key a plant section accepts (SI names, unit-suffixed aliases, Ke) → ``motor``/``load``."""
-    out: dict[str, str] = {}
-    hints = typing.get_type_hints(DriveParams)
-    for section in PLANT_SECTIONS:
-        names = [f.name for f in dataclasses.fields(hints[section]) if f.name != "steps"]
-        out.update(dict.fromkeys(names + list(units.ALIASES.get(section, {})), section))
-    out[units.KE_KEY] = "motor"
-    return out
-
-
-def _plant_error(exc: Exception, section: str) -> PresetError:
-    """Return the message of a motor/load error, naming the field as ``plant.FIELD``."""
-    return PresetError(str(exc).replace(f"{section}.", f"{PLANT}.", 1))
-
-
-def parse_plant(raw: Any, params: DriveParams) -> DriveParams | None:
-    """Return the plant of a raw preset.
-
-    That is ``params`` with the motor and load values of its ``plant`` mapping; None without one
-    (or when it equals the controller's model).
-
-    Raises
-    ------
-    PresetError
-        For a key that is not a motor or load field, a wrong type or a value out of range; the
-        message names ``plant.FIELD``, the value and what is allowed.
-    """
-    block = raw.get(PLANT) if isinstance(raw, dict) else None
-    if block is None or block == {}:
-        return None
-    if not isinstance(block, dict):
-        raise PresetError(f"plant must be a mapping of FIELD: value (motor and load fields), got {block!r}")
-    known = plant_fields()
-    split: dict[str, dict[str, Any]] = {s: {} for s in PLANT_SECTIONS}
-    for key, value in block.items():
-        if str(key) not in known:
-            raise PresetError(f"unknown key plant.{key}{_hint(str(key), list(known))}")
-        split[known[str(key)]][str(key)] = value
-    hints = typing.get_type_hints(DriveParams)
-    parts: dict[str, Any] = {}
-    for section in PLANT_SECTIONS:
-        base = getattr(params, section)
-        aliases = units.ALIASES.get(section, {})
-        given = {_field_of(k, aliases, [units.KE_KEY]) for k in split[section]}
-        if len(given) < len(split[section]):
-            raise PresetError(f"plant gives a {section} field more than once (SI and unit-suffixed forms): "
-                              f"{', '.join(split[section])}")
-        merged = {k: v for k, v in _plain(base).items() if k not in given} | split[section]
-        try:
-            parts[section] = _parse_section(hints[section], merged, section)
-        except (PresetError, ParameterError) as exc:
-            raise _plant_error(exc, section) from None
-    plant = dataclasses.replace(params, **parts)
-    return None if plant == params else plant
-
-
-def plant_raw(params: DriveParams, plant: DriveParams | None) -> dict[str, Any]:
-    """Return the ``plant`` mapping of a preset.
-
-    That is the plant's motor and load values (SI) that differ from the controller's model
-    ``params``; empty when there is no plant.
-    """
-    if plant is None:
-        return {}
-    out: dict[str, Any] = {}
-    for section in PLANT_SECTIONS:
-        model, true = _plain(getattr(params, section)), _plain(getattr(plant, section))
-        if true.get("steps", []) != model.get("steps", []):
-            raise PresetError("plant.steps is not allowed: the load steps are the load section's")
-        out.update({k: v for k, v in true.items() if k != "steps" and v != model[k]})
-    return out
-
-
-def migrate(raw: dict[str, Any]) -> dict[str, Any]:
-    """Upgrade a schema-1 mapping to schema 2 (a copy); schema 2 unchanged; other schemas refused.
-
-    Schema 1 holds the inputs only; its drive parameter exports added ``exported_from`` and a flat
-    ``drive_gains`` (YAML) or wrapped the inputs as ``{"tool", "preset", "inputs", "gains",
-    "derived"}`` (JSON). Their informational parts are dropped (the gains are recomputed).
-    """
-    schema = _schema(raw.get("schema"))
-    if schema not in SCHEMAS_READ:
-        raise PresetError(f"schema = {raw.get('schema')!r} is not supported: allowed schema: "
-                          f"{' or '.join(map(str, SCHEMAS_READ))}")
-    if schema == SCHEMA:
-        return raw
-    if isinstance(raw.get("inputs"), dict) and "tool" in raw:  # schema-1 JSON export
-        raw = raw["inputs"]
-    out = {k: v for k, v in raw.items() if k not in ("exported_from", "drive_gains")}
-    out["schema"] = SCHEMA
-    return out
-
-
-def _check_units(table: Any, sections: list[str]) -> None:
-    """Check that an exported file's ``units`` section states the SI unit of each value it names."""
-    if table is None:
-        return
-    if not isinstance(table, dict):
-        raise PresetError(f"units must be a mapping of section: {{field: unit}}, got {table!r}")
-    for section, fields in table.items():
-        expected = units.SI_UNITS.get(str(section))
-        if section not in sections or expected is None or not isinstance(fields, dict):
-            raise PresetError(f"units.{section} is not a section of this preset{_hint(str(section), sections)}")
-        for name, unit in fields.items():
-            if name in expected and unit != expected[name]:
-                raise PresetError(f"units.{section}.{name} = {unit!r} is not allowed: values in this file are SI "
-                                  f"({expected[name]!r}); write a unit-suffixed key (e.g. L_d_mH) for other units")
 
 
 # ---- YAML front-end: text → raw mapping of texts, lists and mappings -------------------------
@@ -422,14 +152,6 @@ def loads_raw(text: str, origin: str = "<text>") -> Any:
         raise PresetError(f"{origin}: {exc}") from None
 
 
-def _schema(value: Any) -> int | None:
-    """Return the schema number of a preset (text or int), None if it is not a whole number."""
-    try:
-        return _number("schema", value, int)
-    except PresetError:
-        return None
-
-
 def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
     """Apply ``section.field=value`` overrides (values parsed as YAML scalars) to a raw preset."""
     if not isinstance(raw, dict):
@@ -443,14 +165,14 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
             raw[PLANT] = {}
         if not isinstance(raw.get(section), dict):
             known = [k for k, v in raw.items() if isinstance(v, dict)]
-            raise PresetError(f"--set {item!r}: unknown section {section!r}{_hint(section, known)}")
+            raise PresetError(f"--set {item!r}: unknown section {section!r}{hint(section, known)}")
         value = loads_raw(text, f"--set {key}") if text.strip() else None
         if value is None:
             raise PresetError(f"--set {item!r} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
         aliases = units.ALIASES.get(section, {}) if section != PLANT else (
             units.ALIASES["motor"] | units.ALIASES["load"])
-        target = _field_of(name, aliases, [units.KE_KEY])
-        for other in [k for k in raw[section] if _field_of(str(k), aliases, [units.KE_KEY]) == target]:
+        target = field_of(name, aliases, [units.KE_KEY])
+        for other in [k for k in raw[section] if field_of(str(k), aliases, [units.KE_KEY]) == target]:
             del raw[section][other]  # an override replaces the value in any unit form
         raw[section][name] = value
     return raw
@@ -474,7 +196,7 @@ def resolve(name_or_path: str) -> Path:
             return candidate
     except (OSError, ValueError):  # name too long for the file system, NUL byte …
         pass
-    raise PresetError(f"preset {name_or_path!r} not found{_hint(str(name_or_path), list_presets())}")
+    raise PresetError(f"preset {name_or_path!r} not found{hint(str(name_or_path), list_presets())}")
 
 
 def list_presets() -> list[str]:
@@ -562,14 +284,6 @@ def loads_any_raw(text: str, origin: str = "<text>") -> Any:
     return loads_raw(text, origin)
 
 
-def _plain(value: Any) -> Any:
-    if dataclasses.is_dataclass(value):
-        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
-    if isinstance(value, tuple | list):
-        return [_plain(v) for v in value]
-    return value
-
-
 def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
     """Convert a parameter object to a preset mapping.
 
@@ -577,7 +291,7 @@ def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
     from the model is given.
     """
     mode = next(m for m, cls in MODES.items() if isinstance(params, cls))
-    body = _plain(params)
+    body = plain(params)
     raw: dict[str, Any] = {"schema": SCHEMA, "name": body.pop("name"), "source": body.pop("source")}
     if mode != "position":
         raw["mode"] = mode
@@ -631,10 +345,8 @@ def save_preset(params: Any, path: str | Path, plant: DriveParams | None = None)
 
 
 __all__ = [
-    "DEFAULT_PRESET", "MODES", "PAPER_PRESET", "PLANT", "ParameterError", "PresetError", "annotate_units",
-    "apply_overrides", "dumps", "dumps_preset", "list_presets", "load_preset", "load_preset_and_plant",
-    "loads_preset", "loads_preset_and_plant", "parse_plant", "parse_preset", "plant_fields", "plant_raw",
-    "save_preset", "to_raw",
+    "DEFAULT_PRESET", "PAPER_PRESET", "annotate_units", "apply_overrides", "dumps", "dumps_preset", "list_presets",
+    "load_preset", "load_preset_and_plant", "loads_preset", "loads_preset_and_plant", "save_preset", "to_raw",
 ]
 
 

@@ -18,7 +18,8 @@ from typing import Any
 import viser
 
 from app.exports.model import export_download, safe_stem
-from app.io.presets import MAX_BYTES, PresetError, loads_preset, to_raw
+from app.io.preset_schema import PresetError
+from app.io.presets import MAX_BYTES, loads_preset, to_raw
 from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams

@@ -6,7 +6,7 @@ physics is exactly what was typed, or nothing runs and the message names the fie
 the allowed range. Unit selectors (inertia in kg·m² or kg·cm², move in rad/deg/rev, R_s and L per
 phase or line-to-line, Ψ_PM or Ke or Kt) convert the shown values; nothing is committed while
 typing: :meth:`InputsPanel.collect` reads the fields on Simulate (or Enter) and validates them with
-the same loader as the CLI and YAML files (:func:`app.io.presets.parse_preset`).
+the same loader as the CLI and YAML files (:func:`app.io.preset_schema.parse_preset`).
 """
 
 from __future__ import annotations
@@ -19,7 +19,8 @@ import viser
 
 from app.io import units
 from app.io.numbers import NumberFormatError
-from app.io.presets import parse_preset, to_raw
+from app.io.preset_schema import parse_preset
+from app.io.presets import to_raw
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice
 from control.common.checks import FieldSpec, ParameterError

@@ -82,13 +82,13 @@ class Replay:
             self.pause()
         self._on_3d(shown)
 
-    def load(self, comparison: Any, autoplay: bool = True) -> None:
-        """Show a new comparison: the phase plane first, then the time plots; rotors to the end."""
+    def load(self, comparison: Any, autoplay: bool = True, time_plots: bool = True) -> None:
+        """Show a new comparison: the phase plane first, then (if ``time_plots``) the time plots; rotors to the end."""
         self.pause()
         set_figure_json(self._phase, phase_plane_json(comparison))
         self._flush()  # the phase plane goes out before the larger figure is even built
-        if self._time_plots is not None:
-            set_figure_json(self._time_plots, time_plots_json(comparison))
+        if time_plots:
+            self.show_time_plots(comparison)
         with self._lock:
             self._comparison = comparison
             rs = runs(comparison)
@@ -99,6 +99,11 @@ class Replay:
             self.play(restart=True)
         else:
             self.seek(self._t_end)
+
+    def show_time_plots(self, comparison: Any) -> None:
+        """Send the time-plots figure of ``comparison`` (if this panel has one)."""
+        if self._time_plots is not None:
+            set_figure_json(self._time_plots, time_plots_json(comparison))
 
     def seek(self, t_now: float) -> None:
         """Turn the 3D rotors to their angles at ``t_now`` [s]."""

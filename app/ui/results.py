@@ -37,6 +37,7 @@ class ResultsPanel:
         gui = client.gui
         self._on_sweep = on_sweep
         self._comparison = comparison
+        self._rest_pending = False
         self.panel = gui.add_panel()
         phase_tab = self.panel.add_tab("Overview", viser.Icon.CHART_DOTS)
         time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
@@ -81,11 +82,25 @@ class ResultsPanel:
         self.panel.set_width(layout.results_width)
         self.phase.aspect = layout.plot_aspect
 
-    def show(self, comparison: Any, autoplay: bool = True) -> None:
-        """Draw a new comparison: key numbers and overview first (what the user waits for), then the rest."""
+    def show(self, comparison: Any, autoplay: bool = True, overview_only: bool = False) -> None:
+        """Draw a new comparison: key numbers and overview first (what the user waits for), then the rest.
+
+        With ``overview_only`` (a slider being dragged) the other tabs keep their figures until
+        :meth:`show_rest`; each redraw then sends only what the Overview tab shows.
+        """
         self._comparison = comparison
         self.key_numbers.content = key_numbers_html(comparison)
-        self.replay.load(comparison, autoplay=autoplay)
+        self.replay.load(comparison, autoplay=autoplay, time_plots=not overview_only)
+        self._rest_pending = overview_only
+        if not overview_only:
+            self.show_rest()
+
+    def show_rest(self) -> None:
+        """Draw the time plots, energy figures and savings of the comparison last shown."""
+        comparison = self._comparison
+        if self._rest_pending:
+            self.replay.show_time_plots(comparison)
+        self._rest_pending = False
         set_figure_json(self.energy, figure_json(energy_spec(comparison)))
         set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))
         self._update_savings()

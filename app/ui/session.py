@@ -138,6 +138,11 @@ class Session:
         self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
         self.cancel_button.on_click(lambda _: self.cancel())
         self.status = gui.add_markdown("Ready.")
+        self.fold_warnings = gui.add_checkbox("Fold warnings to one line", False,
+                                              hint="Keeps the warnings box folded over new runs; a click on "
+                                                   "its first line still opens it once")
+        self.fold_warnings.on_update(lambda _: self._render_warnings())
+        self._warning_parts: tuple[list[str], str | None, list[str]] = ([], None, [])
         self.warnings = gui.add_html("")
         self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
         self.use_k.on_click(lambda _: self._use_recommended_k())
@@ -210,6 +215,7 @@ class Session:
             self.worker.submit(self._tune_loop)
 
     def _tune_loop(self) -> None:
+        """Re-simulate the latest values while a slider moves; the overview only, the rest once it stops."""
         while self._tune_pending:
             self._tune_pending = False
             try:
@@ -217,7 +223,9 @@ class Session:
             except InputError as exc:
                 self._reject(str(exc))
                 return
-            self._run(params, autoplay=False)
+            self._run(params, autoplay=False, overview_only=True)
+        if self.comparison is not None and self.comparison.fdsmc is not None:
+            self.results.show_rest()
 
     def _apply_knob(self, key: str, value_si: float) -> None:
         """Write a live-tuning slider's value into the inputs panel, as if typed."""
@@ -226,7 +234,7 @@ class Session:
         else:
             self.inputs.set_value(key, value_si)
 
-    def _run(self, params: DriveParams, autoplay: bool = True) -> None:
+    def _run(self, params: DriveParams, autoplay: bool = True, overview_only: bool = False) -> None:
         self.status.content = "Simulating…"
         self.design_note.content = ""
         self.worker.checkpoint()
@@ -235,7 +243,7 @@ class Session:
         self.params, self.comparison, self.error = params, comparison, None
         self.runs += 1
         if comparison.fdsmc is not None:
-            self.results.show(comparison, autoplay=autoplay)
+            self.results.show(comparison, autoplay=autoplay, overview_only=overview_only)
         else:
             self.results.show_derived_only(comparison)
         self._show_text()
@@ -304,7 +312,7 @@ class Session:
         items = list(d.warnings) + run_warnings(self.comparison) + self._nameplate_warnings()
         if self.comparison.fdsmc is None:
             items.append("Not simulated: the manoeuvre is infeasible (see above).")
-        self.warnings.content = warnings_html(items, self.error, comparator_notes(self.comparison))
+        self._render_warnings((items, self.error, comparator_notes(self.comparison)))
         chatter = any(r is not None and r.metrics.chatter
                       for r in (self.comparison.fdsmc, self.comparison.conventional))
         k_rec = recommended_K(d)
@@ -329,9 +337,16 @@ class Session:
         return [f"Nameplate: {x.text}" for x in nameplate_consistency(self.params.motor, **extra)
                 if x.text not in general]
 
+    def _render_warnings(self, parts: tuple[list[str], str | None, list[str]] | None = None) -> None:
+        """Show the warnings (new ``parts``, or the last ones), folded to one line if the user asked."""
+        if parts is not None:
+            self._warning_parts = parts
+        items, error, notes = self._warning_parts
+        self.warnings.content = warnings_html(items, error, notes, folded=bool(self.fold_warnings.value))
+
     def _reject(self, message: str) -> None:
         self.error = message
-        self.warnings.content = warnings_html([], message)
+        self._render_warnings(([], message, []))
         self.client.add_notification("Input rejected — nothing simulated", message, color="red",
                                      auto_close_seconds=12.0)
 

@@ -58,11 +58,12 @@ def derived_markdown(derived: Derived) -> str:
     return "\n".join(lines)
 
 
-def warnings_html(items: list[str], error: str | None = None, notes: list[str] | None = None) -> str:
+def warnings_html(items: list[str], error: str | None = None, notes: list[str] | None = None,
+                  folded: bool = False) -> str:
     """Render the input error and the warnings in a red box, or a green line when there are none.
 
     The ``notes`` (e.g. about the comparator) go in a grey box below. The warnings are an HTML
-    ``<details>`` list, open at first: a click on its summary line ("⚠ 6 warning(s) — first
+    ``<details>`` list, open unless ``folded``: a click on its summary line ("⚠ 6 warning(s) — first
     warning…") folds it to that one line in the browser, and a second click opens it again.
     """
     extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
@@ -77,7 +78,8 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
                      f'simulated: {html.escape(error)}</div>')
     if items:
         lis = "".join(f"<li>{html.escape(w)}</li>" for w in items)
-        parts.append('<details open data-role="warnings-list"><summary data-role="warnings-summary" '
+        parts.append(f'<details{"" if folded else " open"} data-role="warnings-list">'
+                     '<summary data-role="warnings-summary" '
                      'style="cursor:pointer;white-space:nowrap;overflow:hidden;text-overflow:ellipsis">'
                      f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html.escape(items[0])}'
                      f'</span></summary><ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul></details>')

@@ -10,17 +10,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from control.fdsmc import loop_analysis, loop_model, transient
 from control.fdsmc.conventional import ConventionalGains, conventional_gains, friction_energy_conventional
 from control.fdsmc.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
 from control.fdsmc.loop_analysis import (
     GainRecommendation,
-    LoopCase,
-    LoopModel,
     SampleRateCheck,
     loop_warnings,
     recommend_K,
     sample_rate_check,
 )
+from control.fdsmc.loop_model import LoopCase, LoopModel
 from control.fdsmc.model import ModelCoefficients, model_coefficients
 from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer, observer_gains
@@ -73,8 +73,8 @@ class Derived:
     @property
     def loop(self) -> LoopCase:
         """The linearised loop of this case (model, observer and outer laws)."""
-        return LoopCase(self.coefficients, self.params, self.observer, self.alpha.alpha_max, self.profile.T_c,
-                        self.conventional.g1, self.conventional.g2)
+        return LoopCase.of_case(LoopModel.of(self.coefficients, self.params, self.observer), self.params,
+                                self.alpha.alpha_max, self.profile.T_c, self.conventional.g1, self.conventional.g2)
 
 
 def predicted_energy(params: DriveParams, profile: VelocityProfile) -> EnergyPrediction:
@@ -105,13 +105,14 @@ def derive(params: DriveParams) -> Derived:
     obs = observer_gains(params.controller.T_so, coeff.M)
     ctrl = params.controller
     f_s = None if ctrl.is_continuous else float(ctrl.f_s)
-    eta = acceleration_overshoot(LoopModel(coeff, params, obs), f_s, ctrl.delay_samples)
+    lm = LoopModel.of(coeff, params, obs)
+    eta = acceleration_overshoot(lm, f_s, ctrl.delay_samples)
     alpha = alpha_max(params, eta)
     obs_d = None if ctrl.is_continuous else discrete_observer(obs, coeff.M, float(ctrl.f_s))
     prof = velocity_profile(params.manoeuvre.theta_dem, alpha.alpha_max, params.manoeuvre.T_m, ctrl.T_c)
     feas = feasibility(params, alpha, prof.omega_p)
     conv = conventional_gains(params.manoeuvre.T_m)
-    loop = LoopCase(coeff, params, obs, alpha.alpha_max, prof.T_c, conv.g1, conv.g2)
+    loop = LoopCase.of_case(lm, params, alpha.alpha_max, prof.T_c, conv.g1, conv.g2)
     gain, rate = recommend_K(loop), sample_rate_check(loop)
     return Derived(
         params=params,
@@ -128,6 +129,13 @@ def derive(params: DriveParams) -> Derived:
         gain=gain,
         sample_rate=rate,
     )
+
+
+def clear_caches() -> None:
+    """Forget every cached loop verdict and sampled model (benchmarks: what a new drive costs)."""
+    for cached in (loop_analysis._gain_limit, loop_analysis._minimum_sample_rate, loop_model._sampled_parts,
+                   transient._acceleration_overshoot):
+        cached.cache_clear()
 
 
 def _layer_warning(K: float, gain: GainRecommendation, prof: VelocityProfile) -> tuple[str, ...]:

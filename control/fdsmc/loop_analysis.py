@@ -2,15 +2,9 @@
 
 The FDSMC outer loop is linear inside its boundary layer: on the cruise segment eq. (46) of [1]
 reads α_dem = −α_max·K·(ω̂_r − ω_p), on the sloped segment α_dem = −α_max·K·(ω̂_r + θ̂_re/T_c).
-Around i_d = 0 (eq. (10)) with a constant external load the drive is linear in the states
-
-    z = [i_q, θ_r, ω_r, θ̂_r, ω̂_r, L̂0, L̂1]   (+ the held voltage with a one-sample delay)
-
-with the plant di_q/dt = −D·i_q − E·ω_r + G·u_q (eq. (2)), (J_r + J_L)·dω_r/dt = J_r·H·i_q −
-F_v·ω_r (eq. (4b)), the FDC law u_q of eq. (14) (using ω̂_r, L̂0, L̂1), and the corrected
-observer of eq. (15) — continuous, or the ZOH-exact discrete observer of
-:func:`control.fdsmc.observer.discrete_observer` with the plant discretised exactly for held voltages.
-The inertia is the user's estimate J_r + J_L from the preset; the controller knows only J_r.
+The loop around i_d = 0 is built by :mod:`control.fdsmc.loop_model` (plant eqs. (2), (4b), FDC
+eq. (14), corrected observer eq. (15), continuous or sampled). The inertia is the user's estimate
+J_r + J_L from the preset; the controller knows only J_r.
 
 * K_limit: the smallest K at which that loop becomes unstable (a closed-loop eigenvalue crosses
   the imaginary axis / unit circle); the loop then limit-cycles against the saturation of
@@ -18,28 +12,38 @@ The inertia is the user's estimate J_r + J_L from the preset; the controller kno
 * Sample-rate check: the same sampled loop with the slow conventional outer law of eq. (61)
   (i.e. inner loops + observer); its spectral radius ≥ 1 means f_s is too slow for T_so/T_sα.
 
+The searches (:func:`gain_limit`, :func:`minimum_sample_rate`) are pure functions of the numbers
+the loop is built from, and are cached on exactly those numbers: a case that differs only in
+what the search does not read (K, T_m for the cruise limit, the load steps …) reuses the verdict
+computed for it, bit for bit. That is what makes a live slider drag cheap.
+
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from control.common.discrete import zoh
-from control.fdsmc.model import ModelCoefficients
-from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer
-from control.fdsmc.params import DriveParams
+from control.fdsmc.loop_model import (
+    LoopCase,
+    SampledParts,
+    continuous_loop,
+    discrete_loop,
+    reduce_shift_mode,
+    sampled_parts,
+)
 
 #: Default gain margin of the recommended K [-] (2 = 6 dB).
 GAIN_MARGIN = 2.0
 #: Smallest acceptable damping ratio of the ideal sloped-segment loop [-].
 ZETA_SLOPE_MIN = 0.5
 LAWS = ("cruise", "slope", "conventional")
-_N = 7  # [i_q, θ, ω, θ̂, ω̂, L̂0, L̂1]
 
 
 @dataclass(frozen=True)
@@ -98,163 +102,6 @@ class SampleRateCheck:
     delay_samples: int
 
 
-def _outer_gains(d: LoopCase, law: str, K: float) -> tuple[float, float]:
-    """α_dem = a_th·θ̂ + a_w·ω̂ (linear part) for the law [1/s², 1/s]."""
-    a_max, T_c = d.alpha_max, d.T_c
-    if law == "cruise":
-        return 0.0, -a_max * K
-    if law == "slope":
-        return -a_max * K / T_c, -a_max * K
-    return -d.g1, -d.g2
-
-
-def control_row(d: LoopCase, law: str, K: float) -> np.ndarray:
-    """u_q = row·z, the linear part of eq. (14) in [1] at i_d = 0 with the outer law [V per state]."""
-    return fdc_row(d.coefficients, d.params.controller.T_salpha, *_outer_gains(d, law, K))
-
-
-def fdc_row(c: ModelCoefficients, T_salpha: float, a_th: float, a_w: float) -> np.ndarray:
-    """u_q = row·z of eq. (14) in [1] at i_d = 0 for α_dem = a_th·θ̂ + a_w·ω̂ [V per state].
-
-    The demand itself enters u_q with the factor :func:`fdc_input_gain`.
-    """
-    f = 3.0 / T_salpha
-    row = np.zeros(_N)
-    row[0] = (c.D - f) / c.G  # −(3/T_sα)·H·i_q/H + D·i_q
-    row[3] = f * a_th / c.H / c.G
-    row[4] = (f * a_w / c.H + c.E) / c.G
-    row[5] = f * c.M / c.H / c.G
-    row[6] = c.M / c.H / c.G
-    return row
-
-
-def fdc_input_gain(c: ModelCoefficients, T_salpha: float) -> float:
-    """∂u_q/∂α_dem of eq. (14) in [1]: (3/T_sα)/(H·G) [V·s²/rad]."""
-    return 3.0 / T_salpha / c.H / c.G
-
-
-def plant_matrices(d: LoopCase) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous plant [i_q, θ_r, ω_r] with input u_q, eqs. (2), (3), (4b) at i_d = 0."""
-    return plant_matrices_of(d.coefficients, d.params)
-
-
-def plant_matrices_of(c: ModelCoefficients, p: DriveParams) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`plant_matrices` from the model coefficients and the parameters alone."""
-    J_r, J_t = p.motor.J_r, p.J_total
-    A = np.array([[-c.D, 0.0, -c.E], [0.0, 0.0, 1.0], [J_r * c.H / J_t, 0.0, -p.load.F_v / J_t]])
-    b = np.array([c.G, 0.0, 0.0])
-    return A, b
-
-
-@dataclass(frozen=True)
-class LoopModel:
-    """What the linearised loop needs besides the outer law: model, parameters, observer gains."""
-
-    coefficients: ModelCoefficients
-    params: DriveParams
-    observer: ObserverGains
-
-
-@dataclass(frozen=True)
-class LoopCase(LoopModel):
-    """The linearised loop of one case with its outer laws.
-
-    α_max [rad/s²] and T_c [s] of the FDSMC (eqs. (41), (46) in [1]) and the conventional gains
-    g1 [1/s²], g2 [1/s] of eq. (61).
-
-    Built by :func:`control.fdsmc.derivations.derive` before the derived case itself, which
-    then holds the verdicts of :func:`recommend_K` and :func:`sample_rate_check`.
-    """
-
-    alpha_max: float
-    T_c: float
-    g1: float
-    g2: float
-
-
-def continuous_loop(d: LoopCase, law: str, K: float) -> np.ndarray:
-    """Closed-loop matrix (7×7) of the continuous implementation [1/s]."""
-    return continuous_matrix(d, control_row(d, law, K))
-
-
-def continuous_matrix(lm: LoopModel, row: np.ndarray) -> np.ndarray:
-    """Closed-loop matrix (7×7) [1/s] of plant, continuous observer and the control ``row``."""
-    Ap, bp = plant_matrices_of(lm.coefficients, lm.params)
-    o, c = lm.observer, lm.coefficients
-    A = np.zeros((_N, _N))
-    A[:3, :3] = Ap
-    A[:3, :] += np.outer(bp, row)
-    e = np.zeros(_N)
-    e[1], e[3] = 1.0, -1.0  # e_o = θ − θ̂ (corrected eq. (15))
-    A[3, 4] = 1.0
-    A[4, 0], A[4, 5] = c.H, -c.M
-    A[5, 6] = 1.0
-    for i, k in zip((3, 4, 5, 6), (o.K1, o.K2, o.K3, o.K4), strict=True):
-        A[i] += k * e
-    return A
-
-
-@dataclass(frozen=True)
-class SampledParts:
-    """ZOH-exact plant (Ad, bd) and discrete observer for one sample rate."""
-
-    Ad: np.ndarray
-    bd: np.ndarray
-    observer: DiscreteObserver
-
-
-def sampled_parts(d: LoopModel, f_s: float) -> SampledParts:
-    """Plant [i_q, θ_r, ω_r] discretised exactly for held u_q, and the observer, at ``f_s`` [Hz]."""
-    T_s = 1.0 / f_s
-    Ap, bp = plant_matrices_of(d.coefficients, d.params)
-    Ad, bd = zoh(Ap, bp, T_s)
-    return SampledParts(Ad, bd, discrete_observer(d.observer, d.coefficients.M, f_s))
-
-
-def discrete_loop(
-    d: LoopCase, law: str, K: float, f_s: float, delay: int = 0, parts: SampledParts | None = None
-) -> np.ndarray:
-    """Closed-loop transition matrix of the sampled implementation (7×7, or 8×8 with delay)."""
-    sp = sampled_parts(d, f_s) if parts is None else parts
-    return discrete_matrix(sp, d.coefficients.H, control_row(d, law, K), delay)
-
-
-def discrete_matrix(sp: SampledParts, H: float, row7: np.ndarray, delay: int) -> np.ndarray:
-    """Transition matrix (7×7, or 8×8 holding the delayed u_q) of the sampled loop with ``row7``."""
-    Ad, bd, od = sp.Ad, sp.bd, sp.observer
-    n = _N + delay
-    Z = np.zeros((n, n))
-    Z[:3, :3] = Ad
-    row = np.zeros(n)
-    row[:_N] = row7
-    if delay:
-        Z[:3, _N] = bd
-        Z[_N] = row
-    else:
-        Z[:3] += np.outer(bd, row)
-    Z[3:7, 3:7] = od.Phi
-    Z[3:7, 0] += od.Gamma * H
-    Z[3:7, 1] += od.L
-    Z[3:7, 3] -= od.L
-    return Z
-
-
-def reduce_shift_mode(M: np.ndarray) -> np.ndarray:
-    """Remove the structural mode θ_r = θ̂_r = const of the cruise law (θ̂ not fed back).
-
-    In the coordinates (e = θ − θ̂, θ̂) the θ̂ column only feeds itself; dropping it leaves the
-    other eigenvalues unchanged.
-    """
-    n = M.shape[0]
-    T = np.eye(n)
-    T[1, 3] = -1.0  # new state 1 = θ − θ̂
-    T_inv = np.eye(n)
-    T_inv[1, 3] = 1.0
-    Mt = T @ M @ T_inv
-    keep = [i for i in range(n) if i != 3]
-    return Mt[np.ix_(keep, keep)]
-
-
 def stability_measure(
     d: LoopCase, law: str, K: float, f_s: float | None, delay: int = 0,
     parts: SampledParts | None = None,
@@ -284,6 +131,19 @@ def stability_measures(
     return out
 
 
+def law_case(d: LoopCase, law: str) -> LoopCase:
+    """``d`` with every number the loop of ``law`` does not read set to 0: the searches' cache key.
+
+    All laws read the model, observer, inertias, friction and T_sα, and the K search reads α_max
+    (its grid and the laws of eq. (46) in [1]); the sloped law reads T_c, the conventional law
+    g1 and g2. The sample rate and delay are the searches' own arguments.
+    """
+    return dataclasses.replace(
+        d, T_si=0.0, T_so=0.0, f_s=None, delay=0, K=0.0,
+        T_c=d.T_c if law == "slope" else 0.0,
+        g1=d.g1 if law == "conventional" else 0.0, g2=d.g2 if law == "conventional" else 0.0)
+
+
 def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> float:
     """Upper stability limit in K [s/rad] of the linearised loop with ``law``.
 
@@ -291,7 +151,13 @@ def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> floa
     1000/α_max); above the largest stable grid K the first unstable one is refined by bisection
     to 0.5 %. Returns 0 if the loop is unstable for every K (inner loops unstable, or a sloped
     segment too poorly damped, see :func:`slope_damping`) and ``inf`` if it never is.
+    Cached on :func:`law_case`.
     """
+    return _gain_limit(law_case(d, law), law, None if f_s is None else float(f_s), int(delay))
+
+
+@functools.lru_cache(maxsize=512)
+def _gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int) -> float:
     parts = None if f_s is None else sampled_parts(d, f_s)
 
     def unstable(K: float) -> bool:
@@ -324,11 +190,6 @@ def slope_damping(alpha_max: float, K: float, T_c: float) -> float:
     return math.sqrt(alpha_max * K * T_c) / 2.0
 
 
-def _f_s(d: LoopCase) -> float | None:
-    ctrl = d.params.controller
-    return None if ctrl.is_continuous else float(ctrl.f_s)
-
-
 def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN) -> GainRecommendation:
     """Recommended boundary-layer gain K = K_limit/margin for the preset's implementation.
 
@@ -343,13 +204,13 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN) -> GainRecommendation:
     -------
     GainRecommendation
     """
-    f_s, delay = _f_s(d), d.params.controller.delay_samples
+    f_s, delay = d.f_s, d.delay
     k_c = gain_limit(d, "cruise", f_s, delay)
     k_s = gain_limit(d, "slope", f_s, delay)
     # A sloped segment unstable for every K is a damping problem (see slope_damping), reported
     # by zeta_slope/T_c_min; the limit-cycle bound is then the cruise segment's.
     k_lim = min(k_c, k_s) if k_s > 0.0 else k_c
-    K, a_max = d.params.controller.K, d.alpha_max
+    K, a_max = d.K, d.alpha_max
     mode = "continuous" if f_s is None else f"f_s = {f_s:g} Hz"
     k_ok = k_lim > K
     zeta = slope_damping(a_max, K if k_ok else k_lim / margin, d.T_c)
@@ -406,7 +267,7 @@ def sample_rate_check(d: LoopCase) -> SampleRateCheck:
     SampleRateCheck
         In continuous mode: stable, spectral radius 0, no f_s.
     """
-    f_s, delay = _f_s(d), d.params.controller.delay_samples
+    f_s, delay = d.f_s, d.delay
     if f_s is None:
         return SampleRateCheck(None, 0.0, True, None, delay)
     rho = 1.0 + stability_measure(d, "conventional", 0.0, f_s, delay)
@@ -416,8 +277,14 @@ def sample_rate_check(d: LoopCase) -> SampleRateCheck:
 def minimum_sample_rate(d: LoopCase, delay: int = 0) -> float | None:
     """Smallest f_s [Hz] for which the sampled inner loops + observer are stable (1 % steps).
 
-    Searched between 100 Hz and 10 MHz; None if even 10 MHz is unstable.
+    Searched between 100 Hz and 10 MHz; None if even 10 MHz is unstable. Cached on
+    :func:`law_case` without α_max (the conventional law does not read it).
     """
+    return _minimum_sample_rate(dataclasses.replace(law_case(d, "conventional"), alpha_max=0.0), int(delay))
+
+
+@functools.lru_cache(maxsize=256)
+def _minimum_sample_rate(d: LoopCase, delay: int) -> float | None:
     def unstable(fs: float) -> bool:
         return stability_measure(d, "conventional", 0.0, fs, delay) >= 0.0
 

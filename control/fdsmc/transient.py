@@ -13,12 +13,13 @@ rule for α_max can leave room for it instead of a fudge factor.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
 from control.common.discrete import zoh
-from control.fdsmc.loop_analysis import (
+from control.fdsmc.loop_model import (
     LoopModel,
     continuous_matrix,
     discrete_matrix,
@@ -35,15 +36,14 @@ _MAX_STEPS = 3000
 
 def _horizon(lm: LoopModel) -> float:
     """Step-response horizon: 6 times the slowest of T_si, T_sα, T_so [s]."""
-    c = lm.params.controller
-    return 6.0 * max(c.T_si, c.T_salpha, c.T_so)
+    return 6.0 * max(lm.T_si, lm.T_salpha, lm.T_so)
 
 
 def _step_system(lm: LoopModel, f_s: float | None, delay: int) -> tuple[np.ndarray, np.ndarray, float]:
     """(Φ, γ, h): z_{k+1} = Φ·z_k + γ·α_dem of the loop with the outer law open (α_dem input)."""
-    c, ctrl = lm.coefficients, lm.params.controller
-    row = fdc_row(c, ctrl.T_salpha, 0.0, 0.0)
-    g_in = fdc_input_gain(c, ctrl.T_salpha)
+    c = lm.coefficients
+    row = fdc_row(c, lm.T_salpha, 0.0, 0.0)
+    g_in = fdc_input_gain(c, lm.T_salpha)
     if f_s is not None:
         sp = sampled_parts(lm, f_s)
         Z = discrete_matrix(sp, c.H, row, delay)
@@ -56,7 +56,7 @@ def _step_system(lm: LoopModel, f_s: float | None, delay: int) -> tuple[np.ndarr
     A = continuous_matrix(lm, row)
     b = np.zeros(A.shape[0])
     b[0] = c.G * g_in
-    tau = min(ctrl.T_si, ctrl.T_salpha, ctrl.T_so) / 3.0
+    tau = min(lm.T_si, lm.T_salpha, lm.T_so) / 3.0
     h = max(tau / _STEPS_PER_TAU, _horizon(lm) / _MAX_STEPS)
     Phi, gamma = zoh(A, b, h)
     return Phi, gamma, h
@@ -84,17 +84,23 @@ def acceleration_overshoot(lm: LoopModel, f_s: float | None, delay: int = 0) -> 
     -----
     α = (J_r·H·i_q − F_v·ω_r)/(J_r + J_L), eq. (4b) in [1] at Γ_Le = 0. The torque the motor must
     deliver at the start of an acceleration is then ≈ η·α_max·(J_r + J_L) plus friction and load.
+    Cached on the loop model (a new T_m, K or load step on the same drive reuses η).
     """
+    return _acceleration_overshoot(lm.model(), None if f_s is None else float(f_s), int(delay))
+
+
+@functools.lru_cache(maxsize=256)
+def _acceleration_overshoot(lm: LoopModel, f_s: float | None, delay: int) -> float:
     Phi, gamma, h = _step_system(lm, f_s, delay)
     if np.max(np.abs(np.linalg.eigvals(Phi))) >= 1.0 + 1e-6:  # θ, ω: marginal (open outer loop)
         return math.inf
-    p, J_t = lm.params, lm.params.J_total
+    J_t = lm.J_total
     n = int(math.ceil(_horizon(lm) / h)) + delay + 2
     z = np.zeros(Phi.shape[0])
     peak = 0.0
     for _ in range(n):
         z = Phi @ z + gamma
-        peak = max(peak, (p.motor.J_r * lm.coefficients.H * z[0] - p.load.F_v * z[2]) / J_t)
+        peak = max(peak, (lm.J_r * lm.coefficients.H * z[0] - lm.F_v * z[2]) / J_t)
     return max(1.0, peak)
 
 

@@ -27,7 +27,8 @@ from dataclasses import dataclass
 
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import alpha_max, exceeds, feasibility, torque_limit, voltage_limit
-from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN, LoopModel
+from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
+from control.fdsmc.loop_model import LoopModel
 from control.fdsmc.model import model_coefficients
 from control.fdsmc.observer import observer_gains
 from control.fdsmc.params import DriveParams
@@ -126,7 +127,7 @@ def _round_up(x: float, digits: int = 3) -> float:
 def _overshoot(params: DriveParams) -> float:
     c = params.controller
     coeff = model_coefficients(params.motor)
-    lm = LoopModel(coeff, params, observer_gains(c.T_so, coeff.M))
+    lm = LoopModel.of(coeff, params, observer_gains(c.T_so, coeff.M))
     return acceleration_overshoot(lm, None if c.is_continuous else float(c.f_s), c.delay_samples)
 
 

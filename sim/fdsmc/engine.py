@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -53,6 +54,10 @@ CONTINUOUS_STEP_RATIO = 0.1875
 PLANT_STEP_MAX_S = 5e-5
 #: Most trace points kept per run (energies and peaks use every step).
 MAX_POINTS = 20000
+#: Threads that run the second and further controllers of every :func:`compare` in this process
+#: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
+#: client) do not oversubscribe the cores, and no thread is started per call.
+_RUNS = ThreadPoolExecutor(max_workers=max(2, os.cpu_count() or 2), thread_name_prefix="sim-run")
 #: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
 PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
 #: The manoeuvre times [s] of Table 1 in [1]: the default sweep.
@@ -447,13 +452,9 @@ def compare(
     check_budget(params, len(controllers), **options)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
-    runs: dict[str, RunResult] = {}
-    if len(controllers) > 1:
-        with ThreadPoolExecutor(max_workers=len(controllers)) as pool:
-            futures = {c: pool.submit(simulate, params, c, d, plant=plant, **options) for c in controllers}
-            runs = {c: f.result() for c, f in futures.items()}
-    else:
-        runs = {c: simulate(params, c, d, plant=plant, **options) for c in controllers}
+    futures = {c: _RUNS.submit(simulate, params, c, d, plant=plant, **options) for c in controllers[1:]}
+    runs = {c: simulate(params, c, d, plant=plant, **options) for c in controllers[:1]}
+    runs |= {c: f.result() for c, f in futures.items()}
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
                       _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"))

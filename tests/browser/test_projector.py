@@ -153,6 +153,27 @@ def test_warnings_box_folds_to_one_line_and_expands(projector):
     assert box.bounding_box()["height"] == pytest.approx(tall, abs=2)
 
 
+def test_folded_warnings_stay_folded_over_a_new_run_with_other_warnings(page):
+    """The "Fold warnings to one line" choice holds for every later run: the paper preset's
+    K = 1000 s/rad chatters (warned); with K = 0.3 s/rad, under the limit of the linearised loop,
+    that warning goes and the new set of warnings arrives folded.
+    """
+    from tests.browser.conftest import set_number
+
+    box = page.locator('[data-role="warnings"]')
+    box.wait_for()
+    before = box.inner_text()
+    assert "K = 1000" in before
+    page.get_by_label("Fold warnings to one line").check()
+    page.wait_for_function("() => !document.querySelector('[data-role=\"warnings-list\"]').open")
+    set_number(page, "K boundary-layer gain [s/rad]", "0.3")
+    page.get_by_role("button", name="Simulate").click()
+    page.wait_for_function("(t) => { const s = document.querySelector('[data-role=\"warnings\"]');"
+                           " return s && s.innerText !== t; }", arg=before)
+    assert "K = 1000" not in box.inner_text()  # the new warnings are there…
+    assert not page.evaluate("() => document.querySelector('[data-role=\"warnings-list\"]').open")  # …folded
+
+
 @pytest.fixture(scope="module")
 def server_3d() -> Iterator[Any]:
     """The web UI with the 3D view available (folded by default)."""
