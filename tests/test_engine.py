@@ -264,7 +264,7 @@ def test_continuous_step_follows_the_fastest_designed_pole(continuous_paper):
     larger) would make that RK4 step diverge (h·q = 1.9 per stage on a four-fold pole), so the
     step shrinks tenfold and the run still reproduces eq. (52).
     """
-    from sim.fdsmc.engine import continuous_step
+    from sim.fdsmc.grid import continuous_step
 
     assert continuous_step(continuous_paper) == pytest.approx(5e-6, rel=1e-12)
     fast = _with(continuous_paper, "controller", T_so=2e-5, K=0.45)
@@ -278,7 +278,7 @@ def test_slow_digital_controller_plant_substeps_converged():
     """A 2 kHz controller (T_so = 2 ms, T_sα = 10 ms, stable by the sample-rate check) gets 10 RK4
     plant substeps of 50 µs per sample; doubling them changes the friction by < 0.05 %.
     """
-    from sim.fdsmc.engine import plant_substeps
+    from sim.fdsmc.grid import plant_substeps
 
     base = ["controller.T_so=0.002", "controller.T_salpha=0.01", "controller.f_s=2000"]
     d = derive(load_preset("paper_12kw_pmsm", base))

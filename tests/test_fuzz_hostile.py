@@ -36,7 +36,7 @@ from control.fdsmc.observer import discrete_observer, observer_gains
 from control.fdsmc.profile import velocity_profile
 from sim.bldc.engine import check_budget as bldc_check_budget
 from sim.common import budget
-from sim.fdsmc import engine
+from sim.fdsmc import engine, grid
 
 PAPER = (PRESET_DIR / "paper_12kw_pmsm.yaml").read_text(encoding="utf-8")
 BLDC = (PRESET_DIR / "bldc_smc_paper.yaml").read_text(encoding="utf-8")
@@ -116,7 +116,7 @@ def _check_override(field: str, text: str, full: bool) -> None:
     item = f"{field}={text}"
     try:
         params = load_preset("paper_12kw_pmsm", [item])
-        cost = engine.check_budget(params, 2)
+        cost = grid.check_budget(params, 2)
         a_max, t_min = (lambda d: (d.alpha.alpha_max, d.profile.T_m_min))(derive(params)) if full \
             else _closed_form(params)
     except ValueError as exc:
@@ -198,7 +198,7 @@ def test_fuzz_yaml_files(case):
             assert "allowed" in msg or "not valid YAML" in msg or "missing" in msg or "unknown" in msg, msg
         return
     assert kind in ("scalar", "flow") and params.name == "paper_12kw_pmsm"
-    assert engine.run_cost(params).steps >= 1
+    assert grid.run_cost(params).steps >= 1
 
 
 # ---- measured back-EMF uploads ---------------------------------------------------------------
@@ -290,7 +290,7 @@ def test_accepted_runs_take_no_more_steps_than_the_budget_counted(monkeypatch):
     for over in (["motor.omega_b=2000", "motor.p=10", "manoeuvre.T_m=0.5"], ["controller.f_s=continuous",
                                                                            "manoeuvre.T_m=0.5"]):
         p = load_preset("paper_12kw_pmsm", [*over, "controller.K=0.2"])
-        cost = engine.check_budget(p, 2)
+        cost = grid.check_budget(p, 2)
         seen.clear()
         engine.compare(p)
         assert sum(seen) == cost.steps and cost.fits

@@ -19,7 +19,7 @@ from control.fdsmc.derivations import derive
 from sim.bldc.engine import check_budget as bldc_check_budget
 from sim.bldc.engine import compare_bldc
 from sim.common import budget
-from sim.fdsmc import engine
+from sim.fdsmc import engine, grid
 
 PAPER = (PRESET_DIR / "paper_12kw_pmsm.yaml").read_text(encoding="utf-8")
 BLDC = (PRESET_DIR / "bldc_smc_paper.yaml").read_text(encoding="utf-8")
@@ -134,18 +134,18 @@ def test_substeps_count_in_the_budget_and_are_refused_before_work(monkeypatch, c
     p = load_preset("paper_12kw_pmsm", ["motor.omega_b=1e5", "motor.p=100"])
     best = float(err.split("motor.omega_b = 100000 rad/s → largest accepted ")[1].split()[0])
     runs = len(engine.COMPARATORS)  # simulate runs the FDSMC, the conventional law and the optimum
-    assert engine.check_budget(dataclasses.replace(p, motor=dataclasses.replace(p.motor, omega_b=best)), runs).fits
+    assert grid.check_budget(dataclasses.replace(p, motor=dataclasses.replace(p.motor, omega_b=best)), runs).fits
     over = dataclasses.replace(p, motor=dataclasses.replace(p.motor, omega_b=best * 1.01))
     with pytest.raises(budget.BudgetError):
-        engine.check_budget(over, runs)
+        grid.check_budget(over, runs)
 
 
 def test_budget_counts_every_substep_exactly():
     p = load_preset("paper_12kw_pmsm", ["motor.omega_b=1e4", "motor.p=20"])
-    n_sub = engine.plant_substeps(p)
+    n_sub = grid.plant_substeps(p)
     n_samples = int(-(-1.3 * p.manoeuvre.T_m * 20000 // 1))
     assert n_sub > 1
-    assert engine.run_cost(p).steps == n_sub * n_samples
+    assert grid.run_cost(p).steps == n_sub * n_samples
 
 
 def test_bldc_long_run_refused_before_allocation(monkeypatch):

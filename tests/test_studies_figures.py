@@ -26,7 +26,8 @@ from app.ui.text import md_text
 from control.common.checks import ParameterError
 from control.fdsmc.feasibility import torque_limit
 from sim.common.budget import BudgetError
-from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, check_budget, compare
+from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, compare
+from sim.fdsmc.grid import check_budget
 from sim.fdsmc.optimum_gap import saving_vs_optimum
 from sim.fdsmc.verdicts import TARGET_BAND
 from sim.studies.multiaxis import coordinate

@@ -26,7 +26,8 @@ from app.io.preset_modes import load_mode_preset
 from app.io.presets import load_preset
 from control.fdsmc.derivations import clear_caches, derive
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import CONTINUOUS_STEP_S, TABLE1_T_M, compare, run_steps, table1_sweep
+from sim.fdsmc.engine import TABLE1_T_M, compare, run_steps, table1_sweep
+from sim.fdsmc.grid import CONTINUOUS_STEP_S
 from sim.fdsmc.reference import run_reference
 
 

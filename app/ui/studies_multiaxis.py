@@ -21,7 +21,7 @@ from app.ui.replay import set_figure_json
 from app.ui.text import md_text
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import check_budget
+from sim.fdsmc.grid import check_budget
 from sim.studies.multiaxis import MultiAxisResult, coordinate
 
 #: Where the axes come from in messages.

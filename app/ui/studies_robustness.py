@@ -28,7 +28,7 @@ from control.common.checks import ParameterError
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.params import DriveParams
 from sim.common.budget import MAX_STEPS, BudgetError
-from sim.fdsmc.engine import check_budget
+from sim.fdsmc.grid import check_budget
 from sim.studies.robustness import TRACE_POINTS, RobustnessResult, Spread, robustness
 
 #: Most samples of one study from the page [-].

@@ -4,7 +4,8 @@ The model (plant, FDC inner loops, observer, outer loop, energies) is integrated
 compiled kernel :func:`sim.fdsmc.kernel.run_kernel`; this module packs the parameters, chooses the
 time grid, and turns the raw arrays into frozen results with their :class:`~sim.fdsmc.metrics.RunMetrics`.
 
-Rest-to-rest manoeuvre from θ_r = 0 to θ_dem, simulated over [0, (1 + TAIL_FRACTION)·T_m].
+Rest-to-rest manoeuvre from θ_r = 0 to θ_dem, simulated over [0, (1 + TAIL_FRACTION)·T_m] (the time
+grid and the cost budget are in :mod:`sim.fdsmc.grid`).
 Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) in [1]); the
 ``_total`` ones are over the whole simulated horizon.
 
@@ -13,7 +14,6 @@ Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) i
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -29,8 +29,8 @@ from control.fdsmc.params import DriveParams
 from sim.common import budget
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
+from sim.fdsmc.grid import CONTINUOUS_STEP_S, MAX_POINTS, check_budget, load_steps, run_cost, time_grid, with_field
 from sim.fdsmc.metrics import (
-    CHATTER_MAX_WINDOW_S,
     RunMetrics,
     WindowSamples,
     chatter_window_steps,
@@ -44,16 +44,6 @@ CONTROLLERS = ("fdsmc", "conventional")
 COMPARATORS = CONTROLLERS + ("optimum",)
 #: The name each simulated outer loop goes by in messages, tables and figures.
 LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum"}
-#: Simulated horizon beyond T_m, as a fraction of T_m [-].
-TAIL_FRACTION = 0.3
-#: RK4 step of continuous mode [s]; friction energies converged to < 0.05 % (see tests).
-CONTINUOUS_STEP_S = 5e-6
-#: Largest h·λ_max of continuous mode (λ_max the fastest designed pole) [-]; 5 µs at T_so = 0.2 ms.
-CONTINUOUS_STEP_RATIO = 0.1875
-#: Largest RK4 plant substep between controller samples in digital mode [s].
-PLANT_STEP_MAX_S = 5e-5
-#: Most trace points kept per run (energies and peaks use every step).
-MAX_POINTS = 20000
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
@@ -139,107 +129,6 @@ class Table1Row:
     paper_pct: float | None
 
 
-@dataclass(frozen=True)
-class _Grid:
-    continuous: bool
-    h: float
-    n_steps: int
-    n_sub: int
-    decim: int
-    n_out: int
-
-
-def continuous_step(params: DriveParams, h_max: float = CONTINUOUS_STEP_S) -> float:
-    """RK4 step of continuous mode [s]: h_max, or less so that h·λ_max ≤ CONTINUOUS_STEP_RATIO.
-
-    λ_max [1/s] is the fastest designed pole: the observer's q = 15/(2·T_so) (eq. (17) in [1]),
-    3/T_sα (eq. (13)) or 3/T_si (eq. (8)). At the paper's T_so = 0.2 ms this gives 5 µs, where
-    halving the step changes the friction energy by < 0.05 % (tests); a faster observer or inner
-    loop gets a proportionally smaller step instead of a diverging integration.
-    """
-    c = params.controller
-    lam = max(15.0 / (2.0 * c.T_so), 3.0 / c.T_salpha, 3.0 / c.T_si)
-    return min(h_max, CONTINUOUS_STEP_RATIO / lam)
-
-
-def plant_substeps(params: DriveParams) -> int:
-    """Return the RK4 substeps per sample [-] that keep the plant step short enough.
-
-    The plant step is ≤ PLANT_STEP_MAX_S and ≤ 0.2 rad of the fastest electrical angle
-    p·max(ω_b, 2.1·|θ_dem|/T_m) (the comparator peaks at Δθ·5.6/(e·T_m)); 1 at 20 kHz for the paper's motor.
-    """
-    m = params.motor
-    w_e = m.p * max(m.omega_b, 2.1 * abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
-    h_max = min(PLANT_STEP_MAX_S, 0.2 / w_e)
-    return max(1, int(math.ceil(1.0 / (float(params.controller.f_s) * h_max) - 1e-9)))
-
-
-def _grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: int) -> _Grid:
-    t_end = (1.0 + TAIL_FRACTION) * params.manoeuvre.T_m
-    ctrl = params.controller
-    if ctrl.is_continuous:
-        h_continuous = continuous_step(params, h_continuous)
-        n_steps, h, sub = int(math.ceil(t_end / h_continuous)), h_continuous, 1
-    else:
-        T_s = 1.0 / float(ctrl.f_s)
-        sub = max(n_sub, plant_substeps(params))
-        n_steps, h = int(math.ceil(t_end / T_s)), T_s / sub
-    decim = max(1, int(math.ceil(n_steps / max_points)))
-    return _Grid(ctrl.is_continuous, h, n_steps, sub, decim, n_steps // decim + 1)
-
-
-def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUOUS_STEP_S,
-             max_points: int = MAX_POINTS) -> budget.Cost:
-    """Cost of one controller's run (integration steps, trace bytes), from the parameters alone.
-
-    Trace bytes: the kernel's output (N_CH channels × kept points) and the two full-resolution
-    chatter windows (≤ CHATTER_MAX_WINDOW_S each, θ_r and α_dem), 8 bytes per value.
-    """
-    g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
-    window = min(g.n_steps, int(CHATTER_MAX_WINDOW_S / (g.h * g.n_sub)) + 2)
-    return budget.Cost(g.n_steps * g.n_sub, 8 * (kn.N_CH * g.n_out + 4 * window))
-
-
-def _with(params: DriveParams, field: str, value: float) -> DriveParams:
-    section, name = field.split(".")
-    part = dataclasses.replace(getattr(params, section), **{name: value})
-    return dataclasses.replace(params, **{section: part})
-
-
-def _cost_drivers(params: DriveParams, request: Callable[[DriveParams], budget.Cost]) -> list[budget.Driver]:
-    """Return the fields that set the step count and trace size, with the end of their range that is cheapest."""
-    ctrl, m = params.controller, params.motor
-    fields: list[tuple[str, float, str, float, bool]] = [("manoeuvre.T_m", params.manoeuvre.T_m, "s", 1e-4, False)]
-    if ctrl.is_continuous:
-        fields.append(("controller.T_so", ctrl.T_so, "s", 10.0, False))
-    else:
-        fields.append(("controller.f_s", float(ctrl.f_s), "Hz", 100.0, False))
-        if plant_substeps(params) > 1:
-            fields += [("motor.omega_b", m.omega_b, "rad/s", 1e-3, False), ("motor.p", m.p, "", 1, True)]
-    return [budget.Driver(name, value, unit, lambda v, n=name: request(_with(params, n, v)), limit, integer)
-            for name, value, unit, limit, integer in fields]
-
-
-def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budget.Cost:
-    """Raise :class:`~sim.common.budget.BudgetError` unless ``n_runs`` runs of ``params`` fit the budget.
-
-    Called before any derivation or allocation by :func:`simulate`, :func:`compare` and
-    :func:`table1_sweep` (which checks the whole sweep).
-    """
-    def request(p: DriveParams) -> budget.Cost:
-        one = run_cost(p, **options)
-        return budget.Cost(n_runs * one.steps, n_runs * one.trace_bytes)
-
-    cost = request(params)
-    if cost.fits:
-        return cost
-    g = _grid(params, int(options.get("n_sub", 1)), float(options.get("h_continuous", CONTINUOUS_STEP_S)),
-              int(options.get("max_points", MAX_POINTS)))
-    what = (f"{n_runs} run(s) × {g.n_steps:.3g} RK4 steps of {g.h:.3g} s" if g.continuous else
-            f"{n_runs} run(s) × {g.n_steps:.3g} samples × {g.n_sub} RK4 sub-steps")
-    return budget.check(cost, what, _cost_drivers(params, request))
-
-
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
                     plant: DriveParams | None = None) -> np.ndarray:
     """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.kernel`).
@@ -280,12 +169,6 @@ def _observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if od is None:
         return np.zeros((4, 4)), np.zeros(4), np.zeros(4)
     return np.ascontiguousarray(od.Phi), np.ascontiguousarray(od.Gamma), np.ascontiguousarray(od.L)
-
-
-def _load_steps(params: DriveParams) -> tuple[np.ndarray, np.ndarray]:
-    steps = params.load.steps
-    return (np.array([s.t for s in steps], dtype=float),
-            np.array([s.Gamma_Le for s in steps], dtype=float))
 
 
 def _reference(d: Derived, controller: str) -> np.ndarray:
@@ -351,9 +234,9 @@ def simulate(
     check_budget(params, 1, n_sub=n_sub, h_continuous=h_continuous, max_points=max_points)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
-    g = _grid(params, int(n_sub), float(h_continuous), int(max_points))
+    g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
     prm = pack_parameters(params, d, controller, plant)
-    step_t, step_v = _load_steps(params if plant is None else plant)
+    step_t, step_v = load_steps(params if plant is None else plant)
     Phi, Gam, Lo = _observer_arrays(d)
     out = np.zeros((kn.N_CH, g.n_out))
     info = np.zeros(kn.N_INFO)
@@ -386,7 +269,7 @@ def run_steps(
     check_controller(controller, COMPARATORS)
     d = derive(params) if derived is None else derived
     prm = pack_parameters(params, d, controller)
-    step_t, step_v = _load_steps(params)
+    step_t, step_v = load_steps(params)
     Phi, Gam, Lo = _observer_arrays(d)
     cont = params.controller.is_continuous
     h = h_continuous if cont else 1.0 / float(params.controller.f_s) / n_sub
@@ -487,7 +370,7 @@ def table1_sweep(
         For an infeasible T_m, or when a run is unstable (naming T_m and the reason), so that
         no row is ever computed from a diverged run.
     """
-    points = [_with(params, "manoeuvre.T_m", float(T_m)) for T_m in T_m_values]
+    points = [with_field(params, "manoeuvre.T_m", float(T_m)) for T_m in T_m_values]
     total = sum((run_cost(p, **options) for p in points), budget.Cost(0, 0))
     if points and not budget.Cost(2 * total.steps, 2 * total.trace_bytes).fits:
         check_budget(max(points, key=lambda p: p.manoeuvre.T_m), 2 * len(points), **options)

@@ -18,7 +18,8 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.params import DriveParams
 from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import _grid, _load_steps, pack_parameters
+from sim.fdsmc.engine import pack_parameters
+from sim.fdsmc.grid import load_steps, time_grid
 
 
 class PlantInTheLoop:
@@ -52,9 +53,9 @@ class PlantInTheLoop:
         if params.controller.is_continuous:
             raise ParameterError("controller.f_s = 'continuous': the plant in the loop needs a sample rate in Hz")
         d = derive(params) if derived is None else derived
-        g = _grid(params, 1, 0.0, 1)
+        g = time_grid(params, 1, 0.0, 1)
         self._prm = pack_parameters(params, d, controller)
-        self._step_t, self._step_v = _load_steps(params)
+        self._step_t, self._step_v = load_steps(params)
         self._h, self._n_sub = g.h, g.n_sub
         self.T_s, self.n_samples = g.h * g.n_sub, g.n_steps
         self.x: tuple[float, ...] = (0.0,) * kn.X_THH

@@ -25,7 +25,8 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.params import DriveParams
 from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import continuous_step, pack_parameters, plant_substeps
+from sim.fdsmc.engine import pack_parameters
+from sim.fdsmc.grid import continuous_step, plant_substeps
 from sim.studies.cycle_kernel import run_cycle
 
 #: Joules per kilowatt-hour [J/kWh].
