@@ -94,4 +94,9 @@ def test_bench_prints_figures():
     r = subprocess.run([sys.executable, "-m", "app", "bench", "--repeat", "1"], capture_output=True,
                        text=True, check=False, timeout=120)
     assert r.returncode == 0, r.stderr
-    assert "warm median" in r.stdout and "samples/s" in r.stdout
+    out = r.stdout
+    assert "samples/s" in out
+    # the comparison for a new drive (caches cleared), a new K and a new T_m, each with CPU time
+    for case in ("new drive", "new K each run", "new T_m each run"):
+        line = next(x for x in out.splitlines() if case in x)
+        assert "ms CPU" in line and "derive() alone" in line

@@ -23,6 +23,7 @@ from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
 from app.ui.layout import PanelLayout, WindowFit
 from app.ui.log import LogPanel
+from app.ui.plotly_js import use_basic_plotly
 from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import OptimumToggle, StudiesSection
@@ -101,6 +102,7 @@ class Session:
         gui = self.gui
         gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
         gui.add_html(PAGE_STYLE)
+        use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
         gui.main_panel.dock_left()
         tabs = gui.add_tab_group()
         with tabs.add_tab("Position drive (FDSMC)"):
