@@ -84,12 +84,13 @@ class ResultsPanel:
     def show(self, comparison: Any, autoplay: bool = True, overview_only: bool = False) -> None:
         """Draw a new comparison: key numbers and overview first (what the user waits for), then the rest.
 
-        With ``overview_only`` (a slider being dragged) the other tabs keep their figures until
-        :meth:`show_rest`; each redraw then sends only what the Overview tab shows.
+        With ``overview_only`` (a slider being dragged) the other tabs keep their figures and the
+        overview comes without its replay controls until :meth:`show_rest`; each redraw then sends
+        only what the Overview tab shows, and the browser redraws it faster.
         """
         self._comparison = comparison
         self.key_numbers.content = key_numbers_html(comparison)
-        self.replay.load(comparison, autoplay=autoplay, time_plots=not overview_only)
+        self.replay.load(comparison, autoplay=autoplay, light=overview_only)
         self._rest_pending = overview_only
         if not overview_only:
             self.show_rest()
@@ -98,7 +99,7 @@ class ResultsPanel:
         """Draw the time plots, energy figures and savings of the comparison last shown."""
         comparison = self._comparison
         if self._rest_pending:
-            self.replay.show_time_plots(comparison)
+            self.replay.complete(comparison)
         self._rest_pending = False
         set_figure_json(self.energy, figure_json(energy_spec(comparison)))
         set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))
