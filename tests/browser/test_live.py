@@ -83,3 +83,9 @@ def test_dragging_the_K_slider_resimulates_with_the_latest_value(page):
     assert page.evaluate(BAND_JS) != before_band
     after_y = page.evaluate(FDSMC_Y_JS)
     assert len(after_y) != len(before_y) or max(abs(a - b) for a, b in zip(after_y, before_y, strict=True)) > 1e-3
+    # once the drag has stopped the overview gets its replay back (play buttons and scrub slider)
+    page.wait_for_function("() => { const el = [...document.querySelectorAll('.js-plotly-plot')]"
+                           ".find(e => e.layout.meta.id === 'phase_plane');"
+                           " return (el.layout.updatemenus || []).length > 0"
+                           " && (el.layout.sliders || []).length > 0; }")
+    assert abs(float(page.evaluate(BAND_JS).split("±")[2].split()[0]) * k_shown - 1) < 6e-3
