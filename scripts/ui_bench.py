@@ -6,12 +6,15 @@
   follows), websocket bytes received by the page including a full replay, and the round trip
   click → both new trajectories drawn;
 * the same round trip with 1, 5 and 10 pages clicking at once;
-* replay frame rate actually drawn by the browser (phase plane) and the server traffic meanwhile;
+* page open broken down by message kind (plotly.js itself, each figure, the rest);
+* the round trip split into click → overview message arrived → drawn;
+* replay frame rate actually drawn by the browser (animation frames in which the phase-plane marker
+  moved, at 0.1× and 0.01×) and the server traffic meanwhile;
 * live tuning: re-simulated phase planes drawn per second while the K slider is moved
   (one key step every 50 ms, paper preset at 20 kHz);
 * server memory (RSS) idle and with the pages connected.
 
-Every figure is the median of ``--runs`` rounds (≥ 5) with its min and max; the machine's load
+Every figure is the median of ``--runs`` rounds (≥ 3; 5 for the record) with its min and max; the machine's load
 average is printed at the start and at the end (figures from a shared machine are pessimistic).
 The whole script takes about 3–5 minutes. It is a measurement, never a test.
 
@@ -27,6 +30,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import itertools
+import json
 import os
 import statistics
 import subprocess
@@ -50,12 +54,17 @@ PHASE_READY = ("(w) => [...document.querySelectorAll('.js-plotly-plot')].some(e 
 #: shows ω_p = w (polled every frame), or NaN after 60 s.
 WATCH_READY = ("(w) => { const t0 = Date.now(); window.__ready = new Promise(r => { const f = () => (" + PHASE_READY
                + ")(w) ? r(Date.now()) : (Date.now() - t0 > 60000 ? r(NaN) : requestAnimationFrame(f)); f(); }); }")
+#: Resolves with the number of browser animation frames, within ``ms``, in which the drawn FDSMC marker
+#: (its SVG transform) moved: key frames and Plotly's glides between them alike.
 COUNT_FRAMES = """(ms) => new Promise(resolve => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
-  let n = 0; const on = () => { n += 1; };
-  el.on('plotly_afterplot', on); el.on('plotly_animatingframe', on);
-  setTimeout(() => { el.removeListener('plotly_afterplot', on);
-                     el.removeListener('plotly_animatingframe', on); resolve(n); }, ms);
+  const pos = () => { const g = [...el.querySelectorAll('g.trace.scatter')]
+      .find(g => g.__data__[0].trace.name === 'FDSMC now');
+    const p = g && g.querySelector('path.point'); return p && p.getAttribute('transform'); };
+  let n = 0, last = pos(); const t0 = performance.now();
+  const f = () => { const p = pos(); if (p !== last) { n += 1; last = p; }
+                    if (performance.now() - t0 < ms) requestAnimationFrame(f); else resolve(n); };
+  requestAnimationFrame(f);
 })"""
 PLAY_IN_PLOT = """(label) => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
@@ -68,16 +77,46 @@ PLAY_IN_PLOT = """(label) => {
 
 
 class WsCounter:
-    """Bytes and messages a page receives over its websockets."""
+    """Bytes and messages a page receives over its websockets, with their arrival times [ms since epoch]."""
 
-    def __init__(self, page) -> None:
+    def __init__(self, page, keep: bool = False) -> None:
         self.bytes = 0
         self.messages = 0
+        self.arrivals: list[tuple[float, int]] = []
+        self.payloads: list[bytes] = [] if keep else None  # type: ignore[assignment]
         page.on("websocket", lambda ws: ws.on("framereceived", self._add))
 
     def _add(self, payload) -> None:
         self.bytes += len(payload)
         self.messages += 1
+        self.arrivals.append((time.time() * 1e3, len(payload)))
+        if self.payloads is not None and isinstance(payload, bytes):
+            self.payloads.append(payload)
+
+
+def breakdown(payloads: list[bytes], top: int = 8) -> str:
+    """Per kind of viser message: bytes as sent (zstd) and decoded, biggest first (one line each)."""
+    import msgspec
+    import zstandard
+
+    z, c = zstandard.ZstdDecompressor(), zstandard.ZstdCompressor(level=1)
+    kinds: dict[str, list[float]] = {}
+    for f in payloads:
+        n_in, n_c = int.from_bytes(f[:8], "little"), int.from_bytes(f[8:16], "little")
+        for m in msgspec.msgpack.decode(z.decompress(f[16:16 + n_c], max_output_size=n_in))["messages"]:
+            raw = msgspec.msgpack.encode(m)
+            fig = (m.get("props") or {}).get("_plotly_json_str") or (m.get("updates") or {}).get("_plotly_json_str")
+            name = m.get("type", "?")
+            if fig:
+                meta = json.loads(fig).get("layout", {}).get("meta") or {}
+                name = f"figure {meta.get('id', '(empty)')}"
+            k = kinds.setdefault(name, [0, 0.0, 0.0])
+            k[0] += 1
+            k[1] += len(c.compress(raw))
+            k[2] += len(raw)
+    rows = sorted(kinds.items(), key=lambda kv: -kv[1][1])
+    return "\n".join(f"    {v[1] / 1e3:8.1f} kB sent ({v[2] / 1e3:8.1f} kB decoded) ×{v[0]:<3d} {k}"
+                     for k, v in rows[:top])
 
 
 def cpu_s(pid: int) -> float:
@@ -106,11 +145,11 @@ def start_server(port: int, scene_3d: bool) -> subprocess.Popen:
     raise RuntimeError("server did not start")
 
 
-def open_page(browser, url: str) -> tuple[float, int, object, object, WsCounter]:
+def open_page(browser, url: str, keep: bool = False) -> tuple[float, int, object, object, WsCounter]:
     ctx = browser.new_context(viewport=VIEWPORT)
     page = ctx.new_page()
     page.set_default_timeout(120_000)
-    ws = WsCounter(page)
+    ws = WsCounter(page, keep)
     t0 = time.perf_counter()
     page.goto(url)
     page.get_by_role("button", name="Simulate").wait_for()
@@ -149,7 +188,25 @@ def click_all(pages: list, k: int) -> list[float]:
         starts.append(time.time() * 1e3)
         page.get_by_role("button", name="Simulate").click(no_wait_after=True)
     ends = [page.evaluate("() => window.__ready") for page in pages]
+    LAST_CLICK[:] = [starts[0], ends[0]]
     return [(t1 - t0) / 1e3 for t1, t0 in zip(ends, starts, strict=True) if t1 == t1]  # NaN: not drawn in 60 s
+
+
+#: [click, drawn] of the first page's last click [ms since epoch].
+LAST_CLICK: list[float] = []
+
+
+def split(ws: WsCounter) -> tuple[float, float] | None:
+    """(click → the overview's message arrived, arrived → drawn) [s] of the last click of ``ws``'s page.
+
+    The overview is the first message of ≥ 20 kB after the click (it goes out first, then the time plots).
+    """
+    t0, t1 = LAST_CLICK
+    within = [t for t, n in ws.arrivals if t0 <= t <= t1 and n >= 20_000]
+    if not within or t1 != t1:
+        return None
+    t_arrived = within[0]
+    return (t_arrived - t0) / 1e3, (t1 - t_arrived) / 1e3
 
 
 def med(xs: list[float], scale: float = 1e3, fmt: str = ".0f") -> str:
@@ -193,10 +250,14 @@ def slider_redraws(page, seconds: float, direction: str) -> float:
 
 def per_simulate(page, ws: WsCounter, pid: int, runs: int, replay_wait: float) -> None:
     """Server CPU, websocket bytes (incl. the replay that follows) and round trip of one page."""
-    cpus, sizes, msgs, lat = [], [], [], []
+    cpus, sizes, msgs, lat, arrive, draw = [], [], [], [], [], []
     for k in range(runs):
         b0, m0, c0 = ws.bytes, ws.messages, cpu_s(pid)
         lat += click_all([page], k)
+        parts = split(ws)
+        if parts is not None:
+            arrive.append(parts[0])
+            draw.append(parts[1])
         page.wait_for_timeout(1e3 * replay_wait)  # the full replay, if the server pushes it
         cpus.append(cpu_s(pid) - c0)
         sizes.append(ws.bytes - b0)
@@ -204,27 +265,38 @@ def per_simulate(page, ws: WsCounter, pid: int, runs: int, replay_wait: float) -
     print(f"per Simulate, 1 page ({runs} runs, incl. {replay_wait:g} s of replay): server CPU "
           f"{med(cpus)} ms [target ≤ 60]; websocket {med(sizes, 1e-3)} kB in "
           f"{statistics.median(msgs):.0f} messages [target ≤ 500 kB]; round trip {med(lat)} ms")
+    print(f"  round trip split: click → overview message arrived {med(arrive)} ms (server: inputs, simulate, "
+          f"figure JSON, send); arrived → drawn {med(draw)} ms (browser: decode, Plotly.react)")
 
 
 def replay_rate(page, ws: WsCounter, runs: int) -> None:
     """Phase-plane frames/s drawn by the browser during the in-plot replay, server bytes meanwhile."""
-    rates, traffic = [], []
-    for _ in range(runs):
-        b0 = ws.bytes
-        if not page.evaluate(PLAY_IN_PLOT, "▶ 0.1×"):
-            print("replay: no in-plot replay buttons found")
-            return
-        rates.append(page.evaluate(COUNT_FRAMES, 2000) / 2.0)
-        traffic.append((ws.bytes - b0) / 2.0)
-    print(f"replay (client-side animation, {runs} runs): {med(rates, 1, '.1f')} frames/s drawn; "
-          f"{med(traffic, 1e-3, '.2f')} kB/s from the server   [target ≥ 30 frames/s, ≤ 1 kB/frame]")
+    for label in ("▶ 0.1×", "▶ 0.01×"):
+        rates, traffic = [], []
+        for _ in range(runs):
+            b0 = ws.bytes
+            if not page.evaluate(PLAY_IN_PLOT, label):
+                print("replay: no in-plot replay buttons found")
+                return
+            page.wait_for_timeout(800)  # past the first key frame (a jump to t = 0)
+            rates.append(page.evaluate(COUNT_FRAMES, 2000) / 2.0)
+            traffic.append((ws.bytes - b0) / 2.8)
+        print(f"replay {label[2:]} (client-side animation, {runs} runs): {med(rates, 1, '.1f')} frames/s with the "
+              f"marker moved; {med(traffic, 1e-3, '.2f')} kB/s from the server   [target ≥ 30 frames/s, ≤ 1 kB/frame]")
+    frame_rate = page.evaluate("""() => new Promise(r => { let n = 0; const t0 = performance.now();
+      const f = () => { n += 1; if (performance.now() - t0 < 2000) requestAnimationFrame(f); else r(n / 2); };
+      requestAnimationFrame(f); })""")
+    print(f"  the page's own animation frame rate meanwhile: {frame_rate:.1f} frames/s (the ceiling of the above)")
 
 
 def open_pages(browser, url: str, n: int, timed: int, pid: int) -> list:
     """``timed`` pages opened one after the other (timed), then the rest of ``n`` all at once."""
-    opened = [open_page(browser, url) for _ in range(min(n, timed))]
+    opened = [open_page(browser, url, keep=k == 0) for k in range(min(n, timed))]
     print(f"page open → usable ({len(opened)} pages, one after the other): {med([o[0] for o in opened], 1, '.2f')} s;"
           f" websocket bytes {med([o[1] for o in opened], 1e-6, '.2f')} MB   [target ≤ 1 MB]")
+    first = opened[0][4]
+    print("  page open, first page, by message kind:\n" + breakdown(first.payloads))
+    first.payloads = None  # type: ignore[assignment]
     rest = []
     for _ in range(n - len(opened)):
         ctx = browser.new_context(viewport=VIEWPORT)
@@ -242,14 +314,14 @@ def open_pages(browser, url: str, n: int, timed: int, pid: int) -> list:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=5, help="rounds per figure (median; at least 5)")
+    ap.add_argument("--runs", type=int, default=5, help="rounds per figure (median; at least 3, 5 for the record)")
     ap.add_argument("--clients", default="1,5,10", help="numbers of pages clicking at once")
     ap.add_argument("--replay-wait", type=float, default=4.0, help="time allowed for a full replay [s]")
     ap.add_argument("--with-3d", action="store_true",
                     help="serve the 3D rotor view too (each headless page then renders WebGL in software on "
                          "the server's cores, which distorts the server figures on a small machine)")
     args = ap.parse_args()
-    runs, counts, t_start = max(5, args.runs), [int(c) for c in args.clients.split(",")], time.perf_counter()
+    runs, counts, t_start = max(3, args.runs), [int(c) for c in args.clients.split(",")], time.perf_counter()
     print(f"start: {load_average()}; 3D view {'on' if args.with_3d else 'off (--no-3d)'}")
     port = free_port()
     server = start_server(port, args.with_3d)

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from app.figures.comparison import (
-    MAX_POINTS,
     cursor_index,
     decimate_index,
     layer_entry_index,
@@ -16,9 +15,10 @@ from app.figures.comparison import (
     make_time_plots_figure,
     phase_plane_spec,
 )
+from app.figures.decimate import BINS_PHASE
 from app.figures.energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
 from app.figures.plain import figure_json
-from app.figures.replay import MAX_FRAMES, SPEEDS
+from app.figures.replay import KEY_RATE, MAX_FRAMES, SPEEDS
 from app.ui.replay import phase_plane_json
 from sim.fdsmc.engine import PAPER_TABLE1, Comparison, Table1Row, compare
 
@@ -43,7 +43,7 @@ def test_phase_plane_has_boundary_band_and_both_trajectories(comparison):
     np.testing.assert_allclose(y[sloped], -x[sloped] / prof.T_c)  # −1/T_c line through the origin
     for name in ("FDSMC", "Conventional"):
         traj = traces[f"{name} trajectory"]
-        assert 100 < len(traj.x) <= MAX_POINTS
+        assert 100 < len(traj.x) <= 2 * BINS_PHASE + 2
         theta_dem = comparison.derived.params.manoeuvre.theta_dem
         assert traj.x[0] == pytest.approx(-theta_dem)  # starts at rest, θ_re = −θ_dem
     assert fig.layout.meta["id"] == "phase_plane"
@@ -72,9 +72,14 @@ def test_replay_frames_put_the_markers_on_the_trajectories(comparison):
         assert frames[k]["data"][1]["x"][0] == pytest.approx(np.interp(t_k, tr.t, tr.theta_r) - th, rel=1e-4, abs=1e-6)
         assert frames[k]["data"][1]["y"][0] == pytest.approx(np.interp(t_k, tr.t, tr.omega_r), rel=1e-4, abs=1e-6)
         assert frames[-1]["data"][0]["text"] == [f"t = {t_end:.3f} s"]
-    # at 0.25× the frames come at least 30 per second unless capped
+        # the browser glides linearly between key frames, each glide lasting one frame; the first jumps
+        glides = opts["transition"]
+        assert len(glides) == n and glides[0]["duration"] == 0
+        assert all(g == {"duration": opts["frame"]["duration"], "easing": "linear"} for g in glides[1:])
+        assert opts["frame"]["redraw"] is False
+    # at 0.25× a key frame comes at least KEY_RATE times per wall second unless capped
     frames, opts = buttons[1]["args"]
-    assert opts["frame"]["duration"] <= 1e3 / 30 + 1e-9 or len(frames) == MAX_FRAMES
+    assert opts["frame"]["duration"] <= 1e3 / KEY_RATE + 1e-9 or len(frames) == MAX_FRAMES
 
 
 def test_dict_figure_json_matches_plotly(comparison):
@@ -87,7 +92,12 @@ def test_dict_figure_json_matches_plotly(comparison):
         for key in ("x", "y"):
             if isinstance(a[key], dict):
                 assert a[key] == b[key]  # identical base64 typed arrays
-    assert ours["layout"]["template"] == theirs["layout"]["template"]
+    # the template is plotly_white cut to what cartesian scatter/bar figures use, every kept value as Plotly's
+    mine, full = ours["layout"]["template"], theirs["layout"]["template"]
+    assert set(mine["data"]) == {"scatter", "bar"} and all(mine["data"][k] == full["data"][k] for k in mine["data"])
+    assert {"xaxis", "yaxis", "colorway", "plot_bgcolor", "paper_bgcolor", "font"} <= set(mine["layout"])
+    assert all(mine["layout"][k] == full["layout"][k] for k in mine["layout"])
+    assert len(json.dumps(mine)) < 0.2 * len(json.dumps(full))
 
 
 def test_phase_plane_marks_boundary_layer_entry(comparison):

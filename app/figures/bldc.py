@@ -14,6 +14,7 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from app.figures.plain import slim_template
 from app.io.units import rad_s_to_rpm
 from control.bldc.design import BldcDesign
 from control.bldc.dqx import dqx_coefficients, ideal_coefficients
@@ -28,7 +29,7 @@ _MARGIN = {"l": 55, "r": 15, "t": 40, "b": 40}
 
 def _layout(fig: go.Figure, fid: str, title: str, height: int = 320) -> go.Figure:
     fig.update_layout(meta={"id": fid}, title={"text": title, "font": {"size": 13}}, height=height,
-                      margin=_MARGIN, template="plotly_white", legend={"orientation": "h", "y": -0.2},
+                      margin=_MARGIN, template=slim_template(), legend={"orientation": "h", "y": -0.2},
                       hovermode="x unified")
     return fig
 

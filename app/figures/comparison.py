@@ -2,8 +2,8 @@
 
 Every ``make_*_figure`` function takes results and returns a new :class:`plotly.graph_objects.Figure`;
 nothing here touches the GUI. Each figure carries ``layout.meta = {"id": …}`` so that the page
-(and the browser tests) can tell the figures apart. Long traces are decimated to at most
-:data:`MAX_POINTS` points per trace for drawing.
+(and the browser tests) can tell the figures apart. Long traces are decimated for drawing with
+min/max bins (:mod:`app.figures.decimate`), so that chatter stays visible as a band.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -15,11 +15,12 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
+from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index, time_axis
 from app.figures.plain import to_figure
 from control.fdsmc.sliding_mode import boundary_speed
 from sim.fdsmc.engine import LABELS, Comparison, RunResult
 
-#: Most points drawn per trace.
+#: Most points drawn per trace by :func:`decimate_index` (the drive-log overlay).
 MAX_POINTS = 2000
 #: Most points per trace in the (24-trace) time plots: about one per pixel of the plot's width.
 MAX_POINTS_TIME = 800
@@ -41,20 +42,6 @@ def decimate_index(n: int, n_max: int = MAX_POINTS) -> np.ndarray:
 def stride_index(n: int, n_max: int) -> np.ndarray:
     """Every k-th sample of ``n`` with k chosen so that at most ``n_max`` remain (a uniform grid stays uniform)."""
     return np.arange(0, n, max(1, -(-n // n_max)))
-
-
-def time_axis(t: np.ndarray) -> dict[str, Any]:
-    """Trace keys for the time axis: ``x0``/``dx`` if ``t`` [s] is uniform (half the bytes), else ``x``."""
-    if len(t) > 2:
-        dt = np.diff(t)
-        if np.ptp(dt) <= 1e-6 * abs(float(dt.mean())):
-            return {"x0": float(t[0]), "dx": float(t[-1] - t[0]) / (len(t) - 1)}
-    return {"x": f32(t)}
-
-
-def f32(a: np.ndarray) -> np.ndarray:
-    """Return ``a`` as float32: halves the figure JSON (base64 typed arrays) at ample drawing precision."""
-    return np.asarray(a, dtype=np.float32)
 
 
 def runs(comparison: Comparison) -> list[tuple[str, RunResult]]:
@@ -90,10 +77,11 @@ def _phase_static_traces(comparison: Comparison) -> list[dict[str, Any]]:
     x, y = boundary_xy(comparison)
     half = 1.0 / comparison.derived.params.controller.K
     return [
-        {"type": "scatter", "x": np.concatenate([x, x[::-1]]), "y": np.concatenate([y + half, (y - half)[::-1]]),
+        {"type": "scatter", "x": f32(np.concatenate([x, x[::-1]])),
+         "y": f32(np.concatenate([y + half, (y - half)[::-1]])),
          "fill": "toself", "fillcolor": BAND_COLOUR, "line": {"width": 0}, "hoverinfo": "skip",
          "name": f"Boundary layer ±1/K = ±{half:.3g} rad/s, eq. (45)"},
-        {"type": "scatter", "x": x, "y": y, "mode": "lines", "name": "Switching boundary, eq. (41)",
+        {"type": "scatter", "x": f32(x), "y": f32(y), "mode": "lines", "name": "Switching boundary, eq. (41)",
          "line": {"color": BOUNDARY_COLOUR, "width": 2, "dash": "dash"}},
     ]
 
@@ -121,7 +109,7 @@ def _phase_marks(comparison: Comparison, key: str, run: RunResult) -> list[dict[
     out = []
     k = layer_entry_index(comparison, run) if key != "optimum" else None  # the optimum does not slide
     if k is not None and key == "fdsmc":
-        i = k + decimate_index(len(tr.t) - k)
+        i = k + minmax_index(tr.omega_r[k:], BINS_PHASE)
         out.append({"type": "scatter", "x": f32(tr.theta_r[i] - th), "y": f32(tr.omega_r[i]), "mode": "lines",
                     "name": "FDSMC sliding phase (in the layer)", "hoverinfo": "skip", "opacity": 0.3,
                     "line": {"color": COLOURS[key], "width": 9}})
@@ -149,7 +137,7 @@ def phase_plane_spec(comparison: Comparison) -> dict[str, Any]:
     data = _phase_static_traces(comparison)
     for key, run in runs(comparison):
         tr = run.trace
-        i = decimate_index(len(tr.t))
+        i = minmax_index(tr.omega_r, BINS_PHASE)  # the chatter band of ω_r survives
         t, x, y = tr.t[i], f32(tr.theta_r[i] - d.params.manoeuvre.theta_dem), f32(tr.omega_r[i])
         colour, label = COLOURS[key], LABELS[key]
         data.append({"type": "scatter", "x": x, "y": y, "mode": "lines", "name": f"{label} trajectory",
@@ -235,20 +223,19 @@ def _time_axes(n_rows: int, spacing: float = 0.025) -> tuple[dict[str, Any], lis
 
 
 def time_plots_spec(comparison: Comparison, rows: tuple[int, ...] | None = None,
-                    n_max: int = MAX_POINTS_TIME) -> dict[str, Any]:
+                    n_bins: int = BINS_TIME_PLOTS) -> dict[str, Any]:
     """Time plots as a plain-dict figure (see :func:`make_time_plots_figure`); ``rows`` picks rows of TIME_ROWS."""
     rows = tuple(range(len(TIME_ROWS))) if rows is None else rows
     data: list[dict[str, Any]] = []
     t_end = 0.0
     for key, run in runs(comparison):
         tr = run.trace
-        i = stride_index(len(tr.t), n_max)
         t_end = max(t_end, float(tr.t[-1]))
-        t = time_axis(tr.t[i])
         for pos, row in enumerate(rows, start=1):
             _, unit, signals = TIME_ROWS[row]
             for attr, label, dash in signals:
-                data.append({"type": "scatter", **t, "y": f32(getattr(tr, attr)[i]), "mode": "lines",
+                t, y = envelope(tr.t, getattr(tr, attr), n_bins)  # chatter stays a band
+                data.append({"type": "scatter", **t, "y": f32(y), "mode": "lines",
                              "name": f"{label} {LABELS[key]}", "legendgroup": key,
                              "line": {"color": COLOURS[key], "width": 1.6, "dash": dash},
                              "hovertemplate": f"%{{y:.4g}} {unit}", "xaxis": f"x{'' if pos == 1 else pos}",
@@ -291,7 +278,7 @@ def cursor_index(t: np.ndarray, t_now: float) -> int:
 
 __all__ = [
     "COLOURS", "LABELS", "MAX_POINTS", "TIME_ROWS", "boundary_xy", "cursor_index", "decimate_index",
-    "stride_index", "time_axis", "layer_entry_index", "load_step_times", "make_phase_plane_figure",
+    "stride_index", "time_axis", "f32", "layer_entry_index", "load_step_times", "make_phase_plane_figure",
     "make_time_plots_figure",
     "phase_plane_extent", "phase_plane_spec", "runs", "time_plots_spec",
 ]

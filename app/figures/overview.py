@@ -16,17 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.comparison import (
-    COLOURS,
-    LABELS,
-    MAX_POINTS_TIME,
-    f32,
-    load_step_times,
-    phase_plane_spec,
-    runs,
-    stride_index,
-    time_axis,
-)
+from app.figures.comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
+from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
 from control.fdsmc.feasibility import torque_limit
 
 #: Horizontal domains [-] of the phase plane and of the compact time plot.
@@ -58,15 +49,15 @@ def _row_traces(comparison: Any) -> tuple[list[dict[str, Any]], list[list[float]
     t_end = 0.0
     for key, run in runs(comparison):
         tr = run.trace
-        i = stride_index(len(tr.t), MAX_POINTS_TIME // 2)
-        t, t_end = time_axis(tr.t[i]), max(t_end, float(tr.t[-1]))
-        gamma = motor_torque(motor, tr.i_d[i], tr.i_q[i])
-        style = {"type": "scatter", "mode": "lines", "showlegend": False, **t}
-        for row, y, name, unit, line in (
-                (0, tr.omega_r[i], "ω_r", "rad/s", {"width": 1.6}),
+        t_end = max(t_end, float(tr.t[-1]))
+        gamma = motor_torque(motor, tr.i_d, tr.i_q)
+        style = {"type": "scatter", "mode": "lines", "showlegend": False}
+        for row, full, name, unit, line in (
+                (0, tr.omega_r, "ω_r", "rad/s", {"width": 1.6}),
                 (1, gamma, "Γ", "N·m", {"width": 1.6}),
-                (1, tr.Gamma_L[i], "Γ_L", "N·m", {"width": 1.2, "dash": "dot"})):
-            data.append({**style, "y": f32(y), "name": f"{name} {LABELS[key]}", "xaxis": f"x{row + 2}",
+                (1, tr.Gamma_L, "Γ_L", "N·m", {"width": 1.2, "dash": "dot"})):
+            t, y = envelope(tr.t, full, BINS_OVERVIEW_ROWS)  # a chattering Γ stays a band
+            data.append({**style, **t, "y": f32(y), "name": f"{name} {LABELS[key]}", "xaxis": f"x{row + 2}",
                          "yaxis": f"y{row + 2}", "line": {"color": COLOURS[key], **line},
                          "hovertemplate": f"t = %{{x:.4f}} s: %{{y:.4g}} {unit}<extra>{LABELS[key]}</extra>"})
             ys[row] += [float(np.min(y)), float(np.max(y))]

@@ -19,11 +19,39 @@ import numpy as np
 import plotly.graph_objects as go
 import plotly.io as pio
 
+#: Trace types whose template defaults are kept (the only ones the page draws), and the layout
+#: parts of a template that cartesian 2D figures never use (polar, ternary, 3D scene, geo, …).
+_TEMPLATE_TRACES = ("scatter", "bar")
+_UNUSED_LAYOUT = ("polar", "ternary", "scene", "geo", "mapbox", "map", "coloraxis", "colorscale", "shapedefaults",
+                  "annotationdefaults", "autotypenumbers")
+
 
 @functools.cache
 def template_json(name: str) -> str:
-    """JSON of a named Plotly template (e.g. ``"plotly_white"``), rendered once."""
-    return json.dumps(pio.templates[name].to_plotly_json(), separators=(",", ":"))
+    """JSON of a named Plotly template (e.g. ``"plotly_white"``) cut to what the page's figures use, rendered once.
+
+    The full template (≈7 kB) sets defaults for some 40 trace types and for polar, ternary, 3D and
+    geo axes; each figure carries its template, so only the scatter and bar defaults and the
+    layout of cartesian axes, colours and fonts are kept (≈1.5 kB): the figures look the same.
+    """
+    full = pio.templates[name].to_plotly_json()
+    slim = {"data": {k: v for k, v in full.get("data", {}).items() if k in _TEMPLATE_TRACES},
+            "layout": {k: v for k, v in full.get("layout", {}).items() if k not in _UNUSED_LAYOUT}}
+    return json.dumps(slim, separators=(",", ":"))
+
+
+@functools.cache
+def slim_template(name: str = "plotly_white") -> go.layout.Template:
+    """Return the cut template of :func:`template_json` as a ``go.layout.Template`` (for ``go.Figure``)."""
+    return go.layout.Template(json.loads(template_json(name)))
+
+
+def blank_figure() -> go.Figure:
+    """Return an empty figure with the slim template (a placeholder until results arrive).
+
+    ``go.Figure()`` carries Plotly's full default template, ≈ 7 kB per placeholder at page open.
+    """
+    return go.Figure(layout={"template": slim_template()})
 
 
 def _default(obj: Any) -> Any:
@@ -60,4 +88,4 @@ def to_figure(spec: dict[str, Any]) -> go.Figure:
     return go.Figure(spec)
 
 
-__all__ = ["figure_json", "template_json", "to_figure"]
+__all__ = ["blank_figure", "figure_json", "slim_template", "template_json", "to_figure"]

@@ -1,11 +1,21 @@
-"""The replay, animated by the browser: Plotly buttons and a slider with inline frames.
+"""The replay, animated by the browser: Plotly buttons and a slider with inline key frames.
 
 Viser hands Plotly only ``data``/``layout``/``config`` (``fig.frames`` are dropped), but
 ``Plotly.animate`` also takes a list of frame *objects*, and a layout ``updatemenus`` button
 passes its ``args`` straight to it. So each speed's button carries its own short list of
-frames, each moving only the phase-plane "now" markers and the time cursors of the overview
+*key frames*, each moving only the phase-plane "now" markers and the time cursors of the overview
 figure (:mod:`app.figures.overview`; a few numbers per frame); the figure goes out once per
 Simulate and the replay then costs no server traffic at all.
+
+Between two key frames Plotly moves the markers and the cursor lines itself, at the browser's
+frame rate: each frame's ``transition`` lasts exactly the frame's duration with ``"linear"``
+easing, and ``redraw: false`` keeps it to the moved traces. (``Plotly.animate`` takes one
+transition per frame as a list: the first is instantaneous, so a replay jumps to t = 0 instead of
+gliding back from where the marker stands.) Key frames are evenly spaced in
+simulated time, so the cursors (``x = [t, t]``) move exactly with time and the markers follow the
+trajectory through a key frame every 1/:data:`KEY_RATE` wall seconds (at most
+:data:`MAX_FRAMES` per speed). A slow replay (0.01×) is therefore as smooth as a fast one, with a
+figure that stays small (≈150 B per key frame, before compression).
 """
 
 from __future__ import annotations
@@ -21,10 +31,10 @@ from sim.fdsmc.engine import Comparison
 
 #: Replay speeds: button label → simulated seconds per wall-clock second.
 SPEEDS = {"1×": 1.0, "0.25×": 0.25, "0.1×": 0.1, "0.01×": 0.01}
-#: Frames per wall-clock second aimed at, and the most frames per speed (bounds the figure size).
-FRAME_RATE, MAX_FRAMES = 30.0, 600
+#: Key frames per wall-clock second, and the most key frames per speed (bounds the figure size).
+KEY_RATE, MAX_FRAMES = 10.0, 150
 #: Positions on the scrub slider.
-SLIDER_STEPS = 100
+SLIDER_STEPS = 50
 
 
 def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = ()) -> str:
@@ -53,8 +63,8 @@ def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cur
 
 
 def _n_frames(t_end: float, speed: float) -> int:
-    """Frames of one speed: :data:`FRAME_RATE` per wall second, at most :data:`MAX_FRAMES`."""
-    return int(min(MAX_FRAMES, max(2, math.ceil(t_end / speed * FRAME_RATE) + 1)))
+    """Key frames of one speed: :data:`KEY_RATE` per wall second, at most :data:`MAX_FRAMES`."""
+    return int(min(MAX_FRAMES, max(2, math.ceil(t_end / speed * KEY_RATE) + 1)))
 
 
 def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[dict[str, Any], dict[str, str]]:
@@ -84,9 +94,11 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
     for k, (label, speed) in enumerate(SPEEDS.items()):
         n = _n_frames(t_end, speed)
         raw[f"__frames_{k}__"] = _frames_json(comparison, now, np.linspace(0.0, t_end, n), cursors)
+        ms = 1e3 * t_end / speed / (n - 1)
+        # per key frame: a jump to the start, then glides of one frame's duration each
+        glide = [{"duration": 0}] + [{"duration": ms, "easing": "linear"} for _ in range(n - 1)]
         buttons.append({"label": f"▶ {label}", "method": "animate", "args": [f"__frames_{k}__", {
-            "mode": "immediate", "frame": {"duration": 1e3 * t_end / speed / (n - 1), "redraw": False},
-            "transition": {"duration": 0}}]})
+            "mode": "immediate", "frame": {"duration": ms, "redraw": False}, "transition": glide}]})
     buttons.append({"label": "Pause", "method": "animate", "args": [[None], {
         "mode": "immediate", "frame": {"duration": 0, "redraw": False}, "transition": {"duration": 0}}]})
     t_grid = np.linspace(0.0, t_end, SLIDER_STEPS + 1)
@@ -108,4 +120,4 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
     }, raw
 
 
-__all__ = ["FRAME_RATE", "MAX_FRAMES", "SPEEDS", "replay_layout"]
+__all__ = ["KEY_RATE", "MAX_FRAMES", "SPEEDS", "replay_layout"]

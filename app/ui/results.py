@@ -12,11 +12,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-import plotly.graph_objects as go
 import viser
 
 from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
-from app.figures.plain import figure_json
+from app.figures.plain import blank_figure, figure_json
 from app.io.numbers import parse_T_m_list
 from app.ui.layout import PanelLayout
 from app.ui.replay import Replay, set_figure_json
@@ -43,14 +42,14 @@ class ResultsPanel:
         time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
         with phase_tab:
             self.key_numbers = gui.add_html(key_numbers_html(comparison))
-            self.phase = gui.add_plotly(go.Figure(), aspect=ASPECT_PHASE)
+            self.phase = gui.add_plotly(blank_figure(), aspect=ASPECT_PHASE)
         with time_tab:
-            self.time_plots = gui.add_plotly(go.Figure(), aspect=ASPECT_TIME)
+            self.time_plots = gui.add_plotly(blank_figure(), aspect=ASPECT_TIME)
         with phase_tab:
             self.replay = Replay(gui, self.phase, self.time_plots, scene, flush=client.flush, on_3d=on_3d)
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
-            self.energy = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
-            self.bars = gui.add_plotly(go.Figure(), aspect=ASPECT_SMALL)
+            self.energy = gui.add_plotly(blank_figure(), aspect=ASPECT_SMALL)
+            self.bars = gui.add_plotly(blank_figure(), aspect=ASPECT_SMALL)
             self._build_savings(gui)
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
@@ -85,12 +84,13 @@ class ResultsPanel:
     def show(self, comparison: Any, autoplay: bool = True, overview_only: bool = False) -> None:
         """Draw a new comparison: key numbers and overview first (what the user waits for), then the rest.
 
-        With ``overview_only`` (a slider being dragged) the other tabs keep their figures until
-        :meth:`show_rest`; each redraw then sends only what the Overview tab shows.
+        With ``overview_only`` (a slider being dragged) the other tabs keep their figures and the
+        overview comes without its replay controls until :meth:`show_rest`; each redraw then sends
+        only what the Overview tab shows, and the browser redraws it faster.
         """
         self._comparison = comparison
         self.key_numbers.content = key_numbers_html(comparison)
-        self.replay.load(comparison, autoplay=autoplay, time_plots=not overview_only)
+        self.replay.load(comparison, autoplay=autoplay, light=overview_only)
         self._rest_pending = overview_only
         if not overview_only:
             self.show_rest()
@@ -99,7 +99,7 @@ class ResultsPanel:
         """Draw the time plots, energy figures and savings of the comparison last shown."""
         comparison = self._comparison
         if self._rest_pending:
-            self.replay.show_time_plots(comparison)
+            self.replay.complete(comparison)
         self._rest_pending = False
         set_figure_json(self.energy, figure_json(energy_spec(comparison)))
         set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))

@@ -23,11 +23,13 @@ from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
 from app.ui.layout import PanelLayout, WindowFit
 from app.ui.log import LogPanel
+from app.ui.plotly_js import use_basic_plotly
 from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import OptimumToggle, StudiesSection
-from app.ui.text import checked_choice, derived_markdown, design_markdown, md_text, warnings_html
+from app.ui.text import checked_choice, derived_markdown, design_markdown, md_text
 from app.ui.tuning import LiveTuning
+from app.ui.verdict_panel import VerdictPanel
 from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Cancelled, Worker
 from control.fdsmc.derivations import derive
@@ -35,7 +37,7 @@ from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
-from sim.fdsmc.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
+from sim.fdsmc.verdicts import T_c_advice, recommended_K
 
 #: Page-wide CSS: the 3D canvas is hidden while a BLDC tab is shown (viser mounts only the active
 #: tab, and marks it ``aria-selected``; the BLDC tabs' titles start with "BLDC").
@@ -100,6 +102,7 @@ class Session:
         gui = self.gui
         gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
         gui.add_html(PAGE_STYLE)
+        use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
         gui.main_panel.dock_left()
         tabs = gui.add_tab_group()
         with tabs.add_tab("Position drive (FDSMC)"):
@@ -138,16 +141,7 @@ class Session:
         self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
         self.cancel_button.on_click(lambda _: self.cancel())
         self.status = gui.add_markdown("Ready.")
-        self.fold_warnings = gui.add_checkbox("Fold warnings to one line", False,
-                                              hint="Keeps the warnings box folded over new runs; a click on "
-                                                   "its first line still opens it once")
-        self.fold_warnings.on_update(lambda _: self._render_warnings())
-        self._warning_parts: tuple[list[str], str | None, list[str]] = ([], None, [])
-        self.warnings = gui.add_html("")
-        self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
-        self.use_k.on_click(lambda _: self._use_recommended_k())
-        self.use_tc = gui.add_button("Use T_c,min", visible=False, color="orange")
-        self.use_tc.on_click(lambda _: self._use_T_c_min())
+        self.verdicts = VerdictPanel(gui, self._use_recommended_k, self._use_T_c_min)
         self.tuning = LiveTuning(gui, self._apply_knob, self.tune)
         with gui.add_form(None) as form:
             self.inputs = InputsPanel(gui, self.params)
@@ -309,20 +303,7 @@ class Session:
         if self._recentre:
             self._recentre = False
             self.tuning.centre(self.params, d.profile.T_c)
-        items = list(d.warnings) + run_warnings(self.comparison) + self._nameplate_warnings()
-        if self.comparison.fdsmc is None:
-            items.append("Not simulated: the manoeuvre is infeasible (see above).")
-        self._render_warnings((items, self.error, comparator_notes(self.comparison)))
-        chatter = any(r is not None and r.metrics.chatter
-                      for r in (self.comparison.fdsmc, self.comparison.conventional))
-        k_rec = recommended_K(d)
-        self.use_k.visible = k_rec is not None and (chatter or 1.001 * k_rec < self.params.controller.K)
-        if k_rec is not None:
-            self.use_k.label = f"Use recommended K = {k_rec:.4g} s/rad"
-        T_c = T_c_advice(d)
-        self.use_tc.visible = T_c is not None
-        if T_c is not None:
-            self.use_tc.label = f"Use T_c = {T_c * 1e3:.4g} ms (damps the approach to θ_dem)"
+        self.verdicts.show(self.comparison, self.params.controller.K, self.error, self._nameplate_warnings())
         self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: {md_text(self.origin)}."
 
     def _nameplate_warnings(self) -> list[str]:
@@ -337,16 +318,9 @@ class Session:
         return [f"Nameplate: {x.text}" for x in nameplate_consistency(self.params.motor, **extra)
                 if x.text not in general]
 
-    def _render_warnings(self, parts: tuple[list[str], str | None, list[str]] | None = None) -> None:
-        """Show the warnings (new ``parts``, or the last ones), folded to one line if the user asked."""
-        if parts is not None:
-            self._warning_parts = parts
-        items, error, notes = self._warning_parts
-        self.warnings.content = warnings_html(items, error, notes, folded=bool(self.fold_warnings.value))
-
     def _reject(self, message: str) -> None:
         self.error = message
-        self._render_warnings(([], message, []))
+        self.verdicts.reject(message)
         self.client.add_notification("Input rejected — nothing simulated", message, color="red",
                                      auto_close_seconds=12.0)
 

@@ -9,10 +9,9 @@ from __future__ import annotations
 
 from typing import Any
 
-import plotly.graph_objects as go
 import viser
 
-from app.figures.plain import figure_json
+from app.figures.plain import blank_figure, figure_json
 from app.figures.studies import multiaxis_spec, multiaxis_table_markdown
 from app.io.preset_modes import list_presets_of
 from app.io.presets import MAX_BYTES, loads_raw
@@ -95,7 +94,7 @@ class MultiAxisView:
         self.run_button = gui.add_button("Run multi-axis move", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.status = gui.add_markdown("Not run yet.")
         self.table = gui.add_markdown("")
-        self.figure = gui.add_plotly(go.Figure(), aspect=0.8)
+        self.figure = gui.add_plotly(blank_figure(), aspect=0.8)
         self.add_button.on_click(lambda _: self._add_axis())
         self.upload.on_upload(lambda _: self._uploaded())
         self.run_button.on_click(lambda _: self.start())

@@ -15,10 +15,9 @@ from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from typing import Any
 
-import plotly.graph_objects as go
 import viser
 
-from app.figures.plain import figure_json
+from app.figures.plain import blank_figure, figure_json
 from app.figures.studies import robustness_spec, robustness_table_markdown
 from app.io.study_inputs import parse_spread
 from app.ui.replay import set_figure_json
@@ -105,7 +104,7 @@ class RobustnessView:
         self.progress = gui.add_progress_bar(0.0, animated=False)
         self.status = gui.add_markdown("Not run yet: the controller keeps the simulated inputs as its model; "
                                        "each sample draws the plant from the spreads above.")
-        self.figure = gui.add_plotly(go.Figure(), aspect=0.8)
+        self.figure = gui.add_plotly(blank_figure(), aspect=0.8)
         self.table = gui.add_markdown("")
         self.run_button.on_click(lambda _: self.start())
         self.cancel_button.on_click(lambda _: self.cancel())

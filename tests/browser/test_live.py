@@ -11,10 +11,17 @@ MARKER_JS = """() => {
   const t = el._fullData.find(t => t.name === 'FDSMC now');
   return [Number(t.x[0]), Number(t.y[0]), (t.text || [''])[0]];
 }"""
+#: Counts the animation frames in which the drawn FDSMC marker (its SVG transform) moved: the key
+#: frames and Plotly's glides between them.
 COUNT_FRAMES_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
-  window.__frames = 0;
-  el.on('plotly_animatingframe', () => { window.__frames += 1; });
+  const g = () => [...el.querySelectorAll('g.trace.scatter')]
+    .find(g => g.__data__[0].trace.name === 'FDSMC now');
+  const pos = () => { const t = g(); const p = t && t.querySelector('path.point');
+                      return p && p.getAttribute('transform'); };
+  window.__frames = 0; let last = pos();
+  const f = () => { const p = pos(); if (p !== last) { window.__frames += 1; last = p; } requestAnimationFrame(f); };
+  requestAnimationFrame(f);
 }"""
 
 
@@ -27,9 +34,10 @@ def test_in_plot_replay_moves_the_marker_without_server_traffic(page, ui_server)
     t_end = float(ui_server.config.initial().fdsmc.trace.t[-1])
     page.evaluate(COUNT_FRAMES_JS)
     n0 = len(received)
-    page.locator(".updatemenu-button", has_text=f"▶ {list(SPEEDS)[0]}").click()
+    page.locator(".updatemenu-button", has_text=f"▶ {list(SPEEDS)[1]}").click()
     # the marker starts at t = 0 (θ_re = −θ_dem, at rest) and runs to the end of the trajectory
-    page.wait_for_function(f"() => window.__frames >= 30 && ({MARKER_JS})()[2] === 't = {t_end:.3f} s'")
+    page.wait_for_function(f"() => window.__frames >= 30 && ({MARKER_JS})()[2] === 't = {t_end:.3f} s'",
+                           timeout=30_000 + 8000 * t_end)
     end = page.evaluate(MARKER_JS)
     frames = page.evaluate("() => window.__frames")
     assert frames >= 30
@@ -75,3 +83,9 @@ def test_dragging_the_K_slider_resimulates_with_the_latest_value(page):
     assert page.evaluate(BAND_JS) != before_band
     after_y = page.evaluate(FDSMC_Y_JS)
     assert len(after_y) != len(before_y) or max(abs(a - b) for a, b in zip(after_y, before_y, strict=True)) > 1e-3
+    # once the drag has stopped the overview gets its replay back (play buttons and scrub slider)
+    page.wait_for_function("() => { const el = [...document.querySelectorAll('.js-plotly-plot')]"
+                           ".find(e => e.layout.meta.id === 'phase_plane');"
+                           " return (el.layout.updatemenus || []).length > 0"
+                           " && (el.layout.sliders || []).length > 0; }")
+    assert abs(float(page.evaluate(BAND_JS).split("±")[2].split()[0]) * k_shown - 1) < 6e-3

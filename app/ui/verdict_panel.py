@@ -1,0 +1,64 @@
+"""The verdicts under the Simulate button: the warnings box (foldable) and the one-click remedies.
+
+Shows the derivation's and the runs' warnings, the comparator notes and any input error in one
+box (:func:`app.ui.text.warnings_html`), folded to one line over every later run when the user
+ticks "Fold warnings to one line", and offers "Use recommended K" / "Use T_c" when the loop
+analysis has a remedy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import viser
+
+from app.ui.text import warnings_html
+from sim.fdsmc.engine import Comparison
+from sim.fdsmc.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
+
+#: What the warnings box shows: warnings, input error (or None) and grey notes.
+WarningParts = tuple[list[str], str | None, list[str]]
+
+
+class VerdictPanel:
+    """Warnings box with its fold choice, and the remedy buttons, of one client."""
+
+    def __init__(self, gui: viser.GuiApi, use_K: Callable[[], None], use_T_c: Callable[[], None]) -> None:
+        self.fold = gui.add_checkbox("Fold warnings to one line", False,
+                                     hint="Keeps the warnings box folded over new runs; a click on its first "
+                                          "line still opens it once")
+        self.fold.on_update(lambda _: self.render())
+        self._parts: WarningParts = ([], None, [])
+        self.box = gui.add_html("")
+        self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
+        self.use_k.on_click(lambda _: use_K())
+        self.use_tc = gui.add_button("Use T_c,min", visible=False, color="orange")
+        self.use_tc.on_click(lambda _: use_T_c())
+
+    def render(self, parts: WarningParts | None = None) -> None:
+        """Show the warnings (new ``parts``, or the last ones), folded to one line if the user asked."""
+        if parts is not None:
+            self._parts = parts
+        items, error, notes = self._parts
+        self.box.content = warnings_html(items, error, notes, folded=bool(self.fold.value))
+
+    def reject(self, message: str) -> None:
+        """Show an input error: nothing was simulated."""
+        self.render(([], message, []))
+
+    def show(self, comparison: Comparison, K: float, error: str | None, extra: list[str]) -> None:
+        """Show the verdicts of ``comparison`` (run with boundary-layer gain ``K`` [s/rad]) and its remedies."""
+        d = comparison.derived
+        items = list(d.warnings) + run_warnings(comparison) + extra
+        if comparison.fdsmc is None:
+            items.append("Not simulated: the manoeuvre is infeasible (see above).")
+        self.render((items, error, comparator_notes(comparison)))
+        chatter = any(r is not None and r.metrics.chatter for r in (comparison.fdsmc, comparison.conventional))
+        k_rec = recommended_K(d)
+        self.use_k.visible = k_rec is not None and (chatter or 1.001 * k_rec < K)
+        if k_rec is not None:
+            self.use_k.label = f"Use recommended K = {k_rec:.4g} s/rad"
+        T_c = T_c_advice(d)
+        self.use_tc.visible = T_c is not None
+        if T_c is not None:
+            self.use_tc.label = f"Use T_c = {T_c * 1e3:.4g} ms (damps the approach to θ_dem)"
