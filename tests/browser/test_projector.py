@@ -15,8 +15,6 @@ from app.figures.overview import CURSORS
 from app.figures.replay import SPEEDS
 from tests.browser.conftest import ARTIFACTS, TIMEOUT_MS, UiServer, click_tab, session_of, wait_for_layout
 
-DOCS = ARTIFACTS.parent / "docs"
-
 #: Bounding boxes (page pixels) of the phase-plane subplot, the two time rows and the key numbers.
 BOXES_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
@@ -94,8 +92,8 @@ def test_1280x720_shows_phase_plane_time_plot_and_numbers_without_scrolling(proj
     text = page.inner_text('[data-role="key-numbers"]')
     assert "FDSMC saves" in text and "Γ_max" in text
     page.wait_for_timeout(300)  # let the last layout message settle before the picture
-    DOCS.mkdir(exist_ok=True)
-    out = DOCS / "projector_1280x720.png"
+    ARTIFACTS.mkdir(exist_ok=True)
+    out = ARTIFACTS / "projector_1280x720.png"  # copied by hand to docs/ for the README
     page.screenshot(path=str(out))
     assert out.stat().st_size > 30_000
 
