@@ -81,23 +81,6 @@ def test_projector_layout_fits_1280x720_and_uses_wide_screens():
     assert shown.results_width < wide.results_width  # the 3D view takes its share
 
 
-def test_a_report_made_before_the_new_layout_arrived_does_not_flip_the_layout():
-    """The browser may report its canvas under the layout it still shows (the previous one)."""
-    applied = []
-    fit = WindowFit(applied.append)
-    old = applied[-1]
-    fit.canvas_reported(1400, 900)  # first report: the whole window → a layout for 1400 × 900
-    new = applied[-1]
-    assert new != old
-    stale = 1400 - old.control_width - old.results_width - 8  # canvas under the old layout
-    fresh = 1400 - new.control_width - new.results_width - 8
-    for canvas in (stale, fresh, stale, fresh):
-        fit.canvas_reported(canvas, 900)
-    assert applied == [old, new] and fit.window == (1400, 900)
-    fit.canvas_reported(fresh + 200, 900)  # a real resize (200 px wider) is still followed
-    assert applied[-1] == layout_for_window(1600, 900)
-
-
 def test_window_size_from_the_canvas_and_refit():
     applied = []
     fit = WindowFit(applied.append)

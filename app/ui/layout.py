@@ -80,7 +80,6 @@ class WindowFit:
         self.show_3d = show_3d
         self.window = DEFAULT_WINDOW
         self.layout = layout_for_window(*DEFAULT_WINDOW, show_3d)
-        self._previous: PanelLayout | None = None  # the layout before the last one pushed
         self._first = True
         self._lock = threading.Lock()  # camera messages arrive on viser's thread pool
         apply(self.layout)
@@ -92,8 +91,6 @@ class WindowFit:
 
     def _canvas_reported(self, canvas_width: float, canvas_height: float) -> None:
         first, self._first = self._first, False
-        if not first and self._explains(canvas_width, canvas_height):
-            return
         if first and canvas_width > CANVAS_MIN + 1.0 and canvas_height > 0:
             size: tuple[float, float] | None = (float(canvas_width), float(canvas_height))  # whole window
         else:
@@ -104,19 +101,6 @@ class WindowFit:
             self.window = size
             self._refit()
 
-    def _explains(self, canvas_width: float, canvas_height: float) -> bool:
-        """Return True if the report fits the known window under the current or the previous layout.
-
-        The browser may report its canvas before it has applied the layout pushed last; reading that
-        report under the new layout would give a wrong window and push the layouts back and forth
-        (each push redraws every plot). Such a stale report is consistent with the previous layout.
-        """
-        for shown in (self.layout, self._previous):
-            size = None if shown is None else window_size(canvas_width, canvas_height, shown)
-            if size is not None and abs(size[0] - self.window[0]) <= 2 and abs(size[1] - self.window[1]) <= 2:
-                return True
-        return False
-
     def set_3d(self, show: bool) -> None:
         """Fold (False) or show (True) the 3D view."""
         with self._lock:
@@ -126,7 +110,7 @@ class WindowFit:
     def _refit(self) -> None:
         layout = layout_for_window(*self.window, self.show_3d)
         if layout != self.layout:
-            self._previous, self.layout = self.layout, layout
+            self.layout = layout
             self._apply(layout)
 
 
