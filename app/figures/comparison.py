@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
-from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index, time_axis
+from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index
 from app.figures.plain import to_figure
 from control.fdsmc.sliding_mode import boundary_speed
 from sim.fdsmc.engine import LABELS, Comparison, RunResult
@@ -278,7 +278,7 @@ def cursor_index(t: np.ndarray, t_now: float) -> int:
 
 __all__ = [
     "COLOURS", "LABELS", "MAX_POINTS", "TIME_ROWS", "boundary_xy", "cursor_index", "decimate_index",
-    "stride_index", "time_axis", "f32", "layer_entry_index", "load_step_times", "make_phase_plane_figure",
+    "stride_index", "layer_entry_index", "load_step_times", "make_phase_plane_figure",
     "make_time_plots_figure",
     "phase_plane_extent", "phase_plane_spec", "runs", "time_plots_spec",
 ]

@@ -10,7 +10,8 @@ from typing import Any
 
 import plotly.graph_objects as go
 
-from app.figures.comparison import COLOURS, MAX_POINTS_TIME, f32, runs, stride_index, time_axis
+from app.figures.comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
+from app.figures.decimate import f32, time_axis
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, Table1Row
 from sim.fdsmc.optimum_gap import saving_vs_optimum
 
