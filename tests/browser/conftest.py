@@ -83,13 +83,15 @@ def browser() -> Iterator[Any]:
 
 
 def open_page(browser: Any, ui: UiServer, viewport: dict[str, int] | None = None,
-              init_script: str | None = None) -> tuple[Any, Any]:
+              init_script: str | None = None, scale: float = 1.0) -> tuple[Any, Any]:
     """A new context + page of ``ui``, waited until the phase plane is drawn and the panels are
     fitted to the window (:func:`wait_for_layout`). Returns (context, page).
 
-    ``init_script`` runs in the page before any of its own scripts.
+    ``init_script`` runs in the page before any of its own scripts; ``scale`` is the device
+    pixel ratio (device pixels per CSS pixel).
     """
-    context = browser.new_context(viewport=viewport or VIEWPORT, accept_downloads=True)
+    context = browser.new_context(viewport=viewport or VIEWPORT, accept_downloads=True,
+                                  device_scale_factor=scale)
     if init_script is not None:
         context.add_init_script(init_script)
     page = context.new_page()

@@ -50,9 +50,13 @@ def _expected(width: int, height: int) -> dict[str, Any]:
     return {"results": lay.results_width, "control": lay.control_width + BORDERS / 2, "canvas": canvas}
 
 
-@pytest.mark.parametrize(("width", "height"), [(1280, 720), (1920, 1080)])
-def test_panels_take_one_width_from_the_first_frame(browser, ui_server, width, height):
-    context, page = open_page(browser, ui_server, {"width": width, "height": height}, init_script=RECORD_JS)
+@pytest.mark.parametrize(("width", "height", "scale"), [(1280, 720, 1.0), (1920, 1080, 1.0), (1280, 720, 1.5)])
+def test_panels_take_one_width_from_the_first_frame(browser, ui_server, width, height, scale):
+    """Also on a high-density screen (1.5 device pixels per CSS pixel, e.g. a laptop at 150 %
+    driving a projector), where the 3D canvas's drawing buffer is 1.5× its CSS size.
+    """
+    context, page = open_page(browser, ui_server, {"width": width, "height": height}, init_script=RECORD_JS,
+                              scale=scale)
     try:
         aspect = layout_for_window(width, height).plot_aspect
         page.wait_for_function(PLOT_AT_ASPECT_JS, arg=aspect, polling="raf")  # plot refitted: steady
