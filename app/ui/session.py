@@ -96,7 +96,7 @@ class Session:
         The page's CSS sizes the panels from the window's width; the overview plot's height
         follows the window size the page reports into a hidden field (:mod:`app.ui.layout`).
         """
-        with self.client.atomic():  # the client places the panels in one go: never a floating panel
+        with self.client.atomic():  # one batch: the page CSS, the panels and their docking arrive together
             gui = self.gui
             gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
             self._window_probe = gui.add_text("window [px]", "")
