@@ -20,12 +20,14 @@ from app.ui.layout import (
     CONTROL_WIDTH_WIDE,
     DEFAULT_WINDOW,
     PLOT_PADDING,
+    RAIL,
     RESULTS_MIN,
     SCENE_MIN,
     WIDE_WINDOW,
     WindowFit,
+    install_css_js,
     layout_for_window,
-    page_style,
+    page_css,
     parse_window,
     window_report_js,
 )
@@ -90,18 +92,27 @@ def test_window_fit_refits_on_a_new_size_and_ignores_junk():
     assert applied[-1] == layout_for_window(1400, 900)
 
 
-def test_page_style_carries_the_widths_of_layout_for_window():
-    folded, shown = page_style("probe-1"), page_style("probe-1", show_3d=True)
-    assert folded.startswith("<style>") and folded.endswith("</style>") and folded != shown
-    # control panel + viser's two 2 px gutters, narrow and wide windows
-    assert f"{CONTROL_WIDTH + BORDERS / 2:g}px" in folded and f"{CONTROL_WIDTH_WIDE + BORDERS / 2:g}px" in folded
-    assert f"(min-width: {WIDE_WINDOW + 1:g}px)" in folded
+def test_page_css_carries_the_widths_of_layout_for_window():
+    folded, shown = page_css("probe-1"), page_css("probe-1", show_3d=True)
+    assert folded != shown
+    # control panel + viser's two 2 px gutters, narrow and wide windows; a folded region: the rail
+    assert f"--fit-left: {CONTROL_WIDTH + BORDERS / 2:g}px" in folded
+    wide_px = CONTROL_WIDTH_WIDE + BORDERS / 2
+    wide = f"(min-width: {WIDE_WINDOW + 1:g}px) {{ [data-dock-root] {{--fit-left: {wide_px:g}px}}"
+    assert wide in folded
+    assert f"--fit-left: {RAIL + BORDERS / 2:g}px" in folded and f"--fit-right: {RAIL + BORDERS / 2:g}px" in folded
     # results: the rest of the window beside the folded canvas; 22 % of it for the shown 3D view
-    assert f"calc(100% - {CONTROL_WIDTH + BORDERS / 2:g}px - {CANVAS_SPARE:g}px)" in folded
-    assert f"max({SCENE_MIN:g}px, 22%)" in shown and f"{CANVAS_SPARE:g}px)" not in shown
-    assert f"max({RESULTS_MIN + BORDERS / 2:g}px" in folded
+    assert f"--fit-canvas: {CANVAS_SPARE:g}px" in folded and f"--fit-canvas: max({SCENE_MIN:g}px, 22%)" in shown
+    rest = f"--fit-right: max({RESULTS_MIN + BORDERS / 2:g}px, calc(100% - var(--fit-left) - var(--fit-canvas)))"
+    assert rest in folded
     assert 'label[for="probe-1"]' in folded and "display: none" in folded  # the window field is hidden
     assert '[title^="BLDC"]) canvas {visibility: hidden}' in folded
+
+
+def test_css_script_quotes_the_css():
+    css = page_css('x"); alert(1); ("')
+    js = install_css_js(css)
+    assert f"s.textContent = {json.dumps(css)};" in js  # a JSON string, not raw text
 
 
 def test_window_report_script_quotes_the_field_id():

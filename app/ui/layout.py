@@ -1,6 +1,6 @@
 """Panel widths and plot height that fit the browser window (a 1280×720 projector up to wide screens).
 
-The page's own CSS (:func:`page_style`) sizes the docked panels from the window width, so the
+The page's own CSS (:func:`page_css`) sizes the docked panels from the window width, so the
 browser lays out their final widths on its very first frame: the control panel left
 (:data:`CONTROL_WIDTH`, :data:`CONTROL_WIDTH_WIDE` above :data:`WIDE_WINDOW`), the 3D canvas
 next to it (:data:`CANVAS_SPARE` wide while the 3D view is folded, :data:`SCENE_SHARE` of the
@@ -31,6 +31,8 @@ EDGE_GAP = 2.0
 BORDERS = 4 * EDGE_GAP
 #: Height of the handle bar above a docked region's panel [px] (measured).
 REGION_HANDLE = 15.0
+#: Width of a docked region folded to viser's rail [px] (without the gutters).
+RAIL = 36.0
 #: Control panel width [px] on windows up to WIDE_WINDOW px wide, and beyond.
 CONTROL_WIDTH, CONTROL_WIDTH_WIDE, WIDE_WINDOW = 400.0, 440.0, 1600.0
 #: Least width of the results panel [px] (narrow windows scroll rather than squash it).
@@ -75,41 +77,50 @@ def layout_for_window(width: float, height: float, show_3d: bool = False) -> Pan
     return PanelLayout(control, results, round(min(ASPECT_MAX, max(ASPECT_MIN, aspect)), 3), show_3d)
 
 
-def _width_rules(control: float, show_3d: bool) -> str:
-    """CSS giving the docked regions, their shadows and the canvas the widths of :func:`layout_for_window`.
+def page_css(probe_uuid: str, show_3d: bool = False) -> str:
+    """Return the page's CSS: panel widths, hidden window-size field, no 3D canvas in the BLDC tabs.
 
-    ``100%`` is the width of viser's dock root: the window's width. viser first shows a new panel
-    floating, for a frame or more, before its dock command applies: the results panel's floating
-    window is given the place and width it will have docked, so it appears once, where it stays.
+    The docked regions, their shadows and the canvas between them get the widths of
+    :func:`layout_for_window` for the window's width (``100%``: viser's dock root, the window).
+    A docked region folded to its rail keeps viser's rail width and the others take the rest.
+    viser first shows a new panel floating, for a frame or more, before its dock command applies:
+    the results panel's floating window gets the place and width it will have docked, so it
+    appears once, where it stays. The field :func:`window_report_js` writes to is hidden. viser
+    mounts only the active tab and marks it ``aria-selected``; the BLDC tabs' titles start with
+    "BLDC".
     """
-    left = f"{control + 2 * EDGE_GAP:g}px"
+    gutters = 2 * EDGE_GAP
     canvas = f"max({SCENE_MIN:g}px, {100 * SCENE_SHARE:g}%)" if show_3d else f"{CANVAS_SPARE:g}px"
-    right = f"max({RESULTS_MIN + 2 * EDGE_GAP:g}px, calc(100% - {left} - {canvas}))"
-    root = "[data-dock-root] > div"
+    root, child = "[data-dock-root]", "[data-dock-root] > div"
+    railed = 'body:has([data-dock-region="{}"] [data-dock-column-rail]) [data-dock-root]'
     floating = '[data-floating-window]:has([role="tab"][title="Overview"])'
-    return (f'[data-dock-region="left"], {root}:has(+ [data-dock-region="left"]) {{width: {left} !important}} '
-            f'[data-dock-region="right"], {root}:has(+ [data-dock-region="right"]) {{width: {right} !important}} '
-            f"{root}:first-child {{left: {left} !important; right: {right} !important}} "
-            f"{floating} {{left: auto !important; right: {EDGE_GAP:g}px !important; "
-            f"top: {REGION_HANDLE:g}px !important; height: calc(100% - {REGION_HANDLE:g}px) !important; "
-            f"width: calc({right} - {2 * EDGE_GAP:g}px) !important}}")
+    return (
+        'body:has([role="tab"][aria-selected="true"][title^="BLDC"]) canvas {visibility: hidden} '
+        f'div:has(> .mantine-Flex-root label[for="{probe_uuid}"]) {{display: none !important}} '
+        f"{root} {{--fit-left: {CONTROL_WIDTH + gutters:g}px; --fit-canvas: {canvas}; "
+        f"--fit-right: max({RESULTS_MIN + gutters:g}px, calc(100% - var(--fit-left) - var(--fit-canvas)))}} "
+        f"@media (min-width: {WIDE_WINDOW + 1:g}px) {{ {root} {{--fit-left: {CONTROL_WIDTH_WIDE + gutters:g}px}} }} "
+        f"{railed.format('left')} {{--fit-left: {RAIL + gutters:g}px}} "
+        f"{railed.format('right')} {{--fit-right: {RAIL + gutters:g}px}} "
+        '[data-dock-region="left"], [data-dock-root] > div:has(+ [data-dock-region="left"]) '
+        "{width: var(--fit-left) !important} "
+        '[data-dock-region="right"], [data-dock-root] > div:has(+ [data-dock-region="right"]) '
+        "{width: var(--fit-right) !important} "
+        "[data-dock-region] div:has(> [data-dock-column]) {width: 100% !important} "
+        f"{child}:first-child {{left: var(--fit-left) !important; right: var(--fit-right) !important}} "
+        f"{floating} {{left: auto !important; right: {EDGE_GAP:g}px !important; "
+        f"top: {REGION_HANDLE:g}px !important; height: calc(100% - {REGION_HANDLE:g}px) !important; "
+        f"width: calc(var(--fit-right) - {gutters:g}px) !important}}")
 
 
-def page_style(probe_uuid: str, show_3d: bool = False) -> str:
-    """Return the page's ``<style>`` element: panel widths, hidden window-size field, BLDC canvas.
+def install_css_js(css: str) -> str:
+    """Return a script putting ``css`` into the page's own ``<style>`` element in the document head.
 
-    The panels get the widths of :func:`layout_for_window` for the window's width; the field
-    :func:`window_report_js` writes to is hidden; the 3D canvas is hidden while a BLDC tab is shown:
-    viser mounts only the active tab and marks it ``aria-selected``; the BLDC tabs' titles start
-    with "BLDC".
+    There it holds whatever viser mounts or unmounts (a folded panel's content is unmounted).
     """
-    return ("<style>"
-            'body:has([role="tab"][aria-selected="true"][title^="BLDC"]) canvas {visibility: hidden} '
-            f'div:has(> .mantine-Flex-root label[for="{probe_uuid}"]) {{display: none !important}} '
-            "[data-dock-region] div:has(> [data-dock-column]) {width: 100% !important} "
-            f"{_width_rules(CONTROL_WIDTH, show_3d)} "
-            f"@media (min-width: {WIDE_WINDOW + 1:g}px) {{ {_width_rules(CONTROL_WIDTH_WIDE, show_3d)} }}"
-            "</style>")
+    return ("(() => { let s = document.getElementById('app-page-style'); if (!s) {"
+            " s = document.createElement('style'); s.id = 'app-page-style'; document.head.appendChild(s); }"
+            f" s.textContent = {json.dumps(css)}; }})();")
 
 
 def window_report_js(probe_uuid: str) -> str:
@@ -187,4 +198,5 @@ class WindowFit:
             self._apply(layout)
 
 
-__all__ = ["PanelLayout", "WindowFit", "layout_for_window", "page_style", "parse_window", "window_report_js"]
+__all__ = ["PanelLayout", "WindowFit", "install_css_js", "layout_for_window", "page_css", "parse_window",
+           "window_report_js"]

@@ -22,7 +22,7 @@ from app.io.preset_modes import list_presets_of, load_mode_preset, require_mode
 from app.threads import limit_blas_threads
 from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
-from app.ui.layout import PanelLayout, WindowFit, page_style, window_report_js
+from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
 from app.ui.results import ResultsPanel
@@ -101,7 +101,7 @@ class Session:
             gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
             self._window_probe = gui.add_text("window [px]", "")
             probe_id = self._window_probe._impl.uuid
-            self._page_style = gui.add_html(page_style(probe_id), order=self._window_probe.order - 0.5)
+            gui._websock_interface.queue_message(RunJavascriptMessage(source=install_css_js(page_css(probe_id))))
             use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
             gui.main_panel.dock_left()
             tabs = gui.add_tab_group()
@@ -123,7 +123,8 @@ class Session:
         self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
         if layout.show_3d != self._style_3d:
             self._style_3d = layout.show_3d
-            self._page_style.content = page_style(self._window_probe._impl.uuid, layout.show_3d)
+            css = page_css(self._window_probe._impl.uuid, layout.show_3d)
+            self.gui._websock_interface.queue_message(RunJavascriptMessage(source=install_css_js(css)))
 
     def _controls(self) -> None:
         gui = self.gui

@@ -1,6 +1,7 @@
 """Panels that fit the window from the first frame: while a page opens, the results panel, the
 control panel and the 3D canvas each take one width (the one of ``layout_for_window``) and the
-results panel's tab row stays where it is; a resized window refits them and the overview plot.
+results panel's tab row stays where it is; a resized window refits them and the overview plot;
+the results panel takes the width the control panel frees when folded to its rail.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from app.ui.layout import BORDERS, layout_for_window
+from app.ui.layout import BORDERS, CANVAS_SPARE, RAIL, layout_for_window
 from tests.browser.conftest import open_page, session_of, wait_for_layout
 
 #: Every animation frame from the page's start: the results panel's width (the dock group of the
@@ -42,6 +43,10 @@ PLOT_AT_ASPECT_JS = """(aspect) => {
   const L = el && el._fullLayout;
   return !!L && Math.abs(L.height - aspect * L.width) <= 1.5;
 }"""
+
+#: True once the results panel is ``w`` px wide.
+RESULTS_AT_JS = """(w) => { const l = window.__layouts[window.__layouts.length - 1];
+  return !!l && Math.abs(l.results - w) <= 0.5; }"""
 
 
 def _expected(width: int, height: int) -> dict[str, Any]:
@@ -79,13 +84,19 @@ def test_a_resized_window_refits_the_panels_and_the_plot(browser, ui_server):
         for width, height in ((1920, 1080), (1400, 900)):
             page.set_viewport_size({"width": width, "height": height})
             want = _expected(width, height)
-            page.wait_for_function("(w) => { const l = window.__layouts[window.__layouts.length - 1];"
-                                   " return Math.abs(l.results - w.results) <= 0.5"
-                                   " && Math.abs(l.control - w.control) <= 0.5; }", arg=want, polling="raf")
+            page.wait_for_function(RESULTS_AT_JS, arg=want["results"], polling="raf")
+            assert page.evaluate("() => window.__layouts")[-1]["control"] == pytest.approx(want["control"], abs=0.5)
             wait_for_layout(page, session)  # the server has the new window…
             lay = layout_for_window(width, height)
             assert session.fit.layout == lay
             page.wait_for_function(PLOT_AT_ASPECT_JS, arg=lay.plot_aspect, polling="raf")  # …and the plot fits it
             assert page.evaluate("() => window.__layouts")[-1]["canvas"] == pytest.approx(want["canvas"], abs=0.5)
+        # the control panel folded to viser's rail: the results panel takes the width it frees
+        page.locator('[data-dock-region-handle="left"]').click()
+        rail = RAIL + BORDERS / 2
+        page.wait_for_function(RESULTS_AT_JS, arg=1400 - rail - CANVAS_SPARE - BORDERS / 2, polling="raf")
+        assert page.evaluate("() => window.__layouts")[-1]["control"] == pytest.approx(rail, abs=0.5)
+        page.locator('[data-dock-region="left"] [data-dock-minimize-all]').click()  # unfolded again
+        page.wait_for_function(RESULTS_AT_JS, arg=_expected(1400, 900)["results"], polling="raf")
     finally:
         context.close()
