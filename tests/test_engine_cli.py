@@ -98,5 +98,7 @@ def test_bench_prints_figures():
     assert "samples/s" in out
     # the comparison for a new drive (caches cleared), a new K and a new T_m, each with CPU time
     for case in ("new drive", "new K each run", "new T_m each run"):
-        line = next(x for x in out.splitlines() if case in x)
-        assert "ms CPU" in line and "derive() alone" in line
+        lines = [x for x in out.splitlines() if case in x]
+        assert len(lines) == 2 and all("ms CPU" in x and "derive() alone" in x for x in lines)
+    # at the preset's own move (T_m = 1 s of Table 1's first column) and at a long one
+    assert "comparison T_m = 1 s" in out and "comparison T_m = 2.6 s" in out
