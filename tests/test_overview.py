@@ -1,4 +1,4 @@
-"""Overview figure (phase plane + compact time plot, one replay) and the window-fitted panel layout."""
+"""Overview figure (phase plane + compact time plot, one replay); the panel layout: tests/test_layout.py."""
 
 from __future__ import annotations
 
@@ -8,16 +8,6 @@ import numpy as np
 import pytest
 
 from app.figures.overview import CURSORS, motor_torque, overview_spec
-from app.ui.layout import (
-    CANVAS_MIN,
-    CANVAS_SPARE,
-    CHROME_HEIGHT,
-    DEFAULT_WINDOW,
-    PLOT_PADDING,
-    WindowFit,
-    layout_for_window,
-    window_size,
-)
 from app.ui.replay import phase_plane_json
 from sim.fdsmc.engine import Comparison, compare
 
@@ -92,30 +82,3 @@ def test_a_scrub_puts_the_markers_on_the_trajectories_at_that_time(comparison):
             assert update["x"][k] == pytest.approx([t, t], abs=1e-6)
             assert update["y"][k] == list(spec["data"][i]["y"])
         assert update["text"][0] == [f"t = {t:.3f} s"]
-
-
-def test_projector_layout_fits_1280x720_and_uses_wide_screens():
-    small = layout_for_window(1280, 720)
-    assert small.control_width + small.results_width + CANVAS_SPARE <= 1280
-    plot_h = small.plot_aspect * (small.results_width - PLOT_PADDING)
-    assert plot_h + CHROME_HEIGHT <= 720 + 1  # no scrolling
-    wide = layout_for_window(1920, 1080)
-    assert wide.results_width > 960 and wide.plot_aspect * (wide.results_width - PLOT_PADDING) <= 1080 - 140
-    shown = layout_for_window(1920, 1080, show_3d=True)
-    assert shown.results_width < wide.results_width  # the 3D view takes its share
-
-
-def test_window_size_from_the_canvas_and_refit():
-    applied = []
-    fit = WindowFit(applied.append)
-    assert applied == [layout_for_window(*DEFAULT_WINDOW)]
-    fit.canvas_reported(1920, 1080)  # the first report: the whole window, panels not yet placed
-    assert fit.window == (1920, 1080) and applied[-1] == layout_for_window(1920, 1080)
-    lay = applied[-1]
-    canvas = 1920 - lay.control_width - lay.results_width - 8
-    assert window_size(canvas, 1080, lay) == pytest.approx((1920, 1080))
-    n = len(applied)
-    fit.canvas_reported(canvas, 1080)  # consistent: nothing to do
-    assert len(applied) == n
-    fit.canvas_reported(CANVAS_MIN, 1080)  # squeezed: back to widths that fit the smallest window
-    assert applied[-1] == layout_for_window(*DEFAULT_WINDOW) and window_size(CANVAS_MIN, 720, lay) is None

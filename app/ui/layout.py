@@ -1,32 +1,40 @@
 """Panel widths and plot height that fit the browser window (a 1280×720 projector up to wide screens).
 
-viser places docked panels in pixels and keeps the 3D canvas at least :data:`CANVAS_MIN` wide,
-shrinking every docked panel when they do not fit. The server learns the window only through
-the camera messages, which carry the canvas size. So the page starts with widths that fit a
-1280×720 window, and each reported canvas size (unclamped: wider than :data:`CANVAS_MIN`) gives
-the window size (the very first report of a page comes before the panels are placed: it is the
-whole window), from which :func:`layout_for_window` sizes the panels: the control panel left,
-the results panel right using the rest of the width, and the canvas — the 3D view — between
-them, :data:`CANVAS_SPARE` wide while the 3D view is folded away.
+The page's own CSS (:func:`page_style`) sizes the docked panels from the window width, so the
+browser lays out their final widths on its very first frame: the control panel left
+(:data:`CONTROL_WIDTH`, :data:`CONTROL_WIDTH_WIDE` above :data:`WIDE_WINDOW`), the 3D canvas
+next to it (:data:`CANVAS_SPARE` wide while the 3D view is folded, :data:`SCENE_SHARE` of the
+window while shown) and the results panel right, taking the rest. The rules override the pixel
+widths viser writes on its docked regions, so nothing on the server has to guess the window.
+
+Only the overview plot's height needs the window on the server (viser draws a plot at
+``width × aspect``): a small script (:func:`window_report_js`) writes the window's CSS size into a
+hidden text field whenever it changes, and :class:`WindowFit` refits the plot from it. The camera
+messages are not used: their canvas size is the WebGL drawing buffer, scaled by the device pixel
+ratio (and by viser's adaptive resolution), not the CSS size the panels are laid out in.
 """
 
 from __future__ import annotations
 
+import json
+import re
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
-#: Narrowest 3D canvas viser's client keeps [px] (measured: 121 px at any window size).
-CANVAS_MIN = 121.0
-#: Canvas width while the 3D view is folded [px]: above CANVAS_MIN, so the canvas width reported
-#: by the camera still tells the window width.
+#: Canvas width while the 3D view is folded [px].
 CANVAS_SPARE = 140.0
 #: Share of the window width given to the 3D view when it is shown [-], and its least width [px].
 SCENE_SHARE, SCENE_MIN = 0.22, 280.0
-#: Panel borders and resize handles between the docked panels [px] (measured).
-BORDERS = 8.0
+#: viser's gutter on each side of a docked region [px]; two regions: :data:`BORDERS`.
+EDGE_GAP = 2.0
+BORDERS = 4 * EDGE_GAP
+#: Height of the handle bar above a docked region's panel [px] (measured).
+REGION_HANDLE = 15.0
 #: Control panel width [px] on windows up to WIDE_WINDOW px wide, and beyond.
 CONTROL_WIDTH, CONTROL_WIDTH_WIDE, WIDE_WINDOW = 400.0, 440.0, 1600.0
+#: Least width of the results panel [px] (narrow windows scroll rather than squash it).
+RESULTS_MIN = 320.0
 #: Vertical space of the results panel not available to the overview plot [px]: panel header and
 #: tab strip (≈ 78), the key-numbers line (≈ 44), paddings.
 CHROME_HEIGHT = 150.0
@@ -34,21 +42,27 @@ CHROME_HEIGHT = 150.0
 PLOT_PADDING = 36.0
 #: Bounds of the overview plot's aspect (height / width) [-].
 ASPECT_MIN, ASPECT_MAX = 0.42, 0.85
-#: Window assumed until the browser reports its canvas [px].
+#: Window assumed until the browser reports its size [px].
 DEFAULT_WINDOW = (1280.0, 720.0)
+#: Window sizes accepted from the browser [px] (anything else is not a window and is ignored).
+WINDOW_LIMITS = (100.0, 20000.0)
 
 
 @dataclass(frozen=True)
 class PanelLayout:
-    """Widths of the docked panels [px] and the overview plot's aspect (height / width) [-]."""
+    """Widths of the docked panels [px], the overview plot's aspect [-], the 3D view shown or not.
+
+    ``plot_aspect`` is the plot's height / width.
+    """
 
     control_width: float
     results_width: float
     plot_aspect: float
+    show_3d: bool = False
 
 
 def layout_for_window(width: float, height: float, show_3d: bool = False) -> PanelLayout:
-    """Size the panels for a ``width`` × ``height`` [px] window.
+    """Size the panels for a ``width`` × ``height`` [px] window, as :func:`page_style` does.
 
     The control panel keeps its width, the 3D canvas gets :data:`CANVAS_SPARE` (folded) or
     :data:`SCENE_SHARE` of the width (shown), the results panel the rest; the overview plot is as
@@ -56,20 +70,85 @@ def layout_for_window(width: float, height: float, show_3d: bool = False) -> Pan
     """
     control = CONTROL_WIDTH_WIDE if width > WIDE_WINDOW else CONTROL_WIDTH
     canvas = max(SCENE_MIN, SCENE_SHARE * width) if show_3d else CANVAS_SPARE
-    results = max(320.0, width - control - canvas - BORDERS)
+    results = max(RESULTS_MIN, width - control - canvas - BORDERS)
     aspect = (height - CHROME_HEIGHT) / max(results - PLOT_PADDING, 1.0)
-    return PanelLayout(control, results, round(min(ASPECT_MAX, max(ASPECT_MIN, aspect)), 3))
+    return PanelLayout(control, results, round(min(ASPECT_MAX, max(ASPECT_MIN, aspect)), 3), show_3d)
 
 
-def window_size(canvas_width: float, canvas_height: float, shown: PanelLayout) -> tuple[float, float] | None:
-    """Window size [px] from the canvas size the camera reports under the layout ``shown``.
+def _width_rules(control: float, show_3d: bool) -> str:
+    """CSS giving the docked regions, their shadows and the canvas the widths of :func:`layout_for_window`.
 
-    None when the canvas is at viser's minimum width (the panels were shrunk to fit, so the
-    window is narrower than they ask for and its width is unknown).
+    ``100%`` is the width of viser's dock root: the window's width. viser first shows a new panel
+    floating, for a frame or more, before its dock command applies: the results panel's floating
+    window is given the place and width it will have docked, so it appears once, where it stays.
     """
-    if canvas_width <= CANVAS_MIN + 1.0 or canvas_height <= 0:
+    left = f"{control + 2 * EDGE_GAP:g}px"
+    canvas = f"max({SCENE_MIN:g}px, {100 * SCENE_SHARE:g}%)" if show_3d else f"{CANVAS_SPARE:g}px"
+    right = f"max({RESULTS_MIN + 2 * EDGE_GAP:g}px, calc(100% - {left} - {canvas}))"
+    root = "[data-dock-root] > div"
+    floating = '[data-floating-window]:has([role="tab"][title="Overview"])'
+    return (f'[data-dock-region="left"], {root}:has(+ [data-dock-region="left"]) {{width: {left} !important}} '
+            f'[data-dock-region="right"], {root}:has(+ [data-dock-region="right"]) {{width: {right} !important}} '
+            f"{root}:first-child {{left: {left} !important; right: {right} !important}} "
+            f"{floating} {{left: auto !important; right: {EDGE_GAP:g}px !important; "
+            f"top: {REGION_HANDLE:g}px !important; height: calc(100% - {REGION_HANDLE:g}px) !important; "
+            f"width: calc({right} - {2 * EDGE_GAP:g}px) !important}}")
+
+
+def page_style(probe_uuid: str, show_3d: bool = False) -> str:
+    """Return the page's ``<style>`` element: panel widths, hidden window-size field, BLDC canvas.
+
+    The panels get the widths of :func:`layout_for_window` for the window's width; the field
+    :func:`window_report_js` writes to is hidden; the 3D canvas is hidden while a BLDC tab is shown:
+    viser mounts only the active tab and marks it ``aria-selected``; the BLDC tabs' titles start
+    with "BLDC".
+    """
+    return ("<style>"
+            'body:has([role="tab"][aria-selected="true"][title^="BLDC"]) canvas {visibility: hidden} '
+            f'div:has(> .mantine-Flex-root label[for="{probe_uuid}"]) {{display: none !important}} '
+            "[data-dock-region] div:has(> [data-dock-column]) {width: 100% !important} "
+            f"{_width_rules(CONTROL_WIDTH, show_3d)} "
+            f"@media (min-width: {WIDE_WINDOW + 1:g}px) {{ {_width_rules(CONTROL_WIDTH_WIDE, show_3d)} }}"
+            "</style>")
+
+
+def window_report_js(probe_uuid: str) -> str:
+    """Return a script reporting the window's CSS size ``"<width>x<height>"`` [px] to the server.
+
+    It writes the size into the text field ``probe_uuid`` as if typed (so viser sends it), now and
+    after every resize of the window.
+    """
+    return """(() => {
+  const uuid = UUID;
+  const setValue = Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set;
+  let frame = 0;
+  const report = () => {
+    const label = document.querySelector(`label[for="${uuid}"]`);
+    const input = label && label.closest('.mantine-Flex-root').querySelector('input');
+    if (!input) {  // not mounted yet: look again next frame (for at most ≈ 1 min)
+      if (++frame < 3600) requestAnimationFrame(report);
+      return;
+    }
+    const size = `${window.innerWidth}x${window.innerHeight}`;
+    if (input.value === size) return;
+    setValue.call(input, size);
+    input.dispatchEvent(new Event('input', {bubbles: true}));
+  };
+  if (window.__reportWindow) window.removeEventListener('resize', window.__reportWindow);
+  window.__reportWindow = () => { frame = 0; report(); };
+  window.addEventListener('resize', window.__reportWindow);
+  report();
+})();""".replace("UUID", json.dumps(probe_uuid))
+
+
+def parse_window(text: str) -> tuple[float, float] | None:
+    """Window size [px] from ``"<width>x<height>"``; None for anything else or out of :data:`WINDOW_LIMITS`."""
+    match = re.fullmatch(r"\s*(\d{1,6})x(\d{1,6})\s*", text)
+    if match is None:
         return None
-    return canvas_width + shown.control_width + shown.results_width + BORDERS, float(canvas_height)
+    width, height = float(match.group(1)), float(match.group(2))
+    lo, hi = WINDOW_LIMITS
+    return (width, height) if lo <= width <= hi and lo <= height <= hi else None
 
 
 class WindowFit:
@@ -77,41 +156,35 @@ class WindowFit:
 
     def __init__(self, apply: Callable[[PanelLayout], None], show_3d: bool = False) -> None:
         self._apply = apply
-        self.show_3d = show_3d
         self.window = DEFAULT_WINDOW
         self.layout = layout_for_window(*DEFAULT_WINDOW, show_3d)
-        self._first = True
-        self._lock = threading.Lock()  # camera messages arrive on viser's thread pool
+        self._lock = threading.Lock()  # GUI messages arrive on viser's thread pool
         apply(self.layout)
 
-    def canvas_reported(self, canvas_width: float, canvas_height: float) -> None:
-        """Refit when the window implied by a camera message (its canvas size [px]) changed."""
-        with self._lock:
-            self._canvas_reported(canvas_width, canvas_height)
+    @property
+    def show_3d(self) -> bool:
+        """Whether the 3D view is shown."""
+        return self.layout.show_3d
 
-    def _canvas_reported(self, canvas_width: float, canvas_height: float) -> None:
-        first, self._first = self._first, False
-        if first and canvas_width > CANVAS_MIN + 1.0 and canvas_height > 0:
-            size: tuple[float, float] | None = (float(canvas_width), float(canvas_height))  # whole window
-        else:
-            size = window_size(canvas_width, canvas_height, self.layout)
-        if size is None:  # squeezed: back to widths that fit the smallest window, then measure again
-            size = DEFAULT_WINDOW if self.window != DEFAULT_WINDOW else None
-        if size is not None and (abs(size[0] - self.window[0]) > 2 or abs(size[1] - self.window[1]) > 2):
+    def window_reported(self, text: str) -> None:
+        """Refit when the window size the browser reported (``"<width>x<height>"`` [px]) changed."""
+        size = parse_window(text)
+        if size is None:
+            return
+        with self._lock:
             self.window = size
-            self._refit()
+            self._refit(self.show_3d)
 
     def set_3d(self, show: bool) -> None:
         """Fold (False) or show (True) the 3D view."""
         with self._lock:
-            self.show_3d = bool(show)
-            self._refit()
+            self._refit(bool(show))
 
-    def _refit(self) -> None:
-        layout = layout_for_window(*self.window, self.show_3d)
+    def _refit(self, show_3d: bool) -> None:
+        layout = layout_for_window(*self.window, show_3d)
         if layout != self.layout:
             self.layout = layout
             self._apply(layout)
 
 
-__all__ = ["PanelLayout", "WindowFit", "layout_for_window", "window_size"]
+__all__ = ["PanelLayout", "WindowFit", "layout_for_window", "page_style", "parse_window", "window_report_js"]

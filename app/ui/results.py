@@ -77,8 +77,7 @@ class ResultsPanel:
         self.savings.content = savings_markdown(annual_savings(self._comparison, *values))
 
     def fit(self, layout: PanelLayout) -> None:
-        """Size the panel and the overview plot for the window (see :mod:`app.ui.layout`)."""
-        self.panel.set_width(layout.results_width)
+        """Size the overview plot for the window; the page's CSS sizes the panel (:mod:`app.ui.layout`)."""
         self.phase.aspect = layout.plot_aspect
 
     def show(self, comparison: Any, autoplay: bool = True, overview_only: bool = False) -> None:

@@ -16,12 +16,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import viser
+from viser._messages import RunJavascriptMessage
 
 from app.io.preset_modes import list_presets_of, load_mode_preset, require_mode
 from app.threads import limit_blas_threads
 from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
-from app.ui.layout import PanelLayout, WindowFit
+from app.ui.layout import PanelLayout, WindowFit, page_style, window_report_js
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
 from app.ui.results import ResultsPanel
@@ -38,11 +39,6 @@ from control.fdsmc.params import DriveParams
 from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
 from sim.fdsmc.verdicts import T_c_advice, recommended_K
-
-#: Page-wide CSS: the 3D canvas is hidden while a BLDC tab is shown (viser mounts only the active
-#: tab, and marks it ``aria-selected``; the BLDC tabs' titles start with "BLDC").
-PAGE_STYLE = ('<style>body:has([role="tab"][aria-selected="true"][title^="BLDC"]) canvas '
-              '{visibility: hidden}</style>')
 
 
 def comparison_or_derived(params: DriveParams, optimum: bool = False) -> Comparison:
@@ -97,29 +93,37 @@ class Session:
     def _layout(self, scene: RotorScene | None) -> None:
         """Dock the control panel left, the results panel right, the 3D canvas between them.
 
-        The widths follow the window the browser reports (:mod:`app.ui.layout`).
+        The page's CSS sizes the panels from the window's width; the overview plot's height
+        follows the window size the page reports into a hidden field (:mod:`app.ui.layout`).
         """
-        gui = self.gui
-        gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
-        gui.add_html(PAGE_STYLE)
-        use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
-        gui.main_panel.dock_left()
-        tabs = gui.add_tab_group()
-        with tabs.add_tab("Position drive (FDSMC)"):
-            self._controls()
-        self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep,
-                                    on_3d=lambda shown: self.fit.set_3d(shown))
-        self.studies = StudiesSection(self)
-        _add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
-        self.results.panel.dock_right()
-        self.fit = WindowFit(self._apply_layout)
-        if scene is not None:
-            aim_camera(self.client.camera)
-        self.client.camera.on_update(lambda cam: self.fit.canvas_reported(cam.image_width, cam.image_height))
+        with self.client.atomic():  # one batch: the page CSS, the panels and their docking arrive together
+            gui = self.gui
+            gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
+            self._window_probe = gui.add_text("window [px]", "")
+            probe_id = self._window_probe._impl.uuid
+            self._page_style = gui.add_html(page_style(probe_id), order=self._window_probe.order - 0.5)
+            use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
+            gui.main_panel.dock_left()
+            tabs = gui.add_tab_group()
+            with tabs.add_tab("Position drive (FDSMC)"):
+                self._controls()
+            self.results = ResultsPanel(self.client, self.comparison, scene, self.sweep,
+                                        on_3d=lambda shown: self.fit.set_3d(shown))
+            self.results.panel.dock_right()
+            self.studies = StudiesSection(self)
+            _add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
+            self._style_3d = False
+            self.fit = WindowFit(self._apply_layout)
+            if scene is not None:
+                aim_camera(self.client.camera)
+        self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
+        gui._websock_interface.queue_message(RunJavascriptMessage(source=window_report_js(probe_id)))
 
     def _apply_layout(self, layout: PanelLayout) -> None:
-        self.gui.main_panel.set_width(layout.control_width)
-        self.results.fit(layout)
+        self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
+        if layout.show_3d != self._style_3d:
+            self._style_3d = layout.show_3d
+            self._page_style.content = page_style(self._window_probe._impl.uuid, layout.show_3d)
 
     def _controls(self) -> None:
         gui = self.gui

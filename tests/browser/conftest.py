@@ -82,11 +82,18 @@ def browser() -> Iterator[Any]:
             b.close()
 
 
-def open_page(browser: Any, ui: UiServer, viewport: dict[str, int] | None = None) -> tuple[Any, Any]:
+def open_page(browser: Any, ui: UiServer, viewport: dict[str, int] | None = None,
+              init_script: str | None = None, scale: float = 1.0) -> tuple[Any, Any]:
     """A new context + page of ``ui``, waited until the phase plane is drawn and the panels are
     fitted to the window (:func:`wait_for_layout`). Returns (context, page).
+
+    ``init_script`` runs in the page before any of its own scripts; ``scale`` is the device
+    pixel ratio (device pixels per CSS pixel).
     """
-    context = browser.new_context(viewport=viewport or VIEWPORT, accept_downloads=True)
+    context = browser.new_context(viewport=viewport or VIEWPORT, accept_downloads=True,
+                                  device_scale_factor=scale)
+    if init_script is not None:
+        context.add_init_script(init_script)
     page = context.new_page()
     page.set_default_timeout(TIMEOUT_MS)
     before = set(ui.config.sessions)
@@ -115,37 +122,19 @@ def session_of(page: Any, ui: UiServer, before: set[int]) -> Any:
     raise AssertionError(f"the page opened no session on the server within {TIMEOUT_MS} ms")
 
 
-# Widths of the results panel (the dock group holding the "Overview" tab) [px], recorded once per
-# animation frame; true once it showed ``want`` in three frames running (stable over two frames).
-PANEL_FITTED_JS = """(want) => {
-  const tab = [...document.querySelectorAll('[role="tab"]')].find(t => t.title === 'Overview');
-  const w = tab ? tab.closest('[data-dock-tab]').parentElement.getBoundingClientRect().width : -1;
-  const seen = window.__panelWidths = (window.__panelWidths || []).concat([w]).slice(-3);
-  return seen.length === 3 && seen.every(v => Math.abs(v - want) <= 1);
-}"""
-
-
 def wait_for_layout(page: Any, session: Any) -> None:
-    """Wait until the panels are fitted to the page's window and the server agrees.
+    """Wait until the server knows the page's window size.
 
-    The server sizes the panels from the canvas size each camera message reports
-    (``app/ui/layout.py``), so while a page opens the results panel changes width several times
-    and its tab row moves. Fitted means: the browser shows the results width
-    ``layout_for_window(viewport)`` in three animation frames running, the server holds that
-    layout, and the last canvas size the server received is the one that layout leaves (so no
-    earlier report is still to be answered with another width).
+    The page's CSS gives the panels their widths from the first frame (``app/ui/layout.py``);
+    only the overview plot's height follows the window size the page reports to the server.
     """
-    from app.ui.layout import BORDERS, layout_for_window
-
     vp = page.viewport_size
-    for _ in range(TIMEOUT_MS // 50):
-        want = layout_for_window(vp["width"], vp["height"], session.fit.show_3d)
-        canvas = vp["width"] - want.control_width - want.results_width - BORDERS
-        page.wait_for_function(PANEL_FITTED_JS, arg=want.results_width, polling="raf")
-        if session.fit.layout == want and abs(session.client.camera.image_width - canvas) <= 2:
+    want = (float(vp["width"]), float(vp["height"]))
+    for _ in range(TIMEOUT_MS // 20):
+        if session.fit.window == want:
             return
-        page.wait_for_timeout(50)  # poll the server's state again (a positive condition)
-    raise AssertionError(f"panels not fitted to the {vp} window: server layout {session.fit.layout}")
+        page.wait_for_timeout(20)  # poll the server's state again (a positive condition)
+    raise AssertionError(f"the server never got the {vp} window: it has {session.fit.window}")
 
 
 # A tab's bounding box, recorded once per animation frame; true once it stayed the same in three

@@ -64,9 +64,11 @@ def _open(browser: Any, ui: UiServer, width: int, height: int) -> tuple[Any, Any
     return context, page
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def projector(browser: Any, ui_server: Any) -> Iterator[Any]:
-    """A page in a 1280×720 window, fitted (the results panel reached its width for this window)."""
+    """A page in a 1280×720 window, shared by the tests that leave it as they found it: the
+    replay ends where it starts (at t_end), the warnings box is unfolded again.
+    """
     context, page = _open(browser, ui_server, 1280, 720)
     try:
         yield page

@@ -1,0 +1,110 @@
+"""Panel layout for the browser window: widths, overview-plot aspect, the page's CSS, the window report.
+
+The widths the page's CSS gives the panels in a real browser are checked against
+:func:`layout_for_window` in tests/browser/test_layout_steady.py.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from app.ui.layout import (
+    ASPECT_MAX,
+    ASPECT_MIN,
+    BORDERS,
+    CANVAS_SPARE,
+    CHROME_HEIGHT,
+    CONTROL_WIDTH,
+    CONTROL_WIDTH_WIDE,
+    DEFAULT_WINDOW,
+    PLOT_PADDING,
+    RESULTS_MIN,
+    SCENE_MIN,
+    WIDE_WINDOW,
+    WindowFit,
+    layout_for_window,
+    page_style,
+    parse_window,
+    window_report_js,
+)
+
+
+def _plot_height(lay) -> float:
+    return lay.plot_aspect * (lay.results_width - PLOT_PADDING)
+
+
+def test_projector_layout_fits_1280x720_and_uses_wide_screens():
+    small = layout_for_window(1280, 720)
+    assert small.control_width + small.results_width + CANVAS_SPARE + BORDERS == 1280  # the whole width
+    assert _plot_height(small) + CHROME_HEIGHT <= 720 + 1  # no scrolling
+    wide = layout_for_window(1920, 1080)
+    assert wide.control_width == CONTROL_WIDTH_WIDE and small.control_width == CONTROL_WIDTH
+    assert wide.results_width > 960 and _plot_height(wide) + CHROME_HEIGHT <= 1080 + 1
+    shown = layout_for_window(1920, 1080, show_3d=True)
+    assert shown.show_3d and 1920 - shown.control_width - shown.results_width - BORDERS == pytest.approx(0.22 * 1920)
+    small_3d = layout_for_window(1280, 720, show_3d=True)  # 22 % of 1280 px = 281.6 px ≥ SCENE_MIN
+    assert 1280 - small_3d.control_width - small_3d.results_width - BORDERS >= SCENE_MIN
+
+
+@pytest.mark.parametrize("width", [WIDE_WINDOW, WIDE_WINDOW + 1])
+def test_the_wide_control_panel_starts_just_above_wide_window(width):
+    lay = layout_for_window(width, 900)
+    assert lay.control_width == (CONTROL_WIDTH_WIDE if width > WIDE_WINDOW else CONTROL_WIDTH)
+
+
+def test_aspect_is_bounded_and_the_results_panel_has_a_least_width():
+    assert layout_for_window(1280, 4000).plot_aspect == ASPECT_MAX  # very tall: no taller than ASPECT_MAX
+    assert layout_for_window(3000, 400).plot_aspect == ASPECT_MIN  # very flat: no flatter than ASPECT_MIN
+    assert layout_for_window(600, 720).results_width == RESULTS_MIN
+
+
+@pytest.mark.parametrize(("text", "size"), [("1280x720", (1280.0, 720.0)), (" 1920x1080 ", (1920.0, 1080.0))])
+def test_a_reported_window_size_is_read(text, size):
+    assert parse_window(text) == size
+
+
+@pytest.mark.parametrize("text", ["", "1280", "1280x", "x720", "1280 x 720", "-1280x720", "1e3x720",
+                                  "99x720", "1280x20001", "1280x720;drop", "<b>1280x720</b>"])
+def test_anything_else_is_not_a_window(text):
+    assert parse_window(text) is None
+
+
+def test_window_fit_refits_on_a_new_size_and_ignores_junk():
+    applied = []
+    fit = WindowFit(applied.append)
+    assert applied == [layout_for_window(*DEFAULT_WINDOW)] and not fit.show_3d
+    fit.window_reported("1280x720")  # the window assumed at start: nothing to send
+    assert len(applied) == 1
+    fit.window_reported("1920x1080")
+    assert fit.window == (1920.0, 1080.0) and applied[-1] == layout_for_window(1920, 1080)
+    fit.window_reported("garbage")  # not a size: the layout stays
+    fit.window_reported("0x0")
+    assert fit.window == (1920.0, 1080.0) and len(applied) == 2
+    fit.set_3d(True)
+    assert applied[-1] == layout_for_window(1920, 1080, show_3d=True) and fit.show_3d
+    fit.window_reported("1400x900")  # the 3D view stays shown through a resize
+    assert applied[-1] == layout_for_window(1400, 900, show_3d=True)
+    fit.set_3d(False)
+    assert applied[-1] == layout_for_window(1400, 900)
+
+
+def test_page_style_carries_the_widths_of_layout_for_window():
+    folded, shown = page_style("probe-1"), page_style("probe-1", show_3d=True)
+    assert folded.startswith("<style>") and folded.endswith("</style>") and folded != shown
+    # control panel + viser's two 2 px gutters, narrow and wide windows
+    assert f"{CONTROL_WIDTH + BORDERS / 2:g}px" in folded and f"{CONTROL_WIDTH_WIDE + BORDERS / 2:g}px" in folded
+    assert f"(min-width: {WIDE_WINDOW + 1:g}px)" in folded
+    # results: the rest of the window beside the folded canvas; 22 % of it for the shown 3D view
+    assert f"calc(100% - {CONTROL_WIDTH + BORDERS / 2:g}px - {CANVAS_SPARE:g}px)" in folded
+    assert f"max({SCENE_MIN:g}px, 22%)" in shown and f"{CANVAS_SPARE:g}px)" not in shown
+    assert f"max({RESULTS_MIN + BORDERS / 2:g}px" in folded
+    assert 'label[for="probe-1"]' in folded and "display: none" in folded  # the window field is hidden
+    assert '[title^="BLDC"]) canvas {visibility: hidden}' in folded
+
+
+def test_window_report_script_quotes_the_field_id():
+    js = window_report_js('a"b')
+    assert f"const uuid = {json.dumps('a' + chr(34) + 'b')};" in js  # a JSON string, not raw text
+    assert "window.innerWidth" in js and "addEventListener('resize'" in js
