@@ -91,12 +91,14 @@ def test_bad_input_exits_2_with_one_line(argv, capsys):
 
 
 def test_bench_prints_figures():
-    r = subprocess.run([sys.executable, "-m", "app", "bench", "--repeat", "1"], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "app", "bench", "--smoke"], capture_output=True,
                        text=True, check=False, timeout=120)
     assert r.returncode == 0, r.stderr
     out = r.stdout
     assert "samples/s" in out
     # the comparison for a new drive (caches cleared), a new K and a new T_m, each with CPU time
     for case in ("new drive", "new K each run", "new T_m each run"):
-        line = next(x for x in out.splitlines() if case in x)
-        assert "ms CPU" in line and "derive() alone" in line
+        lines = [x for x in out.splitlines() if case in x]
+        assert len(lines) == 2 and all("ms CPU" in x and "derive() alone" in x for x in lines)
+    # at the preset's own move (T_m = 1 s of Table 1's first column) and at a long one
+    assert "comparison T_m = 1 s" in out and "comparison T_m = 2.6 s" in out

@@ -54,7 +54,31 @@ def test_every_replay_frame_puts_the_cursors_at_the_markers_time(comparison):
             for d in f["data"][-2:]:
                 assert d["x"][0] == d["x"][1] == pytest.approx(t, abs=1e-3)
         assert frames[-1]["data"][-1]["x"][0] == pytest.approx(t_end, rel=1e-5)
-    # the scrub slider moves the cursors too and keeps their vertical extent
-    step = spec["layout"]["sliders"][0]["steps"][0]
-    assert step["args"][1][-2:] == cursors and step["args"][0]["x"][-1] == [0.0, 0.0]
-    assert step["args"][0]["y"][-1] == spec["data"][cursors[1]]["y"]
+    # no Plotly slider: it would be drawn again with every redraw of the figure
+    assert "sliders" not in spec["layout"]
+
+
+def test_a_scrub_puts_the_markers_on_the_trajectories_at_that_time(comparison):
+    """The "Replay t" scrub: markers at (θ_r(t) − θ_dem, ω_r(t)) of each run, cursors at x = [t, t]
+    with their vertical extent kept, the time in the first marker's text.
+    """
+    from app.figures.replay import ScrubTargets, scrub_update
+
+    spec = overview_spec(comparison)
+    names = [t["name"] for t in spec["data"]]
+    targets = ScrubTargets.of(spec["data"])
+    assert [names[i] for i in targets.now] == ["FDSMC now", "Conventional now"]
+    assert [names[i] for i in targets.cursors] == list(CURSORS)
+    th = comparison.derived.params.manoeuvre.theta_dem
+    for t in (0.0, 0.2345, float(comparison.fdsmc.trace.t[-1])):
+        update, indices = scrub_update(comparison, targets, t)
+        assert indices == [*targets.now, *targets.cursors]
+        for j, run in enumerate((comparison.fdsmc, comparison.conventional)):
+            tr = run.trace
+            # 5 significant digits, as the key frames
+            assert update["x"][j][0] == pytest.approx(np.interp(t, tr.t, tr.theta_r) - th, rel=1e-4, abs=1e-9)
+            assert update["y"][j][0] == pytest.approx(np.interp(t, tr.t, tr.omega_r), rel=1e-4, abs=1e-6)
+        for k, i in enumerate(targets.cursors, start=len(targets.now)):
+            assert update["x"][k] == pytest.approx([t, t], abs=1e-6)
+            assert update["y"][k] == list(spec["data"][i]["y"])
+        assert update["text"][0] == [f"t = {t:.3f} s"]

@@ -134,8 +134,10 @@ def _send_update(hostport: str, config: object, handle_of: str, value: str, wait
     session_box: list[object] = []
 
     async def go() -> None:
+        # this client never reads what the server sends, so the closing handshake cannot complete:
+        # close at once instead of waiting websockets' default 10 s for it
         async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
-                                      subprotocols=[PROTOCOL], max_size=None) as ws:
+                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
             await ws.send(msgspec.msgpack.encode(CAMERA))  # viser counts a client after its first camera
             for _ in range(600):
                 new = set(config.sessions) - known

@@ -85,3 +85,50 @@ def test_parse_steps_and_T_m_list():
 def test_loopback_detection():
     assert is_loopback("127.0.0.1") and is_loopback("localhost") and is_loopback("::1")
     assert not is_loopback("0.0.0.0") and not is_loopback("192.168.1.5")
+
+
+def test_tune_runner_runs_the_latest_value_and_draws_the_rest_once_the_drag_stops():
+    """Moves faster than a run: no stale value is queued, the last move's value is what runs last,
+    and the rest of the results is drawn once, only after no move came for TUNE_SETTLE_S.
+    """
+    from app.ui.tuning import TUNE_SETTLE_S, TuneRunner
+
+    value, ran, finished = [0], [], []
+    runner: TuneRunner
+
+    def run_latest() -> bool:
+        ran.append((value[0], time.monotonic()))
+        time.sleep(0.03)  # a run slower than the moves
+        return True
+
+    w = Worker(lambda busy: busy or runner.resume(), lambda exc: None)
+    runner = TuneRunner(w, run_latest, lambda: finished.append(time.monotonic()))
+    for k in range(1, 21):  # a drag: a move every 10 ms
+        value[0] = k
+        runner.request()
+        time.sleep(0.01)
+    t_last_move = time.monotonic()
+    for _ in range(300):
+        if finished and not w.busy:
+            break
+        time.sleep(0.01)
+    assert ran[-1][0] == 20  # the latest value ran
+    assert len(ran) < 20  # moves during a run were merged, not queued
+    assert [v for v, _ in ran] == sorted({v for v, _ in ran})  # never an older value after a newer one
+    assert len(finished) == 1 and finished[0] - t_last_move >= TUNE_SETTLE_S - 0.02
+    w.close()
+
+
+def test_tune_runner_stops_on_an_input_error_without_drawing_the_rest():
+    from app.ui.tuning import TuneRunner
+
+    finished: list[int] = []
+    w = Worker(lambda busy: None, lambda exc: None)
+    runner = TuneRunner(w, lambda: False, lambda: finished.append(1))
+    runner.request()
+    for _ in range(200):
+        if not w.busy:
+            break
+        time.sleep(0.01)
+    assert not w.busy and finished == []
+    w.close()

@@ -35,6 +35,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``bench``."""
     add_preset_arguments(p, default="paper_12kw_pmsm")
     p.add_argument("--repeat", type=int, default=7, help="repetitions of each figure (median; at least 5)")
+    p.add_argument("--smoke", action="store_true",
+                   help="one repetition of each figure: checks that every figure runs (not figures of record)")
 
 
 def _timed(fn: object, *args: object, **kw: object) -> float:
@@ -46,7 +48,7 @@ def _timed(fn: object, *args: object, **kw: object) -> float:
 def _medians(repeat: int, fn: object, *args: object, **kw: object) -> tuple[float, float]:
     """Median wall time and median process CPU time (all threads) [s] of ``repeat`` calls."""
     walls, cpus = [], []
-    for _ in range(max(5, repeat)):
+    for _ in range(repeat):
         w0, c0 = time.perf_counter(), time.process_time()
         fn(*args, **kw)  # type: ignore[operator]
         walls.append(time.perf_counter() - w0)
@@ -61,9 +63,12 @@ def _ms(wall_cpu: tuple[float, float]) -> str:
 def run(args: argparse.Namespace) -> int:
     """Print the speed figures."""
     base = args.overrides
-    p = load_mode_preset(args.preset, [*base, "manoeuvre.T_m=2.6", "controller.f_s=20000"], mode="position")
-    rep = max(5, args.repeat)
-    print(comparison_figure(p, rep))
+    rep = 1 if args.smoke else max(5, args.repeat)
+    if args.smoke:
+        print("smoke run: one repetition of each figure, so these are single timings, not medians")
+    for t_m in ([], ["manoeuvre.T_m=2.6"]):  # the preset's own move (what the page opens with), a long one
+        p = load_mode_preset(args.preset, [*base, *t_m, "controller.f_s=20000"], mode="position")
+        print(comparison_figure(p, rep))
     pd = load_preset(args.preset, [*base, "controller.f_s=20000"])
     table1_sweep(pd, TABLE1_T_M[:1])
     print(f"Table-1 sweep, 5 points, digital 20 kHz: {_ms(_medians(rep, table1_sweep, pd, TABLE1_T_M))}   "
@@ -124,8 +129,8 @@ def comparison_figure(p: DriveParams, rep: int) -> str:
     CLI call pays.
     """
     first = _timed(compare, p)
-    lines = [f"comparison T_m = 2.6 s (+30 % tail), f_s = 20 kHz, derive included ({rep} runs each): first call "
-             f"{first * 1e3:.0f} ms (cache load)"]
+    lines = [f"comparison T_m = {p.manoeuvre.T_m:g} s (+30 % tail), f_s = 20 kHz, derive included ({rep} runs "
+             f"each): first call {first * 1e3:.0f} ms"]
     for what, label in (("drive", "new drive (J_L) each run, caches cleared — one CLI call"),
                         ("K", "new K each run (K slider)"), ("T_m", "new T_m each run (T_m slider)")):
         cases = _varied(p, rep, what)
@@ -175,7 +180,7 @@ def cold_start_figure(preset: str, overrides: list[str], repeat: int) -> str:
     for o in overrides:
         cmd += ["--set", o]
     walls, cpus = [], []
-    for _ in range(max(5, repeat)):
+    for _ in range(repeat):
         r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)

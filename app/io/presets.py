@@ -16,6 +16,8 @@ R_s: 0.12}``); see :func:`app.io.preset_schema.parse_plant`.
 
 from __future__ import annotations
 
+import copy
+import functools
 import json
 import re
 import typing
@@ -214,7 +216,17 @@ def load_raw(name_or_path: str) -> Any:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise PresetError(f"cannot read preset {str(path)!r}: {exc}") from None
-    return loads_any_raw(text, path.name)
+    return copy.deepcopy(_parsed_file(text, path.name))  # the caller may apply overrides to it
+
+
+@functools.lru_cache(maxsize=32)
+def _parsed_file(text: str, origin: str) -> Any:
+    """Return :func:`loads_any_raw` of a file's text, kept by its exact text.
+
+    Every page open lists the presets' modes and loads the BLDC preset; parsing the same text
+    again would give the same data.
+    """
+    return loads_any_raw(text, origin)
 
 
 def load_preset(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()) -> Any:

@@ -8,10 +8,10 @@ error is shown in the tab's status line, never as a traceback.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 from typing import Any
 
-import plotly.graph_objects as go
 import viser
 
 from app.figures.bldc import (
@@ -23,6 +23,7 @@ from app.figures.bldc import (
     make_speed_figure,
     make_torque_figure,
 )
+from app.figures.plain import blank_figure, placeholder_json
 from app.io.bldc_emf import read_measured, with_measured
 from app.io.bldc_view import metric_table
 from app.io.numbers import NumberFormatError
@@ -31,6 +32,7 @@ from app.io.presets import annotate_units, dumps_preset
 from app.io.units import from_si, s_to_ms, shown_range, spec_of, to_si
 from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
+from app.ui.replay import set_figure_json
 from app.ui.text import checked_choice, md_text
 from app.ui.worker import Cancelled, Worker
 from control.bldc.design import bldc_design
@@ -77,11 +79,22 @@ def read_si(field: NumberInput, key: str) -> float | int:
                       lambda x: to_si(x, spec.shown_unit), integer=spec.integer)
 
 
-def _placeholder(fid: str, title: str) -> go.Figure:
-    fig = go.Figure()
-    fig.update_layout(meta={"id": fid}, title={"text": f"{title} — press “Simulate BLDC”", "font": {"size": 13}},
-                      height=260, template="plotly_white", margin={"l": 40, "r": 10, "t": 40, "b": 30})
-    return fig
+def _placeholder(gui: viser.GuiApi, figure_id: str, title: str, aspect: float) -> viser.GuiPlotlyHandle:
+    handle = gui.add_plotly(blank_figure(), aspect=aspect)
+    set_figure_json(handle, placeholder_json(figure_id, f"{title} — press “Simulate BLDC”"))
+    return handle
+
+
+@functools.lru_cache(maxsize=16)
+def design_view(p: BldcParams) -> tuple[str, str, str, tuple[str, ...]]:
+    """Return the JSON of the back-EMF, a_x/θ_x and reachability figures of ``p`` and its design warnings.
+
+    Pure and kept per parameter set: every page opens on the same preset.
+    """
+    table = machine_table(p.machine)
+    design = bldc_design(p)
+    return (make_emf_figure(table, p.machine.Phi_m).to_json(), make_dqx_figure(table, p.machine.Phi_m).to_json(),
+            make_reachability_figure(design).to_json(), tuple(design.warnings))
 
 
 def metrics_markdown(comp: BldcComparison) -> str:
@@ -138,13 +151,13 @@ class BldcTab:
         with self._figures_container or gui.add_folder("Figures", expand_by_default=True):
             with gui.add_folder("Metrics", expand_by_default=True):
                 self.metrics = gui.add_markdown("No run yet — press **Simulate BLDC**.")
-            self.fig_speed = gui.add_plotly(_placeholder("bldc_speed", "Speed"), aspect=ASPECT)
-            self.fig_torque = gui.add_plotly(_placeholder("bldc_torque", "Torque"), aspect=ASPECT)
-            self.fig_sigma = gui.add_plotly(_placeholder("bldc_sigma", "σ_ω"), aspect=ASPECT)
-            self.fig_currents = gui.add_plotly(_placeholder("bldc_currents", "Phase currents"), aspect=ASPECT)
-            self.fig_emf = gui.add_plotly(_placeholder("bldc_emf", "Back-EMF"), aspect=ASPECT)
-            self.fig_dqx = gui.add_plotly(_placeholder("bldc_dqx", "a_x, θ_x"), aspect=1.0)
-            self.fig_reach = gui.add_plotly(_placeholder("bldc_reach", "Reachability"), aspect=ASPECT)
+            self.fig_speed = _placeholder(gui, "bldc_speed", "Speed", ASPECT)
+            self.fig_torque = _placeholder(gui, "bldc_torque", "Torque", ASPECT)
+            self.fig_sigma = _placeholder(gui, "bldc_sigma", "σ_ω", ASPECT)
+            self.fig_currents = _placeholder(gui, "bldc_currents", "Phase currents", ASPECT)
+            self.fig_emf = _placeholder(gui, "bldc_emf", "Back-EMF", ASPECT)
+            self.fig_dqx = _placeholder(gui, "bldc_dqx", "a_x, θ_x", 1.0)
+            self.fig_reach = _placeholder(gui, "bldc_reach", "Reachability", ASPECT)
         self.download = gui.add_button("Download BLDC preset (YAML)", icon=viser.Icon.DOWNLOAD)
         self.download.on_click(lambda _: self._download())
         self.import_preset = gui.add_upload_button("Import BLDC preset (YAML)", icon=viser.Icon.UPLOAD,
@@ -175,13 +188,10 @@ class BldcTab:
         return dataclasses.replace(p, scenario=scen, **new)
 
     def _show_design(self) -> None:
-        p = self.params
-        table = machine_table(p.machine)
-        self.fig_emf.figure = make_emf_figure(table, p.machine.Phi_m)
-        self.fig_dqx.figure = make_dqx_figure(table, p.machine.Phi_m)
-        design = bldc_design(p)
-        self.fig_reach.figure = make_reachability_figure(design)
-        self.warnings.content = "\n".join(f"⚠ {md_text(w)}  " for w in design.warnings)
+        emf, dqx, reach, warnings = design_view(self.params)
+        for handle, json_str in ((self.fig_emf, emf), (self.fig_dqx, dqx), (self.fig_reach, reach)):
+            set_figure_json(handle, json_str)
+        self.warnings.content = "\n".join(f"⚠ {md_text(w)}  " for w in warnings)
 
     # ---- actions ------------------------------------------------------------------------------
     def simulate(self) -> bool:

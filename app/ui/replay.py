@@ -1,15 +1,18 @@
 """Replay of a comparison: the browser animates the overview figure, the server turns the 3D rotors.
 
 The overview figure (phase plane and compact time plot, :mod:`app.figures.overview`) carries its
-own play buttons (one per speed), pause and time slider (:mod:`app.figures.replay`): it is sent
-once per Simulate and animated by Plotly in the browser — the phase-plane markers and the time
-cursors move together — with no server traffic per frame. The 3D rotors are scene nodes, folded
-away by default ("Show 3D rotors"); their replay (Play/Pause and a time slider in the "3D view"
-folder) sends one small orientation update per rotor per tick and runs only while playing.
+own play buttons (one per speed) and pause (:mod:`app.figures.replay`): it is sent once per
+Simulate and animated by Plotly in the browser — the phase-plane markers and the time cursors
+move together — with no server traffic per frame. The "Replay t" slider below it scrubs: each move
+sends one ``Plotly.restyle`` of the markers and cursors (a few hundred bytes) and turns the 3D
+rotors to the same time. The 3D rotors are scene nodes, folded away by default ("Show 3D rotors");
+their replay (Play/Pause) sends one small orientation update per rotor and one scrub per tick and
+runs only while playing.
 """
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from collections.abc import Callable
@@ -17,11 +20,12 @@ from typing import Any
 
 import numpy as np
 import viser
+from viser import _messages
 
 from app.figures.comparison import runs, time_plots_spec
 from app.figures.overview import overview_spec
 from app.figures.plain import figure_json
-from app.figures.replay import SPEEDS, replay_layout
+from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, replay_layout, scrub_update
 from app.ui.scene import RotorScene
 
 FRAME_HZ = 25.0
@@ -35,18 +39,41 @@ def set_figure_json(handle: viser.GuiPlotlyHandle, json_str: str) -> None:
     handle._plotly_json_str = json_str
 
 
-def phase_plane_json(comparison: Any, replay: bool = True) -> str:
-    """JSON of the overview figure (phase plane + compact time plot), with its in-browser replay if ``replay``.
+def overview_json(comparison: Any, replay: bool = True) -> tuple[str, ScrubTargets]:
+    """JSON of the overview figure (phase plane + compact time plot) and the traces a scrub moves.
 
-    Without the replay's buttons, slider and frames the browser redraws the figure ≈ 1/3 faster
-    (what a slider drag needs; the replay comes back when the drag stops).
+    With ``replay`` the figure carries its in-browser replay (play buttons and key frames); without
+    them the browser redraws it faster (what a slider drag needs; the replay comes back when the
+    drag stops).
     """
     spec = overview_spec(comparison)
+    targets = ScrubTargets.of(spec["data"])
     if not replay:
-        return figure_json(spec)
+        return figure_json(spec), targets
     layout, raw = replay_layout(comparison, spec["data"])
     spec["layout"].update(layout)
-    return figure_json(spec, raw)
+    return figure_json(spec, raw), targets
+
+
+def phase_plane_json(comparison: Any, replay: bool = True) -> str:
+    """JSON of the overview figure, with its in-browser replay if ``replay`` (see :func:`overview_json`)."""
+    return overview_json(comparison, replay)[0]
+
+
+#: Script run in the page for a scrub: stop the overview's replay, then restyle its moved traces.
+SCRUB_JS = """(() => {{ const P = window.Plotly; if (!P) return;
+  for (const el of document.querySelectorAll('.js-plotly-plot')) {{
+    if (!(el.layout && el.layout.meta && el.layout.meta.id === 'phase_plane' && el.data)) continue;
+    P.animate(el, [null], {pause});
+    P.restyle(el, {update}, {indices});
+  }} }})();"""
+
+
+def scrub_js(comparison: Any, targets: ScrubTargets, t: float) -> str:
+    """Return the page script that puts the overview's markers and cursors at time ``t`` [s]."""
+    update, indices = scrub_update(comparison, targets, t)
+    return SCRUB_JS.format(pause=json.dumps(PAUSE), update=json.dumps(update, separators=(",", ":")),
+                           indices=json.dumps(indices))
 
 
 def time_plots_json(comparison: Any) -> str:
@@ -55,7 +82,7 @@ def time_plots_json(comparison: Any) -> str:
 
 
 class Replay:
-    """Sends the figures of a comparison; Play/Pause and a time slider for the 3D rotors."""
+    """Sends the figures of a comparison; the "Replay t" scrub; Play/Pause for the 3D rotors."""
 
     def __init__(self, gui: viser.GuiApi, phase: viser.GuiPlotlyHandle,
                  time_plots: viser.GuiPlotlyHandle | None, scene: RotorScene | None,
@@ -65,16 +92,20 @@ class Replay:
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
+        self._gui = gui
         self._comparison: Any = None
+        self._targets = ScrubTargets((), (), ())
         self._t_end = 1.0
         self._t_now = 0.0
+        self.slider = gui.add_slider("Replay t [s]", min=0.0, max=1.0, step=0.001, initial_value=1.0,
+                                     hint="Scrub: the phase-plane markers, the time cursors and the 3D rotors "
+                                          "go to this time")
         self.folder = gui.add_folder("3D view", expand_by_default=False, visible=scene is not None)
         with self.folder:
             self.show_3d = gui.add_checkbox("Show 3D rotors", False,
                                             hint="FDSMC (blue, left) and conventional (orange, right) rotors "
                                                  "turning with θ_r; hidden in the BLDC tabs")
             self.buttons = gui.add_button_group("3D rotors", ("Play", "Pause", "Replay"))
-            self.slider = gui.add_slider("t [s]", min=0.0, max=1.0, step=0.001, initial_value=0.0)
             self.speed = gui.add_dropdown("Speed", tuple(SPEEDS), initial_value="0.25×")
         self.buttons.on_click(self._on_button)
         self.slider.on_update(self._on_slider)
@@ -95,20 +126,22 @@ class Replay:
         plots, until :meth:`complete`.
         """
         self.pause()
-        set_figure_json(self._phase, phase_plane_json(comparison, replay=not light))
+        figure, targets = overview_json(comparison, replay=not light)
+        set_figure_json(self._phase, figure)
         self._flush()  # the phase plane goes out before the larger figure is even built
         if not light:
             self.show_time_plots(comparison)
         with self._lock:
-            self._comparison = comparison
+            self._comparison, self._targets = comparison, targets
             rs = runs(comparison)
             self._t_end = max((float(run.trace.t[-1]) for _, run in rs), default=1.0)
         self.slider.max = self._t_end
         self.slider.step = self._t_end / 1000.0
+        self.slider.value = self._t_end  # the figure shows the end of the runs
         if autoplay and self._scene is not None and self._scene.visible and rs:
             self.play(restart=True)
         else:
-            self.seek(self._t_end)
+            self.seek(self._t_end, scrub=False)
 
     def complete(self, comparison: Any) -> None:
         """Send what a light :meth:`load` left out: the overview's replay and the time plots."""
@@ -120,14 +153,19 @@ class Replay:
         if self._time_plots is not None:
             set_figure_json(self._time_plots, time_plots_json(comparison))
 
-    def seek(self, t_now: float) -> None:
-        """Turn the 3D rotors to their angles at ``t_now`` [s]."""
+    def seek(self, t_now: float, scrub: bool = True) -> None:
+        """Turn the 3D rotors to their angles at ``t_now`` [s]; with ``scrub`` move the overview's markers too."""
         with self._lock:
-            comparison = self._comparison
+            comparison, targets = self._comparison, self._targets
             self._t_now = t_now = min(max(t_now, 0.0), self._t_end)
-        if self._scene is not None and comparison is not None:
+        if comparison is None or not runs(comparison):
+            return
+        if self._scene is not None:
             self._scene.show({key: float(np.interp(t_now, run.trace.t, run.trace.theta_r))
                               for key, run in runs(comparison)})
+        if scrub:
+            source = scrub_js(comparison, targets, t_now)
+            self._gui._websock_interface.queue_message(_messages.RunJavascriptMessage(source=source))
 
     def play(self, restart: bool = False) -> None:
         """Start (or restart from t = 0) the 3D replay thread."""

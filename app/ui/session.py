@@ -29,7 +29,7 @@ from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import OptimumToggle, StudiesSection
 from app.ui.text import checked_choice, derived_markdown, design_markdown, md_text
-from app.ui.tuning import LiveTuning
+from app.ui.tuning import LiveTuning, TuneRunner
 from app.ui.verdict_panel import VerdictPanel
 from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Cancelled, Worker
@@ -81,9 +81,9 @@ class Session:
         self.comparison = config.initial()
         self.error: str | None = None
         self.runs = 0
-        self._tune_pending = False
         self._recentre = True
         self.worker = Worker(self._set_busy, self._job_failed, name=f"ui-client-{client.client_id}")
+        self.tuner = TuneRunner(self.worker, self._run_latest, self._tuned)
         scene = RotorScene(client.scene) if config.scene_3d else None
         self._layout(scene)
         self.results.show(self.comparison, autoplay=False)
@@ -147,7 +147,7 @@ class Session:
         self.cancel_button.on_click(lambda _: self.cancel())
         self.status = gui.add_markdown("Ready.")
         self.verdicts = VerdictPanel(gui, self._use_recommended_k, self._use_T_c_min)
-        self.tuning = LiveTuning(gui, self._apply_knob, self.tune)
+        self.tuning = LiveTuning(gui, self._apply_knob, self.tuner.request)
         with gui.add_form(None) as form:
             self.inputs = InputsPanel(gui, self.params)
         form.on_submit(lambda _: self.simulate())
@@ -203,26 +203,18 @@ class Session:
         self.status.content = "Cancelling…"
         return True
 
-    def tune(self) -> None:
-        """Simulate the inputs panel's latest values as soon as the worker is free (live tuning).
+    def _run_latest(self) -> bool:
+        """Simulate the inputs panel's values, overview only (a slider moves); False on an input error."""
+        try:
+            params = self.inputs.collect()
+        except InputError as exc:
+            self._reject(str(exc))
+            return False
+        self._run(params, autoplay=False, overview_only=True)
+        return True
 
-        Moves while a run is in progress only mark the values as changed; one run of the latest
-        values follows (see :meth:`_tune_loop`). Nothing stale is queued.
-        """
-        self._tune_pending = True
-        if not self.worker.busy:
-            self.worker.submit(self._tune_loop)
-
-    def _tune_loop(self) -> None:
-        """Re-simulate the latest values while a slider moves; the overview only, the rest once it stops."""
-        while self._tune_pending:
-            self._tune_pending = False
-            try:
-                params = self.inputs.collect()
-            except InputError as exc:
-                self._reject(str(exc))
-                return
-            self._run(params, autoplay=False, overview_only=True)
+    def _tuned(self) -> None:
+        """Draw the rest of the results of the last run once a drag has stopped."""
         if self.comparison is not None and self.comparison.fdsmc is not None:
             self.results.show_rest()
 
@@ -346,8 +338,8 @@ class Session:
             self.status.content = f"Ready — {self.runs} run(s) in this session."
 
     def _set_busy(self, busy: bool) -> None:
-        if not busy and self._tune_pending:
-            self.worker.submit(self._tune_loop)  # a slider moved during the run: its latest value
+        if not busy:
+            self.tuner.resume()  # a slider moved during the run: its latest value
         self.simulate_button.disabled = busy
         self.design_button.disabled = busy
         self.cancel_button.visible = busy

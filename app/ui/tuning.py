@@ -9,6 +9,7 @@ inputs panel shows.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -16,12 +17,16 @@ from typing import Any
 import viser
 
 from app.io import units
+from app.ui.worker import Worker
 from control.fdsmc.params import DriveParams
 
 #: Slider range around the value it is centred on: [value / SPAN, value · SPAN].
 SPAN = 5.0
 #: Positions per slider.
 STEPS = 200
+#: Quiet time after the last slider move before the rest of the results (replay, time plots,
+#: energy figures) is drawn [s]: a drag's moves arrive tens of ms apart.
+TUNE_SETTLE_S = 0.4
 
 
 @dataclass(frozen=True)
@@ -83,3 +88,46 @@ class LiveTuning:
             return
         self._apply(knob.key, knob.to_si(float(self._sliders[knob.key].value)))
         self._request_run()
+
+
+class TuneRunner:
+    """Runs the latest slider values on a client's worker while a slider moves.
+
+    ``run_latest()`` simulates the inputs panel's values (False: an input error, stop); ``finish()``
+    draws the rest of the results once no move came for :data:`TUNE_SETTLE_S`.
+    """
+
+    def __init__(self, worker: Worker, run_latest: Callable[[], bool], finish: Callable[[], None]) -> None:
+        self._worker, self._run_latest, self._finish = worker, run_latest, finish
+        self._pending = False
+        self._moved = threading.Event()
+
+    def request(self) -> None:
+        """Run the latest slider value as soon as the worker is free (a slider moved)."""
+        self._pending = True
+        self._moved.set()
+        if not self._worker.busy:
+            self._worker.submit(self._loop)
+
+    def resume(self) -> None:
+        """Run the latest value if a slider moved during the job that just ended (the worker is free)."""
+        if self._pending:
+            self._worker.submit(self._loop)
+
+    def _loop(self) -> None:
+        """One run per batch of moves, overview only; the rest once the drag has stopped.
+
+        The drag has stopped once no move came for :data:`TUNE_SETTLE_S`: a drag's moves arrive
+        tens of ms apart, often slower than a run, and drawing the rest between two moves would
+        double the browser's work.
+        """
+        while True:
+            self._moved.clear()
+            while self._pending:
+                self._pending = False
+                if not self._run_latest():
+                    return
+            if not self._moved.wait(TUNE_SETTLE_S):
+                break
+            self._worker.checkpoint()
+        self._finish()

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import msgspec
 import numpy as np
+import pytest
 
 from app.figures.replay import SPEEDS
 
@@ -25,11 +27,29 @@ COUNT_FRAMES_JS = """() => {
 }"""
 
 
+def sent_bytes(ui_server) -> list[int]:
+    """Sizes [B] of the messages the server queues for the newest page from now on (msgpack).
+
+    Counted on the server: Playwright reports the frames of a page's sockets opened after
+    ``page.on("websocket")`` only, and the page's socket is open before the test starts.
+    """
+    sessions = ui_server.config.sessions
+    connection = sessions[max(sessions)].client.gui._websock_interface  # the newest page's
+    sizes: list[int] = []
+    queue = connection.queue_message
+
+    def counted(message) -> None:
+        sizes.append(len(msgspec.msgpack.encode(message.as_serializable_dict())))
+        queue(message)
+
+    connection.queue_message = counted
+    return sizes
+
+
 def test_in_plot_replay_moves_the_marker_without_server_traffic(page, ui_server):
     for close in page.locator(".mantine-Notification-closeButton").all():
         close.click()  # e.g. viser's "software WebGL" notice
-    received: list[int] = []
-    page.on("websocket", lambda ws: ws.on("framereceived", lambda p: received.append(len(p))))
+    received = sent_bytes(ui_server)
     start = page.evaluate(MARKER_JS)
     t_end = float(ui_server.config.initial().fdsmc.trace.t[-1])
     page.evaluate(COUNT_FRAMES_JS)
@@ -83,9 +103,30 @@ def test_dragging_the_K_slider_resimulates_with_the_latest_value(page):
     assert page.evaluate(BAND_JS) != before_band
     after_y = page.evaluate(FDSMC_Y_JS)
     assert len(after_y) != len(before_y) or max(abs(a - b) for a, b in zip(after_y, before_y, strict=True)) > 1e-3
-    # once the drag has stopped the overview gets its replay back (play buttons and scrub slider)
+    # once the drag has stopped the overview gets its replay back (play buttons)
     page.wait_for_function("() => { const el = [...document.querySelectorAll('.js-plotly-plot')]"
                            ".find(e => e.layout.meta.id === 'phase_plane');"
-                           " return (el.layout.updatemenus || []).length > 0"
-                           " && (el.layout.sliders || []).length > 0; }")
+                           " return (el.layout.updatemenus || []).length > 0; }")
     assert abs(float(page.evaluate(BAND_JS).split("±")[2].split()[0]) * k_shown - 1) < 6e-3
+
+
+def test_the_replay_t_slider_puts_the_markers_on_the_trajectories_at_that_time(page, ui_server):
+    """Scrubbing to t: each "now" marker drawn at (θ_r(t) − θ_dem, ω_r(t)) of its run, with a few
+    hundred bytes from the server per move.
+    """
+    comparison = ui_server.config.initial()
+    th = comparison.derived.params.manoeuvre.theta_dem
+    received = sent_bytes(ui_server)
+    # the slider's number box (the slider itself also holds a hidden input)
+    box = page.locator('xpath=//label[normalize-space(.)="Replay t [s]"]/ancestor::*[.//input][1]'
+                       '//input[not(@type="hidden")]').first
+    for t in (0.25, 0.6):
+        n0 = len(received)
+        box.fill(f"{t:g}")
+        box.press("Tab")
+        page.wait_for_function(f"() => ({MARKER_JS})()[2] === 't = {t:.3f} s'")
+        x, y, _ = page.evaluate(MARKER_JS)
+        tr = comparison.fdsmc.trace
+        assert x == pytest.approx(np.interp(t, tr.t, tr.theta_r) - th, rel=1e-4, abs=1e-9)
+        assert y == pytest.approx(np.interp(t, tr.t, tr.omega_r), rel=1e-4, abs=1e-6)
+        assert received[n0:] and max(received[n0:]) < 1000  # small scripts and values, never a figure
