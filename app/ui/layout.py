@@ -64,7 +64,7 @@ class PanelLayout:
 
 
 def layout_for_window(width: float, height: float, show_3d: bool = False) -> PanelLayout:
-    """Size the panels for a ``width`` × ``height`` [px] window, as :func:`page_style` does.
+    """Size the panels for a ``width`` × ``height`` [px] window, as :func:`page_css` does.
 
     The control panel keeps its width, the 3D canvas gets :data:`CANVAS_SPARE` (folded) or
     :data:`SCENE_SHARE` of the width (shown), the results panel the rest; the overview plot is as
