@@ -15,15 +15,20 @@ from app.figures.overview import CURSORS
 from app.figures.replay import SPEEDS
 from tests.browser.conftest import ARTIFACTS, TIMEOUT_MS, UiServer, click_tab, session_of, wait_for_layout
 
-#: Bounding boxes (page pixels) of the phase-plane subplot, the two time rows and the key numbers.
+#: Bounding boxes (page pixels) of the phase-plane subplot, the two time rows, the key numbers and
+#: the "Replay t" slider row.
 BOXES_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
   const r = el.getBoundingClientRect(), L = el._fullLayout;
   const box = (xa, ya) => ({x: r.x + L[xa]._offset, y: r.y + L[ya]._offset,
                             width: L[xa]._length, height: L[ya]._length});
   const k = document.querySelector('[data-role="key-numbers"]').getBoundingClientRect();
+  const label = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'Replay t [s]');
+  let row = label; while (row && !row.querySelector('[role="slider"]')) row = row.parentElement;
+  const s = row.getBoundingClientRect();
   return {phase: box('xaxis', 'yaxis'), omega: box('xaxis2', 'yaxis2'), torque: box('xaxis3', 'yaxis3'),
           numbers: {x: k.x, y: k.y, width: k.width, height: k.height},
+          scrub: {x: s.x, y: s.y, width: s.width, height: s.height},
           results: [...document.querySelectorAll('[role="tab"]')].filter(t => t.title === 'Overview')
                      .map(t => t.closest('[data-dock-tab]').parentElement.getBoundingClientRect().width)[0],
           scroll: [document.scrollingElement.scrollWidth, document.scrollingElement.scrollHeight]};
@@ -81,12 +86,12 @@ def _inside(box: dict[str, float], width: int, height: int) -> bool:
             and box["x"] + box["width"] <= width and box["y"] + box["height"] <= height)
 
 
-def test_1280x720_shows_phase_plane_time_plot_and_numbers_without_scrolling(projector):
+def test_1280x720_shows_phase_plane_time_plot_numbers_and_scrub_without_scrolling(projector):
     page = projector
     page.wait_for_function(f"() => {{ const b = ({BOXES_JS})(); const r = p => p.y + p.height <= 720;"
-                           " return r(b.phase) && r(b.torque) && r(b.numbers); }")
+                           " return r(b.phase) && r(b.torque) && r(b.numbers) && r(b.scrub); }")
     boxes = page.evaluate(BOXES_JS)
-    for name in ("phase", "omega", "torque", "numbers"):
+    for name in ("phase", "omega", "torque", "numbers", "scrub"):
         assert _inside(boxes[name], 1280, 720), (name, boxes[name])
     assert boxes["scroll"] == [1280, 720]  # the page itself does not scroll
     assert boxes["phase"]["width"] >= 300 and boxes["phase"]["height"] >= 250  # legible on a projector
