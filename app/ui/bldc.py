@@ -23,7 +23,7 @@ from app.figures.bldc import (
     make_speed_figure,
     make_torque_figure,
 )
-from app.figures.plain import blank_figure, placeholder_json
+from app.figures.plain import placeholder_json
 from app.io.bldc_emf import read_measured, with_measured
 from app.io.bldc_view import metric_table
 from app.io.numbers import NumberFormatError
@@ -32,7 +32,7 @@ from app.io.presets import annotate_units, dumps_preset
 from app.io.units import from_si, s_to_ms, shown_range, spec_of, to_si
 from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
-from app.ui.replay import set_figure_json
+from app.ui.plots import add_figure, set_figure_json
 from app.ui.text import checked_choice, md_text
 from app.ui.worker import Cancelled, Worker
 from control.bldc.design import bldc_design
@@ -80,9 +80,11 @@ def read_si(field: NumberInput, key: str) -> float | int:
 
 
 def _placeholder(gui: viser.GuiApi, figure_id: str, title: str, aspect: float) -> viser.GuiPlotlyHandle:
-    handle = gui.add_plotly(blank_figure(), aspect=aspect)
-    set_figure_json(handle, placeholder_json(figure_id, f"{title} — press “Simulate BLDC”"))
-    return handle
+    return add_figure(gui, placeholder_json(figure_id, f"{title} — press “Simulate BLDC”"), aspect)
+
+
+def _warnings_markdown(warnings: tuple[str, ...]) -> str:
+    return "\n".join(f"⚠ {md_text(w)}  " for w in warnings)
 
 
 @functools.lru_cache(maxsize=16)
@@ -116,7 +118,6 @@ class BldcTab:
         self.params: BldcParams = load_mode_preset(PRESET, mode="bldc")
         self.comparison: BldcComparison | None = None
         self._build()
-        self._show_design()
 
     # ---- layout -------------------------------------------------------------------------------
     def _build(self) -> None:
@@ -139,7 +140,8 @@ class BldcTab:
         self.cancel_button.on_click(lambda _: self._cancel())
         self.status = gui.add_markdown("Ready — press **Simulate BLDC**; the metrics and figures are in "
                                        "the results panel's **BLDC figures** tab.")
-        self.warnings = gui.add_markdown("")
+        emf, dqx, reach, warnings = design_view(p)  # the preset's design, in the widgets' first messages
+        self.warnings = gui.add_markdown(_warnings_markdown(warnings))
         with gui.add_folder("Scenario", expand_by_default=False):
             self.w_ref, self.t_end = (number_input(gui, key) for key in SCENARIO_FIELDS)
             self._scenario_chosen()
@@ -155,9 +157,9 @@ class BldcTab:
             self.fig_torque = _placeholder(gui, "bldc_torque", "Torque", ASPECT)
             self.fig_sigma = _placeholder(gui, "bldc_sigma", "σ_ω", ASPECT)
             self.fig_currents = _placeholder(gui, "bldc_currents", "Phase currents", ASPECT)
-            self.fig_emf = _placeholder(gui, "bldc_emf", "Back-EMF", ASPECT)
-            self.fig_dqx = _placeholder(gui, "bldc_dqx", "a_x, θ_x", 1.0)
-            self.fig_reach = _placeholder(gui, "bldc_reach", "Reachability", ASPECT)
+            self.fig_emf = add_figure(gui, emf, ASPECT)
+            self.fig_dqx = add_figure(gui, dqx, 1.0)
+            self.fig_reach = add_figure(gui, reach, ASPECT)
         self.download = gui.add_button("Download BLDC preset (YAML)", icon=viser.Icon.DOWNLOAD)
         self.download.on_click(lambda _: self._download())
         self.import_preset = gui.add_upload_button("Import BLDC preset (YAML)", icon=viser.Icon.UPLOAD,
@@ -191,7 +193,7 @@ class BldcTab:
         emf, dqx, reach, warnings = design_view(self.params)
         for handle, json_str in ((self.fig_emf, emf), (self.fig_dqx, dqx), (self.fig_reach, reach)):
             set_figure_json(handle, json_str)
-        self.warnings.content = "\n".join(f"⚠ {md_text(w)}  " for w in warnings)
+        self.warnings.content = _warnings_markdown(warnings)
 
     # ---- actions ------------------------------------------------------------------------------
     def simulate(self) -> bool:

@@ -26,17 +26,10 @@ from app.figures.comparison import runs, time_plots_spec
 from app.figures.overview import overview_spec
 from app.figures.plain import figure_json
 from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, replay_layout, scrub_update
+from app.ui.plots import set_figure_json
 from app.ui.scene import RotorScene
 
 FRAME_HZ = 25.0
-
-
-def set_figure_json(handle: viser.GuiPlotlyHandle, json_str: str) -> None:
-    """Send a ready-made Plotly JSON string to a plot widget (skips re-encoding a go.Figure).
-
-    ``_plotly_json_str`` is the widget property that ``GuiPlotlyHandle.figure`` itself sets.
-    """
-    handle._plotly_json_str = json_str
 
 
 def overview_json(comparison: Any, replay: bool = True) -> tuple[str, ScrubTargets]:
@@ -81,23 +74,30 @@ def time_plots_json(comparison: Any) -> str:
     return figure_json(time_plots_spec(comparison))
 
 
+def _t_end(comparison: Any) -> float:
+    """End of the longest run of ``comparison`` [s] (1 s without runs)."""
+    rs = runs(comparison) if comparison is not None else []
+    return max((float(run.trace.t[-1]) for _, run in rs), default=1.0)
+
+
 class Replay:
     """Sends the figures of a comparison; the "Replay t" scrub; Play/Pause for the 3D rotors."""
 
     def __init__(self, gui: viser.GuiApi, phase: viser.GuiPlotlyHandle,
                  time_plots: viser.GuiPlotlyHandle | None, scene: RotorScene | None,
+                 shown: tuple[Any, ScrubTargets] | None = None,
                  flush: Any = lambda: None, on_3d: Callable[[bool], None] = lambda _: None) -> None:
+        """``shown``: the comparison the figure widgets already show, and the traces a scrub moves."""
         self._phase, self._time_plots, self._scene, self._flush = phase, time_plots, scene, flush
         self._on_3d = on_3d
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._gui = gui
-        self._comparison: Any = None
-        self._targets = ScrubTargets((), (), ())
-        self._t_end = 1.0
-        self._t_now = 0.0
-        self.slider = gui.add_slider("Replay t [s]", min=0.0, max=1.0, step=0.001, initial_value=1.0,
+        self._comparison, self._targets = shown if shown is not None else (None, ScrubTargets((), (), ()))
+        self._t_end = self._t_now = _t_end(self._comparison)
+        self.slider = gui.add_slider("Replay t [s]", min=0.0, max=self._t_end, step=self._t_end / 1000.0,
+                                     initial_value=self._t_end,
                                      hint="Scrub: the phase-plane markers, the time cursors and the 3D rotors "
                                           "go to this time")
         self.folder = gui.add_folder("3D view", expand_by_default=False, visible=scene is not None)
@@ -134,7 +134,7 @@ class Replay:
         with self._lock:
             self._comparison, self._targets = comparison, targets
             rs = runs(comparison)
-            self._t_end = max((float(run.trace.t[-1]) for _, run in rs), default=1.0)
+            self._t_end = _t_end(comparison)
         self.slider.max = self._t_end
         self.slider.step = self._t_end / 1000.0
         self.slider.value = self._t_end  # the figure shows the end of the runs

@@ -14,11 +14,13 @@ from typing import Any
 
 import viser
 
+from app.figures.comparison import runs
 from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
-from app.figures.plain import blank_figure, figure_json
+from app.figures.plain import figure_json
 from app.io.numbers import parse_T_m_list
 from app.ui.layout import PanelLayout
-from app.ui.replay import Replay, set_figure_json
+from app.ui.plots import add_figure, set_figure_json
+from app.ui.replay import Replay, overview_json, time_plots_json
 from app.ui.scene import RotorScene
 from app.ui.text import annual_savings, key_numbers_html, savings_markdown
 from sim.fdsmc.engine import TABLE1_T_M
@@ -40,16 +42,21 @@ class ResultsPanel:
         self.panel = gui.add_panel()
         phase_tab = self.panel.add_tab("Overview", viser.Icon.CHART_DOTS)
         time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
+        # the widgets carry the start-up comparison from their first message (app/ui/plots.py)
+        overview, targets = overview_json(comparison)
         with phase_tab:
             self.key_numbers = gui.add_html(key_numbers_html(comparison))
-            self.phase = gui.add_plotly(blank_figure(), aspect=ASPECT_PHASE)
+            self.phase = add_figure(gui, overview, ASPECT_PHASE)
         with time_tab:
-            self.time_plots = gui.add_plotly(blank_figure(), aspect=ASPECT_TIME)
+            self.time_plots = add_figure(gui, time_plots_json(comparison), ASPECT_TIME)
         with phase_tab:
-            self.replay = Replay(gui, self.phase, self.time_plots, scene, flush=client.flush, on_3d=on_3d)
+            self.replay = Replay(gui, self.phase, self.time_plots, scene, (comparison, targets),
+                                 flush=client.flush, on_3d=on_3d)
+        simulated = bool(runs(comparison))
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
-            self.energy = gui.add_plotly(blank_figure(), aspect=ASPECT_SMALL)
-            self.bars = gui.add_plotly(blank_figure(), aspect=ASPECT_SMALL)
+            self.energy = add_figure(gui, figure_json(energy_spec(comparison)) if simulated else None, ASPECT_SMALL)
+            self.bars = add_figure(gui, figure_json(energy_bars_spec(comparison)) if simulated else None,
+                                   ASPECT_SMALL)
             self._build_savings(gui)
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))

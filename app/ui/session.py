@@ -85,8 +85,7 @@ class Session:
         self.worker = Worker(self._set_busy, self._job_failed, name=f"ui-client-{client.client_id}")
         self.tuner = TuneRunner(self.worker, self._run_latest, self._tuned)
         scene = RotorScene(client.scene) if config.scene_3d else None
-        self._layout(scene)
-        self.results.show(self.comparison, autoplay=False)
+        self._layout(scene)  # the results panel shows the start-up comparison from its first message
         self._show_text()
 
     # ---- layout -------------------------------------------------------------------------------

@@ -11,12 +11,12 @@ from typing import Any
 
 import viser
 
-from app.figures.plain import blank_figure, figure_json
+from app.figures.plain import figure_json
 from app.figures.studies import multiaxis_spec, multiaxis_table_markdown
 from app.io.preset_modes import list_presets_of
 from app.io.presets import MAX_BYTES, loads_raw
 from app.io.study_inputs import parse_axes
-from app.ui.replay import set_figure_json
+from app.ui.plots import add_figure, set_figure_json
 from app.ui.text import md_text
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
@@ -94,7 +94,7 @@ class MultiAxisView:
         self.run_button = gui.add_button("Run multi-axis move", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.status = gui.add_markdown("Not run yet.")
         self.table = gui.add_markdown("")
-        self.figure = gui.add_plotly(blank_figure(), aspect=0.8)
+        self.figure = add_figure(gui, aspect=0.8)
         self.add_button.on_click(lambda _: self._add_axis())
         self.upload.on_upload(lambda _: self._uploaded())
         self.run_button.on_click(lambda _: self.start())

@@ -17,10 +17,10 @@ from typing import Any
 
 import viser
 
-from app.figures.plain import blank_figure, figure_json
+from app.figures.plain import figure_json
 from app.figures.studies import robustness_spec, robustness_table_markdown
 from app.io.study_inputs import parse_spread
-from app.ui.replay import set_figure_json
+from app.ui.plots import add_figure, set_figure_json
 from app.ui.text import md_text
 from app.ui.worker import Cancelled
 from control.common.checks import ParameterError
@@ -104,7 +104,7 @@ class RobustnessView:
         self.progress = gui.add_progress_bar(0.0, animated=False)
         self.status = gui.add_markdown("Not run yet: the controller keeps the simulated inputs as its model; "
                                        "each sample draws the plant from the spreads above.")
-        self.figure = gui.add_plotly(blank_figure(), aspect=0.8)
+        self.figure = add_figure(gui, aspect=0.8)
         self.table = gui.add_markdown("")
         self.run_button.on_click(lambda _: self.start())
         self.cancel_button.on_click(lambda _: self.cancel())
