@@ -229,3 +229,42 @@ def test_worker_cancel_stops_at_the_next_checkpoint():
     assert len(reached) < 1000 and isinstance(errors[0], Cancelled)
     assert not worker.busy and not worker.cancel()
     worker.close()
+
+
+def test_page_open_sends_each_figure_once(served):
+    """A new page gets every figure once: viser's creation message of a plot widget shares its
+    properties with the handle, so a figure set before that message left used to travel twice.
+    """
+    import json
+
+    import zstandard
+
+    hostport, _, config = served
+    known = set(config.sessions)
+    figures: list[tuple[str, str]] = []  # (widget uuid, figure id) per figure JSON received
+
+    async def go() -> None:
+        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}", subprotocols=[PROTOCOL],
+                                      max_size=None, close_timeout=0.2) as ws:
+            await ws.send(msgspec.msgpack.encode(CAMERA))
+            quiet = 0
+            while quiet < 10 or not set(config.sessions) - known:  # until 1 s without a message
+                try:
+                    frame = await asyncio.wait_for(ws.recv(), 0.1)
+                except TimeoutError:
+                    quiet += 1
+                    continue
+                quiet = 0
+                n_in, n_c = int.from_bytes(frame[:8], "little"), int.from_bytes(frame[8:16], "little")
+                raw = zstandard.ZstdDecompressor().decompress(frame[16:16 + n_c], max_output_size=n_in)
+                for m in msgspec.msgpack.decode(raw)["messages"]:
+                    fig = (m.get("props") or {}).get("_plotly_json_str") or (m.get("updates") or {}).get(
+                        "_plotly_json_str")
+                    meta = json.loads(fig).get("layout", {}).get("meta") if fig else None
+                    if meta:
+                        figures.append((m["uuid"], meta["id"]))
+
+    _run(go)
+    ids = [fid for _, fid in figures]
+    assert {"phase_plane", "time_plots", "energy_time", "energy_bars", "bldc_emf"} <= set(ids)
+    assert len(figures) == len(set(figures)), sorted(f for f in ids if ids.count(f) > 1)

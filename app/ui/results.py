@@ -62,7 +62,7 @@ class ResultsPanel:
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
             self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
             self.progress = gui.add_progress_bar(0.0, animated=False)
-            self.table1 = gui.add_plotly(make_table1_figure([]), aspect=ASPECT_SMALL)
+            self.table1 = add_figure(gui, make_table1_figure([]).to_json(), ASPECT_SMALL)
         self.sweep_button.on_click(lambda _: self._sweep_clicked(client))
 
     def _build_savings(self, gui: viser.GuiApi) -> None:
