@@ -349,6 +349,7 @@ def main() -> int:
             print(f"server RSS idle, no client: {rss_mb(server.pid):.1f} MB")
             opened = open_pages(browser, f"http://127.0.0.1:{port}", max(counts), runs, server.pid)
             page, ws = opened[0][3], opened[0][4]
+            page.wait_for_timeout(5000)  # the pages opened all at once finish drawing before anything is timed
             per_simulate(page, ws, server.pid, runs, args.replay_wait)
             for n in counts:
                 pages = [o[3] for o in opened[:n]]

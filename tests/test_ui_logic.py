@@ -132,3 +132,24 @@ def test_tune_runner_stops_on_an_input_error_without_drawing_the_rest():
         time.sleep(0.01)
     assert not w.busy and finished == []
     w.close()
+
+
+def test_assign_sends_only_changed_properties():
+    """Viser sends every assignment; assign() leaves equal values alone (nothing re-sent, nothing re-drawn)."""
+    from app.ui.props import assign
+
+    class Handle:
+        def __init__(self) -> None:
+            object.__setattr__(self, "sent", [])
+            object.__setattr__(self, "content", "a")
+            object.__setattr__(self, "visible", True)
+
+        def __setattr__(self, name: str, value: object) -> None:
+            self.sent.append(name)
+            object.__setattr__(self, name, value)
+
+    h = Handle()
+    assign(h, content="a", visible=True)
+    assert h.sent == []
+    assign(h, content="b", visible=True)
+    assert h.sent == ["content"] and h.content == "b"

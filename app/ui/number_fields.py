@@ -13,6 +13,7 @@ from collections.abc import Callable
 import viser
 
 from app.io.numbers import NumberFormatError, parse_integer, parse_number
+from app.ui.props import assign
 
 
 def shown_text(value: float | int) -> str:
@@ -56,7 +57,7 @@ class NumberInput:
         """
         self._shown = shown_text(value)
         self._value = value if exact is None else exact
-        self.handle.value = self._shown
+        assign(self.handle, value=self._shown)
 
     @property
     def touched(self) -> bool:

@@ -27,6 +27,7 @@ from app.figures.overview import overview_spec
 from app.figures.plain import figure_json
 from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, replay_layout, scrub_update
 from app.ui.plots import set_figure_json
+from app.ui.props import assign
 from app.ui.scene import RotorScene
 
 FRAME_HZ = 25.0
@@ -135,9 +136,8 @@ class Replay:
             self._comparison, self._targets = comparison, targets
             rs = runs(comparison)
             self._t_end = _t_end(comparison)
-        self.slider.max = self._t_end
-        self.slider.step = self._t_end / 1000.0
-        self.slider.value = self._t_end  # the figure shows the end of the runs
+        # the figure shows the end of the runs
+        assign(self.slider, max=self._t_end, step=self._t_end / 1000.0, value=self._t_end)
         if autoplay and self._scene is not None and self._scene.visible and rs:
             self.play(restart=True)
         else:

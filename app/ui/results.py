@@ -20,6 +20,7 @@ from app.figures.plain import figure_json
 from app.io.numbers import parse_T_m_list
 from app.ui.layout import PanelLayout
 from app.ui.plots import add_figure, set_figure_json
+from app.ui.props import assign
 from app.ui.replay import Replay, overview_json, time_plots_json
 from app.ui.scene import RotorScene
 from app.ui.text import annual_savings, key_numbers_html, savings_markdown
@@ -95,7 +96,7 @@ class ResultsPanel:
         only what the Overview tab shows, and the browser redraws it faster.
         """
         self._comparison = comparison
-        self.key_numbers.content = key_numbers_html(comparison)
+        assign(self.key_numbers, content=key_numbers_html(comparison))
         self.replay.load(comparison, autoplay=autoplay, light=overview_only)
         self._rest_pending = overview_only
         if not overview_only:

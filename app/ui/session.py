@@ -25,6 +25,7 @@ from app.ui.inputs import InputError, InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
+from app.ui.props import assign
 from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import OptimumToggle, StudiesSection
@@ -216,6 +217,7 @@ class Session:
         """Draw the rest of the results of the last run once a drag has stopped."""
         if self.comparison is not None and self.comparison.fdsmc is not None:
             self.results.show_rest()
+        self._show_text()
 
     def _apply_knob(self, key: str, value_si: float) -> None:
         """Write a live-tuning slider's value into the inputs panel, as if typed."""
@@ -225,8 +227,10 @@ class Session:
             self.inputs.set_value(key, value_si)
 
     def _run(self, params: DriveParams, autoplay: bool = True, overview_only: bool = False) -> None:
-        self.status.content = "Simulating…"
-        self.design_note.content = ""
+        """Simulate ``params`` and show the results (``overview_only``: a live-tuning run, see :meth:`_run_latest`)."""
+        if not overview_only:
+            self.status.content = "Simulating…"
+        assign(self.design_note, content="")
         self.worker.checkpoint()
         comparison = comparison_or_derived(params, self.optimum.wanted)  # ParameterError → _job_failed
         self.worker.checkpoint()
@@ -236,7 +240,7 @@ class Session:
             self.results.show(comparison, autoplay=autoplay, overview_only=overview_only)
         else:
             self.results.show_derived_only(comparison)
-        self._show_text()
+        self._show_text(status=not overview_only)
 
     def sweep(self, T_m_values: list[float]) -> None:
         """Run the Table-1 sweep over ``T_m_values`` [s] on the worker with a progress bar."""
@@ -291,16 +295,17 @@ class Session:
             self.simulate()
 
     # ---- feedback -----------------------------------------------------------------------------
-    def _show_text(self) -> None:
+    def _show_text(self, status: bool = True) -> None:
         d = self.comparison.derived
-        self.derived.content = derived_markdown(d)
+        assign(self.derived, content=derived_markdown(d))
         self.optimum.show(self.comparison)
         self.inputs.show_T_c_in_force(d.profile.T_c)
         if self._recentre:
             self._recentre = False
             self.tuning.centre(self.params, d.profile.T_c)
         self.verdicts.show(self.comparison, self.params.controller.K, self.error, self._nameplate_warnings())
-        self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: {md_text(self.origin)}."
+        if status:
+            self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: {md_text(self.origin)}."
 
     def _nameplate_warnings(self) -> list[str]:
         """Disagreements with the optional datasheet Kt / rated torque typed on the page."""

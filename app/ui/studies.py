@@ -17,6 +17,7 @@ import viser
 
 from app.figures.comparison import LABELS
 from app.figures.energy import optimum_gaps
+from app.ui.props import assign
 from app.ui.studies_multiaxis import MultiAxisView
 from app.ui.studies_robustness import RobustnessView
 from sim.fdsmc.optimum_gap import OPTIMUM_BASIS
@@ -52,7 +53,7 @@ class OptimumToggle:
 
     def show(self, comparison: Any) -> None:
         """Return the optimum's numbers of the comparison shown (empty without an optimum run)."""
-        self.numbers.content = optimum_markdown(comparison)
+        assign(self.numbers, content=optimum_markdown(comparison))
 
 
 class StudiesSection:

@@ -12,6 +12,7 @@ from collections.abc import Callable
 
 import viser
 
+from app.ui.props import assign
 from app.ui.text import warnings_html
 from sim.fdsmc.engine import Comparison
 from sim.fdsmc.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
@@ -40,7 +41,7 @@ class VerdictPanel:
         if parts is not None:
             self._parts = parts
         items, error, notes = self._parts
-        self.box.content = warnings_html(items, error, notes, folded=bool(self.fold.value))
+        assign(self.box, content=warnings_html(items, error, notes, folded=bool(self.fold.value)))
 
     def reject(self, message: str) -> None:
         """Show an input error: nothing was simulated."""
@@ -55,10 +56,10 @@ class VerdictPanel:
         self.render((items, error, comparator_notes(comparison)))
         chatter = any(r is not None and r.metrics.chatter for r in (comparison.fdsmc, comparison.conventional))
         k_rec = recommended_K(d)
-        self.use_k.visible = k_rec is not None and (chatter or 1.001 * k_rec < K)
+        assign(self.use_k, visible=k_rec is not None and (chatter or 1.001 * k_rec < K))
         if k_rec is not None:
-            self.use_k.label = f"Use recommended K = {k_rec:.4g} s/rad"
+            assign(self.use_k, label=f"Use recommended K = {k_rec:.4g} s/rad")
         T_c = T_c_advice(d)
-        self.use_tc.visible = T_c is not None
+        assign(self.use_tc, visible=T_c is not None)
         if T_c is not None:
-            self.use_tc.label = f"Use T_c = {T_c * 1e3:.4g} ms (damps the approach to θ_dem)"
+            assign(self.use_tc, label=f"Use T_c = {T_c * 1e3:.4g} ms (damps the approach to θ_dem)")
