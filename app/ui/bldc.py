@@ -314,6 +314,14 @@ class BldcTab:
                                        save_immediately=True)
 
 
+def add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,
+                 submit: Callable[[Callable[[], None]], Any], results: Any, worker: Worker) -> BldcTab:
+    """Add the second mode: a "BLDC speed SMC" tab of ``tabs`` (inputs) and a "BLDC figures" tab of ``results``."""
+    figures_tab = results.add_tab("BLDC figures", viser.Icon.ENGINE)
+    with tabs.add_tab("BLDC speed SMC", viser.Icon.ENGINE):
+        return build_bldc_tab(client, submit, figures_tab, worker)
+
+
 def build_bldc_tab(client: viser.ClientHandle, submit: Callable[[Callable[[], None]], Any],
                    figures_container: Any = None, worker: Worker | None = None) -> BldcTab:
     """Build the BLDC tab in the current GUI container of ``client``; returns its handle object.

@@ -24,7 +24,8 @@ from app.io.presets import to_raw
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice
 from control.common.checks import FieldSpec, ParameterError
-from control.fdsmc.params import DriveParams
+from control.fdsmc.nameplate import nameplate_consistency
+from control.fdsmc.params import DriveParams, Motor
 
 Conv = Callable[[float, int], float]  # (value, pole pairs) → value
 
@@ -300,6 +301,20 @@ class InputsPanel:
             return self.numbers[f.key].read(page, conv)
         except NumberFormatError as exc:
             raise InputError(str(exc)) from None
+
+    def nameplate_warnings(self, motor: Motor) -> list[str]:
+        """Disagreements of ``motor`` with the optional datasheet Kt / rated torque typed on the page.
+
+        Only those that :func:`derive` does not already report from the nameplate itself.
+        """
+        try:
+            extra = self.nameplate_checks()
+        except InputError as exc:
+            return [str(exc)]
+        if not extra:
+            return []
+        general = {x.text for x in nameplate_consistency(motor)}
+        return [f"Nameplate: {x.text}" for x in nameplate_consistency(motor, **extra) if x.text not in general]
 
     def nameplate_checks(self) -> dict[str, float]:
         """Return the optional datasheet values typed for the cross-check (empty fields left out)."""

@@ -13,13 +13,13 @@ import threading
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
 
 import viser
 from viser._messages import RunJavascriptMessage
 
 from app.io.preset_modes import list_presets_of, load_mode_preset, require_mode
 from app.threads import limit_blas_threads
+from app.ui.bldc import add_bldc_tab
 from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
@@ -35,7 +35,6 @@ from app.ui.verdict_panel import VerdictPanel
 from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Cancelled, Worker
 from control.fdsmc.derivations import derive
-from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
@@ -111,7 +110,7 @@ class Session:
                                         on_3d=lambda shown: self.fit.set_3d(shown))
             self.results.panel.dock_right()
             self.studies = StudiesSection(self)
-            _add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
+            add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
             self._style_3d = False
             self.fit = WindowFit(self._apply_layout)
             if scene is not None:
@@ -303,21 +302,10 @@ class Session:
         if self._recentre:
             self._recentre = False
             self.tuning.centre(self.params, d.profile.T_c)
-        self.verdicts.show(self.comparison, self.params.controller.K, self.error, self._nameplate_warnings())
+        nameplate = self.inputs.nameplate_warnings(self.params.motor)
+        self.verdicts.show(self.comparison, self.params.controller.K, self.error, nameplate)
         if status:
             self.status.content = f"Ready — {self.runs} run(s) in this session. Preset: {md_text(self.origin)}."
-
-    def _nameplate_warnings(self) -> list[str]:
-        """Disagreements with the optional datasheet Kt / rated torque typed on the page."""
-        try:
-            extra = self.inputs.nameplate_checks()
-        except InputError as exc:
-            return [str(exc)]
-        if not extra:
-            return []
-        general = {x.text for x in nameplate_consistency(self.params.motor)}  # already in derive's warnings
-        return [f"Nameplate: {x.text}" for x in nameplate_consistency(self.params.motor, **extra)
-                if x.text not in general]
 
     def _reject(self, message: str) -> None:
         self.error = message
@@ -367,18 +355,6 @@ class Session:
         """Stop the worker and the replay (client disconnected)."""
         self.worker.close()
         self.results.replay.close()
-
-
-def _add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,
-                  submit: Callable[[Callable[[], None]], Any], results: Any, worker: Worker) -> None:
-    """Second mode: the BLDC tab (inputs left, figures in a "BLDC figures" tab of ``results``)."""
-    try:
-        from app.ui.bldc import build_bldc_tab
-    except ImportError:
-        return
-    figures_tab = results.add_tab("BLDC figures", viser.Icon.ENGINE)
-    with tabs.add_tab("BLDC speed SMC", viser.Icon.ENGINE):
-        build_bldc_tab(client, submit, figures_tab, worker)
 
 
 def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", port: int = 8080,
