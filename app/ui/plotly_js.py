@@ -39,6 +39,11 @@ def bundle_version() -> str:
     return match.group(1)
 
 
+def run_script(gui: viser.GuiApi, source: str) -> None:
+    """Run the JavaScript ``source`` in the page of ``gui``'s client (viser's own script message)."""
+    gui._websock_interface.queue_message(_messages.RunJavascriptMessage(source=source))
+
+
 def use_basic_plotly(gui: viser.GuiApi) -> None:
     """Send the basic plotly.js bundle to this client instead of viser's full one.
 
@@ -47,8 +52,8 @@ def use_basic_plotly(gui: viser.GuiApi) -> None:
     """
     if getattr(gui, "_setup_plotly_js", False):
         return
-    gui._websock_interface.queue_message(_messages.RunJavascriptMessage(source=bundle_source()))
+    run_script(gui, bundle_source())
     gui._setup_plotly_js = True
 
 
-__all__ = ["BUNDLE", "TRACE_TYPES", "bundle_source", "bundle_version", "use_basic_plotly"]
+__all__ = ["BUNDLE", "TRACE_TYPES", "bundle_source", "bundle_version", "run_script", "use_basic_plotly"]

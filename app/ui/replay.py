@@ -20,12 +20,12 @@ from typing import Any
 
 import numpy as np
 import viser
-from viser import _messages
 
 from app.figures.comparison import runs, time_plots_spec
 from app.figures.overview import overview_spec
 from app.figures.plain import figure_json
 from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, replay_layout, scrub_update
+from app.ui.plotly_js import run_script
 from app.ui.plots import set_figure_json
 from app.ui.props import assign
 from app.ui.scene import RotorScene
@@ -166,7 +166,7 @@ class Replay:
                               for key, run in runs(comparison)})
         if scrub:
             source = scrub_js(comparison, targets, t_now)
-            self._gui._websock_interface.queue_message(_messages.RunJavascriptMessage(source=source))
+            run_script(self._gui, source)
 
     def play(self, restart: bool = False) -> None:
         """Start (or restart from t = 0) the 3D replay thread."""

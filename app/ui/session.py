@@ -15,7 +15,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import viser
-from viser._messages import RunJavascriptMessage
 
 from app.io.preset_modes import list_presets_of, load_mode_preset, require_mode
 from app.threads import limit_blas_threads
@@ -24,7 +23,7 @@ from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
 from app.ui.log import LogPanel
-from app.ui.plotly_js import use_basic_plotly
+from app.ui.plotly_js import run_script, use_basic_plotly
 from app.ui.props import assign
 from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene, aim_camera
@@ -100,7 +99,7 @@ class Session:
             gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
             self._window_probe = gui.add_text("window [px]", "")
             probe_id = self._window_probe._impl.uuid
-            gui._websock_interface.queue_message(RunJavascriptMessage(source=install_css_js(page_css(probe_id))))
+            run_script(gui, install_css_js(page_css(probe_id)))
             use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
             gui.main_panel.dock_left()
             tabs = gui.add_tab_group()
@@ -116,14 +115,14 @@ class Session:
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
-        gui._websock_interface.queue_message(RunJavascriptMessage(source=window_report_js(probe_id)))
+        run_script(gui, window_report_js(probe_id))
 
     def _apply_layout(self, layout: PanelLayout) -> None:
         self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
         if layout.show_3d != self._style_3d:
             self._style_3d = layout.show_3d
             css = page_css(self._window_probe._impl.uuid, layout.show_3d)
-            self.gui._websock_interface.queue_message(RunJavascriptMessage(source=install_css_js(css)))
+            run_script(self.gui, install_css_js(css))
 
     def _controls(self) -> None:
         gui = self.gui
