@@ -25,7 +25,6 @@ each redraw ≈ 40 % slower (≈ 114 ms instead of ≈ 64 ms in headless Chromiu
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -61,6 +60,18 @@ class ScrubTargets:
                    tuple(tuple(float(v) for v in data[i]["y"]) for i in cursors))
 
 
+def end_time(comparison: Comparison) -> float:
+    """End of the longest run of ``comparison`` [s] (1 s when nothing was simulated)."""
+    return max((float(run.trace.t[-1]) for _, run in runs(comparison)), default=1.0)
+
+
+def _marker_positions(comparison: Comparison, t_grid: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(θ_r − θ_dem [rad], ω_r [rad/s]) of each run at the times ``t_grid`` [s], linear between samples."""
+    th = comparison.derived.params.manoeuvre.theta_dem
+    return [(np.interp(t_grid, run.trace.t, run.trace.theta_r) - th, np.interp(t_grid, run.trace.t, run.trace.omega_r))
+            for _, run in runs(comparison)]
+
+
 def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = ()) -> str:
     """Write the JSON list of frames at the times ``t_grid`` [s].
 
@@ -69,13 +80,8 @@ def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cur
 
     Written as text directly: a few thousand small frames are ~10× faster this way than as dicts.
     """
-    th = comparison.derived.params.manoeuvre.theta_dem
-    cols = []
-    for _, run in runs(comparison):
-        tr = run.trace
-        x = np.interp(t_grid, tr.t, tr.theta_r) - th
-        y = np.interp(t_grid, tr.t, tr.omega_r)
-        cols.append(([f"{v:.5g}" for v in x.tolist()], [f"{v:.5g}" for v in y.tolist()]))
+    cols = [([f"{v:.5g}" for v in x.tolist()], [f"{v:.5g}" for v in y.tolist()])
+            for x, y in _marker_positions(comparison, t_grid)]
     traces = ",".join(map(str, [*now, *cursors]))
     frames = []
     for k, t in enumerate(t_grid.tolist()):
@@ -111,7 +117,7 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
     if not rs:
         return {}, {}
     targets = ScrubTargets.of(data)
-    t_end = max(float(run.trace.t[-1]) for _, run in rs)
+    t_end = end_time(comparison)
     buttons, raw = [], {}
     for k, (label, speed) in enumerate(SPEEDS.items()):
         n = _n_frames(t_end, speed)
@@ -146,12 +152,12 @@ def scrub_update(comparison: Comparison, targets: ScrubTargets, t: float) -> tup
     (dict, list of int)
         The update and the indices of the traces it applies to.
     """
-    frame = json.loads(_frames_json(comparison, list(targets.now), np.array([float(t)]), targets.cursors))[0]
-    marks = frame["data"]
-    n_now = len(targets.now)
-    texts = [marks[0].get("text", [""])] + [[""]] * (len(marks) - 1)
-    return ({"x": [m["x"] for m in marks], "y": [m["y"] for m in marks[:n_now]] + [list(y) for y in targets.cursor_y],
-             "text": texts}, [*targets.now, *targets.cursors])
+    t = float(t)
+    marks = [(float(x[0]), float(y[0])) for x, y in _marker_positions(comparison, np.array([t]))]
+    texts = [[f"t = {t:.3f} s"]] + [[""]] * (len(marks) - 1 + len(targets.cursors))
+    return ({"x": [[x] for x, _ in marks] + [[t, t]] * len(targets.cursors),
+             "y": [[y] for _, y in marks] + [list(y) for y in targets.cursor_y], "text": texts},
+            [*targets.now, *targets.cursors])
 
 
-__all__ = ["KEY_RATE", "MAX_FRAMES", "PAUSE", "SPEEDS", "ScrubTargets", "replay_layout", "scrub_update"]
+__all__ = ["KEY_RATE", "MAX_FRAMES", "PAUSE", "SPEEDS", "ScrubTargets", "end_time", "replay_layout", "scrub_update"]

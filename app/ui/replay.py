@@ -24,7 +24,7 @@ import viser
 from app.figures.comparison import runs, time_plots_spec
 from app.figures.overview import overview_spec
 from app.figures.plain import figure_json
-from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, replay_layout, scrub_update
+from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
 from app.ui.plotly_js import run_script
 from app.ui.plots import set_figure_json
 from app.ui.props import assign
@@ -76,12 +76,6 @@ def time_plots_json(comparison: Any) -> str:
     return figure_json(time_plots_spec(comparison))
 
 
-def _t_end(comparison: Any) -> float:
-    """End of the longest run of ``comparison`` [s] (1 s without runs)."""
-    rs = runs(comparison) if comparison is not None else []
-    return max((float(run.trace.t[-1]) for _, run in rs), default=1.0)
-
-
 class Replay:
     """Sends the figures of a comparison; the "Replay t" scrub; Play/Pause for the 3D rotors."""
 
@@ -97,7 +91,7 @@ class Replay:
         self._thread: threading.Thread | None = None
         self._gui = gui
         self._comparison, self._targets = shown if shown is not None else (None, ScrubTargets((), (), ()))
-        self._t_end = self._t_now = _t_end(self._comparison)
+        self._t_end = self._t_now = end_time(self._comparison) if self._comparison is not None else 1.0
         self.slider = gui.add_slider("Replay t [s]", min=0.0, max=self._t_end, step=self._t_end / 1000.0,
                                      initial_value=self._t_end,
                                      hint="Scrub: the phase-plane markers, the time cursors and the 3D rotors "
@@ -136,7 +130,7 @@ class Replay:
         with self._lock:
             self._comparison, self._targets = comparison, targets
             rs = runs(comparison)
-            self._t_end = _t_end(comparison)
+            self._t_end = end_time(comparison)
         # the figure shows the end of the runs
         assign(self.slider, max=self._t_end, step=self._t_end / 1000.0, value=self._t_end)
         if autoplay and self._scene is not None and self._scene.visible and rs:
