@@ -153,3 +153,17 @@ def test_assign_sends_only_changed_properties():
     assert h.sent == []
     assign(h, content="b", visible=True)
     assert h.sent == ["content"] and h.content == "b"
+
+
+@pytest.mark.parametrize("value", [0.0431, 4.86e-5, 2.6, 21.72, 1000.0])
+def test_a_live_tuning_key_step_moves_the_value_whatever_its_size(value):
+    """The page rounds a slider value to the slider's precision: one step up or down from the
+    centre must move it by about one step (a K of 0.043 s/rad was rounded back to 0.04).
+    """
+    from app.ui.tuning import slider_precision, slider_range
+
+    lo, hi, step = slider_range(value)
+    digits = slider_precision(step)
+    for sign in (1, -1):
+        moved = round(value + sign * step, digits)
+        assert abs(moved - (value + sign * step)) < 0.1 * step

@@ -9,6 +9,7 @@ inputs panel shows.
 
 from __future__ import annotations
 
+import math
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -59,6 +60,16 @@ def slider_range(value: float) -> tuple[float, float, float]:
     return lo, hi, (hi - lo) / STEPS
 
 
+def slider_precision(step: float) -> int:
+    """Decimals a slider with ``step`` keeps: two finer than the step.
+
+    The page rounds every slider value to its ``precision``, which viser fixes when the slider is
+    made; a slider re-centred on a small value (K = 0.043 s/rad, step ≈ 0.001) with the
+    precision of its first range (2) rounded each key step back to 0.04.
+    """
+    return max(0, 2 - math.floor(math.log10(step)))
+
+
 class LiveTuning:
     """The "Live tuning" folder; ``apply(key, si)`` writes a value into the inputs panel."""
 
@@ -81,6 +92,7 @@ class LiveTuning:
             lo, hi, step = slider_range(shown)
             slider = self._sliders[knob.key]
             slider.min, slider.max, slider.step = lo, hi, step
+            slider.precision = slider_precision(step)
             slider.value = shown
 
     def _moved(self, event: viser.GuiEvent, knob: Knob) -> None:
