@@ -14,13 +14,15 @@ import pytest
 from app.io.presets import load_preset
 from control.fdsmc.derivations import derive
 from control.fdsmc.loop_analysis import (
+    affine_loop,
     gain_limit,
     minimum_sample_rate,
     recommend_K,
     sample_rate_check,
     stability_measure,
 )
-from control.fdsmc.loop_model import continuous_loop, reduce_shift_mode
+from control.fdsmc.loop_model import continuous_loop, discrete_loop, reduce_shift_mode
+from control.fdsmc.transient import step_response
 from sim.fdsmc.engine import simulate
 
 
@@ -149,3 +151,28 @@ def test_slow_manoeuvre_sloped_segment_needs_larger_T_c():
     assert not good.chatter
     assert good.copper_total_J < 1e-2 * bad.copper_total_J
     assert abs(good.theta_error_at_Tm_rad) < 0.02 * 60.0
+
+
+@pytest.mark.parametrize("f_s", [None, 20000.0])
+@pytest.mark.parametrize("law", ["cruise", "slope", "conventional"])
+def test_loop_is_affine_in_K(law, f_s):
+    """The searches build the loop at K as M0 + K·M1; that is the loop built at K directly."""
+    loop = derive(_params()).loop
+    M0, M1 = affine_loop(loop, law, f_s, 1)
+    for K in (1e-3, 0.3, 40.0, 1e4):
+        M = continuous_loop(loop, law, K) if f_s is None else discrete_loop(loop, law, K, f_s, 1)
+        M = reduce_shift_mode(M) if law == "cruise" else M
+        np.testing.assert_allclose(M0 + K * M1, M, rtol=1e-12, atol=1e-12 * np.max(np.abs(M)))
+
+
+def test_step_response_by_doubling_equals_the_recursion():
+    """z_k = Σ_{j<k} Φ^j·γ from the doubling equals z_{k+1} = Φ·z_k + γ stepped n times."""
+    rng = np.random.default_rng(7)
+    Phi = rng.normal(size=(6, 6))
+    Phi *= 0.97 / np.max(np.abs(np.linalg.eigvals(Phi)))
+    gamma = rng.normal(size=6)
+    z, ref = np.zeros(6), []
+    for _ in range(777):
+        z = Phi @ z + gamma
+        ref.append(z)
+    np.testing.assert_allclose(step_response(Phi, gamma, 777), ref, rtol=1e-11, atol=1e-12)

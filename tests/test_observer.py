@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from control.common.discrete import zoh
 from control.fdsmc.observer import (
     discrete_observer,
     error_matrix,
@@ -59,3 +60,14 @@ def test_discrete_observer_tracks_constant_load_exactly():
         x = d.Phi @ x
     assert xh[2] == pytest.approx(5.0, rel=1e-6)
     assert xh[1] == pytest.approx(x[1], rel=1e-6)
+
+
+@pytest.mark.parametrize("f_s", [100.0, 8e3, 20e3, 1e6])
+def test_discrete_observer_model_is_the_exact_zoh(f_s):
+    """Φ, Γ of the integrator chain in closed form (A⁴ = 0) equal the matrix exponential (Van Loan)."""
+    A = np.array([[0, 1, 0, 0], [0, 0, -M, 0], [0, 0, 0, 1], [0, 0, 0, 0]], dtype=float)
+    b = np.array([0.0, 1.0, 0.0, 0.0])
+    Phi, Gamma = zoh(A, b, 1.0 / f_s)
+    d = discrete_observer(observer_gains(2e-4, M), M, f_s)
+    np.testing.assert_allclose(d.Phi, Phi, rtol=1e-14, atol=0.0)
+    np.testing.assert_allclose(d.Gamma, Gamma, rtol=1e-14, atol=0.0)

@@ -121,7 +121,8 @@ def test_derive_runs_and_manoeuvre_is_feasible(case):
     assert d.profile.feasible
     assert params.manoeuvre.T_m >= 1.3 * d.profile.T_m_min
     assert d.feasibility.speed_ok and d.feasibility.voltage_ok
-    assert d.gain.K_ok and d.gain.K_recommended >= params.controller.K
+    # The preset's K is the recommended K printed in full; the searches may move it in the last digits.
+    assert d.gain.K_ok and d.gain.K_recommended * (1.0 + 1e-12) >= params.controller.K
     assert not any("Infeasible" in w for w in d.warnings)
 
 

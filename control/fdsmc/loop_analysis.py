@@ -117,17 +117,34 @@ def stability_measures(
     """:func:`stability_measure` for each gain in ``Ks``, with one batched eigenvalue call."""
     if f_s is not None and parts is None:
         parts = sampled_parts(d, f_s)
-    mats = [continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
-            for K in Ks]
-    if law == "cruise":
-        mats = [reduce_shift_mode(M) for M in mats]
-    finite = [bool(np.all(np.isfinite(M))) for M in mats]  # a huge gain can overflow the loop
-    out = [math.inf] * len(mats)
-    if any(finite):
-        ev = np.linalg.eigvals(np.stack([M for M, ok in zip(mats, finite, strict=True) if ok]))
-        worst = np.max(ev.real, axis=1) if f_s is None else np.max(np.abs(ev), axis=1) - 1.0
-        for i, w in zip((i for i, ok in enumerate(finite) if ok), worst, strict=True):
-            out[i] = float(w)
+    M0, M1 = affine_loop(d, law, f_s, delay, parts)
+    return [float(m) for m in _measures(M0, M1, Ks, f_s is not None)]
+
+
+def affine_loop(d: LoopCase, law: str, f_s: float | None, delay: int = 0,
+                parts: SampledParts | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(M0, M1): the loop matrix of ``law`` at the gain K is M0 + K·M1.
+
+    The outer laws of eq. (46) in [1] are linear in K and the loop is linear in the outer law,
+    so two matrices serve a whole search over K (the conventional law does not read K: M1 = 0).
+    The cruise loop is returned without its structural shift mode (:func:`reduce_shift_mode`).
+    """
+    def at(K: float) -> np.ndarray:
+        M = continuous_loop(d, law, K) if f_s is None else discrete_loop(d, law, K, f_s, delay, parts)
+        return reduce_shift_mode(M) if law == "cruise" else M
+
+    M0 = at(0.0)
+    return M0, (np.zeros_like(M0) if law == "conventional" else at(1.0) - M0)
+
+
+def _measures(M0: np.ndarray, M1: np.ndarray, Ks: list[float] | np.ndarray, sampled: bool) -> np.ndarray:
+    """Stability measure of M0 + K·M1 for each K (inf where a huge gain overflows the matrix)."""
+    mats = M0 + np.asarray(Ks, dtype=float)[:, None, None] * M1
+    out = np.full(len(mats), math.inf)
+    finite = np.all(np.isfinite(mats), axis=(1, 2))
+    if finite.any():
+        ev = np.linalg.eigvals(mats[finite])
+        out[finite] = np.max(np.abs(ev), axis=1) - 1.0 if sampled else np.max(ev.real, axis=1)
     return out
 
 
@@ -158,19 +175,17 @@ def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> floa
 
 @functools.lru_cache(maxsize=512)
 def _gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int) -> float:
-    parts = None if f_s is None else sampled_parts(d, f_s)
-
-    def unstable(K: float) -> bool:
-        return stability_measure(d, law, K, f_s, delay, parts) >= 0.0
-
-    grid = [float(K) for K in np.logspace(-5, 6, 23) * 1000.0 / d.alpha_max]
-    flags = [m >= 0.0 for m in stability_measures(d, law, grid, f_s, delay, parts)]
-    if all(flags):
+    M0, M1 = affine_loop(d, law, f_s, delay, None if f_s is None else sampled_parts(d, f_s))
+    sampled = f_s is not None
+    grid = np.logspace(-5, 6, 23) * 1000.0 / d.alpha_max
+    flags = _measures(M0, M1, grid, sampled) >= 0.0
+    if flags.all():
         return 0.0
-    last_stable = max(i for i, f in enumerate(flags) if not f)
+    last_stable = int(np.flatnonzero(~flags)[-1])
     if last_stable == len(grid) - 1:
         return math.inf
-    return geometric_bisect(unstable, grid[last_stable], grid[last_stable + 1], 1.005)
+    return geometric_bisect(lambda K: bool(_measures(M0, M1, [K], sampled)[0] >= 0.0),
+                            float(grid[last_stable]), float(grid[last_stable + 1]), 1.005)
 
 
 def slope_damping(alpha_max: float, K: float, T_c: float) -> float:

@@ -22,8 +22,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.common.discrete import zoh
-
 
 @dataclass(frozen=True)
 class ObserverGains:
@@ -137,6 +135,20 @@ def printed_error_matrix(g: ObserverGains, M: float) -> np.ndarray:
     )
 
 
+def _chain_zoh(M: float, T_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Exact ZOH (Φ, Γ) of the observer's real-time model (:func:`_plant_matrices`) [-, (s², s, 0, 0)].
+
+    The model is a chain of integrators, so A⁴ = 0 and e^{A·t} = I + A·t + (A·t)²/2 + (A·t)³/6
+    exactly; Γ = ∫₀^{T_s} e^{A·τ}·b dτ with b = e₂ (the input a_em drives ω_r).
+    """
+    t = T_s
+    Phi = np.array([[1.0, t, -M * t**2 / 2.0, -M * t**3 / 6.0],
+                    [0.0, 1.0, -M * t, -M * t**2 / 2.0],
+                    [0.0, 0.0, 1.0, t],
+                    [0.0, 0.0, 0.0, 1.0]])
+    return Phi, np.array([t**2 / 2.0, t, 0.0, 0.0])
+
+
 def discrete_observer(g: ObserverGains, M: float, f_s: float) -> DiscreteObserver:
     """Discrete-time equivalent of the observer for sample rate ``f_s``.
 
@@ -158,12 +170,12 @@ def discrete_observer(g: ObserverGains, M: float, f_s: float) -> DiscreteObserve
         Matrices of the prediction-form observer.
     """
     T_s = 1.0 / f_s
-    A, b, c = _plant_matrices(M)
-    Phi, Gamma = zoh(A, b, T_s)  # exact: the model is a chain of integrators
+    Phi, Gamma = _chain_zoh(M, T_s)
     z = math.exp(-g.q * T_s)
-    # Ackermann: L = p(Φ) · O⁻¹ · e4 with p(λ) = (λ − z)⁴ and O the observability matrix.
-    O = np.vstack([c @ np.linalg.matrix_power(Phi, k) for k in range(4)])
-    I4 = np.eye(4)
-    p_Phi = np.linalg.matrix_power(Phi - z * I4, 4)
-    L = p_Phi @ np.linalg.solve(O, I4[:, 3])
+    # Ackermann: L = p(Φ) · O⁻¹ · e4 with p(λ) = (λ − z)⁴ and O the observability matrix, whose
+    # rows c·Φ^k = c·e^{A·k·T_s} are the first rows of the series below at t = k·T_s.
+    O = np.array([[1.0, t, -M * t**2 / 2.0, -M * t**3 / 6.0] for t in (0.0, T_s, 2.0 * T_s, 3.0 * T_s)])
+    P = Phi - z * np.eye(4)
+    P2 = P @ P
+    L = (P2 @ P2) @ np.linalg.solve(O, np.array([0.0, 0.0, 0.0, 1.0]))
     return DiscreteObserver(T_s=T_s, z_pole=z, Phi=Phi, Gamma=Gamma, L=L)

@@ -94,14 +94,23 @@ def _acceleration_overshoot(lm: LoopModel, f_s: float | None, delay: int) -> flo
     Phi, gamma, h = _step_system(lm, f_s, delay)
     if np.max(np.abs(np.linalg.eigvals(Phi))) >= 1.0 + 1e-6:  # θ, ω: marginal (open outer loop)
         return math.inf
-    J_t = lm.J_total
     n = int(math.ceil(_horizon(lm) / h)) + delay + 2
-    z = np.zeros(Phi.shape[0])
-    peak = 0.0
-    for _ in range(n):
-        z = Phi @ z + gamma
-        peak = max(peak, (lm.J_r * lm.coefficients.H * z[0] - lm.F_v * z[2]) / J_t)
-    return max(1.0, peak)
+    w = np.zeros(Phi.shape[0])
+    w[0], w[2] = lm.J_r * lm.coefficients.H / lm.J_total, -lm.F_v / lm.J_total
+    return max(1.0, float(np.max(step_response(Phi, gamma, n) @ w)))
 
 
-__all__ = ["acceleration_overshoot"]
+def step_response(Phi: np.ndarray, gamma: np.ndarray, n: int) -> np.ndarray:
+    """States z_1 … z_n of z_{k+1} = Φ·z_k + γ from z_0 = 0 (n × len(γ)).
+
+    z_k = Σ_{j<k} Φ^j·γ: the terms Φ^j·γ are made by doubling (rows j ≥ m are Φ^m times rows
+    j − m), about log₂ n matrix products instead of n steps, then summed.
+    """
+    terms, Phi_m = gamma[None, :], Phi
+    while len(terms) < n:
+        terms = np.vstack([terms, terms @ Phi_m.T])
+        Phi_m = Phi_m @ Phi_m
+    return np.cumsum(terms[:n], axis=0)
+
+
+__all__ = ["acceleration_overshoot", "step_response"]
