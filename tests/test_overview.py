@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from app.figures.overview import CURSORS, motor_torque, overview_spec
-from app.ui.replay import phase_plane_json
+from app.ui.replay import overview_json, phase_plane_json
 from sim.fdsmc.engine import Comparison, compare
 
 
@@ -82,3 +82,15 @@ def test_a_scrub_puts_the_markers_on_the_trajectories_at_that_time(comparison):
             assert update["x"][k] == pytest.approx([t, t], abs=1e-6)
             assert update["y"][k] == list(spec["data"][i]["y"])
         assert update["text"][0] == [f"t = {t:.3f} s"]
+
+
+def test_the_drag_overview_draws_the_same_curves_statically(comparison):
+    """While a slider is dragged: the same traces and data, a static plot, no replay, no empty text layers."""
+    full, drag = (json.loads(overview_json(comparison, replay)[0]) for replay in (True, False))
+    assert drag["config"] == {"staticPlot": True}
+    assert "updatemenus" not in drag["layout"] and not drag.get("frames")
+    assert [t["name"] for t in drag["data"]] == [t["name"] for t in full["data"]]
+    for a, b in zip(full["data"], drag["data"], strict=True):
+        assert a.get("x") == b.get("x") and a.get("y") == b.get("y")
+        assert b.get("mode") == ("markers" if a["name"].endswith(" now") else a.get("mode"))
+    assert next(t for t in drag["data"] if t["name"] == "FDSMC enters boundary layer")["mode"] == "markers+text"

@@ -43,11 +43,22 @@ def overview_json(comparison: Any, replay: bool = True) -> tuple[str, ScrubTarge
     spec = overview_spec(comparison)
     targets = ScrubTargets.of(spec["data"])
     if not replay:
-        # nor Plotly's mode bar (≈ 13 % of a redraw in headless Chromium; it shows only on hover)
-        return figure_json({**spec, "config": {"displayModeBar": False}}), targets
+        return figure_json(_drag_figure(spec)), targets
     layout, raw = replay_layout(comparison, spec["data"])
     spec["layout"].update(layout)
     return figure_json(spec, raw), targets
+
+
+def _drag_figure(spec: dict[str, Any]) -> dict[str, Any]:
+    """Return the overview as drawn while a slider is dragged: static, and no empty text layers.
+
+    A static plot (no hover, zoom or mode bar; they return with the replay once the drag stops)
+    and the "now" markers without their text layer (empty until a replay runs) take ≈ 20 % off
+    each redraw in headless Chromium.
+    """
+    data = [{**tr, "mode": "markers"} if tr.get("mode") == "markers+text" and not any(tr.get("text", []))
+            else tr for tr in spec["data"]]
+    return {**spec, "data": data, "config": {"staticPlot": True}}
 
 
 def phase_plane_json(comparison: Any, replay: bool = True) -> str:
