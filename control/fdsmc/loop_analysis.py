@@ -118,6 +118,8 @@ def stability_measures(
     if f_s is not None and parts is None:
         parts = sampled_parts(d, f_s)
     M0, M1 = affine_loop(d, law, f_s, delay, parts)
+    if len(Ks) == 1:
+        return [_measure(M0 + float(Ks[0]) * M1, f_s is not None)]
     return [float(m) for m in _measures(M0, M1, Ks, f_s is not None)]
 
 
@@ -135,6 +137,14 @@ def affine_loop(d: LoopCase, law: str, f_s: float | None, delay: int = 0,
 
     M0 = at(0.0)
     return M0, (np.zeros_like(M0) if law == "conventional" else at(1.0) - M0)
+
+
+def _measure(M: np.ndarray, sampled: bool) -> float:
+    """Stability measure of one loop matrix (inf where a huge gain overflowed it)."""
+    if not np.isfinite(M).all():
+        return math.inf
+    ev = np.linalg.eigvals(M)
+    return float(np.abs(ev).max() - 1.0) if sampled else float(ev.real.max())
 
 
 def _measures(M0: np.ndarray, M1: np.ndarray, Ks: list[float] | np.ndarray, sampled: bool) -> np.ndarray:
@@ -184,7 +194,7 @@ def _gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int) -> float:
     last_stable = int(np.flatnonzero(~flags)[-1])
     if last_stable == len(grid) - 1:
         return math.inf
-    return geometric_bisect(lambda K: bool(_measures(M0, M1, [K], sampled)[0] >= 0.0),
+    return geometric_bisect(lambda K: _measure(M0 + K * M1, sampled) >= 0.0,
                             float(grid[last_stable]), float(grid[last_stable + 1]), 1.005)
 
 
