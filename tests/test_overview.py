@@ -88,6 +88,7 @@ def test_the_drag_overview_draws_the_same_curves_statically(comparison):
     """While a slider is dragged: the same traces and data, a static plot, no replay, no empty text layers."""
     full, drag = (json.loads(overview_json(comparison, replay)[0]) for replay in (True, False))
     assert drag["config"] == {"staticPlot": True}
+    assert full["config"] == {}  # explicit: Plotly.react would keep the drag figure's static config
     assert "updatemenus" not in drag["layout"] and not drag.get("frames")
     assert [t["name"] for t in drag["data"]] == [t["name"] for t in full["data"]]
     for a, b in zip(full["data"], drag["data"], strict=True):

@@ -46,7 +46,9 @@ def overview_json(comparison: Any, replay: bool = True) -> tuple[str, ScrubTarge
         return figure_json(_drag_figure(spec)), targets
     layout, raw = replay_layout(comparison, spec["data"])
     spec["layout"].update(layout)
-    return figure_json(spec, raw), targets
+    # Plotly.react keeps the previous figure's config when given none: the default config must be
+    # explicit, or the drag figure's static mode would outlive the drag
+    return figure_json({**spec, "config": {}}, raw), targets
 
 
 def _drag_figure(spec: dict[str, Any]) -> dict[str, Any]:

@@ -108,6 +108,11 @@ def test_dragging_the_K_slider_resimulates_with_the_latest_value(page):
                            ".find(e => e.layout.meta.id === 'phase_plane');"
                            " return (el.layout.updatemenus || []).length > 0; }")
     assert abs(float(page.evaluate(BAND_JS).split("±")[2].split()[0]) * k_shown - 1) < 6e-3
+    # and is interactive again: the drag's static plot (no hover, zoom, mode bar) ends with the drag
+    assert page.evaluate("() => { const el = [...document.querySelectorAll('.js-plotly-plot')]"
+                         ".find(e => e.layout.meta.id === 'phase_plane');"
+                         " return [el._context.staticPlot, !!el.querySelector('.modebar'),"
+                         " !!el.querySelector('.nsewdrag')]; }") == [False, True, True]
 
 
 def test_the_replay_t_slider_puts_the_markers_on_the_trajectories_at_that_time(page, ui_server):
