@@ -12,6 +12,8 @@
   moved, at 0.1× and 0.01×) and the server traffic meanwhile;
 * live tuning: re-simulated phase planes drawn per second while the K slider is moved
   (one key step every 50 ms, paper preset at 20 kHz);
+  these two with one page open (the concurrency rounds' other pages are closed first: nine idle
+  pages share the same two cores, which is the concurrency figure's business, not these);
 * server memory (RSS) idle and with the pages connected.
 
 Every figure is the median of ``--runs`` rounds (≥ 3; 5 for the record) with its min and max; the machine's load
@@ -356,6 +358,9 @@ def main() -> int:
                 rts = [t for k in range(runs) for t in (click_all(pages, k), pages[0].wait_for_timeout(500))[0]]
                 print(f"Simulate → drawn, {n:2d} pages clicking at once ({runs} rounds): {med(rts)} ms"
                       f"   [target: 1 page ≤ 150, 10 pages median ≤ 600]")
+            for o in opened[1:]:  # the replay and the slider are one page's figures: the others leave
+                o[2].close()
+            page.wait_for_timeout(2000)
             replay_rate(page, ws, runs)
             rates = [slider_redraws(page, 2.0, "ArrowLeft" if k % 2 else "ArrowRight") for k in range(runs)]
             print(f"live tuning, K slider moved (key events) every 50 ms for 2 s ({runs} rounds): redraws "
