@@ -22,7 +22,7 @@ from control.fdsmc.loop_analysis import (
     stability_measure,
 )
 from control.fdsmc.loop_model import continuous_loop, discrete_loop, reduce_shift_mode
-from control.fdsmc.transient import step_response
+from control.fdsmc.transient import step_peak
 from sim.fdsmc.engine import simulate
 
 
@@ -165,14 +165,22 @@ def test_loop_is_affine_in_K(law, f_s):
         np.testing.assert_allclose(M0 + K * M1, M, rtol=1e-12, atol=1e-12 * np.max(np.abs(M)))
 
 
-def test_step_response_by_doubling_equals_the_recursion():
-    """z_k = Σ_{j<k} Φ^j·γ from the doubling equals z_{k+1} = Φ·z_k + γ stepped n times."""
+@pytest.mark.parametrize("n", [1, 777, 4096, 10_001])
+def test_step_peak_by_blocks_equals_the_recursion(n):
+    """max_k w·z_k from doubling and blocks (4096 rows) equals z_{k+1} = Φ·z_k + γ stepped n times."""
     rng = np.random.default_rng(7)
     Phi = rng.normal(size=(6, 6))
-    Phi *= 0.97 / np.max(np.abs(np.linalg.eigvals(Phi)))
-    gamma = rng.normal(size=6)
-    z, ref = np.zeros(6), []
-    for _ in range(777):
+    Phi *= 0.999 / np.max(np.abs(np.linalg.eigvals(Phi)))
+    gamma, w = rng.normal(size=6), rng.normal(size=6)
+    z, ref = np.zeros(6), -np.inf
+    for _ in range(n):
         z = Phi @ z + gamma
-        ref.append(z)
-    np.testing.assert_allclose(step_response(Phi, gamma, 777), ref, rtol=1e-11, atol=1e-12)
+        ref = max(ref, float(w @ z))
+    assert step_peak(Phi, gamma, w, n) == pytest.approx(ref, rel=1e-10)
+
+
+def test_an_overlong_step_response_is_refused_naming_the_fields():
+    """6·max(T_si, T_sα, T_so)·f_s samples: 10 MHz with T_so = 1 s would be 6e7; refused, not run."""
+    p = _params("controller.f_s=1e7", "controller.T_so=1.0")
+    with pytest.raises(ValueError, match=r"controller\.f_s = 1e\+07 Hz .* allowed ≤ 4e\+07"):
+        derive(p)

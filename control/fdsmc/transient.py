@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from control.common.checks import ParameterError
 from control.common.discrete import zoh
 from control.fdsmc.loop_model import (
     LoopModel,
@@ -32,6 +33,10 @@ from control.fdsmc.loop_model import (
 _STEPS_PER_TAU = 40
 #: Most steps of the continuous step response [-].
 _MAX_STEPS = 3000
+#: Most samples of the sampled step response [-]: ≈ 2 s of CPU at ≈ 50 ns per sample.
+MAX_RESPONSE_SAMPLES = 40_000_000
+#: Samples of the step response computed at once [-] (memory ≈ rows × states × 8 B).
+_BLOCK = 4096
 
 
 def _horizon(lm: LoopModel) -> float:
@@ -95,22 +100,35 @@ def _acceleration_overshoot(lm: LoopModel, f_s: float | None, delay: int) -> flo
     if np.max(np.abs(np.linalg.eigvals(Phi))) >= 1.0 + 1e-6:  # θ, ω: marginal (open outer loop)
         return math.inf
     n = int(math.ceil(_horizon(lm) / h)) + delay + 2
+    if n > MAX_RESPONSE_SAMPLES:  # sampled: n = 6·max(T_si, T_sα, T_so)·f_s
+        raise ParameterError(
+            f"controller.f_s = {f_s:g} Hz with the slowest settling time max(T_si, T_sα, T_so) = "
+            f"{_horizon(lm) / 6.0:g} s needs {n:.3g} samples of the inner-loop step response; allowed "
+            f"≤ {MAX_RESPONSE_SAMPLES:.3g} (lower f_s or that settling time)")
     w = np.zeros(Phi.shape[0])
     w[0], w[2] = lm.J_r * lm.coefficients.H / lm.J_total, -lm.F_v / lm.J_total
-    return max(1.0, float(np.max(step_response(Phi, gamma, n) @ w)))
+    return max(1.0, step_peak(Phi, gamma, w, n))
 
 
-def step_response(Phi: np.ndarray, gamma: np.ndarray, n: int) -> np.ndarray:
-    """States z_1 … z_n of z_{k+1} = Φ·z_k + γ from z_0 = 0 (n × len(γ)).
+def step_peak(Phi: np.ndarray, gamma: np.ndarray, w: np.ndarray, n: int) -> float:
+    """Return max over k = 1 … n of w·z_k, where z_{k+1} = Φ·z_k + γ from z_0 = 0.
 
-    z_k = Σ_{j<k} Φ^j·γ: the terms Φ^j·γ are made by doubling (rows j ≥ m are Φ^m times rows
-    j − m), about log₂ n matrix products instead of n steps, then summed.
+    z_k = Σ_{j<k} Φ^j·γ. The terms of the first block (j < B, B a power of 2) are made by doubling:
+    rows j ≥ m are Φ^m times rows j − m, about log₂ B matrix products instead of B steps. Each next
+    block's terms are Φ^B times the last block's, and the running sum carries z_k across blocks.
+    Memory is bounded by the block (:data:`_BLOCK` rows).
     """
-    terms, Phi_m = gamma[None, :], Phi
-    while len(terms) < n:
+    terms, Phi_m = gamma[None, :], Phi  # invariant: Phi_m = Φ^len(terms)
+    while len(terms) < min(n, _BLOCK):
         terms = np.vstack([terms, terms @ Phi_m.T])
         Phi_m = Phi_m @ Phi_m
-    return np.cumsum(terms[:n], axis=0)
+    z_end, peak, done = np.zeros_like(gamma), -math.inf, 0
+    while done < n:
+        z = z_end + np.cumsum(terms[: n - done], axis=0)
+        peak = max(peak, float(np.max(z @ w)))
+        z_end, done = z[-1], done + len(z)
+        terms = terms @ Phi_m.T
+    return peak
 
 
-__all__ = ["acceleration_overshoot", "step_response"]
+__all__ = ["MAX_RESPONSE_SAMPLES", "acceleration_overshoot", "step_peak"]
