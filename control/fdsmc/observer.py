@@ -173,8 +173,8 @@ def discrete_observer(g: ObserverGains, M: float, f_s: float) -> DiscreteObserve
     Phi, Gamma = _chain_zoh(M, T_s)
     z = math.exp(-g.q * T_s)
     # Ackermann: L = p(Φ) · O⁻¹ · e4 with p(λ) = (λ − z)⁴ and O the observability matrix, whose
-    # rows c·Φ^k = c·e^{A·k·T_s} are the first rows of the series below at t = k·T_s.
-    O = np.array([[1.0, t, -M * t**2 / 2.0, -M * t**3 / 6.0] for t in (0.0, T_s, 2.0 * T_s, 3.0 * T_s)])
+    # rows c·Φ^k = c·e^{A·k·T_s} (c = e₁) are the first rows of e^{A·t} at t = k·T_s.
+    O = np.array([_chain_zoh(M, k * T_s)[0][0] for k in range(4)])
     P = Phi - z * np.eye(4)
     P2 = P @ P
     L = (P2 @ P2) @ np.linalg.solve(O, np.array([0.0, 0.0, 0.0, 1.0]))
