@@ -114,9 +114,11 @@ def test_phase_plane_marks_boundary_layer_entry(comparison):
     th_re = tr.theta_r - d.params.manoeuvre.theta_dem
     gap = np.abs(tr.omega_r - boundary_speed(th_re, d.profile.omega_p, d.profile.T_c))
     assert gap[k] <= 1.0 / d.params.controller.K < gap[k - 1]
-    entry = next(t for t in make_phase_plane_figure(comparison).data if t.name == "FDSMC enters boundary layer")
-    # θ_dem > 0: the move starts at the plot's left edge, so the label leans right, into the plot
-    assert d.params.manoeuvre.theta_dem > 0 and entry.textposition == "top right"
+    fig = make_phase_plane_figure(comparison)
+    entry = next(t for t in fig.data if t.name == "FDSMC enters boundary layer")
+    # the label leans into the plot, away from the nearer edge of the θ_re axis
+    lo, hi = fig.layout.xaxis.range
+    assert entry.textposition == ("top right" if entry.x[0] < (lo + hi) / 2 else "top left")
 
 
 def test_time_plots_have_all_signals_of_both_controllers(comparison):

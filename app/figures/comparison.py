@@ -116,8 +116,9 @@ def _phase_marks(comparison: Comparison, key: str, run: RunResult) -> list[dict[
     if k is not None:
         out.append({"type": "scatter", "x": [float(tr.theta_r[k] - th)], "y": [float(tr.omega_r[k])],
                     "mode": "markers+text", "text": ["reaching → sliding"] if key == "fdsmc" else [""],
-                    # the label leans toward θ_dem: the move starts at the plot's edge, where it was clipped
-                    "textposition": "top right" if th > 0 else "top left",
+                    # the label leans into the plot (it was clipped at the plot's edge)
+                    "textposition": "top right" if tr.theta_r[k] - th < sum(phase_plane_extent(comparison)) / 2
+                    else "top left",
                     "name": f"{LABELS[key]} enters boundary layer",
                     "marker": {"symbol": "diamond", "size": 11, "color": COLOURS[key],
                                "line": {"color": BOUNDARY_COLOUR, "width": 1.5}},
