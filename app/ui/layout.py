@@ -22,8 +22,8 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
-#: Canvas width while the 3D view is folded [px].
-CANVAS_SPARE = 140.0
+#: Canvas width while the 3D view is folded [px]: a gutter (the results panel takes the rest).
+CANVAS_SPARE = 12.0
 #: Share of the window width given to the 3D view when it is shown [-], and its least width [px].
 SCENE_SHARE, SCENE_MIN = 0.22, 280.0
 #: viser's gutter on each side of a docked region [px]; two regions: :data:`BORDERS`.
