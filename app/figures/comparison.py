@@ -103,8 +103,11 @@ def load_step_times(comparison: Comparison) -> list[float]:
     return [float(s.t) for s in comparison.derived.params.load.steps]
 
 
-def _phase_marks(comparison: Comparison, key: str, run: RunResult) -> list[dict[str, Any]]:
-    """Return the sliding phase (FDSMC, from the layer entry on), layer entry and load steps of a trajectory."""
+def _phase_marks(comparison: Comparison, key: str, run: RunResult, x_mid: float) -> list[dict[str, Any]]:
+    """Return the sliding phase (FDSMC, from the layer entry on), layer entry and load steps of a trajectory.
+
+    ``x_mid`` is the middle of the θ_re axis [rad]: the entry's label leans from there into the plot.
+    """
     tr, th = run.trace, comparison.derived.params.manoeuvre.theta_dem
     out = []
     k = layer_entry_index(comparison, run) if key != "optimum" else None  # the optimum does not slide
@@ -117,8 +120,7 @@ def _phase_marks(comparison: Comparison, key: str, run: RunResult) -> list[dict[
         out.append({"type": "scatter", "x": [float(tr.theta_r[k] - th)], "y": [float(tr.omega_r[k])],
                     "mode": "markers+text", "text": ["reaching → sliding"] if key == "fdsmc" else [""],
                     # the label leans into the plot (it was clipped at the plot's edge)
-                    "textposition": "top right" if tr.theta_r[k] - th < sum(phase_plane_extent(comparison)) / 2
-                    else "top left",
+                    "textposition": "top right" if tr.theta_r[k] - th < x_mid else "top left",
                     "name": f"{LABELS[key]} enters boundary layer",
                     "marker": {"symbol": "diamond", "size": 11, "color": COLOURS[key],
                                "line": {"color": BOUNDARY_COLOUR, "width": 1.5}},
@@ -138,6 +140,7 @@ def phase_plane_spec(comparison: Comparison) -> dict[str, Any]:
     """Phase plane θ_re–ω_r as a plain-dict figure (see :func:`make_phase_plane_figure`)."""
     d = comparison.derived
     data = _phase_static_traces(comparison)
+    lo, hi = phase_plane_extent(comparison)
     for key, run in runs(comparison):
         tr = run.trace
         i = minmax_index(tr.omega_r, BINS_PHASE)  # the chatter band of ω_r survives
@@ -147,13 +150,12 @@ def phase_plane_spec(comparison: Comparison) -> dict[str, Any]:
                      "customdata": f32(t), "line": {"color": colour, "width": 2},
                      "hovertemplate": "t = %{customdata:.4f} s<br>θ_re = %{x:.4g} rad<br>"
                                       "ω_r = %{y:.4g} rad/s<extra>" + label + "</extra>"})
-        data.extend(_phase_marks(comparison, key, run))
+        data.extend(_phase_marks(comparison, key, run, (lo + hi) / 2.0))
         data.append({"type": "scatter", "x": x[-1:], "y": y[-1:], "mode": "markers+text", "text": [""],
                      "textposition": "bottom right", "name": f"{label} now", "showlegend": False,
                      "hoverinfo": "skip", "textfont": {"size": 13},
                      "marker": {"color": colour, "size": 14, "line": {"color": "white", "width": 2}}})
     prof = d.profile
-    lo, hi = phase_plane_extent(comparison)
     return {"data": data, "layout": {
         "meta": {"id": "phase_plane", "omega_p": prof.omega_p, "T_c": prof.T_c},
         "title": {"text": f"Phase plane — ω_p = {prof.omega_p:.4g} rad/s, T_c = {prof.T_c:.4g} s", "x": 0.01},

@@ -172,8 +172,7 @@ class Replay:
             self._scene.show({key: float(np.interp(t_now, run.trace.t, run.trace.theta_r))
                               for key, run in runs(comparison)})
         if scrub:
-            source = scrub_js(comparison, targets, t_now)
-            run_script(self._gui, source)
+            run_script(self._gui, scrub_js(comparison, targets, t_now))
 
     def play(self, restart: bool = False) -> None:
         """Start (or restart from t = 0) the 3D replay thread."""

@@ -98,8 +98,7 @@ class Session:
             gui = self.gui
             gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
             self._window_probe = gui.add_text("window [px]", "")
-            probe_id = self._window_probe._impl.uuid
-            run_script(gui, install_css_js(page_css(probe_id)))
+            self._install_page_css(show_3d=False)
             use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
             gui.main_panel.dock_left()
             tabs = gui.add_tab_group()
@@ -110,19 +109,21 @@ class Session:
             self.results.panel.dock_right()
             self.studies = StudiesSection(self)
             add_bldc_tab(self.client, tabs, self.submit, self.results.panel, self.worker)
-            self._style_3d = False
             self.fit = WindowFit(self._apply_layout)
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
-        run_script(gui, window_report_js(probe_id))
+        run_script(gui, window_report_js(self._window_probe._impl.uuid))
 
     def _apply_layout(self, layout: PanelLayout) -> None:
         self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
         if layout.show_3d != self._style_3d:
-            self._style_3d = layout.show_3d
-            css = page_css(self._window_probe._impl.uuid, layout.show_3d)
-            run_script(self.gui, install_css_js(css))
+            self._install_page_css(layout.show_3d)
+
+    def _install_page_css(self, show_3d: bool) -> None:
+        """Put the page's CSS (:func:`app.ui.layout.page_css`) for the 3D view shown or folded into the page."""
+        self._style_3d = show_3d
+        run_script(self.gui, install_css_js(page_css(self._window_probe._impl.uuid, show_3d)))
 
     def _controls(self) -> None:
         gui = self.gui

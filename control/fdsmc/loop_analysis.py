@@ -107,20 +107,10 @@ def stability_measure(
     parts: SampledParts | None = None,
 ) -> float:
     """Largest Re(s) [1/s] (continuous) or largest |z| − 1 [-] (sampled); < 0 means stable."""
-    return stability_measures(d, law, [K], f_s, delay, parts)[0]
-
-
-def stability_measures(
-    d: LoopCase, law: str, Ks: list[float], f_s: float | None, delay: int = 0,
-    parts: SampledParts | None = None,
-) -> list[float]:
-    """:func:`stability_measure` for each gain in ``Ks``, with one batched eigenvalue call."""
     if f_s is not None and parts is None:
         parts = sampled_parts(d, f_s)
     M0, M1 = affine_loop(d, law, f_s, delay, parts)
-    if len(Ks) == 1:
-        return [_measure(M0 + float(Ks[0]) * M1, f_s is not None)]
-    return [float(m) for m in _measures(M0, M1, Ks, f_s is not None)]
+    return _measure(M0 + float(K) * M1, f_s is not None)
 
 
 def affine_loop(d: LoopCase, law: str, f_s: float | None, delay: int = 0,
