@@ -43,8 +43,10 @@ class PassCriteria:
 
 
 def drive_current(params: DriveParams) -> float:
-    """The drive's current limit [A]: the hard limit of :func:`control.fdsmc.feasibility.current_limit`,
-    else the current of Γ_max (Γ_max/K_t, eq. (5) in [1]).
+    """Return the drive's current limit [A].
+
+    The hard limit of :func:`control.fdsmc.feasibility.current_limit`, else the current of Γ_max
+    (Γ_max/K_t, eq. (5) in [1]).
     """
     return current_limit(params) or params.motor.Gamma_max / torque_constant(params.motor)
 

@@ -140,7 +140,7 @@ def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: flo
 
 @_helper
 def measure(k: int, p: tuple, prm: np.ndarray, noise: np.ndarray) -> tuple[float, float, float]:
-    """What the controller reads at sample k: (θ_r [rad], i_d, i_q [A]) through :mod:`sim.common.sensors`."""
+    """Return what the controller reads at sample k: (θ_r [rad], i_d, i_q [A]) through :mod:`sim.common.sensors`."""
     j = k % noise.shape[1]
     return (sensors.encoder_angle(p[X_TH], prm[P_ENC]),
             sensors.adc_current(p[X_ID], noise[0, j], prm[P_INOISE], prm[P_ISTEP], prm[P_IFS]),

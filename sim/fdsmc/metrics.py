@@ -220,7 +220,7 @@ def response_metrics(
 
 
 def kernel_checks(info: np.ndarray, T_step: float) -> dict[str, float | None]:
-    """Current, in-position and overshoot figures the kernel tracks at every sample (RunMetrics fields).
+    """Return the current, in-position and overshoot figures the kernel tracks at every sample (RunMetrics fields).
 
     Parameters
     ----------

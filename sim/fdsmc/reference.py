@@ -80,7 +80,7 @@ class ReferenceDrive:
         return g + ld.Gamma_Le_ramp * t
 
     def measure(self, x: np.ndarray) -> tuple[float, float, float]:
-        """The readings (θ_r [rad], i_d, i_q [A]) of the sensors at the current sample."""
+        """Return the readings (θ_r [rad], i_d, i_q [A]) of the sensors at the current sample."""
         se, j = self.p.sensors, self.k % self.noise.shape[1]
         adc = [sensors.adc_current(x[i], self.noise[i, j], se.i_noise, self.adc_step, se.i_adc_range)
                for i in (0, 1)]
