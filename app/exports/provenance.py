@@ -58,7 +58,7 @@ def failed_checks(cmp: Comparison) -> list[Constraint]:
 
 def check_text(c: Constraint) -> str:
     """One line naming a failed check: ``name: value unit (limit …) — text``."""
-    return f"{c.name}: {c.value:.4g} {c.unit} (limit {c.limit:.4g} {c.unit}) — {c.text}"
+    return f"{c.name}: {c.value:.4g} {c.unit} (limit {c.limit:.4g} {c.unit}) — {c.text.rstrip('.')}"
 
 
 def gate(fmt: str, cmp: Comparison, force: bool) -> list[Constraint]:
