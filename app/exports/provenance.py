@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import importlib.metadata
 import json
@@ -98,4 +99,9 @@ def header_lines(cmp: Comparison, failed: Sequence[Constraint]) -> list[str]:
     lines += [f"design warning: {w}" for w in cmp.derived.warnings]
     lines += [f"simulated whole-run energy, {name}: {_energy(run)}" for name, run in
               (("FDSMC", cmp.fdsmc), ("tracked optimum", cmp.optimum), ("stock route (this file)", cmp.stock))]
+    if cmp.stock is not None:
+        # the stock run checked against the same limits and the FDSMC's 2 % arrival band
+        stock = [c for c in run_checks(p, dataclasses.replace(cmp.stock, controller="fdsmc")) if c.violated]
+        lines += ["stock route within the drive's limits and on time (2 % band at T_m)"] if not stock else \
+            [f"stock route exceeds: {check_text(c)}" for c in stock]
     return lines
