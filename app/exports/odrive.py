@@ -116,8 +116,9 @@ def parse_odrive(text: str, origin: str = "<odrive>") -> VendorFile:
         comment = [comment]
     pairs = _leaves(data)
     for key, raw in pairs:
-        if key in KEYS and isinstance(raw, float) and not math.isfinite(raw):
-            raise ParameterError(f"{key} = {raw!r} is not allowed: a finite number in {KEYS[key].unit}")
+        if key in KEYS and (isinstance(raw, str) or isinstance(raw, float) and not math.isfinite(raw)):
+            what = f"a finite number in {KEYS[key].unit}" if KEYS[key].kind == "float" else "an integer"
+            raise ParameterError(f"{key} = {raw!r} is not allowed: {what} (a JSON number)")
     return vendor_file(pairs, KEYS, (str(c) for c in comment))
 
 
