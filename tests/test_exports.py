@@ -33,7 +33,6 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
 from sim.fdsmc.engine import Comparison, compare
 
-
 #: The paper's case is not clean (K = 1000 chatters, torque and voltage beyond the drive's): its
 #: exports pass the gate only forced (the gate itself: tests/test_stock_exports.py).
 FORCE = ExportOptions(force=True)
