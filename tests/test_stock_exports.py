@@ -30,9 +30,21 @@ def clean_case():
     return case(load_preset("yaskawa_sgm7j_04a"), "odrive")
 
 
-def test_new_formats_are_in_the_one_export_model():
+def test_new_formats_are_in_the_one_export_model_and_the_page_menu():
+    from app.ui.files import EXPORTS
+
     assert FORMATS == ("yaml", "json", "c", "csv", "html", "odrive", "moteus", "vesc", "setpoints")
-    assert set(DRIVE_FORMATS) <= set(FORMATS)
+    assert set(DRIVE_FORMATS) <= set(FORMATS) and set(EXPORTS.values()) == set(FORMATS)
+
+
+def test_cli_setpoint_options_are_checked(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["export", "yaskawa_sgm7j_04a", "--format", "setpoints", "--cycle-ms", "-1", "-o", str(out)]) == 2
+    assert "--cycle-ms = '-1' is not allowed: a time > 0 ms" in capsys.readouterr().err and not out.exists()
+    assert main(["export", "yaskawa_sgm7j_04a", "--format", "setpoints", "--cycle-ms", "2", "--angle-unit", "deg",
+                 "-o", str(out)]) == 0
+    rows = [ln for ln in out.read_text().splitlines() if not ln.startswith("#")]
+    assert rows[0] == "t [s],theta [deg],omega [deg/s],alpha [deg/s^2]" and rows[2].startswith("0.002,")
 
 
 def test_clean_verdict_is_exactly_run_checks(paper_case, clean_case):

@@ -69,12 +69,15 @@ def cycle_seconds(text: str | None) -> float | None:
 
 def write_atomic(path: Path, content: bytes) -> None:
     """Write ``content`` to ``path`` whole: a temporary file in the same folder, then ``os.replace``."""
+    tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent if str(path.parent) else ".")
         with os.fdopen(fd, "wb") as fh:
             fh.write(content)
         os.replace(tmp, path)
     except OSError as exc:
+        if tmp is not None and os.path.exists(tmp):
+            os.unlink(tmp)
         raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
 
