@@ -59,7 +59,8 @@ def real_case(request):
 
 
 def _text(fmt: str, cmp) -> str:
-    ((_, content),) = export_files(fmt, cmp).items()
+    """The exported file (forced: the formats are tested here whatever the verdict; the gate in test_stock_exports)."""
+    ((_, content),) = export_files(fmt, cmp, ExportOptions(force=True)).items()
     return content.decode("utf-8")
 
 
@@ -126,7 +127,7 @@ def test_vesc_round_trip_and_units(real_case):
 def test_setpoints_at_the_drive_cycle_in_the_users_unit(unit):
     cmp = case(load_preset("yaskawa_sgm7j_04a"), "setpoints")
     s = stock_settings(cmp)
-    files = export_files("setpoints", cmp, ExportOptions(angle_unit=unit, cycle_s=1e-3))
+    files = export_files("setpoints", cmp, ExportOptions(force=True, angle_unit=unit, cycle_s=1e-3))
     table = setpoints.parse_setpoints(next(iter(files.values())).decode())
     scale = {"rad": 1.0, "deg": 180.0 / math.pi, "rev": 1.0 / TURN_RAD}[unit]
     assert table.unit == unit and np.allclose(np.diff(table.t), 1e-3)
