@@ -59,8 +59,10 @@ SENSOR_SLOWDOWN = (1.0, 1.5, 2.25, 3.4, 5.0, 7.6, 11.4)
 PREDICTION_MARGIN = 0.8
 #: T_m stretch per step and the most steps when the verified speed/voltage peak exceeds its limit.
 T_M_STRETCH, MAX_STRETCHES = 1.03, 6
+#: T_c raise per step and the most steps when the verified run overshoots θ_dem.
+T_C_STEP, MAX_T_C_STEPS = 1.25, 10
 #: Checks that slower observer and acceleration loops can mend (the sensors' noise amplified).
-SENSOR_CHECKS = frozenset({"hold_ripple", "in_position", "current_time", "chatter", "saturation"})
+SENSOR_CHECKS = frozenset({"hold_ripple", "in_position", "current", "chatter", "saturation"})
 
 __all__ = ["Constraint", "DriveDesign", "TARGET_BAND", "design_drive", "run_checks", "shortest_fitting_T_m"]
 
@@ -164,8 +166,7 @@ def predicted_noise(p: DriveParams, d: Derived) -> NoiseGain | None:
     if d.loop.f_s is None:
         return None
     se = p.sensors
-    i_rms = math.hypot(se.i_noise, sensors.adc_step(se) / math.sqrt(12.0))
-    return noise_gain(d.loop, "slope", p.controller.K, sensors.encoder_step(se), i_rms)
+    return noise_gain(d.loop, "slope", p.controller.K, sensors.encoder_step(se), sensors.reading_noise(se))
 
 
 def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
@@ -269,7 +270,13 @@ def _simulate(p: DriveParams) -> tuple[DriveParams, Derived, Comparison]:
 
 
 def _verify(p: DriveParams, asked: DriveParams) -> DriveDesign:
-    """Simulate with the sensors; stretch T_m while only speed/voltage fail; collect the checks."""
+    """Simulate with the sensors and mend what a longer T_m or T_c mends; collect the checks.
+
+    Only speed/voltage failing: T_m stretched (T_M_STRETCH, at most MAX_STRETCHES times). Overshoot
+    or the in-position window failing: the sloped segment's T_c scanned upwards from T_a (T_C_STEP,
+    at most MAX_T_C_STEPS) — a slower, better damped final approach that the lagging inner loops
+    follow — and the first T_c that passes taken (else the one with the fewest violations).
+    """
     for _ in range(MAX_STRETCHES + 1):
         p, d, cmp = _simulate(p)
         if cmp.fdsmc is None:  # infeasible after all: derive's warnings say why
@@ -280,7 +287,38 @@ def _verify(p: DriveParams, asked: DriveParams) -> DriveDesign:
             break
         q = _with(p, "manoeuvre", T_m=_round_up(p.manoeuvre.T_m * T_M_STRETCH))
         p = _gain_and_T_c(q, derive(q))
+    if failed & {"overshoot", "in_position"}:
+        step = T_C_STEP if "overshoot" in failed else 1.0 / T_C_STEP
+        p, d, cmp = _scan_T_c(p, (p, d, cmp), len(failed), step)
     return _result(p, d, cmp, asked)
+
+
+def _scan_T_c(p: DriveParams, best: tuple[DriveParams, Derived, Comparison], n_best: int,
+              step: float) -> tuple[DriveParams, Derived, Comparison]:
+    """Scan T_c = T_a·step^k (k = 0 …, K recommended for each) for the first that passes every check.
+
+    ``step`` > 1 (an overshoot: a slower, better damped approach) or < 1 (too slow to get in position
+    within the simulated tail: a faster one). Returns the first clean case, else the one with the
+    fewest violations.
+    """
+    T_a = derive(p).profile.T_a
+    for k in range(MAX_T_C_STEPS + 1):
+        q, d, cmp = _simulate(_with_T_c(p, T_a * step**k))
+        if cmp.fdsmc is None:
+            continue
+        n = len(run_checks(q, cmp.fdsmc))
+        if n < n_best:
+            best, n_best = (q, d, cmp), n
+        if n == 0:
+            break
+    return best
+
+
+def _with_T_c(p: DriveParams, T_c: float) -> DriveParams:
+    """``p`` with the sloped segment's T_c [s] and the K recommended for it."""
+    q = _with(p, "controller", T_c=T_c)
+    g = derive(q).gain
+    return _with(q, "controller", K=g.K_recommended) if g is not None and g.K_recommended > 0.0 else q
 
 
 def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> DriveDesign:
