@@ -163,7 +163,7 @@ class Controller:
     delay_samples: int = spec_field("samples", 0, 1, default=0, integer=True, label="Computation delay")
     V_dc: float = spec_field("V", 0.0, 1e5, default=0.0, low_open=False, label="V_dc inverter DC link (0 = ideal)")
     i_max: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False, aliases=("Arms",),
-                              label="i_max inverter current amplitude (0 = none)")
+                              label="i_max inverter current (0 = none)")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
