@@ -15,7 +15,7 @@ from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.transient import acceleration_overshoot
 from sim.common.sensors import reading_noise
 from sim.fdsmc.engine import compare
-from sim.fdsmc.verdicts import comparator_notes, run_warnings
+from sim.fdsmc.verdicts import run_warnings
 
 
 def _replace(p, section, **kw):

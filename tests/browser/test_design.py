@@ -90,7 +90,8 @@ def test_a_robotics_servo_typed_in_arms_and_kv_with_its_encoder_designs_clean(pa
     """The ODrive D5065 on a 5:1 belt typed from its data: i_max 28.28 A_rms (40 A peak), Kv 270 rpm/V,
     an 8192-count encoder and 0.1 A of current noise. With T_so = 1 ms the encoder's quantization
     alone would give ≈ 3 A rms of standstill ripple (criterion 5 % of 40 A): Design slows the
-    observer, verifies with the sensors and shows the ripple and overshoot it got."""
+    observer, verifies with the sensors and shows the ripple and overshoot it got.
+    """
     session = _latest(default_server)
     page.get_by_text("Flux given as", exact=True).wait_for()
     choose(page, "Flux given as", "Kv [rpm/V LL peak]")
