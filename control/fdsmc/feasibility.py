@@ -33,6 +33,17 @@ def torque_limit(params: DriveParams) -> float:
     return min(g, torque_constant(params.motor) * i_max) if i_max > 0.0 else g
 
 
+def current_limit(params: DriveParams) -> float:
+    """Return the hard limit on |i_dq| the drive enforces [A]; 0 = none (the paper, ``controller.i_max`` = 0).
+
+    A drive set up for its motor never commands more current than the motor's peak torque needs:
+    min(i_max, Γ_max/K_t) with K_t = (3/2)·p·Ψ_PM of eq. (5) in [1] (i_d = 0). Where K_t·i_max > Γ_max
+    the motor's torque, not the inverter, sets the limit.
+    """
+    i_max = params.controller.i_max
+    return min(i_max, params.motor.Gamma_max / torque_constant(params.motor)) if i_max > 0.0 else 0.0
+
+
 def voltage_limit(params: DriveParams) -> float:
     """Largest |u_dq| [V]: V_dc/√3 of the inverter (space-vector limit) when given, else √(2/3)·V_0."""
     V_dc = params.controller.V_dc
