@@ -64,12 +64,16 @@ N_INFO = I_OVS + 1
 WIN_ROWS = 4
 
 
-_FM = {"nsz", "arcp", "contract", "afn", "reassoc"}
+# No fast-math: the compiled kernel computes every operation in the order written, IEEE-exactly,
+# as the same code run as plain Python (NUMBA_DISABLE_JIT=1) does. A chattering loop with a
+# quantized encoder is chaotic — last-bit differences (fused multiply-adds, re-association) grow
+# into different trajectories — so only bit-identical arithmetic lets both agree on every metric
+# and flag (tests/test_compiled_vs_python.py).
 # The hot path works on tuples of scalars (plant p = the first X_THH states, observer o = the
 # last four) and every helper is inlined into run_kernel (inline="always"), so numba keeps the
 # states in registers. The earlier array-based version (states in small arrays, stores inside
 # the loop) took ≈ 240 ns per 20 kHz sample; this one ≈ 75 ns (``python -m app bench``).
-_helper = njit(cache=True, error_model="numpy", fastmath=_FM, inline="always")
+_helper = njit(cache=True, error_model="numpy", inline="always")
 
 
 @_helper
@@ -348,7 +352,7 @@ def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: b
     return (u_d, u_q), observer_update(y[0], o, a_em, Phi, Gam, Lo), hold, (u_d, u_q, a_dem, a_hat, S), sat
 
 
-@njit(cache=True, nogil=True, error_model="numpy", fastmath=_FM)
+@njit(cache=True, nogil=True, error_model="numpy")
 def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray,
                Gam: np.ndarray, Lo: np.ndarray, continuous: bool, h: float, n_steps: int,
                n_sub: int, delay: int, decim: int, out: np.ndarray, info: np.ndarray,
