@@ -198,7 +198,7 @@ def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
           for i, (v, u) in enumerate(zip(od.L, ("-", "1/s", "N*m/rad", "N*m/(rad*s)"), strict=True))]
     return k + [_input("V_DC", params, "DC link (0 = ideal inverter)"),
                 CConstant("U_MAX", u_max, "V", "|u_dq| limit V_dc/sqrt(3) (0 = none)"),
-                _input("I_MAX", params, "current limit (0 = none)"),
+                _input("I_MAX", params, "inverter current amplitude (0 = none)"),
                 _input("GAMMA_MAX", params, "motor torque limit (information)"),
                 CConstant("COUNTS_PER_REV", encoder_counts_per_rev(params), "1/rev",
                           "encoder counts per mechanical revolution", integer=True)]

@@ -108,10 +108,11 @@ $constants
 
 /* Design constants the step uses (precomputed products and reciprocals), in flash. */
 typedef struct {
-    fdsmc_real alpha_max, inv_alpha_max, k_bl, t_c_fixed, t_c_min, omega_p_max, t_m_max, disc_tol;
-    fdsmc_real a, b, c, d, e, f, inv_f, inv_g, h, k, m, three_inv_t_si, three_inv_t_salpha;
+    fdsmc_real alpha_max, inv_alpha_max, k_bl, t_c_fixed, t_c_min, omega_p_max, t_m_max;
+    fdsmc_real a, b, c, d, e, f, g, inv_f, inv_g, h, k, m, three_inv_t_si, three_inv_t_salpha;
     fdsmc_real g1, g2, f_s, f_s2, f_s3, t_s2, j_r;
-    fdsmc_real u_max, u_max2, i_max, i_max2, i_fault2, u_fault2, e_o_max_counts;
+    fdsmc_real u_max, u_max2, i_max, i_max2, phi_d, inv_gam_d, gam_d, phi_q, inv_gam_q, gam_q;
+    fdsmc_real i_fault2, u_fault2, e_o_max_counts;
     fdsmc_real rad_per_count, counts_per_rad;
     fdsmc_real phi[4][4], gamma[4], l[4];
 } fdsmc_params;
@@ -133,9 +134,14 @@ typedef struct {
 typedef struct {
     const fdsmc_params *p;
     fdsmc_count theta_dem;  /* demanded angle [counts] */
+#ifdef FDSMC_USE_FLOAT
     fdsmc_count n0;         /* theta_hat - theta_dem, integer part [counts] */
     fdsmc_real f0;          /* its fractional part [counts], |f0| < 1 */
     fdsmc_real z[3];        /* scaled estimates [rad] */
+#else
+    double theta_dem_rad;   /* theta_dem [rad] */
+    double x[4];            /* theta_hat [rad], omega_hat [rad/s], Gamma_L_hat [N*m], its rate [N*m/s] */
+#endif
     fdsmc_real u_hold[2];   /* voltages computed at the previous call [V] */
     fdsmc_real omega_p;     /* the move's peak speed, eq. (60) [rad/s] */
     fdsmc_real t_c;         /* its sliding-mode time constant, eq. (59) or fixed [s] */
@@ -184,24 +190,27 @@ fdsmc_real fdsmc_electrical_angle(fdsmc_count theta_r, fdsmc_count offset);
 """)
 
 SOURCE = Template("""\
-/* fdsmc_controller.c -- generated with fdsmc_controller.h (see there); drive: $name. */
+/* fdsmc_controller.c -- generated with fdsmc_controller.h (see there); drive: $name.
+ * Two number builds of one controller. Double (default): the simulator's arithmetic operation for
+ * operation (absolute observer state, divisions), so that on the same readings it is bit-identical to
+ * sim/fdsmc/kernel.py. Float (-DFDSMC_USE_FLOAT): the observer scaled to order-1 angles with theta_hat
+ * - theta_dem as counts + fraction, and precomputed reciprocals (FDSMC_DIV), so that no double
+ * operation is needed. */
 #include <math.h>
 #include "fdsmc_controller.h"
 
 #ifdef FDSMC_USE_FLOAT
 #define FDSMC_SQRT(x) sqrtf(x)
 #define FDSMC_FABS(x) fabsf(x)
+#define FDSMC_DIV(x, d, inv_d) ((x) * (inv_d))
+#define FDSMC_DISC_TOL 1.0e-6 /* relative rounding of the discriminant of eq. (60) */
 #else
 #define FDSMC_SQRT(x) sqrt(x)
 #define FDSMC_FABS(x) fabs(x)
-#endif
-#define R_(x) ((fdsmc_real)(x))
-/* Relative rounding tolerance of the discriminant of eq. (60): T_m = T_m,min gives the double root. */
-#ifdef FDSMC_USE_FLOAT
-#define FDSMC_DISC_TOL 1.0e-6
-#else
+#define FDSMC_DIV(x, d, inv_d) ((x) / (d))
 #define FDSMC_DISC_TOL 1.0e-12
 #endif
+#define R_(x) ((fdsmc_real)(x))
 
 const fdsmc_params FDSMC_DESIGN = {
 $design
@@ -214,16 +223,125 @@ static fdsmc_count count_diff(fdsmc_count a, fdsmc_count b)
     return d <= 0x7fffffffu ? (fdsmc_count)d : -(fdsmc_count)(~d) - 1;
 }
 
-void fdsmc_init(fdsmc_state *s, const fdsmc_params *p, fdsmc_count theta_r0)
+/* ---- observer state: the two representations (see the header, "Observer state") ---- */
+#ifdef FDSMC_USE_FLOAT
+static void observer_reset(fdsmc_state *s, fdsmc_count theta_r0)
 {
-    int i;
-    s->p = p;
     s->theta_dem = theta_r0;
     s->n0 = 0;
     s->f0 = R_(0);
-    for (i = 0; i < 3; ++i) {
-        s->z[i] = R_(0);
+    s->z[0] = s->z[1] = s->z[2] = R_(0);
+}
+
+/* |theta_dem - theta_hat| [rad] for a new demand, and theta_hat - theta_dem re-referenced to it. */
+static fdsmc_real move_distance(fdsmc_state *s, fdsmc_count theta_dem, int commit)
+{
+    const fdsmc_count shift = count_diff(theta_dem, s->theta_dem);
+    if (commit) {
+        s->n0 = count_diff(s->n0, shift);
+        s->theta_dem = theta_dem;
+        return R_(0);
     }
+    return FDSMC_FABS(((fdsmc_real)count_diff(shift, s->n0) - s->f0) * s->p->rad_per_count);
+}
+
+/* Innovation e_o = theta_r - theta_hat [counts] (exact integer part, then the fraction). */
+static fdsmc_real innovation_counts(const fdsmc_state *s, fdsmc_count theta_r)
+{
+    return (fdsmc_real)count_diff(count_diff(theta_r, s->theta_dem), s->n0) - s->f0;
+}
+
+/* theta_hat - theta_dem [rad], omega_hat [rad/s], M*L0_hat [rad/s^2], M*L1_hat [rad/s^3]. */
+static void estimates(const fdsmc_state *s, fdsmc_real *th_re, fdsmc_real *w, fdsmc_real *mL0, fdsmc_real *mL1)
+{
+    *th_re = ((fdsmc_real)s->n0 + s->f0) * s->p->rad_per_count;
+    *w = s->z[0] * s->p->f_s;
+    *mL0 = s->z[1] * s->p->f_s2;
+    *mL1 = s->z[2] * s->p->f_s3;
+}
+
+/* z[k+1] = PHI_S*z[k] + GAMMA_S*a_em*T_s^2 + L_S*e_o [rad]; the angle row (PHI_S column 0 is
+ * (1, 0, 0, 0)) advances n0 + f0 in counts. Returns 0, or FDSMC_FAULT_STATE. */
+static uint32_t observer_update(fdsmc_state *s, fdsmc_real e_o, fdsmc_real a_em)
+{
+    const fdsmc_params *p = s->p;
+    const fdsmc_real a_s = a_em * p->t_s2;
+    fdsmc_real z[4], step_counts;
+    fdsmc_count whole;
+    int i;
+    for (i = 0; i < 4; ++i) {
+        z[i] = p->gamma[i] * a_s + p->l[i] * e_o
+               + (p->phi[i][1] * s->z[0] + p->phi[i][2] * s->z[1] + p->phi[i][3] * s->z[2]);
+    }
+    step_counts = z[0] * p->counts_per_rad + s->f0;
+    if (!(FDSMC_FABS(step_counts) < R_(1.0e9))) {
+        return FDSMC_FAULT_STATE; /* not finite (NaN fails every comparison) or beyond range */
+    }
+    whole = (fdsmc_count)step_counts;
+    s->f0 = step_counts - (fdsmc_real)whole;
+    s->n0 = (fdsmc_count)((uint32_t)s->n0 + (uint32_t)whole);
+    s->z[0] = z[1];
+    s->z[1] = z[2];
+    s->z[2] = z[3];
+    return 0u;
+}
+#else
+static void observer_reset(fdsmc_state *s, fdsmc_count theta_r0)
+{
+    s->theta_dem = theta_r0;
+    s->theta_dem_rad = (double)theta_r0 * s->p->rad_per_count;
+    s->x[0] = s->theta_dem_rad;
+    s->x[1] = s->x[2] = s->x[3] = 0.0;
+}
+
+static fdsmc_real move_distance(fdsmc_state *s, fdsmc_count theta_dem, int commit)
+{
+    const double theta = (double)theta_dem * s->p->rad_per_count;
+    if (commit) {
+        s->theta_dem = theta_dem;
+        s->theta_dem_rad = theta;
+    }
+    return fabs(theta - s->x[0]);
+}
+
+static fdsmc_real innovation_counts(const fdsmc_state *s, fdsmc_count theta_r)
+{
+    return ((double)theta_r * s->p->rad_per_count - s->x[0]) * s->p->counts_per_rad;
+}
+
+static void estimates(const fdsmc_state *s, fdsmc_real *th_re, fdsmc_real *w, fdsmc_real *mL0, fdsmc_real *mL1)
+{
+    *th_re = s->x[0] - s->theta_dem_rad;
+    *w = s->x[1];
+    *mL0 = s->p->m * s->x[2];
+    *mL1 = s->p->m * s->x[3];
+}
+
+/* x[k+1] = Phi*x[k] + Gamma*a_em + L*e_o with e_o = theta_r*step - theta_hat, as sim/fdsmc/kernel.py. */
+static uint32_t observer_update_abs(fdsmc_state *s, double theta_m, fdsmc_real a_em)
+{
+    const fdsmc_params *p = s->p;
+    const double e_o = theta_m - s->x[0];
+    double x[4];
+    int i;
+    for (i = 0; i < 4; ++i) {
+        x[i] = p->gamma[i] * a_em + p->l[i] * e_o
+               + (p->phi[i][0] * s->x[0] + p->phi[i][1] * s->x[1] + p->phi[i][2] * s->x[2] + p->phi[i][3] * s->x[3]);
+    }
+    if (!(fabs(x[0] - s->x[0]) + fabs(x[1]) + fabs(x[2]) + fabs(x[3]) < 1.0e300)) {
+        return FDSMC_FAULT_STATE;
+    }
+    for (i = 0; i < 4; ++i) {
+        s->x[i] = x[i];
+    }
+    return 0u;
+}
+#endif
+
+void fdsmc_init(fdsmc_state *s, const fdsmc_params *p, fdsmc_count theta_r0)
+{
+    s->p = p;
+    observer_reset(s, theta_r0);
     s->u_hold[0] = R_(0);
     s->u_hold[1] = R_(0);
     s->omega_p = FDSMC_OMEGA_P;
@@ -244,7 +362,7 @@ static int32_t peak_speed(const fdsmc_params *p, fdsmc_real dtheta, fdsmc_real T
     const fdsmc_real at = p->alpha_max * T_m;
     fdsmc_real disc = at * at - R_(2) * FDSMC_C_57 * p->alpha_max * dtheta;
     if (disc < R_(0)) {
-        if (disc < -p->disc_tol * at * at) {
+        if (disc < -R_(FDSMC_DISC_TOL) * at * at) {
             return FDSMC_ERR_T_M;
         }
         disc = R_(0); /* T_m = T_m,min up to rounding: the double root */
@@ -256,18 +374,16 @@ static int32_t peak_speed(const fdsmc_params *p, fdsmc_real dtheta, fdsmc_real T
 int32_t fdsmc_set_move(fdsmc_state *s, fdsmc_count theta_dem, fdsmc_real T_m)
 {
     const fdsmc_params *p = s->p;
-    const fdsmc_count shift = count_diff(theta_dem, s->theta_dem);
-    fdsmc_real dtheta, omega_p = R_(0), t_c;
+    fdsmc_real omega_p = R_(0), t_c;
     int32_t rc = FDSMC_OK;
     if (s->status.fault != 0u) {
         rc = FDSMC_ERR_FAULT;
     } else if (!(T_m > R_(0) && T_m <= p->t_m_max)) {
         rc = FDSMC_ERR_ARG;
     } else {
-        dtheta = FDSMC_FABS(((fdsmc_real)count_diff(shift, s->n0) - s->f0) * p->rad_per_count);
-        rc = peak_speed(p, dtheta, T_m, &omega_p);
+        rc = peak_speed(p, move_distance(s, theta_dem, 0), T_m, &omega_p);
     }
-    t_c = p->t_c_fixed > R_(0) ? p->t_c_fixed : omega_p * p->inv_alpha_max; /* eq. (59): T_c = T_a */
+    t_c = p->t_c_fixed > R_(0) ? p->t_c_fixed : FDSMC_DIV(omega_p, p->alpha_max, p->inv_alpha_max); /* (59) */
     if (rc == FDSMC_OK && omega_p > p->omega_p_max) {
         rc = FDSMC_ERR_SPEED;
     } else if (rc == FDSMC_OK && t_c < p->t_c_min) {
@@ -275,8 +391,7 @@ int32_t fdsmc_set_move(fdsmc_state *s, fdsmc_count theta_dem, fdsmc_real T_m)
     }
     s->status.last_move = rc;
     if (rc == FDSMC_OK) {
-        s->n0 = count_diff(s->n0, shift); /* theta_hat - theta_dem refers to the new demand */
-        s->theta_dem = theta_dem;
+        (void)move_distance(s, theta_dem, 1);
         s->omega_p = omega_p;
         s->t_c = t_c;
         s->inv_t_c = R_(1) / t_c;
@@ -290,7 +405,7 @@ static fdsmc_real sliding_mode(const fdsmc_state *s, fdsmc_real theta_re, fdsmc_
 {
     fdsmc_real x;
     if (FDSMC_FABS(theta_re) < s->slope_end) {
-        *S = omega_hat + theta_re * s->inv_t_c;
+        *S = omega_hat + FDSMC_DIV(theta_re, s->t_c, s->inv_t_c);
     } else {
         *S = omega_hat + (theta_re > R_(0) ? s->omega_p : (theta_re < R_(0) ? -s->omega_p : R_(0)));
     }
@@ -299,46 +414,21 @@ static fdsmc_real sliding_mode(const fdsmc_state *s, fdsmc_real theta_re, fdsmc_
     return -s->p->alpha_max * x;
 }
 
-/* u_d of eq. (9) with i_d,dem = 0 and u_q of eq. (14) of [1]; mL0 = Gamma_L_hat/J_r, mL1 its rate. */
+/* u_d of eq. (9) with i_d,dem = 0 and u_q of eq. (14) of [1]; mL0 = M*Gamma_L_hat, mL1 = M*dGamma_L_hat/dt. */
 static void fdc_voltages(const fdsmc_params *p, fdsmc_real alpha_dem, fdsmc_real i_d, fdsmc_real i_q,
                          fdsmc_real w, fdsmc_real mL0, fdsmc_real mL1, fdsmc_real *u_d, fdsmc_real *u_q)
 {
     const fdsmc_real hk = p->h + p->k * i_d;
-    const fdsmc_real alpha = hk * i_q - mL0;                                      /* eq. (7) */
-    const fdsmc_real forced = p->three_inv_t_salpha * (alpha_dem - alpha);        /* eq. (13) */
+    const fdsmc_real alpha = hk * i_q - mL0;                                  /* eq. (7) */
+    const fdsmc_real forced = p->three_inv_t_salpha * (alpha_dem - alpha);    /* eq. (13) */
     fdsmc_real coupling;
-    *u_d = (-p->three_inv_t_si * i_d + p->a * i_d - p->b * w * i_q) * p->inv_f;   /* eq. (9) */
+    *u_d = FDSMC_DIV(-p->three_inv_t_si * i_d + p->a * i_d - p->b * w * i_q, p->f, p->inv_f); /* eq. (9) */
     coupling = p->k * i_q * (p->a * i_d - p->b * w * i_q - p->f * *u_d);
-    *u_q = ((forced + coupling + mL1) / hk + p->c * w * i_d + p->d * i_q + p->e * w) * p->inv_g; /* (14) */
+    *u_q = FDSMC_DIV((forced + coupling + mL1) / hk + p->c * w * i_d + p->d * i_q + p->e * w,
+                     p->g, p->inv_g);                                          /* eq. (14) */
 }
 
 $limit_code
-
-/* Observer update z[k+1] = PHI_S*z[k] + GAMMA_S*a_em*T_s^2 + L_S*e_o [rad]; the angle row (PHI_S
- * column 0 is (1, 0, 0, 0)) advances n0 + f0 in counts. Returns 0, or FDSMC_FAULT_STATE. */
-static uint32_t observer_update(fdsmc_state *s, fdsmc_real e_o, fdsmc_real i_d, fdsmc_real i_q)
-{
-    const fdsmc_params *p = s->p;
-    const fdsmc_real a_s = (p->h + p->k * i_d) * i_q * p->t_s2;
-    fdsmc_real z[4], step_counts;
-    fdsmc_count whole;
-    int i;
-    for (i = 0; i < 4; ++i) {
-        z[i] = p->gamma[i] * a_s + p->l[i] * e_o
-               + (p->phi[i][1] * s->z[0] + p->phi[i][2] * s->z[1] + p->phi[i][3] * s->z[2]);
-    }
-    step_counts = z[0] * p->counts_per_rad + s->f0;
-    if (!(FDSMC_FABS(step_counts) < R_(1.0e9))) {
-        return FDSMC_FAULT_STATE; /* not finite (NaN fails every comparison) or beyond range */
-    }
-    whole = (fdsmc_count)step_counts;
-    s->f0 = step_counts - (fdsmc_real)whole;
-    s->n0 = (fdsmc_count)((uint32_t)s->n0 + (uint32_t)whole);
-    for (i = 0; i < 3; ++i) {
-        s->z[i] = z[i + 1];
-    }
-    return 0u;
-}
 
 static void fault(fdsmc_state *s, uint32_t bits, fdsmc_output *out)
 {
@@ -351,22 +441,22 @@ static void fault(fdsmc_state *s, uint32_t bits, fdsmc_output *out)
     out->fault = s->status.fault;
 }
 
-/* Checks the inputs; returns the innovation e_o = theta_r - theta_hat [rad] or latches a fault. */
+/* Checks the readings; sets the innovation e_o = theta_r - theta_hat [rad] or returns the fault bits. */
 static uint32_t check_inputs(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real i_q,
                              fdsmc_real *e_o)
 {
     const fdsmc_params *p = s->p;
-    fdsmc_real e_counts, e_abs;
+    fdsmc_real e_abs;
     if (!(i_d * i_d + i_q * i_q <= p->i_fault2)) {
         return FDSMC_FAULT_CURRENT; /* also NaN and inf */
     }
-    e_counts = (fdsmc_real)count_diff(count_diff(theta_r, s->theta_dem), s->n0) - s->f0;
-    e_abs = FDSMC_FABS(e_counts);
+    *e_o = innovation_counts(s, theta_r);
+    e_abs = FDSMC_FABS(*e_o);
     if (!(e_abs <= p->e_o_max_counts)) {
         return FDSMC_FAULT_INNOVATION;
     }
-    *e_o = e_counts * p->rad_per_count;
     e_abs *= p->rad_per_count;
+    *e_o *= p->rad_per_count;
     s->status.e_o_peak = e_abs > s->status.e_o_peak ? e_abs : s->status.e_o_peak;
     return 0u;
 }
@@ -375,20 +465,29 @@ static void step(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real
                  fdsmc_output *out)
 {
     const fdsmc_params *p = s->p;
-    fdsmc_real e_o = R_(0), th_re, w, S = R_(0), alpha_dem, u_d, u_q, mL0;
+    fdsmc_real e_o = R_(0), th_re, w, S = R_(0), alpha_dem, u_d, u_q, mL0, mL1, i_d0, i_q0;
     uint32_t bad = s->status.fault != 0u ? s->status.fault : check_inputs(s, theta_r, i_d, i_q, &e_o);
     s->status.samples++;
     if (bad != 0u) {
         fault(s, bad, out);
         return;
     }
-    th_re = ((fdsmc_real)s->n0 + s->f0) * p->rad_per_count;
-    w = s->z[0] * p->f_s;
+    estimates(s, &th_re, &w, &mL0, &mL1);
     alpha_dem = conventional ? -p->g1 * th_re - p->g2 * w : sliding_mode(s, th_re, w, &S);
-    mL0 = s->z[1] * p->f_s2;
-    fdc_voltages(p, alpha_dem, i_d, i_q, w, mL0, s->z[2] * p->f_s3, &u_d, &u_q);
-    out->saturated = limit_voltage(p, &u_d, &u_q, i_d, i_q, w);
-    if (!(u_d * u_d + u_q * u_q <= p->u_fault2) || observer_update(s, e_o, i_d, i_q) != 0u) {
+    fdc_voltages(p, alpha_dem, i_d, i_q, w, mL0, mL1, &u_d, &u_q);
+#if FDSMC_DELAY_SAMPLES == 1
+    predict_currents(p, s->u_hold, i_d, i_q, w, &i_d0, &i_q0); /* where the new voltages start acting */
+#else
+    i_d0 = i_d;
+    i_q0 = i_q;
+#endif
+    out->saturated = limit_voltage(p, &u_d, &u_q, i_d0, i_q0, w);
+#ifdef FDSMC_USE_FLOAT
+    bad = observer_update(s, e_o, (p->h + p->k * i_d) * i_q);
+#else
+    bad = observer_update_abs(s, (double)theta_r * p->rad_per_count, (p->h + p->k * i_d) * i_q);
+#endif
+    if (bad != 0u || !(u_d * u_d + u_q * u_q <= p->u_fault2)) {
         fault(s, FDSMC_FAULT_STATE, out);
         return;
     }
@@ -432,17 +531,33 @@ fdsmc_real fdsmc_electrical_angle(fdsmc_count theta_r, fdsmc_count offset)
 
 #: The inverter limits of :func:`control.fdsmc.inverter.limit_voltage`, mirrored.
 LIMIT_CODE = """\
-/* Inverter limits of control/fdsmc/inverter.py: hold di_q/dt = 0 (eq. (2) of [1]) at |i_q| >= I_MAX,
- * then |u_dq| <= U_MAX (compared squared; the root only when the limit acts). */
-static int32_t limit_voltage(const fdsmc_params *p, fdsmc_real *u_d, fdsmc_real *u_q, fdsmc_real i_d,
-                             fdsmc_real i_q, fdsmc_real w)
+/* Inverter limits of control/fdsmc/inverter.py: the currents one sample on are predicted from eqs. (1)-(2)
+ * of [1] with the voltages held (ZOH factors phi, gam of the rates A and D); where the prediction leaves
+ * |i_dq| <= I_MAX the voltage that ends the sample on the circle replaces the demand (i_d first, then
+ * i_q in the room left); then |u_dq| <= U_MAX. Squares are compared; a root only when a limit acts.
+ * i_d0, i_q0: currents at the start of the sample the voltages act over [A]. Returns 1 if limited. */
+static int32_t limit_voltage(const fdsmc_params *p, fdsmc_real *u_d, fdsmc_real *u_q, fdsmc_real i_d0,
+                             fdsmc_real i_q0, fdsmc_real w)
 {
     int32_t sat = 0;
     fdsmc_real mag2;
-    if (p->i_max > R_(0) && FDSMC_FABS(i_q) >= p->i_max) {
-        const fdsmc_real u_hold = (p->c * w * i_d + p->d * i_q + p->e * w) * p->inv_g;
-        if ((*u_q - u_hold) * i_q > R_(0)) {
-            *u_q = u_hold;
+    if (p->i_max > R_(0)) {
+        const fdsmc_real back_q = (p->c * i_d0 + p->e) * w;
+        const fdsmc_real i_d1 = p->phi_d * i_d0 + p->gam_d * (p->b * w * i_q0 + p->f * *u_d);
+        const fdsmc_real i_q1 = p->phi_q * i_q0 + p->gam_q * (p->g * *u_q - back_q);
+        fdsmc_real room2 = p->i_max2, i_d_end = i_d1;
+        if (FDSMC_FABS(i_d1) > p->i_max) {
+            i_d_end = i_d1 > R_(0) ? p->i_max : -p->i_max;
+            *u_d = FDSMC_DIV(FDSMC_DIV(i_d_end - p->phi_d * i_d0, p->gam_d, p->inv_gam_d) - p->b * w * i_q0, p->f,
+                             p->inv_f);
+            sat = 1;
+        }
+        room2 -= i_d_end * i_d_end;
+        room2 = room2 > R_(0) ? room2 : R_(0);
+        if (i_q1 * i_q1 > room2) {
+            const fdsmc_real room = FDSMC_SQRT(room2);
+            *u_q = FDSMC_DIV(FDSMC_DIV((i_q1 > R_(0) ? room : -room) - p->phi_q * i_q0, p->gam_q, p->inv_gam_q)
+                             + back_q, p->g, p->inv_g);
             sat = 1;
         }
     }
@@ -454,4 +569,14 @@ static int32_t limit_voltage(const fdsmc_params *p, fdsmc_real *u_d, fdsmc_real 
         sat = 1;
     }
     return sat;
-}"""
+}
+
+#if FDSMC_DELAY_SAMPLES == 1
+/* Currents [A] at the end of the sample now running, with the held voltages u_hold (computation delay). */
+static void predict_currents(const fdsmc_params *p, const fdsmc_real *u, fdsmc_real i_d, fdsmc_real i_q,
+                             fdsmc_real w, fdsmc_real *i_d1, fdsmc_real *i_q1)
+{
+    *i_d1 = p->phi_d * i_d + p->gam_d * (p->b * w * i_q + p->f * u[0]);
+    *i_q1 = p->phi_q * i_q + p->gam_q * (p->g * u[1] - (p->c * i_d + p->e) * w);
+}
+#endif"""

@@ -10,19 +10,18 @@ exits 0 when every voltage agrees within 1e-6 (double) or 1e-4 (float32) of the 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
-from app.exports.c_design import encoder_counts_per_rev
 from app.exports.c_module import HEADER_NAME, Verdict, c_literal, controller_files, parameter_hash, verdict_of
 from app.exports.c_text import c_string
-from app.exports.c_verify import count_params
+from app.exports.c_verify import count_params, readings
 from app.io.presets import SCHEMA
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
+from sim.common import sensors
 from sim.fdsmc.engine import Comparison, simulate
 from sim.fdsmc.grid import time_grid
 
@@ -99,9 +98,9 @@ def vector_header(params: DriveParams) -> str:
     trace = simulate(sim_params, "fdsmc", max_points=time_grid(sim_params, 1, 0.0, 1).n_steps + 1).trace
     if trace.t.size < n:
         raise ParameterError(f"the simulated run stops after {trace.t.size} samples: no test vectors")
-    per_rad = encoder_counts_per_rev(params) / (2.0 * math.pi)
-    theta = np.rint(trace.theta_r[:n] * per_rad).astype(np.int64)
-    u = np.column_stack([trace.u_d[:n], trace.u_q[:n]])
+    noise = sensors.noise_table(sim_params.sensors)
+    read = np.array([readings(sim_params, k, trace.theta_r[k], trace.i_d[k], trace.i_q[k], noise) for k in range(n)])
+    theta, u = read[:, 0].astype(np.int64), np.column_stack([trace.u_d[:n], trace.u_q[:n]])
     counts = ",\n".join("    " + ", ".join(str(int(c)) for c in theta[j:j + 8]) for j in range(0, n, 8))
     return (f"/* fdsmc_vectors.h -- golden vectors of {c_string(params.name)}: the first {n} samples of the\n"
             " * simulator's digital mode (demand rounded to a count): theta_r [counts], i_d, i_q [A] the\n"
@@ -112,7 +111,7 @@ def vector_header(params: DriveParams) -> str:
             f"#define FDSMC_VEC_U_PEAK {c_literal(float(np.max(np.abs(u))) or 1.0)}\n"
             f"static const fdsmc_count fdsmc_vec_theta[{n}] = {{\n{counts}\n}};\n"
             f"static const fdsmc_real fdsmc_vec_in[{n}][2] = {{\n"
-            f"{_rows(np.column_stack([trace.i_d[:n], trace.i_q[:n]]))}\n}};\n"
+            f"{_rows(read[:, 1:])}\n}};\n"
             f"static const fdsmc_real fdsmc_vec_u[{n}][2] = {{\n{_rows(u)}\n}};\n#endif\n")
 
 

@@ -3,9 +3,10 @@
 The module is compiled with the system C compiler (``cc``) into a shared object and called through
 :mod:`ctypes` — standard library, no build step or extra package — once per controller sample,
 between the RK4 steps of :class:`sim.fdsmc.plant.PlantInTheLoop` (the plant integration of the
-simulator's digital mode). The C module takes the angle as encoder counts; the harness quantizes the
-plant's θ_r to the module's ``FDSMC_COUNTS_PER_REV`` and sets the move with the demand rounded to a
-count, and the simulator is run on the same demand (:func:`count_params`). Agreement = max |C − simulator|
+simulator's digital mode). The C module takes the angle as encoder counts: the harness feeds it what
+the simulator's controller reads (:func:`readings`: the encoder's whole counts of θ_r, the currents with
+the seeded noise and ADC of :mod:`sim.common.sensors`), sets the move with the demand rounded to a count,
+and the simulator runs on the same demand and encoder (:func:`count_params`). Agreement = max |C − simulator|
 / max |simulator| over the run, per signal (error relative to the signal's peak), at every sample.
 
 ``python -m app.exports.c_verify`` prints the figures for the paper preset and the real-motor presets.
@@ -29,6 +30,7 @@ from app.exports.c_module import Verdict, controller_files
 from app.io.presets import SCHEMA, list_presets, load_preset
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
+from sim.common import sensors
 from sim.fdsmc.engine import simulate
 from sim.fdsmc.plant import PlantInTheLoop
 
@@ -44,11 +46,30 @@ def compiler() -> str | None:
 
 
 def count_params(params: DriveParams) -> tuple[DriveParams, int]:
-    """Return the case with θ_dem rounded to a whole encoder count (what the firmware is given), and that count."""
+    """Return the case as the firmware runs it, and the demand in counts.
+
+    θ_dem is rounded to a whole encoder count; an ideal encoder becomes the module's resolution
+    (:data:`app.exports.c_design.IDEAL_COUNTS_PER_REV`), so that the simulator reads the same counts.
+    """
     cpr = encoder_counts_per_rev(params)
-    count = round(params.manoeuvre.theta_dem * cpr / (2.0 * math.pi))
-    man = dataclasses.replace(params.manoeuvre, theta_dem=count * 2.0 * math.pi / cpr)
-    return dataclasses.replace(params, manoeuvre=man), count
+    se = dataclasses.replace(params.sensors, encoder_cpr=cpr)
+    step = sensors.encoder_step(se)
+    count = round(params.manoeuvre.theta_dem / step)
+    man = dataclasses.replace(params.manoeuvre, theta_dem=count * step)
+    return dataclasses.replace(params, manoeuvre=man, sensors=se), count
+
+
+def readings(params: DriveParams, k: int, theta: float, i_d: float, i_q: float,
+             noise: np.ndarray) -> tuple[int, float, float]:
+    """Return what the controller reads at sample k: (encoder count, i_d [A], i_q [A]), as the simulator's sensors.
+
+    ``noise`` is :func:`sim.common.sensors.noise_table` of ``params.sensors``; the encoder must not be ideal.
+    """
+    se, j = params.sensors, k % noise.shape[1]
+    i_step = sensors.adc_step(se)
+    return (math.floor(theta / sensors.encoder_step(se)),
+            sensors.adc_current(i_d, noise[0, j], se.i_noise, i_step, se.i_adc_range),
+            sensors.adc_current(i_q, noise[1, j], se.i_noise, i_step, se.i_adc_range))
 
 
 def write_module(folder: Path, params: DriveParams, verdict: Verdict | None = None) -> None:
@@ -90,10 +111,13 @@ class CModule:
             _fields_ = [("fault", u32), ("fault_sample", u32), ("samples", u32), ("saturated_samples", u32),
                         ("e_o_peak", real), ("last_move", i32)]
 
+        observer = ([("n0", i32), ("f0", real), ("z", real * 3)] if single
+                    else [("theta_dem_rad", ctypes.c_double), ("x", ctypes.c_double * 4)])
+
         class State(ctypes.Structure):
-            _fields_ = [("p", ctypes.c_void_p), ("theta_dem", i32), ("n0", i32), ("f0", real), ("z", real * 3),
-                        ("u_hold", real * 2), ("omega_p", real), ("t_c", real), ("inv_t_c", real),
-                        ("slope_end", real), ("status", Status)]
+            _fields_ = [("p", ctypes.c_void_p), ("theta_dem", i32), *observer, ("u_hold", real * 2),
+                        ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
+                        ("status", Status)]
 
         class Output(ctypes.Structure):
             _fields_ = [("u_d", real), ("u_q", real), ("theta_re", real), ("omega_hat", real),
@@ -118,23 +142,22 @@ class CModule:
 def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller: str = "fdsmc") -> np.ndarray:
     """Plant states [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, …] at every sample, C module in the loop.
 
-    The move is set at run time (``fdsmc_set_move`` to θ_dem rounded to a count, in T_m); θ_r is
-    quantized to the module's encoder counts.
+    ``params`` as :func:`count_params` returns them; the move is set at run time (``fdsmc_set_move``
+    to θ_dem in counts, in T_m); the module reads the sensors of :func:`readings`.
     """
     m = CModule(lib, single)
-    cpr = encoder_counts_per_rev(params)
     state, out = m.new_state(0), m.Output()
     _, count = count_params(params)
     rc = lib.fdsmc_set_move(ctypes.byref(state), count, params.manoeuvre.T_m)
     if rc != 0:
         raise RuntimeError(f"fdsmc_set_move refused the designed move: status {rc}")
     step = lib.fdsmc_step if controller == "fdsmc" else lib.fdsmc_step_conventional
-    plant, per_rad = PlantInTheLoop(params), cpr / (2.0 * math.pi)
+    plant, noise = PlantInTheLoop(params), sensors.noise_table(params.sensors)
     rows = np.zeros((plant.n_samples, len(plant.x)))
     for k in range(plant.n_samples):
         x = plant.x
         rows[k] = x
-        step(ctypes.byref(state), round(x[2] * per_rad), x[0], x[1], ctypes.byref(out))
+        step(ctypes.byref(state), *readings(params, k, x[2], x[0], x[1], noise), ctypes.byref(out))
         plant.step(out.u_d, out.u_q)
     return rows
 
