@@ -121,9 +121,12 @@ def scaled_observer(d: Derived) -> ScaledObserver:
     f_s, J_r = 1.0 / od.T_s, d.params.motor.J_r
     scale = np.array([1.0, f_s, f_s**2 * J_r, f_s**3 * J_r])
     Phi = od.Phi * scale[np.newaxis, :] / scale[:, np.newaxis]
-    if not np.array_equal(Phi[:, 0], [1.0, 0.0, 0.0, 0.0]):  # the C advances the angle in counts
-        raise ParameterError("the discrete observer's angle column is not (1, 0, 0, 0): cannot export it")
-    return ScaledObserver(scale, Phi, od.Gamma * f_s**2 / scale, od.L / scale)
+    Gamma = od.Gamma * f_s**2 / scale
+    # The float C advances the angle in counts and leaves out the zero terms of the chain of integrators.
+    if not (np.array_equal(Phi[:, 0], [1.0, 0.0, 0.0, 0.0]) and not np.tril(Phi, -1).any() and not Gamma[2:].any()):
+        raise ParameterError("the discrete observer is not an upper-triangular chain (Φ column 0 = (1, 0, 0, 0), "
+                             "Γ = (g0, g1, 0, 0)): the C module cannot export it")
+    return ScaledObserver(scale, Phi, Gamma, od.L / scale)
 
 
 #: Constants that are inputs of the preset: C name → ``section.field`` (unit and range from its spec).

@@ -50,7 +50,8 @@ $checks *
  *   inverter (all switches off: zero torque; zero voltage would brake a spinning rotor). Log
  *   s.status (fdsmc_status); recover with fdsmc_init().
  * Build. Double by default (host); -DFDSMC_USE_FLOAT for float32 (Cortex-M4F: -mcpu=cortex-m4
- *   -mfpu=fpv4-sp-d16 -mfloat-abi=hard; no double operation; -fno-math-errno inlines sqrtf).
+ *   -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 -fno-math-errno -ffp-contract=fast: no double operation,
+ *   sqrtf is one VSQRT, multiply-adds fuse to VFMA; the double build is the simulator's arithmetic).
  *
  * Observer state (scaled so that float32 is accurate): theta_hat - theta_dem = (n0 + f0) counts,
  *   z = (omega_hat*T_s, Gamma_L_hat*T_s^2/J_r, dGamma_L_hat/dt*T_s^3/J_r), every component in rad --
@@ -260,29 +261,26 @@ static void estimates(const fdsmc_state *s, fdsmc_real *th_re, fdsmc_real *w, fd
     *mL1 = s->z[2] * s->p->f_s3;
 }
 
-/* z[k+1] = PHI_S*z[k] + GAMMA_S*a_em*T_s^2 + L_S*e_o [rad]; the angle row (PHI_S column 0 is
- * (1, 0, 0, 0)) advances n0 + f0 in counts. Returns 0, or FDSMC_FAULT_STATE. */
+/* z[k+1] = PHI_S*z[k] + GAMMA_S*a_em*T_s^2 + L_S*e_o [rad], PHI_S upper triangular with column 0 =
+ * (1, 0, 0, 0) and GAMMA_S = (g0, g1, 0, 0) (the exporter checks it): the zero terms are left out and
+ * the angle row advances n0 + f0 in counts. Returns 0, or FDSMC_FAULT_STATE. */
 static uint32_t observer_update(fdsmc_state *s, fdsmc_real e_o, fdsmc_real a_em)
 {
     const fdsmc_params *p = s->p;
-    const fdsmc_real a_s = a_em * p->t_s2;
-    fdsmc_real z[4], step_counts;
+    const fdsmc_real a_s = a_em * p->t_s2, z0 = s->z[0], z1 = s->z[1], z2 = s->z[2];
+    fdsmc_real step_counts;
     fdsmc_count whole;
-    int i;
-    for (i = 0; i < 4; ++i) {
-        z[i] = p->gamma[i] * a_s + p->l[i] * e_o
-               + (p->phi[i][1] * s->z[0] + p->phi[i][2] * s->z[1] + p->phi[i][3] * s->z[2]);
-    }
-    step_counts = z[0] * p->counts_per_rad + s->f0;
+    step_counts = (p->gamma[0] * a_s + p->l[0] * e_o + (p->phi[0][1] * z0 + p->phi[0][2] * z1 + p->phi[0][3] * z2))
+                  * p->counts_per_rad + s->f0;
     if (!(FDSMC_FABS(step_counts) < R_(1.0e9))) {
         return FDSMC_FAULT_STATE; /* not finite (NaN fails every comparison) or beyond range */
     }
     whole = (fdsmc_count)step_counts;
     s->f0 = step_counts - (fdsmc_real)whole;
     s->n0 = (fdsmc_count)((uint32_t)s->n0 + (uint32_t)whole);
-    s->z[0] = z[1];
-    s->z[1] = z[2];
-    s->z[2] = z[3];
+    s->z[0] = p->gamma[1] * a_s + p->l[1] * e_o + (p->phi[1][1] * z0 + p->phi[1][2] * z1 + p->phi[1][3] * z2);
+    s->z[1] = p->l[2] * e_o + (p->phi[2][2] * z1 + p->phi[2][3] * z2);
+    s->z[2] = p->l[3] * e_o + p->phi[3][3] * z2;
     return 0u;
 }
 #else
