@@ -252,10 +252,15 @@ def _gate_texts(v: Verdict, hash_value: str) -> dict[str, str]:
             "failed": c_string(names), "error_text": c_string(error)}
 
 
-def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED) -> str:
-    """Text of ``fdsmc_controller.h`` for the derived design ``d`` of ``params``."""
+def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED,
+                      inputs: DriveParams | None = None) -> str:
+    """Text of ``fdsmc_controller.h`` for the derived design ``d`` of ``params``.
+
+    ``inputs``: the preset as entered, whose :func:`parameter_hash` the header carries (default ``params``;
+    the export passes the entered preset when ``params`` has θ_dem rounded to a count).
+    """
     defines = "\n".join(_define(k) for k in controller_constants(params, d))
-    h = parameter_hash(params)
+    h = parameter_hash(params if inputs is None else inputs)
     return HEADER.substitute(tool=TOOL, name=c_string(params.name), source=c_string(params.source), schema=schema,
                              constants=defines, hash_text=h, hash_value=f"0x{h}u", **_gate_texts(verdict, f"0x{h}u"))
 
@@ -267,6 +272,8 @@ def controller_source(params: DriveParams, d: Derived) -> str:
                              limit_code=LIMIT_CODE)
 
 
-def controller_files(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED) -> dict[str, str]:
+def controller_files(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED,
+                     inputs: DriveParams | None = None) -> dict[str, str]:
     """File name → text of the controller module (header and source); unverified unless ``verdict`` says."""
-    return {HEADER_NAME: controller_header(params, d, schema, verdict), SOURCE_NAME: controller_source(params, d)}
+    return {HEADER_NAME: controller_header(params, d, schema, verdict, inputs),
+            SOURCE_NAME: controller_source(params, d)}

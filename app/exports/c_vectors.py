@@ -132,15 +132,16 @@ def c_files(cmp: Comparison, checks: Sequence | None, force: bool = False) -> di
     ParameterError
         When the design is not clean and ``force`` is False, naming the failed checks.
     """
-    params = cmp.derived.params
+    entered = cmp.derived.params
+    params, _ = count_params(entered)  # the firmware's demand is a whole count
     verdict: Verdict = verdict_of(checks if cmp.fdsmc is not None else None)
     if not verdict.clean and not force:
         names = ", ".join(f"{n} ({t})" for n, t in verdict.failed)
         raise ParameterError(f"the design is not clean: {names}; export with --force to write it anyway "
                              "(the header then stops the build unless FDSMC_ACCEPT_UNCLEAN is defined)")
-    files = controller_files(params, cmp.derived if cmp.derived is not None else derive(params), SCHEMA, verdict)
+    files = controller_files(params, derive(params), SCHEMA, verdict, inputs=entered)
     assert HEADER_NAME in files
     if cmp.fdsmc is not None:
-        files[VECTORS_NAME] = vector_header(params)
+        files[VECTORS_NAME] = vector_header(entered)
         files[TEST_NAME] = TEST_PROGRAM
     return files
