@@ -72,6 +72,8 @@ extern "C" {
 #endif
 
 /* ---- verdict gate: an unverified or not clean design does not compile unless accepted ---- */
+#define FDSMC_DRIVE_NAME $name /* the preset's name and source, for logs */
+#define FDSMC_DRIVE_SOURCE $source
 #define FDSMC_PARAM_HASH $hash_value
 #define FDSMC_PARAM_HASH_TEXT "$hash_text"
 #define FDSMC_VERIFIED $verified /* 1: the tool simulated this design */
@@ -124,7 +126,7 @@ extern const fdsmc_params FDSMC_DESIGN;
 /* What the integrator logs. */
 typedef struct {
     uint32_t fault;             /* FDSMC_FAULT_* bits, latched until fdsmc_init() (0 = none) */
-    uint32_t fault_sample;      /* value of .samples when the first fault latched */
+    uint32_t fault_sample;      /* index (from 0) of the fdsmc_step call that latched the first fault */
     uint32_t samples;           /* fdsmc_step calls since fdsmc_init() */
     uint32_t saturated_samples; /* samples in which an inverter limit acted */
     fdsmc_real e_o_peak;        /* largest |theta_r - theta_hat| so far [rad] */
@@ -431,7 +433,7 @@ $limit_code
 static void fault(fdsmc_state *s, uint32_t bits, fdsmc_output *out)
 {
     if (s->status.fault == 0u) {
-        s->status.fault_sample = s->status.samples;
+        s->status.fault_sample = s->status.samples - 1u; /* this call's index */
     }
     s->status.fault |= bits;
     out->u_d = R_(0);
