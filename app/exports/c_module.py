@@ -34,7 +34,8 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
 
-from .c_template import HEADER, LIMIT_CODE, SOURCE
+from .c_source import LIMIT_CODE, SOURCE
+from .c_template import HEADER
 
 TOOL = "pmsm-commissioning (FDSMC)"
 #: File names of the generated module.
@@ -221,9 +222,16 @@ def c_literal(x: float) -> str:
     return text if any(ch in text for ch in ".e") else text + ".0"
 
 
+def _comment(text: str) -> str:
+    """Return the tool's own reference text for a comment: ASCII as is when plainly safe, else :func:`c_string`."""
+    text = c_unit(text)
+    plain = text.isascii() and text.isprintable() and not any(s in text for s in ("*/", "/*", "//", "??", "\\"))
+    return text if plain else c_string(text)
+
+
 def _define(k: CConstant) -> str:
     value = str(int(k.value)) if k.integer else f"((fdsmc_real){c_literal(k.value)})"
-    return f"#define FDSMC_{k.name:<15} {value:<32} /* [{k.unit}] {c_string(k.ref)} */"
+    return f"#define FDSMC_{k.name:<15} {value:<32} /* [{_comment(k.unit)}] {_comment(k.ref)} */"
 
 
 def parameter_hash(params: DriveParams) -> str:
