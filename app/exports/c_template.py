@@ -44,6 +44,9 @@ $checks *
  *   minimum-energy move to theta_dem [counts] in T_m [s] from rest (profile of eq. (60) of [1]
  *   computed on the target). It returns FDSMC_OK or an FDSMC_ERR_* code and then keeps the
  *   previous move: FDSMC_ERR_T_M when T_m < T_m,min = sqrt(2*(5 + 2e^-3)*|dtheta|/alpha_max).
+ * Limits. The voltages returned keep the currents predicted at the end of the next sample within
+ *   |i_dq| <= FDSMC_I_LIMIT = min(i_max, Gamma_max/K_t) (hard, from eqs. (1)-(2) of [1]; i_d first),
+ *   then |u_dq| <= FDSMC_U_MAX; out.saturated = 1 when a limit acted.
  * Faults. Non-finite or implausible currents, an observer innovation |theta_r - theta_hat| above
  *   FDSMC_E_O_MAX (lost counts, stall, wrong sign or pole pairs) and a non-finite result latch a
  *   FDSMC_FAULT_* bit in s.status.fault and give u_d = u_q = 0 from then on: on a fault, open the
@@ -53,10 +56,12 @@ $checks *
  *   -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 -fno-math-errno -ffp-contract=fast: no double operation,
  *   sqrtf is one VSQRT, multiply-adds fuse to VFMA; the double build is the simulator's arithmetic).
  *
- * Observer state (scaled so that float32 is accurate): theta_hat - theta_dem = (n0 + f0) counts,
- *   z = (omega_hat*T_s, Gamma_L_hat*T_s^2/J_r, dGamma_L_hat/dt*T_s^3/J_r), every component in rad --
- *   the angle the estimate moves in one sample -- so that the matrices of z[k+1] = PHI_S*z[k] +
- *   GAMMA_S*a_em[k]*T_s^2 + L_S*e_o[k] are of order 1 (the unscaled gains span ~1e15).
+ * Observer state. Double build: x = (theta_hat [rad], omega_hat, Gamma_L_hat, its rate), updated
+ *   x[k+1] = Phi*x[k] + Gamma*a_em[k] + L*e_o[k] exactly as the simulator (bit-identical results on
+ *   the same readings). Float build (scaled so that float32 is accurate): theta_hat - theta_dem =
+ *   (n0 + f0) counts, z = (omega_hat*T_s, Gamma_L_hat*T_s^2/J_r, dGamma_L_hat/dt*T_s^3/J_r), every
+ *   component in rad -- the angle the estimate moves in one sample -- so that the matrices of
+ *   z[k+1] = PHI_S*z[k] + GAMMA_S*a_em[k]*T_s^2 + L_S*e_o[k] are of order 1 (unscaled: ~1e15 apart).
  *
  * Reference [1]: Dodds, Sooriyakumar, Perryman, "A robust forced dynamic sliding mode minimum
  * energy position controller for PMSM drives": outer loop eqs. (41)-(46), profile eqs. (57)-(60),
