@@ -181,16 +181,43 @@ def measure(params: DriveParams, single: bool, controller: str = "fdsmc") -> dic
         return agreement(params, closed_loop(build(folder, single), single, params, controller), controller)
 
 
+def replay(folder: Path, single: bool) -> float:
+    """Build and run the export's host test program in ``folder``; returns max |u − u_sim| / peak |u| [-]."""
+    cc = compiler()
+    if cc is None:
+        raise RuntimeError("no C compiler (cc) found: scripts/ensure_cc.sh installs it")
+    defines = ["-DFDSMC_USE_FLOAT"] if single else []
+    subprocess.run([cc, *CFLAGS, *defines, accept_flag(folder), "-O2", "fdsmc_test.c", "fdsmc_controller.c", "-lm",
+                    "-o", "fdsmc_test"], cwd=folder, check=True, capture_output=True, text=True)
+    out = subprocess.run(["./fdsmc_test"], cwd=folder, capture_output=True, text=True).stdout
+    return float(out.split("peak |u| = ")[1].split()[0])
+
+
+#: A 17-bit encoder, 0.05 A rms current noise and a 12-bit ADC of ±60 A (``python -m app.exports.c_verify``).
+SENSORS = ("sensors.encoder_cpr=131072", "sensors.i_noise=0.05", "sensors.i_adc_bits=12", "sensors.i_adc_range=60")
+
+
 def main() -> None:
-    """Print the agreement figures of the paper preset (paper K, recommended K) and the real-motor presets."""
+    """Print closed-loop agreement (both builds) and the golden-vector replay, paper and real-motor presets."""
+    from app.exports.c_vectors import c_files  # the vectors module imports this one
+    from sim.fdsmc.design import run_checks
+    from sim.fdsmc.engine import compare
+
     cases = [("paper, K = 1000", "paper_12kw_pmsm", []), ("paper, K = 0.3", "paper_12kw_pmsm", ["controller.K=0.3"])]
-    cases += [(n, n, []) for n in list_presets() if n != "paper_12kw_pmsm" and isinstance(load_preset(n), DriveParams)]
+    cases += [(n, n, list(SENSORS)) for n in list_presets()
+              if n != "paper_12kw_pmsm" and isinstance(load_preset(n), DriveParams)]
     for label, preset, sets in cases:
         params = load_preset(preset, sets)
+        cmp = compare(params)
+        with tempfile.TemporaryDirectory() as tmp:
+            for name, text in c_files(cmp, run_checks(params, cmp.fdsmc), force=True).items():
+                (Path(tmp) / name).write_text(text, encoding="utf-8")
+            same = [replay(Path(tmp), single) for single in (False, True)]
         for single in (False, True):
             err = measure(params, single)
-            text = "  ".join(f"{k} {v:.2e}" for k, v in err.items())
-            print(f"{label:24s} {'float32' if single else 'double ':8s} {text}", flush=True)
+            text = "  ".join(f"{k} {v:.1e}" for k, v in err.items())
+            print(f"{label:20s} {'float32' if single else 'double':7s} closed loop: {text}; same readings: "
+                  f"u {same[single]:.1e}", flush=True)
 
 
 if __name__ == "__main__":
