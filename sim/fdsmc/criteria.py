@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.fdsmc.feasibility import current_limit
+from control.fdsmc.feasibility import current_limit, speed_limit
 from control.fdsmc.model import torque_constant
 from control.fdsmc.params import DriveParams
 
@@ -58,7 +58,7 @@ def pass_criteria(params: DriveParams) -> PassCriteria:
     window = lim.in_position if lim.in_position > 0.0 else IN_POSITION_COUNTS * count
     i_lim = drive_current(params)
     return PassCriteria(
-        omega_max=lim.omega_max if lim.omega_max > 0.0 else params.motor.omega_b,
+        omega_max=speed_limit(params),
         in_position=window,
         overshoot=lim.overshoot if lim.overshoot > 0.0 else window,
         hold_i_rms=lim.hold_i_rms if lim.hold_i_rms > 0.0 else HOLD_RIPPLE_FRACTION * i_lim,

@@ -53,9 +53,12 @@ from sim.fdsmc.metrics import (
 CONTROLLERS = ("fdsmc", "conventional")
 #: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
 #: (:mod:`control.fdsmc.optimum`); the kernel's P_CTRL is the index in this tuple.
-COMPARATORS = CONTROLLERS + ("optimum",)
+COMPARATORS = CONTROLLERS + ("optimum", "stock")
 #: The name each simulated outer loop goes by in messages, tables and figures.
-LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum"}
+LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum", "stock": "Stock trapezoid"}
+#: The kernel's outer law (P_CTRL) of each comparator: the stock drive (a trapezoid tracked by the
+#: P–PI cascade without its integrator, :mod:`control.fdsmc.trapezoid`) is the reference-tracking law.
+KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 2.0, "stock": 2.0}
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
@@ -117,7 +120,7 @@ class Comparison:
 
     ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
     ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
-    ``optimum`` is the tracked minimum-energy move, when asked for.
+    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for.
     """
 
     derived: Derived
@@ -126,6 +129,7 @@ class Comparison:
     saving_friction_pct: float | None
     saving_electrical_pct: float | None
     optimum: RunResult | None = None
+    stock: RunResult | None = None
 
 
 @dataclass(frozen=True)
@@ -163,7 +167,7 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
     prm[[kn.P_RS, kn.P_LD, kn.P_LQ, kn.P_PSI, kn.P_P, kn.P_JR]] = (
         m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, m.J_r)
     prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (pl.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
-    prm[kn.P_CTRL] = COMPARATORS.index(controller)
+    prm[kn.P_CTRL] = KERNEL_LAW[controller]
     pr, o = d.profile, d.observer
     prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
@@ -200,7 +204,12 @@ def _observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _reference(d: Derived, controller: str) -> np.ndarray:
-    """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
+    """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum or trapezoid, else zeros."""
+    if controller == "stock":
+        from control.fdsmc.trapezoid import trapezoid_reference, trapezoid_timing
+
+        tr = trapezoid_timing(d.params.manoeuvre.theta_dem, d.alpha.alpha_max, d.params.manoeuvre.T_m)
+        return np.ascontiguousarray(trapezoid_reference(tr))
     if controller != "optimum":
         return np.zeros((3, 2))
     from control.fdsmc.optimum import tracked_move  # imports cvxpy only when limits are active
@@ -235,7 +244,8 @@ def simulate(
         The commissioning case.
     controller : str
         ``"fdsmc"`` (eqs. 41–46 in [1]), ``"conventional"`` (eq. 62 sign-corrected) or
-        ``"optimum"`` (the minimum-energy move of :mod:`control.fdsmc.optimum`, tracked).
+        ``"optimum"`` (the minimum-energy move of :mod:`control.fdsmc.optimum`, tracked) or ``"stock"``
+        (the trapezoid of :mod:`control.fdsmc.trapezoid` tracked by the stock drive's cascade).
     derived : Derived or None
         ``derive(params)`` if already computed.
     n_sub : int
@@ -371,7 +381,7 @@ def compare(
     runs |= {c: f.result() for c, f in futures.items()}
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
-                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"))
+                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"))
 
 
 def table1_sweep(
