@@ -30,8 +30,8 @@ from sim.fdsmc.design import run_checks
 from sim.fdsmc.engine import compare
 
 ROOT = Path(__file__).resolve().parent.parent
-#: The designed move of yaskawa_sgm7j_04a (10 rev in 0.5 s) in counts of an ideal encoder's module (2^22).
-TEN_REV = 10 * 2**22
+#: The designed move of yaskawa_sgm7j_04a (10 rev in 0.5 s) in counts of its module.
+TEN_REV = 10 * count_params(load_preset("yaskawa_sgm7j_04a"))[0].sensors.encoder_cpr
 CI = os.environ.get("CI") == "true"
 
 

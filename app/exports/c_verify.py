@@ -193,18 +193,17 @@ def replay(folder: Path, single: bool) -> float:
     return float(out.split("peak |u| = ")[1].split()[0])
 
 
-#: A 17-bit encoder, 0.05 A rms current noise and a 12-bit ADC of ±60 A (``python -m app.exports.c_verify``).
-SENSORS = ("sensors.encoder_cpr=131072", "sensors.i_noise=0.05", "sensors.i_adc_bits=12", "sensors.i_adc_range=60")
-
-
 def main() -> None:
-    """Print closed-loop agreement (both builds) and the golden-vector replay, paper and real-motor presets."""
+    """Print closed-loop agreement (both builds) and the golden-vector replay, paper and real-motor presets.
+
+    The real-motor presets run with their own sensors (encoder, current noise, ADC).
+    """
     from app.exports.c_vectors import c_files  # the vectors module imports this one
     from sim.fdsmc.design import run_checks
     from sim.fdsmc.engine import compare
 
     cases = [("paper, K = 1000", "paper_12kw_pmsm", []), ("paper, K = 0.3", "paper_12kw_pmsm", ["controller.K=0.3"])]
-    cases += [(n, n, list(SENSORS)) for n in list_presets()
+    cases += [(n, n, []) for n in list_presets()
               if n != "paper_12kw_pmsm" and isinstance(load_preset(n), DriveParams)]
     for label, preset, sets in cases:
         params = load_preset(preset, sets)
