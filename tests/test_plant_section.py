@@ -11,6 +11,7 @@ from app.cli.main import main
 from app.io.plant_overrides import load_model_and_plant
 from app.io.preset_schema import PresetError
 from app.io.presets import (
+    PRESET_DIR,
     dumps_preset,
     load_preset,
     load_preset_and_plant,
@@ -98,5 +99,5 @@ def test_bad_plant_values_are_refused_naming_the_field(block, match):
 
 def test_bldc_presets_have_no_plant_section():
     with pytest.raises(PresetError, match="unknown top-level key 'plant'"):
-        loads_preset(pathlib.Path("presets/bldc_smc_paper.yaml").read_text(encoding="utf-8")
+        loads_preset((PRESET_DIR / "bldc_smc_paper.yaml").read_text(encoding="utf-8")
                      + "plant:\n  J: 0.1\n", "bldc.yaml")

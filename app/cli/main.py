@@ -101,3 +101,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
+
+
+def entry() -> None:
+    """Console entry point ``pmsm-commission …`` (installed by the wheel): :func:`main`, then exit."""
+    sys.exit(main())

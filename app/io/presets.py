@@ -40,10 +40,12 @@ from app.io.preset_schema import (
     plain,
     plant_raw,
 )
+from app.resources import preset_dir
 from control.common.checks import field_specs
 from control.fdsmc.params import DriveParams
 
-PRESET_DIR = Path(__file__).resolve().parents[2] / "presets"
+#: Folder of the shipped presets (package data, :mod:`app.resources`).
+PRESET_DIR = preset_dir()
 MAX_BYTES = 256 * 1024
 #: The page's start-up preset: a real catalogue servo with a verified clean design.
 DEFAULT_PRESET = "siemens_1ft7044_ak7"
@@ -188,7 +190,7 @@ MAX_NAME = 1024
 
 
 def resolve(name_or_path: str) -> Path:
-    """Preset name (file stem in ``presets/``) or path (YAML or JSON) → path; a clear error if absent."""
+    """Preset name (file stem in ``app/presets/``) or path (YAML or JSON) → path; a clear error if absent."""
     if len(name_or_path) > MAX_NAME:
         raise PresetError(f"preset name {name_or_path[:40]!r}… has {len(name_or_path)} characters: "
                           f"allowed ≤ {MAX_NAME}")

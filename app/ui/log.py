@@ -8,7 +8,6 @@ identified values can be written into the inputs, which marks the parameters' ``
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 from typing import Any
 
 import viser
@@ -16,12 +15,13 @@ import viser
 from app.figures.drive_log import make_log_overlay_figure
 from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
 from app.io.presets import load_preset
+from app.resources import example_log
 from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
 from control.fdsmc.params import DriveParams
 from sim.drivelog.overlay import Overlay, overlay
 
-EXAMPLE_LOG = Path(__file__).resolve().parents[2] / "tests" / "data" / "drive_log_dq.csv"
+EXAMPLE_LOG = example_log()
 EXAMPLE_PRESET = "example_log_drive"
 #: Identified parameter → (section, field) of the inputs; J_total goes to J_L = J_total − J_r.
 TARGETS = {"R_s": ("motor", "R_s"), "L_d": ("motor", "L_d"), "L_q": ("motor", "L_q"),
