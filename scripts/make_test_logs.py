@@ -16,15 +16,18 @@ Usage: ``.venv/bin/python scripts/make_test_logs.py [OUT_DIR]`` (default tests/d
 
 from __future__ import annotations
 
+import shutil
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from app.io.presets import load_preset
+from app.resources import example_log
 from control.fdsmc.derivations import derive
 from sim.drivelog.synthetic import LOG_DURATION, LOG_OVERRIDES, LogNoise, add_noise, clean_log, perturbed
 
+ROOT = Path(__file__).resolve().parent.parent
 HEADER = "# Synthetic drive log made by scripts/make_test_logs.py from the project's plant (seed {seed}).\n"
 
 
@@ -61,7 +64,9 @@ def main(out: Path) -> None:
         "# Mapping of drive_log_phases.csv's columns (column: signal [unit])\n"
         "Time: t [us]\nPos: theta_r [deg]\nIa: i_a [A]\nIb: i_b [A]\nVd_ref: u_d [V]\nVq_ref: u_q [V]\n",
         encoding="utf-8")
+    if out.resolve() == (ROOT / "tests" / "data").resolve():  # the page's Example button reads the shipped copy
+        shutil.copyfile(out / "drive_log_dq.csv", example_log())
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parent.parent / "tests" / "data")
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "tests" / "data")

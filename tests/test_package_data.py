@@ -1,5 +1,6 @@
 """Production code reads package data only: the example drive log shipped in ``app/examples`` is the
-same file as the tests' copy in ``tests/data``, and no module of app/, control/ or sim/ names ``tests/``."""
+same file as the tests' copy in ``tests/data``, and no module of app/, control/ or sim/ names ``tests/``.
+"""
 
 from __future__ import annotations
 
