@@ -32,8 +32,8 @@ from app.io.presets import annotate_units, dumps_preset
 from app.io.units import from_si, s_to_ms, shown_range, spec_of, to_si
 from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
-from app.ui.plots import add_figure, set_figure_json
 from app.ui.text import checked_choice, md_text
+from app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
 from app.ui.worker import Cancelled, Worker
 from control.bldc.design import bldc_design
 from control.bldc.params import EMF_SHAPES, BldcParams
@@ -95,8 +95,10 @@ def design_view(p: BldcParams) -> tuple[str, str, str, tuple[str, ...]]:
     """
     table = machine_table(p.machine)
     design = bldc_design(p)
-    return (make_emf_figure(table, p.machine.Phi_m).to_json(), make_dqx_figure(table, p.machine.Phi_m).to_json(),
-            make_reachability_figure(design).to_json(), tuple(design.warnings))
+    figures = (make_emf_figure(table, p.machine.Phi_m), make_dqx_figure(table, p.machine.Phi_m),
+               make_reachability_figure(design))
+    emf, dqx, reach = (figure_json_of(f) for f in figures)
+    return emf, dqx, reach, tuple(design.warnings)
 
 
 def metrics_markdown(comp: BldcComparison) -> str:
@@ -222,10 +224,9 @@ class BldcTab:
             self.run_button.disabled, self.cancel_button.visible = False, False
         self.params, self.comparison = params, comp
         self._show_design()
-        self.fig_speed.figure = make_speed_figure(comp)
-        self.fig_torque.figure = make_torque_figure(comp)
-        self.fig_sigma.figure = make_sigma_figure(comp)
-        self.fig_currents.figure = make_currents_figure(comp)
+        for handle, make in ((self.fig_speed, make_speed_figure), (self.fig_torque, make_torque_figure),
+                             (self.fig_sigma, make_sigma_figure), (self.fig_currents, make_currents_figure)):
+            set_figure_json(handle, figure_json_of(make(comp)))
         self.metrics.content = metrics_markdown(comp)
         sim_s = params.case.t_end * len(comp.runs)
         self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**, "

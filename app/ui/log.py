@@ -16,6 +16,7 @@ from app.figures.drive_log import make_log_overlay_figure
 from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
 from app.io.presets import load_preset
 from app.resources import example_log
+from app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
 from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
 from control.fdsmc.params import DriveParams
@@ -140,9 +141,9 @@ class LogPanel:
     def _show(self, fig: Any) -> None:
         if self._figure is None:
             with self.s.results.panel.add_tab("Drive log", viser.Icon.CHART_LINE):
-                self._figure = self.s.client.gui.add_plotly(fig, aspect=1.0)
+                self._figure = add_figure(self.s.client.gui, figure_json_of(fig), aspect=1.0)
         else:
-            self._figure.figure = fig
+            set_figure_json(self._figure, figure_json_of(fig))
 
     def _apply(self) -> None:
         if self.identified is None:

@@ -18,7 +18,8 @@ import re
 from pathlib import Path
 
 import viser
-from viser import _messages
+
+from app.ui.viser_adapter import mark_plotly_js_sent, plotly_js_sent, run_script
 
 BUNDLE = Path(__file__).resolve().parent / "assets" / "plotly-basic.min.js"
 #: Trace types the basic bundle draws (scatter comes with plotly.js's core).
@@ -39,21 +40,16 @@ def bundle_version() -> str:
     return match.group(1)
 
 
-def run_script(gui: viser.GuiApi, source: str) -> None:
-    """Run the JavaScript ``source`` in the page of ``gui``'s client (viser's own script message)."""
-    gui._websock_interface.queue_message(_messages.RunJavascriptMessage(source=source))
-
-
 def use_basic_plotly(gui: viser.GuiApi) -> None:
     """Send the basic plotly.js bundle to this client instead of viser's full one.
 
     Must run before the client's first ``add_plotly`` (viser sends the full bundle then, once,
-    unless ``GuiApi._setup_plotly_js`` is already set — the flag viser itself keeps for this).
+    unless viser's own flag says plotly.js is sent: :mod:`app.ui.viser_adapter`).
     """
-    if getattr(gui, "_setup_plotly_js", False):
+    if plotly_js_sent(gui):
         return
     run_script(gui, bundle_source())
-    gui._setup_plotly_js = True
+    mark_plotly_js_sent(gui)
 
 
-__all__ = ["BUNDLE", "TRACE_TYPES", "bundle_source", "bundle_version", "run_script", "use_basic_plotly"]
+__all__ = ["BUNDLE", "TRACE_TYPES", "bundle_source", "bundle_version", "use_basic_plotly"]

@@ -25,10 +25,9 @@ from app.figures.comparison import runs, time_plots_spec
 from app.figures.overview import overview_spec
 from app.figures.plain import figure_json
 from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
-from app.ui.plotly_js import run_script
-from app.ui.plots import set_figure_json
 from app.ui.props import assign
 from app.ui.scene import RotorScene
+from app.ui.viser_adapter import run_script, set_figure_json
 
 FRAME_HZ = 25.0
 

@@ -19,11 +19,11 @@ from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.figures.plain import figure_json
 from app.io.numbers import parse_T_m_list
 from app.ui.layout import PanelLayout
-from app.ui.plots import add_figure, set_figure_json
 from app.ui.props import assign
 from app.ui.replay import Replay, overview_json, time_plots_json
 from app.ui.scene import RotorScene
 from app.ui.text import annual_savings, key_numbers_html, savings_markdown
+from app.ui.viser_adapter import add_figure, set_figure_json
 from sim.fdsmc.engine import TABLE1_T_M
 
 #: Plot height / width per figure [-].

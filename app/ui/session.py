@@ -23,7 +23,7 @@ from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
 from app.ui.log import LogPanel
-from app.ui.plotly_js import run_script, use_basic_plotly
+from app.ui.plotly_js import use_basic_plotly
 from app.ui.props import assign
 from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene, aim_camera
@@ -31,6 +31,7 @@ from app.ui.studies import OptimumToggle, StudiesSection
 from app.ui.text import checked_choice, derived_markdown, design_markdown, md_text
 from app.ui.tuning import LiveTuning, TuneRunner
 from app.ui.verdict_panel import VerdictPanel
+from app.ui.viser_adapter import run_script, widget_id
 from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Cancelled, Worker
 from control.fdsmc.derivations import derive
@@ -113,7 +114,7 @@ class Session:
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
-        run_script(gui, window_report_js(self._window_probe._impl.uuid))
+        run_script(gui, window_report_js(widget_id(self._window_probe)))
 
     def _apply_layout(self, layout: PanelLayout) -> None:
         self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
@@ -123,7 +124,7 @@ class Session:
     def _install_page_css(self, show_3d: bool) -> None:
         """Put the page's CSS (:func:`app.ui.layout.page_css`) for the 3D view shown or folded into the page."""
         self._style_3d = show_3d
-        run_script(self.gui, install_css_js(page_css(self._window_probe._impl.uuid, show_3d)))
+        run_script(self.gui, install_css_js(page_css(widget_id(self._window_probe), show_3d)))
 
     def _controls(self) -> None:
         gui = self.gui

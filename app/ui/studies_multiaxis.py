@@ -16,8 +16,8 @@ from app.figures.studies import multiaxis_spec, multiaxis_table_markdown
 from app.io.preset_modes import list_presets_of
 from app.io.presets import MAX_BYTES, loads_raw
 from app.io.study_inputs import parse_axes
-from app.ui.plots import add_figure, set_figure_json
 from app.ui.text import md_text
+from app.ui.viser_adapter import add_figure, set_figure_json
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.grid import check_budget

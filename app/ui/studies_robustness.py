@@ -20,8 +20,8 @@ import viser
 from app.figures.plain import figure_json
 from app.figures.studies import robustness_spec, robustness_table_markdown
 from app.io.study_inputs import parse_spread
-from app.ui.plots import add_figure, set_figure_json
 from app.ui.text import md_text
+from app.ui.viser_adapter import add_figure, set_figure_json
 from app.ui.worker import Cancelled
 from control.common.checks import ParameterError
 from control.fdsmc.feasibility import torque_limit

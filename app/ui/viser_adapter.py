@@ -1,0 +1,91 @@
+"""Every use of viser's private API, in one file (written for viser 1.1.1, pinned by a test).
+
+The page needs four things viser's public API does not offer:
+
+* **a figure sent once**: ``GuiApi.add_plotly`` queues a creation message whose properties are the
+  very object the returned handle writes to, and then sets the figure (an update message). Until
+  the creation message has left — on every page open, where the widgets and their figures are made
+  in one go — each figure set on the widget therefore travels twice. :func:`add_figure` gives the
+  handle its own copy of the properties right after creation, so the creation message keeps the
+  empty figure and each figure goes out once; :func:`set_figure_json` sends ready-made Plotly JSON
+  (``_plotly_json_str``, the property ``GuiPlotlyHandle.figure`` itself sets) and nothing when the
+  figure is unchanged. Every figure of the page goes through these two functions.
+* **a script run in the page** (:func:`run_script`, viser's own ``RunJavascriptMessage``);
+* **plotly.js sent by the page** (:func:`plotly_js_sent`, :func:`mark_plotly_js_sent`: viser's
+  ``GuiApi._setup_plotly_js`` flag, so ``add_plotly`` does not send its full bundle);
+* **a widget's DOM id** (:func:`widget_id`: the uuid the page's CSS and scripts address).
+
+A viser upgrade is checked here and in ``tests/test_viser_adapter.py`` only.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Protocol
+
+import viser
+from viser import _messages
+
+from app.figures.plain import blank_json
+
+#: The viser release this adapter was written for (``tests/test_viser_adapter.py`` pins it).
+WRITTEN_FOR = "1.1.1"
+
+
+class _Figure(Protocol):
+    def to_json(self) -> str: ...
+
+
+class _ReadyFigure:
+    """What ``GuiApi.add_plotly`` reads of a figure (``to_json()``), carrying ready-made JSON."""
+
+    def __init__(self, json_str: str) -> None:
+        self._json = json_str
+
+    def to_json(self) -> str:
+        """Return the figure's Plotly JSON."""
+        return self._json
+
+
+def add_figure(gui: viser.GuiApi, json_str: str | None = None, aspect: float = 1.0) -> viser.GuiPlotlyHandle:
+    """Add a plot widget showing the Plotly JSON ``json_str`` (an empty figure if None); each figure is sent once."""
+    handle = gui.add_plotly(_ReadyFigure(blank_json()), aspect=aspect)  # type: ignore[arg-type]
+    handle._impl.props = dataclasses.replace(handle._impl.props)  # no longer the queued creation message's
+    if json_str is not None:
+        set_figure_json(handle, json_str)
+    return handle
+
+
+def set_figure_json(handle: viser.GuiPlotlyHandle, json_str: str) -> None:
+    """Send a ready-made Plotly JSON string to a plot widget, unless it already shows exactly that."""
+    if handle._plotly_json_str != json_str:
+        handle._plotly_json_str = json_str
+
+
+def figure_json_of(figure: _Figure) -> str:
+    """Return the Plotly JSON of a ``go.Figure`` exactly as ``GuiPlotlyHandle.figure`` would send it."""
+    return figure.to_json()
+
+
+def run_script(gui: viser.GuiApi, source: str) -> None:
+    """Run the JavaScript ``source`` in the page of ``gui``'s client (viser's own script message)."""
+    gui._websock_interface.queue_message(_messages.RunJavascriptMessage(source=source))
+
+
+def plotly_js_sent(gui: viser.GuiApi) -> bool:
+    """Return True once plotly.js is in this client's page (viser's own flag ``_setup_plotly_js``)."""
+    return bool(getattr(gui, "_setup_plotly_js", False))
+
+
+def mark_plotly_js_sent(gui: viser.GuiApi) -> None:
+    """Record that plotly.js is in this client's page: ``add_plotly`` then sends no bundle of its own."""
+    gui._setup_plotly_js = True
+
+
+def widget_id(handle: Any) -> str:
+    """Return the id of a GUI widget (the uuid its element carries in the page)."""
+    return str(handle._impl.uuid)
+
+
+__all__ = ["WRITTEN_FOR", "add_figure", "figure_json_of", "mark_plotly_js_sent", "plotly_js_sent", "run_script",
+           "set_figure_json", "widget_id"]

@@ -1,0 +1,86 @@
+"""viser's private API is used in app/ui/viser_adapter.py only, for the viser release it was written for.
+
+A viser upgrade fails here first: the version pin, then each private name the adapter relies on,
+exercised on a real (local, verbose-off) server; and no other module of app/ touches a private
+name of viser.
+"""
+
+from __future__ import annotations
+
+import re
+import socket
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+import viser
+
+from app.figures.plain import figure_json
+from app.ui import viser_adapter as va
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_viser_is_the_release_the_adapter_was_written_for():
+    assert viser.__version__ == va.WRITTEN_FOR
+
+
+@pytest.fixture(scope="module")
+def gui() -> Iterator[viser.GuiApi]:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = int(s.getsockname()[1])
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    try:
+        yield server.gui
+    finally:
+        server.stop()
+
+
+def test_a_figure_is_shown_and_an_unchanged_one_not_sent_again(gui, monkeypatch):
+    first = figure_json({"data": [{"type": "scatter", "x": [0, 1], "y": [1, 2]}], "layout": {}})
+    handle = va.add_figure(gui, first, aspect=0.5)
+    assert handle._plotly_json_str == first and handle.aspect == 0.5
+    sent: list[str] = []
+    original = type(handle)._queue_update
+
+    def spy(self, name, value):
+        sent.append(name)
+        return original(self, name, value)
+
+    monkeypatch.setattr(type(handle), "_queue_update", spy)
+    va.set_figure_json(handle, first)  # unchanged: nothing sent
+    second = figure_json({"data": [], "layout": {"title": {"text": "b"}}})
+    va.set_figure_json(handle, second)
+    assert sent == ["_plotly_json_str"] and handle._plotly_json_str == second
+
+
+def test_widget_id_script_and_plotly_flag(gui):
+    text = gui.add_text("probe", "")
+    assert va.widget_id(text) == text._impl.uuid and va.widget_id(text)
+    va.run_script(gui, "void 0;")  # viser's own message type still exists and queues
+    va.mark_plotly_js_sent(gui)
+    assert va.plotly_js_sent(gui) is True and gui._setup_plotly_js is True
+
+
+def _viser_private_names() -> set[str]:
+    root = Path(viser.__file__).parent
+    names: set[str] = set()
+    for f in root.rglob("*.py"):
+        names |= set(re.findall(r"self\.(_[a-zA-Z]\w*)", f.read_text(encoding="utf-8")))
+    return {n for n in names if not n.startswith("__")}
+
+
+def test_no_other_module_touches_viser_privates():
+    names = _viser_private_names()
+    assert {"_impl", "_plotly_json_str", "_websock_interface", "_setup_plotly_js"} <= names
+    attr = re.compile(r"(?<!self)(?<!cls)\.(" + "|".join(sorted(names)) + r")\b")
+    module = re.compile(r"from viser import _|viser\._|import viser\._")
+    offenders = []
+    for path in sorted((ROOT / "app").rglob("*.py")):
+        if path.name == "viser_adapter.py":
+            continue
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            if attr.search(line) or module.search(line):
+                offenders.append(f"{path.relative_to(ROOT)}:{number}: {line.strip()}")
+    assert offenders == []
