@@ -45,6 +45,23 @@ def test_kv_and_kt_give_the_flux_through_the_pole_pairs():
     assert torque_constant(kt) == pytest.approx(0.63 / math.sqrt(2.0), rel=1e-12)
 
 
+@pytest.mark.parametrize(("key", "value"), [("Ke_Vrms_krpm", 57.0), ("Ke_Vpk_krpm", 57.0 * math.sqrt(2.0)),
+                                            ("Ke_ph_Vrms_krpm", 57.0 / math.sqrt(3.0)),
+                                            ("Ke_ph_Vpk_krpm", 57.0 * math.sqrt(2.0 / 3.0))])
+def test_ke_in_any_datasheet_form_gives_the_same_flux(key, value):
+    # 57 V_rms LL/krpm (Siemens 1FT7044) written as LL peak, phase rms and phase peak
+    ref = load_preset("siemens_1ft7044_ak7").motor.psi_pm
+    raw = load_raw("siemens_1ft7044_ak7")
+    raw["motor"].pop("Ke_Vrms_krpm")
+    raw["motor"][key] = value
+    assert parse_preset(raw).motor.psi_pm == pytest.approx(ref, rel=1e-12)
+
+
+def test_line_to_line_winding_values_are_halved():
+    p = load_preset(BASE, ["motor.R_s_LL_Ohm=3.68", "motor.L_d_LL_mH=27.2", "motor.L_q_LL_mH=27.2"])
+    assert p.motor.R_s == pytest.approx(1.84) and p.motor.L_d == pytest.approx(13.6e-3)
+
+
 def test_a_flux_key_and_psi_pm_together_are_refused():
     raw = load_raw("odrive_d5065_belt")
     raw["motor"]["psi_pm"] = 0.003

@@ -41,6 +41,10 @@ TOOL = "pmsm-commissioning (FDSMC)"
 #: File names of the generated module.
 HEADER_NAME, SOURCE_NAME = "fdsmc_controller.h", "fdsmc_controller.c"
 
+#: Why a continuous-mode case has no C export.
+CONTINUOUS_REFUSED = ("controller.f_s = 'continuous' cannot be exported as C firmware: "
+                      "allowed a sample rate in Hz (100 … 1e7)")
+
 
 @dataclass(frozen=True)
 class CConstant:
@@ -117,8 +121,7 @@ def scaled_observer(d: Derived) -> ScaledObserver:
     """
     od = d.observer_discrete
     if od is None:
-        raise ParameterError("controller.f_s = 'continuous' cannot be exported as C firmware: "
-                             "allowed a sample rate in Hz (100 … 1e7)")
+        raise ParameterError(CONTINUOUS_REFUSED)
     f_s, J_r = 1.0 / od.T_s, d.params.motor.J_r
     scale = np.array([1.0, f_s, f_s**2 * J_r, f_s**3 * J_r])
     Phi = od.Phi * scale[np.newaxis, :] / scale[:, np.newaxis]

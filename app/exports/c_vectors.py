@@ -14,7 +14,15 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from app.exports.c_module import HEADER_NAME, Verdict, c_literal, controller_files, parameter_hash, verdict_of
+from app.exports.c_module import (
+    CONTINUOUS_REFUSED,
+    HEADER_NAME,
+    Verdict,
+    c_literal,
+    controller_files,
+    parameter_hash,
+    verdict_of,
+)
 from app.exports.c_text import c_string
 from app.exports.c_verify import count_params, readings
 from app.io.presets import SCHEMA
@@ -133,6 +141,8 @@ def c_files(cmp: Comparison, checks: Sequence | None, force: bool = False) -> di
         When the design is not clean and ``force`` is False, naming the failed checks.
     """
     entered = cmp.derived.params
+    if entered.controller.is_continuous:  # before the counted case, which needs a sample rate for its encoder
+        raise ParameterError(CONTINUOUS_REFUSED)
     params, _ = count_params(entered)  # the firmware's demand is a whole count
     verdict: Verdict = verdict_of(checks if cmp.fdsmc is not None else None)
     if not verdict.clean and not force:

@@ -62,9 +62,9 @@ class Motor:
     omega_b: float = spec_field("rad/s", 0.0, 1e5, label="n_b rated speed", display="rpm")
     Gamma_max: float = spec_field("N·m", 1e-6, 1e6, low_open=False, label="Γ_max peak torque")
     psi_pm: float = spec_field("Wb", 1e-6, 100.0, low_open=False, label="Ψ_PM")
-    L_d: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_d", display="mH")
-    L_q: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_q", display="mH")
-    R_s: float = spec_field("Ω", 0.0, 1e4, label="R_s")
+    L_d: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_d", display="mH", aliases=("mH LL",))
+    L_q: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_q", display="mH", aliases=("mH LL",))
+    R_s: float = spec_field("Ω", 0.0, 1e4, label="R_s", aliases=("Ω LL",))
     p: int = spec_field("-", 1, 100, integer=True, label="p pole pairs")
     J_r: float = spec_field("kg·m²", 1e-9, 1e4, low_open=False, label="J_r rotor inertia", aliases=("kg·cm²",))
 
