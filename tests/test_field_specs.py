@@ -21,8 +21,10 @@ from app.io import units
 from app.io.presets import SCHEMA, annotate_units, dumps_preset, load_preset, loads_raw, parse_preset, to_raw
 from app.ui import bldc as bldc_tab
 from app.ui import inputs
+from control.bldc.params import BldcParams
 from control.common.checks import FieldSpec, ParameterError, field_specs
 from control.fdsmc.derivations import derive
+from control.fdsmc.params import DriveParams
 
 POSITION, BLDC = "paper_12kw_pmsm", "bldc_smc_paper"
 
@@ -38,7 +40,7 @@ def _raw(preset: str) -> dict:
 def _cases() -> list[tuple[str, str, str, FieldSpec]]:
     """(preset, section path, field, spec) of every spec'd field of both modes."""
     out = []
-    for preset, cls in ((POSITION, units.DriveParams), (BLDC, units.BldcParams)):
+    for preset, cls in ((POSITION, DriveParams), (BLDC, BldcParams)):
         for path, tp in units.sections(cls):
             out += [(preset, path, name, spec) for name, spec in field_specs(tp).items()]
     return out
@@ -70,7 +72,7 @@ def _outside(spec: FieldSpec) -> list[float]:
 
 def test_every_number_field_has_a_spec():
     """A float or int field without a spec would have no range, unit or label anywhere."""
-    for cls in (units.DriveParams, units.BldcParams):
+    for cls in (DriveParams, BldcParams):
         for path, tp in units.sections(cls):
             hints = typing.get_type_hints(tp)
             for f in dataclasses.fields(tp):
@@ -177,7 +179,7 @@ def test_bldc_page_field_shows_spec_label_unit_and_range(key):
     _check_hint(units.shown_range(spec), spec, spec.shown_unit, lambda x: units.to_si(x, spec.shown_unit))
 
 
-@pytest.mark.parametrize(("preset", "cls"), [(POSITION, units.DriveParams), (BLDC, units.BldcParams)])
+@pytest.mark.parametrize(("preset", "cls"), [(POSITION, DriveParams), (BLDC, BldcParams)])
 def test_exported_units_and_yaml_comments_follow_the_specs(preset, cls):
     params = parse_preset(_raw(preset))
     text = annotate_units(dumps_preset(params))

@@ -22,8 +22,7 @@ from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 from app.cli.bldc import bench_figure
 from app.cli.main import add_preset_arguments
-from app.io.preset_modes import load_mode_preset
-from app.io.presets import load_preset
+from app.io.presets import load, load_preset
 from control.fdsmc.derivations import clear_caches, derive
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import TABLE1_T_M, compare, run_steps, table1_sweep
@@ -67,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     if args.smoke:
         print("smoke run: one repetition of each figure, so these are single timings, not medians")
     for t_m in ([], ["manoeuvre.T_m=2.6"]):  # the preset's own move (what the page opens with), a long one
-        p = load_mode_preset(args.preset, [*base, *t_m, "controller.f_s=20000"], mode="position")
+        p = load(args.preset, [*base, *t_m, "controller.f_s=20000"], mode="position")
         print(comparison_figure(p, rep))
     pd = load_preset(args.preset, [*base, "controller.f_s=20000"])
     table1_sweep(pd, TABLE1_T_M[:1])

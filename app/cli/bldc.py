@@ -12,8 +12,7 @@ import time
 
 from app.cli.main import add_preset_arguments
 from app.io.bldc_view import comparison_json, metric_table
-from app.io.preset_modes import load_mode_preset
-from app.io.presets import load_preset
+from app.io.presets import load, load_preset
 from app.io.units import Hz_to_kHz, rad_s_to_rpm, s_to_ms
 from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
@@ -55,7 +54,7 @@ def bench_figure(params: BldcParams | None = None, repeat: int = 5) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Print the comparison (table or JSON)."""
-    params = load_mode_preset(args.preset, args.overrides, mode="bldc")
+    params = load(args.preset, args.overrides, mode="bldc")
     if args.bench:
         names = [c.name for c in params.scenario.cases]
         fast = [*args.overrides, "scenario.active=2000rpm"]

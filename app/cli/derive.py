@@ -8,7 +8,7 @@ import json
 from app.cli.main import add_preset_arguments
 from app.io.derived_view import derived_json, derived_rows, format_table
 from app.io.json_data import to_json
-from app.io.preset_modes import load_mode_preset
+from app.io.presets import load
 from control.fdsmc.derivations import derive
 
 
@@ -20,7 +20,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print the derived values (table or JSON) and warnings."""
-    params = load_mode_preset(args.preset, args.overrides, mode="position")
+    params = load(args.preset, args.overrides, mode="position")
     d = derive(params)
     if args.json:
         print(json.dumps(to_json(derived_json(d)), indent=2, ensure_ascii=False, allow_nan=False))

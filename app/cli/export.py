@@ -22,8 +22,7 @@ from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
 from app.exports.drive_units import ANGLE_UNITS
 from app.exports.model import FORMATS, export_files
 from app.io.numbers import parse_number
-from app.io.preset_modes import load_mode_preset
-from app.io.presets import load_preset_and_plant
+from app.io.presets import load, load_with_plant
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
@@ -84,8 +83,8 @@ def write_atomic(path: Path, content: bytes) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Load, simulate, pass the gate, write the export; prints the paths written."""
-    params = load_mode_preset(args.preset, args.overrides, mode="position")
-    _, plant = load_preset_and_plant(args.preset, args.overrides)
+    params = load(args.preset, args.overrides, mode="position")
+    _, plant = load_with_plant(args.preset, args.overrides)
     if plant is not None:  # the files carry the controller's model; the drive's true values are not theirs
         raise ParameterError("plant: export writes the controller's model (motor, load, controller); a plant "
                              "section or --set plant.* (the drive's true values) is not exported: allowed none — "

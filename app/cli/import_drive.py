@@ -16,8 +16,7 @@ from pathlib import Path
 from app.cli.export import write_atomic
 from app.cli.main import check_writable
 from app.exports.drive_import import IMPORT_FORMATS, import_drive
-from app.io.preset_modes import load_mode_preset
-from app.io.presets import MAX_BYTES, dumps, to_raw
+from app.io.presets import MAX_BYTES, dumps, load, to_raw
 from control.common.checks import ParameterError
 
 
@@ -48,7 +47,7 @@ def read_text(path: str) -> str:
 def run(args: argparse.Namespace) -> int:
     """Import, write the preset, list what was imported, kept and not imported."""
     check_writable(args.output, "-o")
-    base = load_mode_preset(args.base, (), mode="position")
+    base = load(args.base, (), mode="position")
     result = import_drive(read_text(args.file), args.format, base, args.file)
     name = args.name or Path(args.file).stem
     params = dataclasses.replace(result.params, name=name,

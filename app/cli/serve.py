@@ -12,8 +12,7 @@ import ipaddress
 import sys
 import time
 
-from app.io.preset_modes import load_mode_preset
-from app.io.presets import DEFAULT_PRESET
+from app.io.presets import DEFAULT_PRESET, load
 from app.ui.web_guard import Guard, new_token
 from control.fdsmc.derivations import derive
 
@@ -44,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     """Start the server, print the URL and serve until Ctrl-C."""
     if not 1 <= args.port <= 65535:
         raise ValueError(f"--port = {args.port} is out of range: allowed 1 … 65535")
-    params = load_mode_preset(args.preset, mode="position")
+    params = load(args.preset, mode="position")
     derive(params)  # a preset the derivations reject fails here, with its message
     token = None if is_loopback(args.host) else new_token()
     if token is not None:

@@ -18,7 +18,7 @@ import sys
 from app.cli.main import add_preset_arguments
 from app.io.json_data import to_json
 from app.io.numbers import format_metric, parse_T_m_list
-from app.io.preset_modes import load_mode_preset
+from app.io.presets import load
 from sim.fdsmc.engine import PAPER_TABLE1, TABLE1_T_M, Table1Row, table1_sweep
 
 DEFAULT_TM = ",".join(map(str, TABLE1_T_M))
@@ -47,7 +47,7 @@ def row_json(r: Table1Row) -> dict[str, float | None]:
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep and print the table (or JSON)."""
-    params = load_mode_preset(args.preset, args.overrides, mode="position")
+    params = load(args.preset, args.overrides, mode="position")
     tms = parse_T_m_list(args.tm, "--tm")
 
     def progress(done: int, total: int) -> None:

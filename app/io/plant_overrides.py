@@ -11,8 +11,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable
 
-from app.io.preset_modes import require_mode
-from app.io.presets import load_preset_and_plant
+from app.io.presets import load_with_plant, require_mode
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams, Load, Motor
 
@@ -55,5 +54,5 @@ def load_model_and_plant(preset: str, overrides: Iterable[str]) -> tuple[DrivePa
     """
     overrides = list(overrides)
     split_overrides(overrides)  # names a bad plant field before anything is loaded
-    params, plant = load_preset_and_plant(preset, overrides)
+    params, plant = load_with_plant(preset, overrides)
     return require_mode(params, "position", preset), plant

@@ -17,8 +17,8 @@ import typing
 from typing import Any
 
 from app.io import units
+from app.io.modes import MODES as _MODES
 from app.io.numbers import NumberFormatError, parse_integer, parse_number
-from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 
@@ -34,9 +34,8 @@ PLANT_SECTIONS = ("motor", "load")
 #: gains are recomputed from the inputs).
 _EXPORT_KEYS = ("exported_by", "units", "drive_gains", "verdicts", "results")
 
-#: Parameter dataclass per preset mode. Other modes register themselves here.
-MODES: dict[str, type] = {"position": DriveParams}
-MODES["bldc"] = BldcParams
+#: Parameter dataclass per preset mode: a view of the one registry :mod:`app.io.modes`.
+MODES: dict[str, type] = dict(_MODES)
 
 
 class PresetError(ValueError):

@@ -27,6 +27,7 @@ from typing import Any
 import yaml
 
 from app.io import units
+from app.io.modes import mode_for
 from app.io.preset_schema import (
     MODES,
     PLANT,
@@ -234,14 +235,31 @@ def _parsed_file(text: str, origin: str) -> Any:
     return loads_any_raw(text, origin)
 
 
-def load_preset(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()) -> Any:
-    """Load, override and validate a preset; returns its parameter object."""
-    return parse_preset(apply_overrides(load_raw(name_or_path), overrides))
+def load(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = (), mode: str | None = None) -> Any:
+    """Load a preset: the one way from a name or path to a parameter object.
+
+    Parameters
+    ----------
+    name_or_path : str
+        A shipped preset's name (``app/presets/NAME.yaml``) or a YAML/JSON file path.
+    overrides : iterable of str
+        ``section.field=value`` overrides (unit-suffixed keys allowed), applied before validation.
+    mode : str or None
+        The preset mode this caller takes (``"position"``, ``"bldc"``); a preset of another mode
+        is refused naming both. None takes any mode.
+
+    Returns
+    -------
+    DriveParams or BldcParams
+        The validated parameter object.
+    """
+    params = parse_preset(apply_overrides(load_raw(name_or_path), overrides))
+    return params if mode is None else require_mode(params, mode, name_or_path)
 
 
-def load_preset_and_plant(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()
-                          ) -> tuple[Any, DriveParams | None]:
-    """Load, override and validate a preset: (the controller's model, the plant or None).
+def load_with_plant(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()
+                    ) -> tuple[Any, DriveParams | None]:
+    """:func:`load` returning (the controller's model, the plant or None).
 
     ``overrides`` may include ``plant.FIELD=VALUE`` (on top of the file's plant section); a
     ``motor.``/``load.`` override changes the model and, where the plant section does not give
@@ -250,6 +268,38 @@ def load_preset_and_plant(name_or_path: str = DEFAULT_PRESET, overrides: typing.
     raw = apply_overrides(load_raw(name_or_path), overrides)
     params = parse_preset(raw)
     return params, (parse_plant(raw, params) if isinstance(params, DriveParams) else None)
+
+
+def load_preset(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = ()) -> Any:
+    """Alias of :func:`load` for any mode (kept for scripts and tests)."""
+    return load(name_or_path, overrides)
+
+
+#: Alias of :func:`load_with_plant` (kept for scripts and tests).
+load_preset_and_plant = load_with_plant
+
+
+def preset_mode(name: str) -> str | None:
+    """Mode of the shipped or given preset ``name``; None if it cannot be read."""
+    try:
+        raw = load_raw(name)
+    except PresetError:
+        return None
+    return str(raw.get("mode", "position")) if isinstance(raw, dict) else None
+
+
+def list_presets_of(mode: str) -> list[str]:
+    """Names of the shipped presets of ``mode``."""
+    return [n for n in list_presets() if preset_mode(n) == mode]
+
+
+def require_mode(params: Any, mode: str, origin: str) -> Any:
+    """Return ``params`` if it belongs to ``mode``, else PresetError naming both modes."""
+    found = mode_for(params).name
+    if found != mode:
+        raise PresetError(f"preset {origin!r} is a {found}-mode preset: allowed here a {mode}-mode preset "
+                          f"(shipped: {', '.join(list_presets_of(mode))})")
+    return params
 
 
 def loads_preset_and_plant(text: str, origin: str = "<upload>") -> tuple[Any, DriveParams | None]:
@@ -307,7 +357,7 @@ def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
     Schema, name, source, mode, sections, and the ``plant`` section when a plant that differs
     from the model is given.
     """
-    mode = next(m for m, cls in MODES.items() if isinstance(params, cls))
+    mode = mode_for(params).name
     body = plain(params)
     raw: dict[str, Any] = {"schema": SCHEMA, "name": body.pop("name"), "source": body.pop("source")}
     if mode != "position":
@@ -363,7 +413,8 @@ def save_preset(params: Any, path: str | Path, plant: DriveParams | None = None)
 
 __all__ = [
     "DEFAULT_PRESET", "PAPER_PRESET", "annotate_units", "apply_overrides", "dumps", "dumps_preset", "list_presets",
-    "load_preset", "load_preset_and_plant", "loads_preset", "loads_preset_and_plant", "save_preset", "to_raw",
+    "list_presets_of", "load", "load_preset", "load_preset_and_plant", "load_with_plant", "preset_mode",
+    "require_mode", "loads_preset", "loads_preset_and_plant", "save_preset", "to_raw",
 ]
 
 

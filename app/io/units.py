@@ -16,9 +16,8 @@ import typing
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from control.bldc.params import BldcParams
+from app.io.modes import MODE_CLASSES as _MODE_CLASSES
 from control.common.checks import FieldSpec, field_specs, range_text
-from control.fdsmc.params import DriveParams
 
 
 def rpm_to_rad_s(n_rpm: float) -> float:
@@ -213,8 +212,8 @@ def sections(cls: type, prefix: str = "") -> Iterator[tuple[str, type]]:
             yield from sections(tp, f"{path}.")
 
 
-#: Parameter dataclass of each mode (the preset loader's registry lives in app.io.presets).
-MODE_CLASSES: tuple[type, ...] = (DriveParams, BldcParams)
+#: Parameter dataclass of each mode (the one registry is :mod:`app.io.modes`).
+MODE_CLASSES: tuple[type, ...] = _MODE_CLASSES
 #: Section path → parameter dataclass, both modes (section names are unique across modes).
 SECTION_CLASSES: dict[str, type] = {path: tp for cls in MODE_CLASSES for path, tp in sections(cls)}
 
@@ -291,19 +290,6 @@ def psi_pm_to_kt_nm_per_arms(psi_pm: float, p: int) -> float:
 def psi_pm_to_ke_vrms_krpm(psi_pm: float, p: int) -> float:
     """Ψ_PM [Wb] → Ke [V_rms line-to-line per krpm]; inverse of :func:`ke_vrms_krpm_to_psi_pm`."""
     return psi_pm * p * rpm_to_rad_s(1000.0) / math.sqrt(2.0 / 3.0)
-
-
-def H_to_mH(L: float) -> float:
-    """Inductance [H] → [mH] (display): inverse of :func:`mH_to_H`."""
-    return L * (1.0 / mH_to_H(1.0))
-
-
-def Hz_to_kHz(f: float) -> float:
-    """Frequency [Hz] → [kHz] (display): inverse of :func:`kHz_to_Hz`."""
-    return f * (1.0 / kHz_to_Hz(1.0))
-
-
-
 
 
 def _unit_text(cls: type, name: str) -> str:

@@ -27,8 +27,7 @@ from app.figures.plain import placeholder_json
 from app.io.bldc_emf import read_measured, with_measured
 from app.io.bldc_view import metric_table
 from app.io.numbers import NumberFormatError
-from app.io.preset_modes import load_mode_preset
-from app.io.presets import annotate_units, dumps_preset
+from app.io.presets import annotate_units, dumps_preset, load
 from app.io.units import from_si, s_to_ms, shown_range, spec_of, to_si
 from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
@@ -117,7 +116,7 @@ class BldcTab:
                  figures_container: Any = None, worker: Worker | None = None) -> None:
         self.client, self.gui, self._submit, self._worker = client, client.gui, submit, worker
         self._figures_container = figures_container
-        self.params: BldcParams = load_mode_preset(PRESET, mode="bldc")
+        self.params: BldcParams = load(PRESET, mode="bldc")
         self.comparison: BldcComparison | None = None
         self._build()
 

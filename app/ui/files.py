@@ -21,9 +21,9 @@ import viser
 
 from app.exports.drive_files import ExportOptions
 from app.exports.model import export_download, safe_stem
+from app.io.modes import REGISTRY
 from app.io.preset_schema import PresetError
 from app.io.presets import MAX_BYTES, loads_preset, to_raw
-from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import Comparison
@@ -64,9 +64,8 @@ def uncommitted(shown: DriveParams, committed: DriveParams) -> list[str]:
     return [f"{k} = {a[k]!r} (simulated: {b.get(k)!r})" for k in a if a[k] != b.get(k)]
 
 
-#: Each mode's presets as an import message names them, and the tab that imports them.
-PRESET_KINDS: dict[type, tuple[str, str]] = {DriveParams: ("position-drive preset", "Position drive (FDSMC)"),
-                                             BldcParams: ("BLDC speed-drive preset", "BLDC speed SMC")}
+#: Each mode's presets as an import message names them, and the tab that imports them (:mod:`app.io.modes`).
+PRESET_KINDS: dict[type, tuple[str, str]] = {m.params: (m.kind, m.tab) for m in REGISTRY}
 
 
 def upload_text(name: str, content: bytes, allowed: str) -> str:

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import viser
 
-from app.io.preset_modes import list_presets_of, load_mode_preset, require_mode
+from app.io.presets import list_presets_of, load, require_mode
 from app.threads import limit_blas_threads
 from app.ui.bldc import add_bldc_tab
 from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
@@ -262,7 +262,7 @@ class Session:
             return
         try:
             name = checked_choice(self.preset.value, self._preset_names, "Preset")
-            params = load_mode_preset(name, mode="position")
+            params = load(name, mode="position")
         except ValueError as exc:
             self.preset.value = self._preset_shown  # back to the preset whose values are shown
             self._reject(str(exc))
