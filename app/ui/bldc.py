@@ -26,9 +26,10 @@ from app.figures.bldc import (
 from app.figures.plain import placeholder_json
 from app.io.bldc_emf import read_measured, with_measured
 from app.io.bldc_view import metric_table
+from app.io.display_units import field_hint, field_label, shown_value, si_value
 from app.io.numbers import NumberFormatError
 from app.io.presets import annotate_units, dumps_preset, load
-from app.io.units import from_si, s_to_ms, shown_range, spec_of, to_si
+from app.io.units import s_to_ms, spec_of
 from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice, md_text
@@ -54,28 +55,19 @@ FIELDS: tuple[str, ...] = (
 SCENARIO_FIELDS: tuple[str, ...] = ("scenario.cases.omega_ref", "scenario.cases.t_end")
 
 
-def field_label(key: str) -> str:
-    """Return the page label of ``section.field``: spec label and display unit, e.g. ``"L_s − M_s [mH]"``."""
-    spec = spec_of(key)
-    return f"{spec.label} [{spec.shown_unit}]"
-
-
 def number_input(gui: viser.GuiApi, key: str) -> NumberInput:
     """Add a number field for ``key`` with its label and its allowed range (display unit) as hint."""
-    return NumberInput(gui, field_label(key), hint=shown_range(spec_of(key)))
+    return NumberInput(gui, field_label(key), hint=field_hint(key))
 
 
 def show_si(field: NumberInput, key: str, si: float) -> None:
     """Show an SI value in the field's display unit; an untouched field reads back ``si`` exactly."""
-    spec = spec_of(key)
-    field.show(int(si) if spec.integer else from_si(si, spec.shown_unit), exact=si)
+    field.show(shown_value(key, si), exact=si)
 
 
 def read_si(field: NumberInput, key: str) -> float | int:
     """Read the field's value in SI units; NumberFormatError naming the field and its label."""
-    spec = spec_of(key)
-    return field.read(f"{key} ({field_label(key)})",
-                      lambda x: to_si(x, spec.shown_unit), integer=spec.integer)
+    return field.read(f"{key} ({field_label(key)})", lambda x: si_value(key, x), integer=spec_of(key).integer)
 
 
 def _placeholder(gui: viser.GuiApi, figure_id: str, title: str, aspect: float) -> viser.GuiPlotlyHandle:

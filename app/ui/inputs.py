@@ -11,130 +11,23 @@ the same loader as the CLI and YAML files (:func:`app.io.preset_schema.parse_pre
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import viser
 
 from app.io import units
+from app.io.display_units import UNIT_GROUPS, Field, Unit
 from app.io.numbers import NumberFormatError
 from app.io.preset_schema import parse_preset
 from app.io.presets import to_raw
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice
-from control.common.checks import FieldSpec, ParameterError
+from control.common.checks import ParameterError
 from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.params import DriveParams, Motor
 
-Conv = Callable[[float, int], float]  # (value, pole pairs) → value
-
-
-def _same(x: float, _p: int) -> float:
-    return x
-
-
-@dataclass(frozen=True)
-class Unit:
-    """A display unit: label and converters to/from SI (they may need the pole pairs p)."""
-
-    label: str
-    to_si: Conv = _same
-    from_si: Conv = _same
-
-
-def _named(unit: str) -> Unit:
-    """Make a display unit converted by :mod:`app.io.units` (``"kg·cm²"``, ``"deg"`` …; an SI unit as is)."""
-    return Unit(unit, lambda x, _p: units.to_si(x, unit), lambda x, _p: units.from_si(x, unit))
-
-
-def _choices(key: str) -> tuple[Unit, ...]:
-    """List the units a field's spec offers: its shown unit first, then the loader's other units."""
-    spec = units.spec_of(key)
-    return tuple(_named(u) for u in dict.fromkeys((spec.shown_unit, spec.unit, *spec.loader_units)))
-
-
-def _winding(label: str, k: float, key: str) -> Unit:
-    """Per phase (k = 1) or line-to-line (k = 2) in the spec's display unit of ``key``."""
-    unit = units.spec_of(key).shown_unit
-    return Unit(label, lambda x, _p: units.to_si(x, unit) / k, lambda x, _p: units.from_si(x, unit) * k)
-
-
-#: Unit choices per selector; the first is the default.
-UNIT_GROUPS: dict[str, tuple[Unit, ...]] = {
-    "inertia": _choices("motor.J_r"),
-    "angle": _choices("manoeuvre.theta_dem"),
-    "flux": (Unit("Ψ_PM [Wb]"),
-             Unit("Ke [V_rms LL/krpm]", lambda x, p: units.ke_vrms_krpm_to_psi_pm(x, p),
-                  lambda x, p: units.psi_pm_to_ke_vrms_krpm(x, p)),
-             Unit("Kt [N·m/A_rms]", lambda x, p: units.kt_nm_per_arms_to_psi_pm(x, p),
-                  lambda x, p: units.psi_pm_to_kt_nm_per_arms(x, p)),
-             Unit("Kv [rpm/V LL peak]", lambda x, p: units.kv_rpm_per_v_to_psi_pm(x, p),
-                  lambda x, p: units.psi_pm_to_kv_rpm_per_v(x, p))),
-    "current": (Unit("A peak"),
-                Unit("A_rms", lambda x, _p: units.to_si(x, "Arms"), lambda x, _p: units.from_si(x, "Arms"))),
-    "resistance": (_winding("per phase", 1.0, "motor.R_s"), _winding("line-to-line", 2.0, "motor.R_s")),
-    "inductance": (_winding("per phase", 1.0, "motor.L_d"), _winding("line-to-line", 2.0, "motor.L_d")),
-}
 SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), ("inertia", "Inertia unit"),
              ("angle", "Move unit"), ("current", "i_max given as"))
-
-
-@dataclass(frozen=True)
-class Field:
-    """One numeric input: SI field ``section.name`` shown as ``label [unit]``.
-
-    Label, display unit and allowed range come from the field's spec (:func:`app.io.units.spec_of`);
-    ``group`` names the selector whose unit choice applies instead of the spec's display unit.
-    """
-
-    section: str
-    name: str
-    group: str | None = None
-
-    @property
-    def key(self) -> str:
-        """``section.name``."""
-        return f"{self.section}.{self.name}"
-
-    @property
-    def spec(self) -> FieldSpec:
-        """The field's one declaration (unit, range, label)."""
-        return units.spec_of(self.key)
-
-    @property
-    def label(self) -> str:
-        """The page label without unit."""
-        return self.spec.label
-
-    @property
-    def unit(self) -> str:
-        """The fixed display unit (fields without a selector)."""
-        return self.spec.shown_unit
-
-    @property
-    def integer(self) -> bool:
-        """True for a whole-number field."""
-        return self.spec.integer
-
-    def unit_of(self, choice: Unit | None) -> str:
-        """Display unit text for the selector's ``choice``."""
-        if self.group in ("resistance", "inductance") and choice is not None:
-            return f"{self.spec.shown_unit}, {choice.label}"
-        return choice.label if choice is not None else self.unit
-
-    def text(self, choice: Unit | None = None) -> str:
-        """Label with unit, as shown on the page."""
-        if self.group == "flux" and choice is not None:
-            return choice.label
-        return f"{self.label} [{self.unit_of(choice)}]"
-
-    def hint(self, choice: Unit | None, p: int) -> str:
-        """Write the allowed range in the shown unit, e.g. ``"allowed 1e-06 ≤ value ≤ 10000 mH"``."""
-        if choice is None:
-            return units.shown_range(self.spec)
-        unit = choice.label.partition("[")[2].rstrip("]") if self.group == "flux" else self.unit_of(choice)
-        return units.range_in(self.spec, lambda b: choice.from_si(b, p), unit)
 
 
 FIELDS: tuple[Field, ...] = (
