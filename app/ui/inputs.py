@@ -6,11 +6,13 @@ physics is exactly what was typed, or nothing runs and the message names the fie
 the allowed range. Unit selectors (inertia in kg·m² or kg·cm², move in rad/deg/rev, R_s and L per
 phase or line-to-line, Ψ_PM or Ke or Kt) convert the shown values; nothing is committed while
 typing: :meth:`InputsPanel.collect` reads the fields on Simulate (or Enter) and validates them with
-the same loader as the CLI and YAML files (:func:`app.io.preset_schema.parse_preset`).
+the same dataclasses (and so the same messages) as the CLI and YAML files, with no preset-file
+round trip (:func:`built`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import viser
@@ -18,13 +20,12 @@ import viser
 from app.io import units
 from app.io.display_units import UNIT_GROUPS, Field, Unit
 from app.io.numbers import NumberFormatError
-from app.io.preset_schema import parse_preset
 from app.io.presets import to_raw
 from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice
 from control.common.checks import ParameterError
 from control.fdsmc.nameplate import nameplate_consistency
-from control.fdsmc.params import DriveParams, Motor
+from control.fdsmc.params import DriveParams, LoadStep, Motor
 
 SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), ("inertia", "Inertia unit"),
              ("angle", "Move unit"), ("current", "i_max given as"))
@@ -231,18 +232,22 @@ class InputsPanel:
         return out
 
     def collect(self) -> DriveParams:
-        """Validate the fields and return the new parameters.
+        """Validate the fields and return the new parameters, built directly as dataclasses.
+
+        The sections are made in the loader's order (motor, load with its steps, controller,
+        manoeuvre, sensors, limits, then the whole), so the first error is the one a preset file
+        with these values would report, with the same message.
 
         Raises
         ------
         InputError
             Naming the page label, the SI field, the value and the allowed range.
         """
-        raw = to_raw(self._params)
+        values: dict[str, dict[str, Any]] = {}
         for f in FIELDS:
-            raw[f.section][f.name] = self._read(f)
-        raw["load"]["steps"] = parse_steps(self.steps.value)
-        c = raw["controller"]
+            values.setdefault(f.section, {})[f.name] = self._read(f)
+        steps = parse_steps(self.steps.value)
+        c = values["controller"]
         try:  # dropdown values are checked against the options offered (a client may send anything)
             tc_rule = checked_choice(self.tc_rule.value, TC_RULES, "T_c rule")
             fs_mode = checked_choice(self.fs_mode.value, FS_MODES, "Controller")
@@ -258,9 +263,26 @@ class InputsPanel:
             raise InputError(str(exc)) from None
         self.nameplate_checks()
         try:
-            return parse_preset(raw)
+            return built(self._params, values, steps)
         except ValueError as exc:
             raise InputError(_with_label(str(exc))) from None
+
+
+def built(base: DriveParams, values: dict[str, dict[str, Any]], steps: list[dict[str, float]]) -> DriveParams:
+    """Return ``base`` with the sections' ``values`` [SI] and the load ``steps``, validated by the dataclasses.
+
+    Sections are replaced in :class:`DriveParams`' field order (the loader's), the load steps
+    before the load; a ParameterError names the field, the value and the allowed range.
+    """
+    sections: dict[str, Any] = {}
+    for f in dataclasses.fields(DriveParams):
+        if f.name in ("name", "source"):
+            continue
+        given = dict(values.get(f.name, {}))
+        if f.name == "load":
+            given["steps"] = tuple(LoadStep(**s) for s in steps)
+        sections[f.name] = dataclasses.replace(getattr(base, f.name), **given)
+    return dataclasses.replace(base, **sections)
 
 
 def _with_label(message: str) -> str:
