@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: binding to {args.host}: the tool is reachable from other machines on the "
               "network; only browsers that open the URL below (with its token) get in. Use --host "
               "127.0.0.1 unless you need this.", file=sys.stderr)
-    from app.ui.session import create_server  # imports viser; keep `--help` fast
+    from app.ui.page import create_server  # imports viser; keep `--help` fast
 
     guard = Guard.for_host(args.host, args.allow_origin, token)
     try:

@@ -14,8 +14,9 @@ import viser
 
 from app.figures.drive_log import make_log_overlay_figure
 from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
-from app.io.presets import load_preset
+from app.io.presets import load
 from app.resources import example_log
+from app.ui.case import CasePort
 from app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
 from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
@@ -83,13 +84,14 @@ class LogPanel:
 
     Parameters
     ----------
-    session : app.ui.session.Session
-        Provides ``client``, ``submit``, ``params``, ``comparison``, ``inputs``, ``origin``,
-        ``results`` and ``simulate``.
+    port : app.ui.case.CasePort
+        The position tab: the case read (its comparison, parameters, origin), its worker
+        (``submit``), its inputs (``collect_inputs``, ``open_case``), a results tab, ``run`` and
+        ``simulate``.
     """
 
-    def __init__(self, session: Any) -> None:
-        self.s, gui = session, session.client.gui
+    def __init__(self, port: CasePort) -> None:
+        self._port, gui = port, port.client.gui
         self.identified: Identification | None = None
         self.log_name = ""
         self._figure: Any = None
@@ -107,32 +109,32 @@ class LogPanel:
 
     def _uploaded(self) -> None:
         f = self.upload.value
-        self.s.submit(lambda: self._process(f.name, f.content))
+        self._port.submit(lambda: self._process(f.name, f.content))
 
     def _example(self) -> None:
-        params = load_preset(EXAMPLE_PRESET)
-        self.s.inputs.populate(params)
-        self.s.origin = EXAMPLE_PRESET
+        params = load(EXAMPLE_PRESET)
+        self._port.open_case(params, EXAMPLE_PRESET)
 
         def job() -> None:
-            self.s._run(params)
+            self._port.run(params)
             self._process(EXAMPLE_LOG.name, EXAMPLE_LOG.read_bytes())
 
-        self.s.submit(job)
+        self._port.submit(job)
 
     def _process(self, name: str, content: bytes) -> None:
         """On the worker: import, overlay on the current run, identify, show."""
-        cmp = self.s.comparison
+        case = self._port.case
+        cmp = case.comparison
         run = cmp.fdsmc if self.compare_with.value == "fdsmc" else cmp.conventional
         try:
             if run is None:
                 raise ParameterError("there is no simulated run to compare with: simulate a feasible case first")
-            log = read_bytes(content, name, run=self.compare_with.value, p=self.s.params.motor.p)
+            log = read_bytes(content, name, run=self.compare_with.value, p=case.params.motor.p)
             ov = overlay(log.signals, run.trace)
         except (LogError, ParameterError) as exc:
-            self.s.client.add_notification("Log rejected", str(exc), color="red", auto_close_seconds=15.0)
+            self._port.client.add_notification("Log rejected", str(exc), color="red", auto_close_seconds=15.0)
             return
-        self.identified, self.log_name = run_identification(log, self.s.params), name
+        self.identified, self.log_name = run_identification(log, case.params), name
         self._show(make_log_overlay_figure(ov, name))
         self.table.content = identified_markdown(self.identified)
         self.apply.visible = any(e.value is not None for e in self.identified.estimates)
@@ -140,8 +142,8 @@ class LogPanel:
 
     def _show(self, fig: Any) -> None:
         if self._figure is None:
-            with self.s.results.panel.add_tab("Drive log", viser.Icon.CHART_LINE):
-                self._figure = add_figure(self.s.client.gui, figure_json_of(fig), aspect=1.0)
+            with self._port.results_tab("Drive log", viser.Icon.CHART_LINE):
+                self._figure = add_figure(self._port.client.gui, figure_json_of(fig), aspect=1.0)
         else:
             set_figure_json(self._figure, figure_json_of(fig))
 
@@ -149,10 +151,9 @@ class LogPanel:
         if self.identified is None:
             return
         try:
-            params = apply_identified(self.s.inputs.collect(), self.identified, self.log_name)
+            params = apply_identified(self._port.collect_inputs(), self.identified, self.log_name)
         except ValueError as exc:
-            self.s.client.add_notification("Not applied", str(exc), color="red", auto_close_seconds=12.0)
+            self._port.client.add_notification("Not applied", str(exc), color="red", auto_close_seconds=12.0)
             return
-        self.s.inputs.populate(params)
-        self.s.origin = f"{self.s.origin} + identified from {self.log_name}"
-        self.s.simulate()
+        self._port.open_case(params, f"{self._port.case.origin} + identified from {self.log_name}")
+        self._port.simulate()

@@ -17,6 +17,7 @@ import viser
 
 from app.figures.comparison import LABELS
 from app.figures.energy import optimum_gaps
+from app.ui.case import CasePort
 from app.ui.props import assign
 from app.ui.studies_multiaxis import MultiAxisView
 from app.ui.studies_robustness import RobustnessView
@@ -59,18 +60,18 @@ class OptimumToggle:
 class StudiesSection:
     """The "Studies" tab of a session's results panel: "Robustness" and "Multi-axis".
 
-    ``session`` provides ``client``, ``worker``, ``submit(fn)``, ``params`` (the simulated inputs)
-    and ``status`` (the session's status line).
+    ``port`` is the position tab's :class:`~app.ui.case.CasePort`: the studies read the simulated
+    inputs (``port.case.params``), run on its worker (``submit``, ``checkpoint``, ``cancel``) and
+    report on its status line (``say``).
     """
 
-    def __init__(self, session: Any) -> None:
-        panel = session.results.panel
-        with panel.add_tab("Studies", viser.Icon.FLASK):  # one tab: the results' tab row stays one line
-            tabs = session.client.gui.add_tab_group()
+    def __init__(self, port: CasePort) -> None:
+        with port.results_tab("Studies", viser.Icon.FLASK):  # one tab: the results' tab row stays one line
+            tabs = port.client.gui.add_tab_group()
             with tabs.add_tab("Robustness", viser.Icon.CHART_HISTOGRAM):
-                self.robustness = RobustnessView(session)
+                self.robustness = RobustnessView(port)
             with tabs.add_tab("Multi-axis", viser.Icon.ARROWS_MAXIMIZE):
-                self.multiaxis = MultiAxisView(session)
+                self.multiaxis = MultiAxisView(port)
 
 
 __all__ = ["OptimumToggle", "StudiesSection", "optimum_markdown"]

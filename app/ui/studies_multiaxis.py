@@ -7,8 +7,6 @@ or loaded from a file. On the page an axis names one of the shipped presets (no 
 
 from __future__ import annotations
 
-from typing import Any
-
 import viser
 
 from app.figures.plain import figure_json
@@ -16,6 +14,7 @@ from app.figures.studies import multiaxis_spec, multiaxis_table_markdown
 from app.io.preset_modes import list_presets_of
 from app.io.presets import MAX_BYTES, loads_raw
 from app.io.study_inputs import parse_axes
+from app.ui.case import CasePort
 from app.ui.text import md_text
 from app.ui.viser_adapter import add_figure, set_figure_json
 from control.common.checks import ParameterError
@@ -76,9 +75,9 @@ def check_axes(axes: list[tuple[str, DriveParams]], T_m: float) -> float | None:
 class MultiAxisView:
     """Axes editor, Run, per-axis table and the axes' motion figure of one session."""
 
-    def __init__(self, session: Any) -> None:
-        self._s = session
-        gui = session.client.gui
+    def __init__(self, port: CasePort) -> None:
+        self._s = port
+        gui = port.client.gui
         self._presets = tuple(list_presets_of("position"))
         self.axes = gui.add_text("Axes (YAML list)", default_axes(self._presets), multiline=True,
                                  hint="The list `python -m app multiaxis FILE` takes: - {preset: NAME, name: LABEL, "
@@ -139,16 +138,16 @@ class MultiAxisView:
         self.run_button.disabled = True
         try:
             result = coordinate(axes, T_m)
-            self._s.worker.checkpoint()
+            self._s.checkpoint()
         except ParameterError as exc:
             self.status.content = f"**Failed:** {md_text(exc)}"
             self._s.client.add_notification("Multi-axis move failed", str(exc), color="red", auto_close_seconds=12.0)
-            self._s.status.content = "Ready — the multi-axis move failed (see its tab)."
+            self._s.say("Ready — the multi-axis move failed (see its tab).")
             return
         finally:
             self.run_button.disabled = False
         self.show(result)
-        self._s.status.content = f"Ready — {len(axes)} axes coordinated at T_m = {result.T_m:.4g} s."
+        self._s.say(f"Ready — {len(axes)} axes coordinated at T_m = {result.T_m:.4g} s.")
 
     def show(self, result: MultiAxisResult) -> None:
         """Draw the per-axis table and the axes' motion."""

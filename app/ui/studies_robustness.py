@@ -13,13 +13,13 @@ import contextlib
 import os
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
-from typing import Any
 
 import viser
 
 from app.figures.plain import figure_json
 from app.figures.studies import robustness_spec, robustness_table_markdown
 from app.io.study_inputs import parse_spread
+from app.ui.case import CasePort
 from app.ui.text import md_text
 from app.ui.viser_adapter import add_figure, set_figure_json
 from app.ui.worker import Cancelled
@@ -92,9 +92,9 @@ def check_study(params: DriveParams, samples: float, seed: float) -> tuple[int, 
 class RobustnessView:
     """Inputs, Run / Cancel, progress, histograms and the summary table of one session."""
 
-    def __init__(self, session: Any) -> None:
-        self._s = session
-        gui = session.client.gui
+    def __init__(self, port: CasePort) -> None:
+        self._s = port
+        gui = port.client.gui
         self.samples = gui.add_number("Samples", 200, min=1, max=MAX_SAMPLES, step=1)
         self.seed = gui.add_number("Seed", 0, min=0, step=1)
         self.spreads = {label: gui.add_text(label, default, hint=SPREAD_HINT) for label, _, default in SPREAD_FIELDS}
@@ -113,7 +113,7 @@ class RobustnessView:
 
     def start(self) -> bool:
         """Check the inputs and the budget, then run the study on the session's worker; False if refused."""
-        params = self._s.params
+        params = self._s.case.params
         try:
             spreads = parse_page_spreads({k: h.value for k, h in self.spreads.items()})
             samples, seed = check_study(params, self.samples.value, self.seed.value)
@@ -124,7 +124,7 @@ class RobustnessView:
 
     def cancel(self) -> bool:
         """Ask the running study to stop; False if nothing runs."""
-        if not self._s.worker.cancel():
+        if not self._s.cancel():
             return False
         self.status.content = f"Cancelling after {self._done} samples…"
         return True
@@ -136,7 +136,7 @@ class RobustnessView:
 
     def _cancel_requested(self) -> bool:
         try:
-            self._s.worker.checkpoint()
+            self._s.checkpoint()
         except Cancelled:
             return True
         return False
@@ -162,12 +162,12 @@ class RobustnessView:
                 raise Cancelled(str(exc)) from None
             self.status.content = f"**Failed:** {md_text(exc)}"
             self._s.client.add_notification("Robustness study failed", str(exc), color="red", auto_close_seconds=12.0)
-            self._s.status.content = "Ready — the robustness study failed (see its tab)."
+            self._s.say("Ready — the robustness study failed (see its tab).")
             return
         finally:
             self.run_button.disabled, self.cancel_button.visible = False, False
         self.show(result, torque_limit(params))
-        self._s.status.content = f"Ready — robustness study of {samples} samples done."
+        self._s.say(f"Ready — robustness study of {samples} samples done.")
 
     def _run(self, params: DriveParams, spreads: list[Spread], samples: int, seed: int) -> RobustnessResult:
         if samples < POOL_MIN_SAMPLES:

@@ -272,6 +272,15 @@ def simulate(
     check_budget(params, 1, n_sub=n_sub, h_continuous=h_continuous, max_points=max_points)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
+    return _simulate_checked(params, controller, d, n_sub=n_sub, h_continuous=h_continuous, max_points=max_points,
+                             plant=plant)
+
+
+def _simulate_checked(
+    params: DriveParams, controller: str, d: Derived, *, n_sub: int = 1, h_continuous: float = CONTINUOUS_STEP_S,
+    max_points: int = MAX_POINTS, plant: DriveParams | None = None,
+) -> RunResult:
+    """:func:`simulate` once the controller, the budget and the feasibility are checked (by the caller)."""
     g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
     T_step = g.h * g.n_sub
     prm = pack_parameters(params, d, controller, plant, T_step)
@@ -376,8 +385,9 @@ def compare(
     check_budget(params, len(controllers), **options)
     d = derive(params) if derived is None else derived
     _check_feasible(d)
-    futures = {c: _RUNS.submit(simulate, params, c, d, plant=plant, **options) for c in controllers[1:]}
-    runs = {c: simulate(params, c, d, plant=plant, **options) for c in controllers[:1]}
+    # checked once above for all runs (the budget of len(controllers) runs covers each one's)
+    futures = {c: _RUNS.submit(_simulate_checked, params, c, d, plant=plant, **options) for c in controllers[1:]}
+    runs = {c: _simulate_checked(params, c, d, plant=plant, **options) for c in controllers[:1]}
     runs |= {c: f.result() for c, f in futures.items()}
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),

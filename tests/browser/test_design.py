@@ -26,7 +26,7 @@ def choose(page: Any, dropdown: str, option: str) -> None:
 @pytest.fixture(scope="module")
 def default_server() -> Iterator[UiServer]:
     from app.io.presets import DEFAULT_PRESET, load_preset
-    from app.ui.session import create_server
+    from app.ui.page import create_server
 
     server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(),
                                    scene_3d=False)

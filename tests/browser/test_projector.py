@@ -186,7 +186,7 @@ def test_folded_warnings_stay_folded_over_a_new_run_with_other_warnings(page):
 def server_3d() -> Iterator[Any]:
     """The web UI with the 3D view available (folded by default)."""
     from app.io.presets import PAPER_PRESET, load_preset
-    from app.ui.session import create_server
+    from app.ui.page import create_server
     from tests.browser.conftest import UiServer, free_port
 
     server, config = create_server(load_preset(PAPER_PRESET), PAPER_PRESET, port=free_port(), scene_3d=True)

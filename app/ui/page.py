@@ -1,0 +1,206 @@
+"""The commissioning web UI's page and server: config, layout, CSS, tabs; one :class:`Session` per browser tab.
+
+``server.gui`` is shared by every client, so nothing per-user lives there: each connection gets
+its own case, inputs, results, worker thread and replay. A session composes the page — the control
+panel docked left with the two mode tabs (:mod:`app.ui.position_tab`, :mod:`app.ui.bldc`), the
+results panel docked right (:mod:`app.ui.results`) with the studies (:mod:`app.ui.studies`), the 3D
+canvas between them — and sizes it from the window (:mod:`app.ui.layout`). Simulations run on the
+session's worker (never on the GUI event loop); a second Simulate while one runs is refused.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, field
+
+import viser
+
+from app.threads import limit_blas_threads
+from app.ui.bldc import add_bldc_tab
+from app.ui.case import Case, CaseState
+from app.ui.inputs import InputsPanel
+from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
+from app.ui.plotly_js import use_basic_plotly
+from app.ui.position_tab import PositionTab, comparison_or_derived
+from app.ui.results import ResultsPanel
+from app.ui.scene import RotorScene, aim_camera
+from app.ui.studies import StudiesSection
+from app.ui.viser_adapter import run_script, widget_id
+from app.ui.web_guard import Guard, guarded
+from app.ui.worker import Worker
+from control.fdsmc.params import DriveParams
+from sim.fdsmc.engine import Comparison
+
+
+@dataclass
+class AppConfig:
+    """Server-wide settings; ``initial`` is simulated once and shared read-only by new sessions."""
+
+    params: DriveParams
+    origin: str
+    scene_3d: bool = True
+    _initial: Comparison | None = None
+    _lock: threading.Lock = field(default_factory=threading.Lock)
+    sessions: dict[int, Session] = field(default_factory=dict)
+    guard: Guard | None = None
+
+    def initial(self) -> Comparison:
+        """Return the comparison of the start-up preset (computed on first use)."""
+        with self._lock:
+            if self._initial is None:
+                self._initial = comparison_or_derived(self.params)
+            return self._initial
+
+
+class Session:
+    """One browser tab's page: its case, its worker, the two mode tabs and the results panel."""
+
+    def __init__(self, client: viser.ClientHandle, config: AppConfig) -> None:
+        self.client, self.gui = client, client.gui
+        self.state = CaseState(Case(config.params, config.origin, config.initial()))
+        self.worker = Worker(lambda busy: self.tab.set_busy(busy), lambda exc: self.tab.job_failed(exc),
+                             name=f"ui-client-{client.client_id}")
+        scene = RotorScene(client.scene) if config.scene_3d else None
+        self._layout(scene)  # the results panel shows the start-up comparison from its first message
+        self.tab.show_text()
+
+    # ---- layout -------------------------------------------------------------------------------
+    def _layout(self, scene: RotorScene | None) -> None:
+        """Dock the control panel left, the results panel right, the 3D canvas between them.
+
+        The page's CSS sizes the panels from the window's width; the overview plot's height
+        follows the window size the page reports into a hidden field (:mod:`app.ui.layout`).
+        """
+        with self.client.atomic():  # one batch: the page CSS, the panels and their docking arrive together
+            gui = self.gui
+            gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
+            self._window_probe = gui.add_text("window [px]", "")
+            self._install_page_css(show_3d=False)
+            use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
+            gui.main_panel.dock_left()
+            tabs = gui.add_tab_group()
+            with tabs.add_tab("Position drive (FDSMC)"):
+                self.tab = PositionTab(self.client, self.state, self.worker)
+            self.results = ResultsPanel(self.client, self.state.current.comparison, scene, self.tab.sweep,
+                                        on_3d=lambda shown: self.fit.set_3d(shown))
+            self.tab.results = self.results
+            self.results.panel.dock_right()
+            self.studies = StudiesSection(self.tab)
+            add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
+            self.fit = WindowFit(self._apply_layout)
+            if scene is not None:
+                aim_camera(self.client.camera)
+        self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
+        run_script(gui, window_report_js(widget_id(self._window_probe)))
+
+    def _apply_layout(self, layout: PanelLayout) -> None:
+        self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
+        if layout.show_3d != self._style_3d:
+            self._install_page_css(layout.show_3d)
+
+    def _install_page_css(self, show_3d: bool) -> None:
+        """Put the page's CSS (:func:`app.ui.layout.page_css`) for the 3D view shown or folded into the page."""
+        self._style_3d = show_3d
+        run_script(self.gui, install_css_js(page_css(widget_id(self._window_probe), show_3d)))
+
+    # ---- what tests and scripts read of a session ---------------------------------------------
+    @property
+    def case(self) -> Case:
+        """The current case (frozen snapshot)."""
+        return self.state.current
+
+    @property
+    def params(self) -> DriveParams:
+        """The committed inputs."""
+        return self.state.current.params
+
+    @property
+    def origin(self) -> str:
+        """Where the committed inputs came from."""
+        return self.state.current.origin
+
+    @property
+    def comparison(self) -> Comparison:
+        """The comparison shown."""
+        return self.state.current.comparison
+
+    @property
+    def error(self) -> str | None:
+        """The last input refusal (None after a successful run)."""
+        return self.state.current.error
+
+    @property
+    def runs(self) -> int:
+        """Runs done in this session."""
+        return self.state.current.runs
+
+    @property
+    def inputs(self) -> InputsPanel:
+        """The position tab's inputs."""
+        return self.tab.inputs
+
+    @property
+    def preset(self) -> viser.GuiDropdownHandle:
+        """The position tab's preset dropdown."""
+        return self.tab.preset
+
+    def simulate(self) -> bool:
+        """Commit the position tab's inputs and simulate them (see :meth:`PositionTab.simulate`)."""
+        return self.tab.simulate()
+
+    def design(self) -> bool:
+        """Design for the position tab's drive (see :meth:`PositionTab.design`)."""
+        return self.tab.design()
+
+    def cancel(self) -> bool:
+        """Cancel the running job; False if nothing runs."""
+        return self.tab.cancel_run()
+
+    def close(self) -> None:
+        """Stop the worker and the replay (client disconnected)."""
+        self.worker.close()
+        self.results.replay.close()
+
+
+def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", port: int = 8080,
+                  scene_3d: bool = True, environment_map: bool = False,
+                  guard: Guard | None = None) -> tuple[viser.ViserServer, AppConfig]:
+    """Start the viser server with one :class:`Session` per connecting client.
+
+    Parameters
+    ----------
+    params : DriveParams  Start-up inputs of every new session.
+    origin : str          Preset name or file they came from.
+    host, port            Bind address; viser moves to the next free port if taken (see ``get_port``).
+    scene_3d : bool       Show the 3D rotors (tests switch it off).
+    environment_map : bool  viser's HDRI background (off by default: it stalls software WebGL).
+    guard : Guard or None   Origin/Host/token rules (default: same-host origins on ``host``, no token).
+
+    Returns
+    -------
+    (viser.ViserServer, AppConfig)
+        The running server and its settings (``config.sessions`` maps client id → Session).
+    """
+    limit_blas_threads()
+    guard = guard or Guard.for_host(host)
+    with guarded(guard):
+        server = viser.ViserServer(host=host, port=port, verbose=False)
+    server.gui.set_panel_label("PMSM commissioning (FDSMC)")
+    if not environment_map:  # the HDRI stalls software WebGL for seconds
+        server.scene.configure_environment_map(hdri=None)
+    config = AppConfig(params, origin, scene_3d, guard=guard)
+
+    @server.on_client_connect
+    def _(client: viser.ClientHandle) -> None:
+        config.sessions[client.client_id] = Session(client, config)
+
+    @server.on_client_disconnect
+    def _(client: viser.ClientHandle) -> None:
+        session = config.sessions.pop(client.client_id, None)
+        if session is not None:
+            session.close()
+
+    return server, config
+
+
+__all__ = ["AppConfig", "Session", "comparison_or_derived", "create_server"]
