@@ -19,6 +19,7 @@ import numpy as np
 from app.figures.comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
 from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
 from control.fdsmc.feasibility import torque_limit
+from control.fdsmc.model import electromagnetic_torque
 
 #: Horizontal domains [-] of the phase plane and of the compact time plot.
 PHASE_X, TIME_X = (0.0, 0.55), (0.66, 1.0)
@@ -31,8 +32,8 @@ REF_LINE = {"color": "#555", "width": 1.2, "dash": "dash"}
 
 
 def motor_torque(motor: Any, i_d: np.ndarray, i_q: np.ndarray) -> np.ndarray:
-    """Electromagnetic torque Γ = (3/2)·p·(Ψ_PM·i_q + (L_d − L_q)·i_d·i_q), eq. (5) in [1] [N·m]."""
-    return 1.5 * motor.p * (motor.psi_pm * i_q + (motor.L_d - motor.L_q) * i_d * i_q)
+    """Electromagnetic torque Γ of eq. (5) in [1] [N·m] (:func:`control.fdsmc.model.electromagnetic_torque`)."""
+    return electromagnetic_torque(motor.p, motor.psi_pm, motor.L_d, motor.L_q, i_d, i_q)
 
 
 def _padded(lo: float, hi: float, pad: float = 0.08) -> list[float]:

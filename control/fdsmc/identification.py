@@ -37,6 +37,8 @@ import numpy as np
 from scipy.signal import savgol_filter
 from scipy.stats import t as student_t
 
+from control.fdsmc.model import electromagnetic_torque
+
 #: Largest relative standard error of a reported estimate [-]; above it the parameter is refused.
 MAX_REL_STDERR = 0.2
 #: Sample delays tried between logged and applied voltage [samples].
@@ -322,7 +324,8 @@ def identify(
     else:
         i_q = signals["i_q"]
         i_d = signals.get("i_d")
-        rel = (L_d - L_q) * i_d if (i_d is not None and L_d is not None and L_q is not None) else 0.0
-        Gamma_em = 1.5 * p * (psi + rel) * i_q
+        known = i_d is not None and L_d is not None and L_q is not None  # else the reluctance term is 0
+        Gamma_em = electromagnetic_torque(p, psi, L_d if known else 0.0, L_q if known else 0.0,
+                                          i_d if known else 0.0, i_q)
         mech, res_m, n_m = identify_mechanical(t, th, w, Gamma_em, window_mechanical_s)
     return Identification(tuple(el + mech), delay, res_el, res_m, n_el, n_m)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from control.common.jit import jitable
 from control.fdsmc.params import Motor
 
 
@@ -67,6 +68,32 @@ def model_coefficients(motor: Motor) -> ModelCoefficients:
         K=3.0 * m.p * (m.L_d - m.L_q) / (2.0 * m.J_r),
         M=1.0 / m.J_r,
     )
+
+
+@jitable
+def electromagnetic_torque(p: float, psi_pm: float, L_d: float, L_q: float, i_d: float, i_q: float) -> float:
+    """Electromagnetic torque Γ_em = (3/2)·p·(Ψ_PM + (L_d − L_q)·i_d)·i_q, eq. (5) in [1] [N·m].
+
+    The one implementation of eq. (5): the compiled kernel, the plain-Python reference, the
+    figures and the drive-log identification call it (scalars or numpy arrays).
+
+    Parameters
+    ----------
+    p : float
+        Pole pairs [-].
+    psi_pm : float
+        Permanent-magnet flux linkage Ψ_PM [Wb].
+    L_d, L_q : float
+        d- and q-axis inductances [H].
+    i_d, i_q : float or numpy.ndarray
+        d- and q-axis currents [A] (amplitude-invariant dq).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Γ_em [N·m].
+    """
+    return 1.5 * p * (psi_pm + (L_d - L_q) * i_d) * i_q
 
 
 def torque_constant(motor: Motor) -> float:

@@ -14,6 +14,7 @@ Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) i
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Callable, Sequence
@@ -49,6 +50,7 @@ from sim.fdsmc.metrics import (
     chatter_windows,
     run_metrics,
 )
+from sim.fdsmc.summary import decode_info
 
 CONTROLLERS = ("fdsmc", "conventional")
 #: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
@@ -69,40 +71,17 @@ PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 
 TABLE1_T_M: tuple[float, ...] = tuple(PAPER_TABLE1)
 
 
-@dataclass(frozen=True)
-class Trace:
-    """Time series of one run on a common grid (SI units; energies cumulative from t = 0).
-
-    Attributes
-    ----------
-    t [s]; theta_r [rad]; omega_r [rad/s]; i_d, i_q [A]; u_d, u_q [V] (applied);
-    alpha [rad/s²] true rotor acceleration dω_r/dt; alpha_dem [rad/s²] outer-loop demand;
-    alpha_hat [rad/s²] eq. (7) with Γ̂_L; Gamma_L [N·m] true total load torque, eq. (4a)/(6);
-    Gamma_L_hat [N·m] observer's L̂0; theta_hat [rad]; omega_hat [rad/s]; S [rad/s] switching
-    function (0 for the conventional law); E_friction, E_copper, E_electrical, E_motoring,
-    E_load [J].
-    """
-
-    t: np.ndarray
-    theta_r: np.ndarray
-    omega_r: np.ndarray
-    i_d: np.ndarray
-    i_q: np.ndarray
-    u_d: np.ndarray
-    u_q: np.ndarray
-    alpha: np.ndarray
-    alpha_dem: np.ndarray
-    Gamma_L: np.ndarray
-    Gamma_L_hat: np.ndarray
-    theta_hat: np.ndarray
-    omega_hat: np.ndarray
-    S: np.ndarray
-    E_friction: np.ndarray
-    E_copper: np.ndarray
-    E_electrical: np.ndarray
-    alpha_hat: np.ndarray
-    E_motoring: np.ndarray
-    E_load: np.ndarray
+#: Time series of one run on a common grid (SI units; energies cumulative from t = 0), one field per
+#: channel of the compiled kernel (:data:`sim.fdsmc.kernel.CHANNELS`, in its order):
+#: t [s]; theta_r [rad]; omega_r [rad/s]; i_d, i_q [A]; u_d, u_q [V] (applied);
+#: alpha [rad/s²] true rotor acceleration dω_r/dt; alpha_dem [rad/s²] outer-loop demand;
+#: Gamma_L [N·m] true total load torque, eq. (4a)/(6); Gamma_L_hat [N·m] observer's L̂0;
+#: theta_hat [rad]; omega_hat [rad/s]; S [rad/s] switching function (0 for the conventional law);
+#: E_friction, E_copper, E_electrical [J]; alpha_hat [rad/s²] eq. (7) with Γ̂_L; E_motoring, E_load [J].
+Trace = dataclasses.make_dataclass(
+    "Trace", [(name, np.ndarray) for name in kn.CHANNELS], frozen=True,
+    namespace={"__module__": __name__, "__doc__": "Time series of one run: one array per kernel channel "
+               "(:data:`sim.fdsmc.kernel.CHANNELS`), SI units; energies cumulative from t = 0."})
 
 
 @dataclass(frozen=True)
@@ -295,11 +274,12 @@ def _simulate_checked(
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
                   params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller),
                   sensors.noise_table(params.sensors))
-    trace = _trace(out[:, : int(info[kn.I_NOUT])])
+    summary = decode_info(info)
+    trace = _trace(out[:, : summary.n_out])
     rows = kn.WIN_ROWS
     samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, *win[rows * j: rows * (j + 1), :n])
                for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
-    met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, info, plant, T_step=T_step)
+    met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, summary, plant, T_step=T_step)
     return RunResult(controller, trace, met)
 
 

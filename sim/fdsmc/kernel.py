@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from control.fdsmc import conventional, fdc, inverter, sliding_mode
+from control.fdsmc import conventional, fdc, inverter, model, sliding_mode
 from sim.common import sensors
 
 # ---- prm indices -------------------------------------------------------------------------
@@ -167,8 +167,8 @@ def control_output(t: float, y: tuple, i0: tuple, o: tuple, prm: np.ndarray,
 
 @_helper
 def electromagnetic_torque(i_d: float, i_q: float, prm: np.ndarray) -> float:
-    """Γ_em of eq. (5) [N·m]."""
-    return 1.5 * prm[P_P] * (prm[P_PSI] + (prm[P_LD] - prm[P_LQ]) * i_d) * i_q
+    """Γ_em of eq. (5) [N·m] (:func:`control.fdsmc.model.electromagnetic_torque` on the packed parameters)."""
+    return model.electromagnetic_torque(prm[P_P], prm[P_PSI], prm[P_LD], prm[P_LQ], i_d, i_q)
 
 
 @_helper

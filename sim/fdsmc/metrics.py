@@ -23,7 +23,7 @@ from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
 from sim.common import signals
 from sim.common.energy import energy_balance
-from sim.fdsmc import kernel as kn
+from sim.fdsmc.summary import KernelState, RunSummary
 
 #: Thresholds of the chatter criterion (fractions of α_max) and the smoothing window [s].
 CHATTER_PTP_FRACTION = 0.2
@@ -219,19 +219,19 @@ def response_metrics(
     }
 
 
-def kernel_checks(info: np.ndarray, T_step: float) -> dict[str, float | None]:
+def kernel_checks(s: RunSummary, T_step: float) -> dict[str, float | None]:
     """Return the current, in-position and overshoot figures the kernel tracks at every sample (RunMetrics fields).
 
     Parameters
     ----------
-    info : numpy.ndarray  The kernel's summary (``I_*`` of :mod:`sim.fdsmc.kernel`).
+    s : RunSummary        The kernel's summary, decoded (:mod:`sim.fdsmc.summary`).
     T_step : float        Sample period (integration step in continuous mode) [s].
     """
-    t_out = float(info[kn.I_TOUT])
+    t_out = float(s.t_out)
     return {
-        "i_peak_A": float(info[kn.I_PIDQ]),
-        "over_i_max_s": float(info[kn.I_TOVER]),
-        "overshoot_rad": float(info[kn.I_OVS]),
+        "i_peak_A": float(s.i_dq_peak),
+        "over_i_max_s": float(s.over_i_max_s),
+        "overshoot_rad": float(s.overshoot),
         "in_position_s": None if math.isinf(t_out) else (0.0 if t_out < 0.0 else t_out + T_step),
     }
 
@@ -243,31 +243,34 @@ def hold_ripple(s: WindowSamples) -> dict[str, float | None]:
     return {"hold_i_q_rms_A": float(np.std(s.i_q)), "hold_u_q_ptp_V": float(np.ptp(s.u_q))}
 
 
-def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
+def kinetic_energy(params: DriveParams, x: KernelState) -> float:
+    """Kinetic energy ½·(J_r + J_L)·ω_r² of state ``x`` [J]."""
+    return float(0.5 * params.J_total * x.omega_r ** 2)
+
+
+def magnetic_energy(params: DriveParams, x: KernelState) -> float:
+    """Magnetic energy (3/4)·(L_d·i_d² + L_q·i_q²) of state ``x`` (amplitude-invariant dq) [J]."""
+    m = params.motor
+    return float(0.75 * (m.L_d * x.i_d ** 2 + m.L_q * x.i_q ** 2))
+
+
+def energy_metrics(params: DriveParams, s: RunSummary) -> dict[str, float]:
     """Return the energies at T_m and at the end, stored energies and the balance residual [J].
 
     The keys are :class:`RunMetrics` fields.
     """
-    snap, end = info[kn.I_SNAP: kn.I_SNAP + kn.N_X], info[kn.I_END: kn.I_END + kn.N_X]
-    m = params.motor
-
-    def kinetic(x: np.ndarray) -> float:
-        return float(0.5 * params.J_total * x[kn.X_W] ** 2)
-
-    def magnetic(x: np.ndarray) -> float:
-        return float(0.75 * (m.L_d * x[kn.X_ID] ** 2 + m.L_q * x[kn.X_IQ] ** 2))
-
+    snap, end = s.at_Tm, s.end
     out: dict[str, float] = {}
     for suffix, x in (("", snap), ("_total", end)):
-        out[f"friction{suffix}_J"] = float(x[kn.X_EF])
-        out[f"copper{suffix}_J"] = float(x[kn.X_ECU])
-        out[f"electrical_in{suffix}_J"] = float(x[kn.X_EEL])
-        out[f"motoring{suffix}_J"] = float(x[kn.X_EMOT])
-        out[f"regenerated{suffix}_J"] = float(x[kn.X_EMOT] - x[kn.X_EEL])
-        out[f"load_work{suffix}_J"] = float(x[kn.X_ELOAD])
-    out["kinetic_at_Tm_J"] = float(kinetic(snap))
-    out["kinetic_end_J"] = kinetic(end)
-    out["magnetic_end_J"] = magnetic(end)
+        out[f"friction{suffix}_J"] = float(x.E_friction)
+        out[f"copper{suffix}_J"] = float(x.E_copper)
+        out[f"electrical_in{suffix}_J"] = float(x.E_electrical)
+        out[f"motoring{suffix}_J"] = float(x.E_motoring)
+        out[f"regenerated{suffix}_J"] = float(x.E_motoring - x.E_electrical)
+        out[f"load_work{suffix}_J"] = float(x.E_load)
+    out["kinetic_at_Tm_J"] = float(kinetic_energy(params, snap))
+    out["kinetic_end_J"] = kinetic_energy(params, end)
+    out["magnetic_end_J"] = magnetic_energy(params, end)
     bal = energy_balance(out["electrical_in_total_J"],
                          (out["copper_total_J"], out["friction_total_J"], out["load_work_total_J"]),
                          (out["kinetic_end_J"], out["magnetic_end_J"]), out["motoring_total_J"])
@@ -324,33 +327,34 @@ def chatter_window_steps(window: tuple[float, float], T_step: float, n_steps: in
 
 def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
-    samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None, *,
+    samples: dict[str, WindowSamples], s: RunSummary, plant: DriveParams | None = None, *,
     T_step: float,
 ) -> RunMetrics:
     """Return all metrics of one run.
 
     They come from the (decimated) trace, the full-resolution chatter-window ``samples`` and the kernel's
-    ``info`` vector; ``T_step`` [s] is the sample period (the in-position time's resolution).
+    summary ``s`` (:func:`sim.fdsmc.summary.decode_info`); ``T_step`` [s] is the sample period (the
+    in-position time's resolution).
 
     Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
     every number becomes None, ``stable`` False and ``reason`` says why. Stored energies use the
     ``plant``'s true values when given.
     """
-    failed = bool(info[kn.I_FAILED])
-    energies = energy_metrics(params if plant is None else plant, info)
-    theta_Tm = float(info[kn.I_SNAP + kn.X_TH])
+    failed = s.failed
+    energies = energy_metrics(params if plant is None else plant, s)
+    theta_Tm = float(s.at_Tm.theta_r)
     resp = response_metrics(t, theta_r, params.manoeuvre.theta_dem, theta_Tm)
-    verdicts = {name: detect_chatter(s.t, s.alpha_dem, s.omega_r, s.window, d.alpha.alpha_max)
-                for name, s in samples.items()}
+    verdicts = {name: detect_chatter(w.t, w.alpha_dem, w.omega_r, w.window, d.alpha.alpha_max)
+                for name, w in samples.items()}
     phase = None if failed else next((name for name, v in verdicts.items() if v.chatter), None)
     cv = verdicts[phase or "cruise"]
     figures: dict[str, float | None] = {
-        **energies, **resp, **kernel_checks(info, T_step), **hold_ripple(samples["hold"]),
-        "omega_peak_rad_s": float(info[kn.I_PW]),
-        "i_q_peak_A": float(info[kn.I_PIQ]),
-        "i_d_peak_A": float(info[kn.I_PID]),
-        "u_peak_V": float(info[kn.I_PU]),
-        "torque_peak_Nm": float(info[kn.I_PTQ]),
+        **energies, **resp, **kernel_checks(s, T_step), **hold_ripple(samples["hold"]),
+        "omega_peak_rad_s": float(s.omega_peak),
+        "i_q_peak_A": float(s.i_q_peak),
+        "i_d_peak_A": float(s.i_d_peak),
+        "u_peak_V": float(s.u_peak),
+        "torque_peak_Nm": float(s.torque_peak),
         "chatter_alpha_ptp_rad_s2": cv.ptp,
         "chatter_frequency_Hz": cv.frequency_Hz,
         "cruise_omega_ptp_rad_s": verdicts["cruise"].omega_ptp,
@@ -359,9 +363,9 @@ def run_metrics(
     if failed:
         figures = dict.fromkeys(figures)
     return RunMetrics(
-        **figures, theta_dem_rad=float(params.manoeuvre.theta_dem), saturated_s=float(info[kn.I_TSAT]),
+        **figures, theta_dem_rad=float(params.manoeuvre.theta_dem), saturated_s=float(s.saturated_s),
         chatter=phase is not None, chatter_phase=phase, stable=not failed,
-        reason=_unstable_reason(d, controller, float(info[kn.I_TFAIL])) if failed else None)
+        reason=_unstable_reason(d, controller, float(s.t_fail)) if failed else None)
 
 
 def _unstable_reason(d: Derived, controller: str, t_fail: float) -> str:

@@ -20,6 +20,7 @@ from control.fdsmc.conventional import conventional_law
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import current_limit
 from control.fdsmc.inverter import decay_factors, limit_voltage, predict_currents
+from control.fdsmc.model import electromagnetic_torque
 from control.fdsmc.params import DriveParams
 from control.fdsmc.sliding_mode import smc_law
 from sim.common import sensors
@@ -115,7 +116,7 @@ class ReferenceDrive:
         """Return the derivatives of [i_d, i_q, θ, ω, E_f, E_cu, E_el], eqs. (1)–(3), (4b), (5)."""
         c, m, ld = self.plant_c, self.p.motor, self.p.load
         i_d, i_q, _, w = x[:4]
-        T_em = 1.5 * m.p * (m.psi_pm + (m.L_d - m.L_q) * i_d) * i_q
+        T_em = electromagnetic_torque(m.p, m.psi_pm, m.L_d, m.L_q, i_d, i_q)
         return np.array([
             -c.A * i_d + c.B * w * i_q + c.F * u_d,
             -(c.C * i_d + c.E) * w - c.D * i_q + c.G * u_q,

@@ -28,6 +28,8 @@ from sim.common import sensors
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.engine import pack_parameters
 from sim.fdsmc.grid import continuous_step, plant_substeps
+from sim.fdsmc.metrics import kinetic_energy, magnetic_energy
+from sim.fdsmc.summary import decode_state
 from sim.studies.cycle_kernel import run_cycle
 
 #: Joules per kilowatt-hour [J/kWh].
@@ -180,11 +182,11 @@ def cycle_run(params: DriveParams, moves: Sequence[Move], controller: str) -> Cy
     if n < 0:
         return CycleRun(None, None, None, None, None, None, None, chans, False)
     e_el = np.concatenate(([0.0], seg[:, kn.X_EEL]))
-    end, m = seg[-1], params.motor
-    stored = 0.5 * params.J_total * end[kn.X_W] ** 2 + 0.75 * (m.L_d * end[kn.X_ID] ** 2 + m.L_q * end[kn.X_IQ] ** 2)
-    return CycleRun(tuple(float(x) for x in np.diff(e_el)), float(end[kn.X_EEL]), float(end[kn.X_ECU]),
-                    float(end[kn.X_EF]), float(end[kn.X_ELOAD]), float(stored),
-                    float(end[kn.X_TH] - sum(mv.theta_dem for mv in moves)), chans, True)
+    end = decode_state(seg[-1])
+    stored = kinetic_energy(params, end) + magnetic_energy(params, end)
+    return CycleRun(tuple(float(x) for x in np.diff(e_el)), float(end.E_electrical), float(end.E_copper),
+                    float(end.E_friction), float(end.E_load), float(stored),
+                    float(end.theta_r - sum(mv.theta_dem for mv in moves)), chans, True)
 
 
 def duty_cycle(params: DriveParams, moves: Sequence[Move]) -> DutyResult:
