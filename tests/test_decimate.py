@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
-from app.figures.comparison import TIME_ROWS, time_plots_spec
 from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, minmax_index
-from app.figures.overview import motor_torque, overview_spec
+from app.figures.fdsmc_comparison import TIME_ROWS, time_plots_spec
+from app.figures.fdsmc_overview import motor_torque, overview_spec
 from app.figures.plain import figure_json
 from sim.fdsmc.engine import LABELS, compare
 

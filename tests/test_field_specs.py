@@ -19,7 +19,7 @@ import pytest
 from app.exports.c_module import INPUT_KEYS, c_unit, controller_header
 from app.io import units
 from app.io.presets import SCHEMA, annotate_units, dumps_preset, load_preset, loads_raw, parse_preset, to_raw
-from app.ui import bldc as bldc_tab
+from app.ui import bldc_tab as bldc_tab
 from app.ui import inputs
 from control.bldc.params import BldcParams
 from control.common.checks import FieldSpec, ParameterError, field_specs

@@ -7,7 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from app.figures.comparison import (
+from app.figures.decimate import BINS_PHASE
+from app.figures.fdsmc_comparison import (
     cursor_index,
     decimate_index,
     layer_entry_index,
@@ -15,10 +16,9 @@ from app.figures.comparison import (
     make_time_plots_figure,
     phase_plane_spec,
 )
-from app.figures.decimate import BINS_PHASE
-from app.figures.energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
+from app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
+from app.figures.fdsmc_replay import KEY_RATE, MAX_FRAMES, SPEEDS
 from app.figures.plain import figure_json
-from app.figures.replay import KEY_RATE, MAX_FRAMES, SPEEDS
 from app.ui.replay import phase_plane_json
 from sim.fdsmc.engine import PAPER_TABLE1, Comparison, Table1Row, compare
 

@@ -27,7 +27,7 @@ from app.io import units
 from app.io.bldc_emf import read_measured
 from app.io.numbers import NumberFormatError, parse_integer, parse_number, parse_T_m_list
 from app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
-from app.ui.text import checked_choice
+from app.ui.choices import checked_choice
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive, predicted_energy
 from control.fdsmc.feasibility import alpha_max, feasibility

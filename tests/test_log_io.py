@@ -195,7 +195,7 @@ def test_apply_identified_writes_values_sets_J_L_and_names_the_log_in_source():
 
 
 def test_overlay_figure_draws_measured_and_simulated_and_its_energy_matches_the_overlay():
-    from app.figures.drive_log import cumulative_input_energy, make_log_overlay_figure
+    from app.figures.fdsmc_drive_log import cumulative_input_energy, make_log_overlay_figure
     from sim.drivelog.overlay import overlay
 
     params = load_preset("example_log_drive")

@@ -7,9 +7,9 @@ from pathlib import Path
 
 from plotly.offline.offline import get_plotlyjs_version
 
-from app.figures.comparison import time_plots_spec
-from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
-from app.figures.overview import overview_spec
+from app.figures.fdsmc_comparison import time_plots_spec
+from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
+from app.figures.fdsmc_overview import overview_spec
 from app.ui.plotly_js import BUNDLE, TRACE_TYPES, bundle_source, bundle_version, use_basic_plotly
 from sim.fdsmc.engine import compare
 

@@ -7,10 +7,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.figures.comparison import phase_plane_spec, time_plots_spec
-from app.figures.energy import energy_bars_spec, optimum_gaps
-from app.figures.plain import to_figure
-from app.figures.studies import (
+from app.figures.fdsmc_comparison import phase_plane_spec, time_plots_spec
+from app.figures.fdsmc_energy import energy_bars_spec, optimum_gaps
+from app.figures.fdsmc_studies import (
     histogram,
     multiaxis_spec,
     multiaxis_table_markdown,
@@ -18,6 +17,7 @@ from app.figures.studies import (
     robustness_table_markdown,
     sample_values,
 )
+from app.figures.plain import to_figure
 from app.io.presets import load_preset
 from app.ui.studies import optimum_markdown
 from app.ui.studies_multiaxis import axis_line, check_axes, default_axes, parse_page_axes

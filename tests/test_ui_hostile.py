@@ -18,8 +18,9 @@ import viser
 import websockets
 
 from app.io.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
+from app.ui.choices import checked_choice
 from app.ui.page import create_server
-from app.ui.text import checked_choice, md_text
+from app.ui.text import md_text
 from app.ui.web_guard import COOKIE, Guard
 from app.ui.worker import Cancelled, Worker
 from control.common.checks import ParameterError

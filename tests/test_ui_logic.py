@@ -11,7 +11,8 @@ import pytest
 from app.cli.serve import is_loopback
 from app.io.numbers import parse_T_m_list
 from app.ui.inputs import InputError, parse_steps
-from app.ui.text import annual_savings, derived_markdown, warnings_html
+from app.ui.savings import annual_savings
+from app.ui.text import derived_markdown, warnings_html
 from app.ui.worker import Worker
 from control.fdsmc.derivations import derive
 from sim.fdsmc.engine import compare

@@ -14,8 +14,8 @@ import plotly.graph_objects as go
 import plotly.io as pio
 
 from app.exports.c_module import TOOL
-from app.figures.comparison import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
-from app.figures.energy import make_energy_bars_figure, make_energy_figure
+from app.figures.fdsmc_comparison import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
+from app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure
 from app.io.derived_view import derived_rows
 from app.io.numbers import format_metric
 from app.io.presets import to_raw

@@ -21,8 +21,8 @@ from app.io import units
 from app.io.display_units import UNIT_GROUPS, Field, Unit
 from app.io.numbers import NumberFormatError
 from app.io.presets import to_raw
+from app.ui.choices import checked_choice
 from app.ui.number_fields import NumberInput
-from app.ui.text import checked_choice
 from control.common.checks import ParameterError
 from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.params import DriveParams, LoadStep, Motor

@@ -12,7 +12,7 @@ from typing import Any
 
 import viser
 
-from app.figures.drive_log import make_log_overlay_figure
+from app.figures.fdsmc_drive_log import make_log_overlay_figure
 from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
 from app.io.presets import load
 from app.resources import example_log

@@ -2,7 +2,7 @@
 
 ``server.gui`` is shared by every client, so nothing per-user lives there: each connection gets
 its own case, inputs, results, worker thread and replay. A session composes the page — the control
-panel docked left with the two mode tabs (:mod:`app.ui.position_tab`, :mod:`app.ui.bldc`), the
+panel docked left with the two mode tabs (:mod:`app.ui.position_tab`, :mod:`app.ui.bldc_tab`), the
 results panel docked right (:mod:`app.ui.results`) with the studies (:mod:`app.ui.studies`), the 3D
 canvas between them — and sizes it from the window (:mod:`app.ui.layout`). Simulations run on the
 session's worker (never on the GUI event loop); a second Simulate while one runs is refused.
@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import viser
 
 from app.threads import limit_blas_threads
-from app.ui.bldc import add_bldc_tab
+from app.ui.bldc_tab import add_bldc_tab
 from app.ui.case import Case, CaseState
 from app.ui.inputs import InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js

@@ -19,13 +19,14 @@ import viser
 
 from app.io.presets import list_presets_of, load, require_mode
 from app.ui.case import Case, CaseState
+from app.ui.choices import checked_choice
 from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
 from app.ui.log import LogPanel
 from app.ui.props import assign
 from app.ui.results import ResultsPanel
 from app.ui.studies import OptimumToggle
-from app.ui.text import checked_choice, derived_markdown, design_markdown, md_text
+from app.ui.text import derived_markdown, design_markdown, md_text
 from app.ui.tuning import LiveTuning, TuneRunner
 from app.ui.verdict_panel import VerdictPanel
 from app.ui.worker import Cancelled, Worker

@@ -1,7 +1,7 @@
 """Replay of a comparison: the browser animates the overview figure, the server turns the 3D rotors.
 
-The overview figure (phase plane and compact time plot, :mod:`app.figures.overview`) carries its
-own play buttons (one per speed) and pause (:mod:`app.figures.replay`): it is sent once per
+The overview figure (phase plane and compact time plot, :mod:`app.figures.fdsmc_overview`) carries its
+own play buttons (one per speed) and pause (:mod:`app.figures.fdsmc_replay`): it is sent once per
 Simulate and animated by Plotly in the browser — the phase-plane markers and the time cursors
 move together — with no server traffic per frame. The "Replay t" slider below it scrubs: each move
 sends one ``Plotly.restyle`` of the markers and cursors (a few hundred bytes) and turns the 3D
@@ -21,10 +21,10 @@ from typing import Any
 import numpy as np
 import viser
 
-from app.figures.comparison import runs, time_plots_spec
-from app.figures.overview import overview_spec
+from app.figures.fdsmc_comparison import runs, time_plots_spec
+from app.figures.fdsmc_overview import overview_spec
+from app.figures.fdsmc_replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
 from app.figures.plain import figure_json
-from app.figures.replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
 from app.ui.props import assign
 from app.ui.scene import RotorScene
 from app.ui.viser_adapter import run_script, set_figure_json

@@ -14,15 +14,16 @@ from typing import Any
 
 import viser
 
-from app.figures.comparison import runs
-from app.figures.energy import energy_bars_spec, energy_spec, make_table1_figure
+from app.figures.fdsmc_comparison import runs
+from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.figures.plain import figure_json
 from app.io.numbers import parse_T_m_list
 from app.ui.layout import PanelLayout
 from app.ui.props import assign
 from app.ui.replay import Replay, overview_json, time_plots_json
+from app.ui.savings import annual_savings, savings_markdown
 from app.ui.scene import RotorScene
-from app.ui.text import annual_savings, key_numbers_html, savings_markdown
+from app.ui.text import key_numbers_html
 from app.ui.viser_adapter import add_figure, set_figure_json
 from sim.fdsmc.engine import TABLE1_T_M
 
@@ -43,7 +44,7 @@ class ResultsPanel:
         self.panel = gui.add_panel()
         phase_tab = self.panel.add_tab("Overview", viser.Icon.CHART_DOTS)
         time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
-        # the widgets carry the start-up comparison from their first message (app/ui/plots.py)
+        # the widgets carry the start-up comparison from their first message (app/ui/viser_adapter.py)
         overview, targets = overview_json(comparison)
         with phase_tab:
             self.key_numbers = gui.add_html(key_numbers_html(comparison))

@@ -15,8 +15,8 @@ from typing import Any
 
 import viser
 
-from app.figures.comparison import LABELS
-from app.figures.energy import optimum_gaps
+from app.figures.fdsmc_comparison import LABELS
+from app.figures.fdsmc_energy import optimum_gaps
 from app.ui.case import CasePort
 from app.ui.props import assign
 from app.ui.studies_multiaxis import MultiAxisView

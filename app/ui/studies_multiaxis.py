@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import viser
 
+from app.figures.fdsmc_studies import multiaxis_spec, multiaxis_table_markdown
 from app.figures.plain import figure_json
-from app.figures.studies import multiaxis_spec, multiaxis_table_markdown
 from app.io.preset_modes import list_presets_of
 from app.io.presets import MAX_BYTES, loads_raw
 from app.io.study_inputs import parse_axes

@@ -16,8 +16,8 @@ from multiprocessing import get_context
 
 import viser
 
+from app.figures.fdsmc_studies import robustness_spec, robustness_table_markdown
 from app.figures.plain import figure_json
-from app.figures.studies import robustness_spec, robustness_table_markdown
 from app.io.study_inputs import parse_spread
 from app.ui.case import CasePort
 from app.ui.text import md_text

@@ -1,4 +1,6 @@
-"""Pure text for the page: derived-values table, warnings, savings estimate (no viser here).
+"""Pure text for the page: derived-values table, warnings, key numbers, the design verdict (no viser here).
+
+Input checks are in :mod:`app.ui.choices`, the savings estimate in :mod:`app.ui.savings`.
 
 The derived values are rendered generically from :func:`app.io.derived_view.derived_rows` so that
 new rows appear on the page without changes here.
@@ -8,17 +10,11 @@ from __future__ import annotations
 
 import html
 import re
-from dataclasses import dataclass
 from typing import Any
 
 from app.io.derived_view import derived_rows
-from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
-
-#: Joules per kilowatt-hour [J/kWh].
-J_PER_KWH = 3.6e6
-
 
 _MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
 
@@ -34,20 +30,6 @@ def md_text(text: object) -> str:
     """
     flat = " ".join(str(text).split())
     return _MARKDOWN_SPECIAL.sub(r"\\\1", html.escape(flat, quote=False))
-
-
-def checked_choice(value: object, options: tuple[str, ...] | list[str], label: str) -> str:
-    """Check a dropdown value the server received against the options it offered.
-
-    Raises
-    ------
-    ParameterError
-        When a (hostile or stale) client sent a value that was never offered.
-    """
-    if not isinstance(value, str) or value not in options:
-        shown = repr(value) if len(repr(value)) <= 80 else repr(value)[:80] + "…"
-        raise ParameterError(f"{label} = {shown} is not one of the offered options: allowed {', '.join(options)}")
-    return value
 
 
 def derived_markdown(derived: Derived) -> str:
@@ -124,22 +106,6 @@ def key_numbers_html(comparison: Any) -> str:
             + " · ".join(parts) + "</div>")
 
 
-@dataclass(frozen=True)
-class AnnualSavings:
-    """Energy and money the FDSMC saves per axis and year vs the conventional controller.
-
-    Attributes
-    ----------
-    per_cycle_J : float   Electrical input energy saved per manoeuvre [J] (negative = costs more).
-    kWh_per_year : float  Saved energy per year [kWh].
-    money_per_year : float  Saved money per year [currency].
-    """
-
-    per_cycle_J: float
-    kWh_per_year: float
-    money_per_year: float
-
-
 def design_markdown(dd: Any) -> str:
     """Verdict of "Design for this drive" (:class:`sim.fdsmc.design.DriveDesign`) with the verified figures.
 
@@ -172,38 +138,4 @@ def _verified_figures(dd: Any) -> str:
             f"standstill ripple {m.hold_i_q_rms_A:.2g} A rms (≤ {crit.hold_i_rms:.2g})")
 
 
-def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
-                   price_per_kWh: float) -> AnnualSavings | None:
-    """Return the savings on the net electrical input energy over the simulated horizon; None without both runs.
-
-    Parameters
-    ----------
-    comparison : sim.fdsmc.engine.Comparison
-    cycles_per_hour : float  Manoeuvres per hour [1/h].
-    hours_per_year : float   Operating hours per year [h].
-    price_per_kWh : float    Energy price [currency/kWh].
-    """
-    f, c = comparison.fdsmc, comparison.conventional
-    if f is None or c is None or not (f.metrics.stable and c.metrics.stable):
-        return None
-    e_f, e_c = f.metrics.electrical_in_total_J, c.metrics.electrical_in_total_J
-    if e_f is None or e_c is None:
-        return None
-    per_cycle = e_c - e_f
-    kwh = per_cycle * cycles_per_hour * hours_per_year / J_PER_KWH
-    return AnnualSavings(per_cycle, kwh, kwh * price_per_kWh)
-
-
-def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
-    """Markdown summary of :func:`annual_savings`."""
-    if s is None:
-        return "_Simulate both controllers (stable runs) to estimate the savings._"
-    verb = "saves" if s.per_cycle_J >= 0 else "**costs more**:"
-    return (f"FDSMC {verb} **{abs(s.per_cycle_J):.4g} J** electrical input per cycle → "
-            f"**{s.kWh_per_year:.4g} kWh/year** and **{s.money_per_year:.4g} {currency}/year** per axis "
-            "(negative = the conventional controller is cheaper).")
-
-
-__all__ = ["AnnualSavings", "design_markdown", "annual_savings", "checked_choice", "derived_markdown",
-           "key_numbers_html", "md_text",
-           "savings_markdown", "warnings_html"]
+__all__ = ["derived_markdown", "design_markdown", "key_numbers_html", "md_text", "warnings_html"]

@@ -25,6 +25,7 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.params import DriveParams
 from sim.common import sensors
+from sim.common.economics import J_PER_KWH, cost_per_year, kwh_per_year  # noqa: F401 - J_PER_KWH re-exported
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.engine import pack_parameters
 from sim.fdsmc.grid import continuous_step, plant_substeps
@@ -32,8 +33,6 @@ from sim.fdsmc.metrics import kinetic_energy, magnetic_energy
 from sim.fdsmc.summary import decode_state
 from sim.studies.cycle_kernel import run_cycle
 
-#: Joules per kilowatt-hour [J/kWh].
-J_PER_KWH = 3.6e6
 COMPARATORS = ("fdsmc", "conventional", "optimum")
 #: Most trace points kept per comparator's run [-].
 TRACE_POINTS = 4000
@@ -97,8 +96,8 @@ class DutyResult:
         """(kWh per year, cost per year [currency]) per comparator."""
         out: dict[str, tuple[float, float] | None] = {}
         for c, w in self.cycle_J.items():
-            kwh = None if w is None else w * cycles_per_hour * hours_per_year / J_PER_KWH
-            out[c] = None if kwh is None else (kwh, kwh * price_per_kWh)
+            kwh = None if w is None else kwh_per_year(w, cycles_per_hour, hours_per_year)
+            out[c] = None if kwh is None else (kwh, cost_per_year(kwh, price_per_kWh))
         return out
 
 

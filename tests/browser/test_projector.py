@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
-from app.figures.overview import CURSORS
-from app.figures.replay import SPEEDS
+from app.figures.fdsmc_overview import CURSORS
+from app.figures.fdsmc_replay import SPEEDS
 from tests.browser.conftest import ARTIFACTS, TIMEOUT_MS, UiServer, click_tab, session_of, wait_for_layout
 
 #: Bounding boxes (page pixels) of the phase-plane subplot, the two time rows, the key numbers and

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import pytest
 
-from app.figures.replay import SPEEDS
+from app.figures.fdsmc_replay import SPEEDS
 from app.io.presets import PAPER_PRESET, load_preset
 from app.ui.plotly_js import BUNDLE
 from app.ui.replay import phase_plane_json

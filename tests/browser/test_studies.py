@@ -6,7 +6,7 @@ import multiprocessing
 import re
 from typing import Any
 
-from app.figures.comparison import LABELS
+from app.figures.fdsmc_comparison import LABELS
 from sim.fdsmc.verdicts import TARGET_BAND
 from tests.browser.conftest import click_tab, figure, set_number
 

@@ -6,8 +6,8 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from app.figures.comparison import decimate_index
 from app.figures.decimate import f32
+from app.figures.fdsmc_comparison import decimate_index
 from sim.drivelog.overlay import Overlay
 
 MEASURED, SIMULATED = "#2b2b2b", "#1f6fd1"

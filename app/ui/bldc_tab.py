@@ -14,7 +14,7 @@ from typing import Any
 
 import viser
 
-from app.figures.bldc import (
+from app.figures.bldc_speed_smc import (
     make_currents_figure,
     make_dqx_figure,
     make_emf_figure,
@@ -30,9 +30,10 @@ from app.io.display_units import field_hint, field_label, shown_value, si_value
 from app.io.numbers import NumberFormatError
 from app.io.presets import annotate_units, dumps_preset, load
 from app.io.units import s_to_ms, spec_of
+from app.ui.choices import checked_choice
 from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
-from app.ui.text import checked_choice, md_text
+from app.ui.text import md_text
 from app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
 from app.ui.worker import Cancelled, Worker
 from control.bldc.design import bldc_design

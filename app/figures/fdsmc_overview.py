@@ -1,8 +1,8 @@
 """The overview figure: phase plane and a compact time plot (ω_r and Γ vs t) in ONE Plotly figure.
 
-One figure, so that each in-browser replay frame (:mod:`app.figures.replay`) moves the phase-plane
+One figure, so that each in-browser replay frame (:mod:`app.figures.fdsmc_replay`) moves the phase-plane
 markers *and* the time cursors together, with no server traffic per frame. The phase plane keeps
-its trace names and order (:func:`app.figures.comparison.phase_plane_spec`); the compact time plot
+its trace names and order (:func:`app.figures.fdsmc_comparison.phase_plane_spec`); the compact time plot
 adds, per controller, ω_r [rad/s] and the motor torque Γ [N·m] (eq. (5) in [1]), the true load
 torque Γ_L dotted, the references ω_p and ±Γ_max dashed, the load steps as red dotted lines, and
 one ``"time cursor …"`` trace per row that the replay moves.
@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
 from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
+from app.figures.fdsmc_comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
 

@@ -4,7 +4,7 @@ Viser hands Plotly only ``data``/``layout``/``config`` (``fig.frames`` are dropp
 ``Plotly.animate`` also takes a list of frame *objects*, and a layout ``updatemenus`` button
 passes its ``args`` straight to it. So each speed's button carries its own short list of
 *key frames*, each moving only the phase-plane "now" markers and the time cursors of the overview
-figure (:mod:`app.figures.overview`; a few numbers per frame); the figure goes out once per
+figure (:mod:`app.figures.fdsmc_overview`; a few numbers per frame); the figure goes out once per
 Simulate and the replay then costs no server traffic at all.
 
 Between two key frames Plotly moves the markers and the cursor lines itself, at the browser's
@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.comparison import runs
+from app.figures.fdsmc_comparison import runs
 from sim.fdsmc.engine import Comparison
 
 #: Replay speeds: button label → simulated seconds per wall-clock second.

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
-from app.figures.comparison import COLOURS, LABELS, MAX_POINTS_TIME, stride_index
 from app.figures.decimate import f32, time_axis
+from app.figures.fdsmc_comparison import COLOURS, LABELS, MAX_POINTS_TIME, stride_index
 from app.figures.plain import to_figure
 from sim.fdsmc.verdicts import TARGET_BAND
 from sim.studies.multiaxis import MultiAxisResult

@@ -10,8 +10,8 @@ from typing import Any
 
 import plotly.graph_objects as go
 
-from app.figures.comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
 from app.figures.decimate import f32, time_axis
+from app.figures.fdsmc_comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, Table1Row
 from sim.fdsmc.optimum_gap import saving_vs_optimum
 
