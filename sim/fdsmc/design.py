@@ -213,7 +213,9 @@ def _slowdowns(p: DriveParams) -> list[float]:
         return [1.0]
     crit = pass_criteria(p).hold_i_rms
     for i, factor in enumerate(SENSOR_SLOWDOWN):
-        q = _slowed(p, factor)
+        q = _planned(_slowed(p, factor))
+        if q is None:
+            continue
         d = derive(q)
         if d.sample_rate is not None and not d.sample_rate.stable:
             continue
@@ -223,20 +225,27 @@ def _slowdowns(p: DriveParams) -> list[float]:
     return [SENSOR_SLOWDOWN[-1]]
 
 
+def _planned(p: DriveParams) -> DriveParams | None:
+    """``p`` at the T_m the design uses (the requested one if it fits, else the shortest that does); None if none."""
+    eta = _overshoot(p)
+    if not math.isfinite(eta):
+        return p
+    T_m = shortest_fitting_T_m(p, eta)
+    return None if T_m is None else _with(p, "manoeuvre", T_m=T_m)
+
+
 def _sensor_limited(dd: DriveDesign) -> bool:
     return not dd.params.sensors.ideal and any(c.violated and c.name in SENSOR_CHECKS for c in dd.limiting)
 
 
 def _design_at(p: DriveParams, asked: DriveParams) -> DriveDesign:
     """Choose T_m, check the sample rate, set K and T_c for ``p``'s loops, and verify."""
-    eta = _overshoot(p)
     limiting: list[Constraint] = []
-    if math.isfinite(eta):
-        T_m = shortest_fitting_T_m(p, eta)
-        if T_m is None:
-            return _refused(p, [Constraint("T_m", asked.manoeuvre.T_m, 1e4, "s", True,
-                                           "No manoeuvre time up to 1e4 s fits the speed/voltage limits.")])
-        p = _with(p, "manoeuvre", T_m=T_m)
+    planned = _planned(p)
+    if planned is None:
+        return _refused(p, [Constraint("T_m", asked.manoeuvre.T_m, 1e4, "s", True,
+                                       "No manoeuvre time up to 1e4 s fits the speed/voltage limits.")])
+    p = planned
     d = derive(p)
     rate = d.sample_rate
     if rate is not None and not rate.stable:
