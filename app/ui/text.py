@@ -15,6 +15,9 @@ from app.io.derived_view import derived_rows
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
+from sim.fdsmc.criteria import pass_criteria
+from sim.fdsmc.engine import LABELS
+from sim.fdsmc.recommend import recommend
 
 #: Joules per kilowatt-hour [J/kWh].
 J_PER_KWH = 3.6e6
@@ -95,19 +98,17 @@ def _saves(pct: float | None) -> str:
 
 
 def key_numbers_html(comparison: Any) -> str:
-    """Render one line of key numbers above the overview figure.
+    """Render the key numbers above the overview figure: net electrical input first.
 
-    Savings [%], friction and electrical input energies [J] of both controllers, peak torques
-    [N·m] vs the drive's limit Γ_max (red when above).
+    Net electrical input [J] (whole run) of every simulated controller with its copper and friction
+    parts, the recommended controller (:func:`sim.fdsmc.recommend.recommend`), then the paper's
+    friction saving and the peak torques [N·m] vs the drive's limit (red when above).
     """
     f, c = comparison.fdsmc, comparison.conventional
     if f is None:
         return '<div data-role="key-numbers" style="font-size:0.9em">Not simulated (infeasible manoeuvre).</div>'
     g_max = torque_limit(comparison.derived.params)
-
-    def energy(key: str) -> str:
-        values = [None if r is None else getattr(r.metrics, key) for r in (f, c)]
-        return " / ".join("–" if v is None else f"{v:.4g}" for v in values)
+    rec = recommend(comparison.derived.params, comparison)
 
     def peak(r: Any) -> str:
         v = r.metrics.torque_peak_Nm if r is not None else None
@@ -115,10 +116,13 @@ def key_numbers_html(comparison: Any) -> str:
             return "–"
         return f'<b style="color:#c92a2a">{v:.4g} ⚠</b>' if v > g_max * 1.001 else f"{v:.4g}"
 
-    parts = [f"<b>FDSMC {_saves(comparison.saving_friction_pct)}</b> friction, "
-             f"{_saves(comparison.saving_electrical_pct)} electrical input",
-             f"friction to T_m FDSMC / conv. {energy('friction_J')} J",
-             f"electrical in {energy('electrical_in_total_J')} J",
+    energies = " · ".join(
+        f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {e.net_electrical_J:.3g} J"
+        f"{'</b>' if e.controller == rec.controller else ''} ({e.copper_J:.2g} Cu + {e.friction_J:.2g} fr.)"
+        for e in rec.energies)
+    best = f"recommended: <b>{LABELS[rec.controller]}</b>" if rec.controller else "no controller passes every check"
+    parts = [f"<b>Net electrical input</b> {energies}", best,
+             f"FDSMC {_saves(comparison.saving_friction_pct)} friction vs conventional",
              f"peak Γ {peak(f)} / {peak(c)} N·m vs Γ_max {g_max:.4g} N·m"]
     return ('<div data-role="key-numbers" style="font-size:0.88em;line-height:1.35;padding:2px 2px 4px 2px">'
             + " · ".join(parts) + "</div>")
@@ -163,8 +167,6 @@ def design_markdown(dd: Any) -> str:
 
 def _verified_figures(dd: Any) -> str:
     """One line of the verification run's figures against the pass criteria."""
-    from sim.fdsmc.criteria import pass_criteria  # the criteria's defaults, resolved once
-
     m, crit = dd.comparison.fdsmc.metrics, pass_criteria(dd.params)
     inpos = "never" if m.in_position_s is None else f"{m.in_position_s:.3g} s"
     return (f"Verified: peak |i_dq| {m.i_peak_A:.3g} A (limit {crit.i_limit:.3g} A) · overshoot "
