@@ -120,6 +120,40 @@ def test_token_required_when_not_on_loopback():
         server.stop()
 
 
+
+def _raw_status(hostport: str, path: bytes, host: bytes | None = None) -> int:
+    """Status code of a GET written byte by byte (any bytes in the path and Host header)."""
+    import socket
+
+    h, port = hostport.rsplit(":", 1)
+    with socket.create_connection((h, int(port)), timeout=10) as s:
+        s.sendall(b"GET " + path + b" HTTP/1.1\r\nHost: " + (host or hostport.encode()) + b"\r\n\r\n")
+        return int(s.recv(64).split(b" ", 2)[1])
+
+
+def test_token_mode_checks_host_one_token_parameter_and_any_token_text_is_403():
+    guard = Guard.for_host("0.0.0.0", token="s3cret-token")
+    server, _ = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, host="127.0.0.1", port=free_port(),
+                              scene_3d=False, guard=guard)
+    try:
+        hostport = f"127.0.0.1:{server.get_port()}"
+        ok = f"{COOKIE}=s3cret-token"
+        assert _http_status(f"http://{hostport}/", {"Cookie": ok})[0] == 200
+        # DNS rebinding with a leaked cookie: a foreign host name is refused even with the token
+        assert _http_status(f"http://{hostport}/", {"Cookie": ok, "Host": "evil.example"})[0] == 403
+        assert _ws_status(hostport, "http://evil.example", {"Cookie": ok, "Host": "evil.example"}) == "403"
+        assert _http_status(f"http://{hostport}/", {"Cookie": ok, "Host": "192.0.2.7:8080"})[0] == 200  # LAN IP
+        # one token parameter only, in either order
+        assert _http_status(f"http://{hostport}/?token=s3cret-token&token=x")[0] == 403
+        assert _http_status(f"http://{hostport}/?token=x&token=s3cret-token")[0] == 403
+        for token in (b"%FF%FE", b"\xc3\xa9t\xc3\xa9", b"%00", b"%ED%A0%80", b"a" * 5000, b"[", b"%25"):
+            assert _raw_status(hostport, b"/?token=" + token) == 403, token
+        for host in (b"[", b"\xff\xfe", b"a:b:c", b"[::1", b"x" * 3000):
+            assert _raw_status(hostport, b"/?token=s3cret-token", host) in (400, 403), host
+        assert all(len(r) <= 300 for r in guard.refused)
+    finally:
+        server.stop()
+
 CAMERA = {"type": "ViewerCameraMessage", "wxyz": [1.0, 0.0, 0.0, 0.0], "position": [0.0, 0.0, 1.0],
           "fov": 1.0, "near": 0.01, "far": 100.0, "image_height": 600, "image_width": 800,
           "look_at": [0.0, 0.0, 0.0], "up_direction": [0.0, 0.0, 1.0]}

@@ -12,7 +12,10 @@ puts :meth:`Guard.check` in front of viser's own ``process_request``:
   refused too.
 * **Token** (only when bound to a non-loopback address): the start-up URL carries
   ``?token=…``; the first page load sets an HttpOnly, SameSite=Strict cookie, and every later
-  request (assets, websocket) must carry the token in the cookie or the query.
+  request (assets, websocket) must carry the token in the cookie or the query (one ``token``
+  parameter only). The Host is checked in token mode too: a name the tool is served as, the
+  machine's own host names, or an IP address literal (a DNS-rebinding page has a foreign name).
+  Any malformed request (token text, Host, Origin) is answered 403, never an error.
 """
 
 from __future__ import annotations
@@ -20,7 +23,9 @@ from __future__ import annotations
 import contextlib
 import hmac
 import http
+import ipaddress
 import secrets
+import socket
 import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -43,6 +48,23 @@ def _host_of(text: str) -> str:
     """Host name of a ``Host`` header or an origin URL, lower case, without port or brackets."""
     netloc = urlsplit(text if "//" in text else f"//{text}").hostname
     return (netloc or "").lower()
+
+
+def _is_ip_literal(host: str) -> bool:
+    """Tell whether ``host`` is an IPv4/IPv6 address written out (no DNS name: no DNS rebinding)."""
+    try:
+        ipaddress.ip_address(host)
+    except ValueError:
+        return False
+    return True
+
+
+def machine_names() -> set[str]:
+    """Return the host name and fully qualified name of this machine, lower case (its names on a LAN)."""
+    names = {socket.gethostname().lower()}
+    with contextlib.suppress(OSError):
+        names.add(socket.getfqdn().lower())
+    return {n for n in names if n}
 
 
 @dataclass
@@ -69,6 +91,8 @@ class Guard:
         hosts = set(LOOPBACK_HOSTS)
         if host not in ("0.0.0.0", "::", ""):
             hosts.add(host.strip("[]").lower())
+        elif token is not None:  # every interface: the machine's own names too
+            hosts |= machine_names()
         origins = {o.rstrip("/").lower() for o in allow_origins}
         hosts |= {_host_of(o) for o in origins}
         return cls(hosts, origins, token)
@@ -76,23 +100,36 @@ class Guard:
     def _token_ok(self, request: Any) -> bool:
         if self.token is None:
             return True
-        query = parse_qs(urlsplit(request.path).query).get("token", [""])[0]
+        queries = parse_qs(urlsplit(request.path).query, keep_blank_values=True).get("token", [])
+        if len(queries) > 1:
+            return False  # ?token=OK&token=x: ambiguous, refused whichever comes first
         cookies = request.headers.get("Cookie", "")
         jar = dict(c.strip().split("=", 1) for c in cookies.split(";") if "=" in c)
-        given = query or jar.get(COOKIE, "")
-        return hmac.compare_digest(given.encode(), self.token.encode())
+        given = queries[0] if queries else jar.get(COOKIE, "")
+        return hmac.compare_digest(given.encode("utf-8", "surrogateescape"), self.token.encode())
+
+    def _host_ok(self, host: str) -> bool:
+        return host in self.hosts or (self.token is not None and _is_ip_literal(host))
 
     def reason(self, request: Any) -> str | None:
-        """Why ``request`` is refused, or None if it may proceed."""
+        """Why ``request`` is refused, or None if it may proceed (a malformed request is refused)."""
+        try:
+            return self._reason(request)
+        except Exception as exc:  # noqa: BLE001 - duplicate headers, bad URL …: a refusal, never a 500
+            return f"malformed request ({type(exc).__name__}): refused"
+
+    def _reason(self, request: Any) -> str | None:
         host_header = request.headers.get("Host", "").lower()
         host = _host_of(host_header)
-        if self.token is None and host not in self.hosts:
-            return f"Host {host!r} is not one this tool is served as ({', '.join(sorted(self.hosts))})"
+        if not self._host_ok(host):
+            shown = host if len(host) <= 80 else host[:80] + "…"
+            return f"Host {shown!r} is not one this tool is served as ({', '.join(sorted(self.hosts))})"
         if request.headers.get("Upgrade", "").lower() == "websocket":
             origin = request.headers.get("Origin", "").rstrip("/").lower()
             same = bool(origin) and urlsplit(origin).netloc == host_header
             if not origin or not (same or origin in self.origins):
-                return f"websocket Origin {origin or '(none)'!r} is not allowed (allowed: this page's own host)"
+                shown = origin[:80] + "…" if len(origin) > 80 else origin or "(none)"
+                return f"websocket Origin {shown!r} is not allowed (allowed: this page's own host)"
         if not self._token_ok(request):
             return "missing or wrong access token: open the URL printed at start-up (…?token=…)"
         return None
