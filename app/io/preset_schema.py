@@ -17,7 +17,7 @@ import typing
 from typing import Any
 
 from app.io import units
-from app.io.numbers import NumberFormatError, parse_integer, parse_number
+from app.io.numbers import NumberFormatError, parse_integer, parse_number, shown
 from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
@@ -73,7 +73,7 @@ def number_of(name: str, value: Any, tp: type) -> Any:
     except NumberFormatError as exc:
         raise PresetError(str(exc)) from None
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
+        raise PresetError(f"{name} = {shown(value)} has the wrong type: allowed {_describe(tp)}")
     if tp is int:  # 4.0 → 4; 2.5, nan … go to the dataclass, which names the allowed range
         return int(value) if math.isfinite(value) and float(value).is_integer() else value
     return float(value)
@@ -84,7 +84,7 @@ def _coerce(name: str, value: Any, tp: Any) -> Any:
     if tp in (float, int):
         return number_of(name, value, tp)
     if tp is str and isinstance(value, str):
-        return value
+        return str(value)  # plain text, whether the file quoted it or not
     if isinstance(tp, types.UnionType):  # e.g. float | str: a number, else the keyword text
         args = typing.get_args(tp)
         if float in args and isinstance(value, str) and str in args:
@@ -102,7 +102,7 @@ def _coerce(name: str, value: Any, tp: Any) -> Any:
         if item is float:  # a list of numbers, e.g. a sampled back-EMF period
             return tuple(_coerce(f"{name}[{i}]", v, float) for i, v in enumerate(value))
         return tuple(_parse_section(item, v, f"{name}[{i}]") for i, v in enumerate(value))
-    raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
+    raise PresetError(f"{name} = {shown(value)} has the wrong type: allowed {_describe(tp)}")
 
 
 def _parse_section(cls: type, raw: Any, section: str) -> Any:
