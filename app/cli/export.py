@@ -14,6 +14,7 @@ from pathlib import Path
 
 from app.cli.main import add_preset_arguments
 from app.exports.model import FORMATS, export_files
+from app.io.atomic import write_atomic
 from app.io.preset_modes import load_mode_preset
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
@@ -54,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
         targets = {Path(args.output or name): content}
     for path, content in targets.items():
         try:
-            path.write_bytes(content)
+            write_atomic(path, content)
         except OSError as exc:
             raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
         sys.stdout.write(f"wrote {path} ({len(content)} bytes)\n")

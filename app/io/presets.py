@@ -26,6 +26,7 @@ from typing import Any
 import yaml
 
 from app.io import units
+from app.io.atomic import write_atomic_text
 from app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
 from app.io.numbers import QuotedText, shorten
 from app.io.preset_schema import (
@@ -382,7 +383,7 @@ def annotate_units(text: str) -> str:
 
 def save_preset(params: Any, path: str | Path, plant: DriveParams | None = None) -> None:
     """Write a parameter object (and optional plant) as a preset file."""
-    Path(path).write_text(dumps_preset(params, plant), encoding="utf-8")
+    write_atomic_text(path, dumps_preset(params, plant))
 
 
 __all__ = [
