@@ -20,7 +20,7 @@ import websockets
 from app.io.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
 from app.ui.session import create_server
 from app.ui.text import checked_choice, md_text
-from app.ui.web_guard import COOKIE, Guard
+from app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
 from app.ui.worker import Cancelled, Worker
 from control.common.checks import ParameterError
 
@@ -199,6 +199,45 @@ def _send_update(hostport: str, config: object, handle_of: str, value: str, wait
     assert done.is_set()
     return session_box[0]
 
+
+HOSTILE_UPDATES = [("results.cycles", {"value": "abc"}), ("results.cycles", {"value": float("nan")}),
+                   ("results.cycles", {"value": True}), ("results.cycles", {"value": [1, 2]}),
+                   ("inputs.alpha_rule", {"value": 5}), ("results.cycles", {"nonexistent": 1}),
+                   ("results.cycles", {"__class__": 1}), ("results.cycles", ["value", 1])]
+
+
+def test_widget_values_are_type_checked_before_viser_casts_them(served):
+    hostport, _, config = served
+    known, before = set(config.sessions), len(REFUSED_UPDATES)
+    box: list[object] = []
+
+    async def go() -> None:
+        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
+                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
+            await ws.send(msgspec.msgpack.encode(CAMERA))
+            for _ in range(600):
+                if set(config.sessions) - known:
+                    box.append(config.sessions[(set(config.sessions) - known).pop()])
+                    break
+                await asyncio.sleep(0.05)
+            session = box[0]
+            for path, updates in [*HOSTILE_UPDATES, ("results.cycles", {"value": 601.0})]:  # last: a valid one
+                handle = session
+                for attr in path.split("."):
+                    handle = getattr(handle, attr)
+                await ws.send(msgspec.msgpack.encode({"type": "GuiUpdateMessage", "uuid": handle._impl.uuid,
+                                                      "updates": updates}))
+            for _ in range(200):  # updates are handled in order: the valid one last
+                if session.results.cycles.value == 601.0:
+                    break
+                await asyncio.sleep(0.05)
+
+    _run(go)
+    session = box[0]
+    assert session.results.cycles.value == 601.0 and session.inputs.alpha_rule.value != 5
+    refused = list(REFUSED_UPDATES)[before:]
+    assert len(refused) == len(HOSTILE_UPDATES), refused
+    assert all(len(r) <= 300 for r in refused) and any("allowed a finite number" in r for r in refused)
 
 def test_hostile_client_cannot_load_a_file_through_the_preset_dropdown(served, tmp_path):
     hostport, _, config = served

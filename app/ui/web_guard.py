@@ -16,14 +16,21 @@ puts :meth:`Guard.check` in front of viser's own ``process_request``:
   parameter only). The Host is checked in token mode too: a name the tool is served as, the
   machine's own host names, or an IP address literal (a DNS-rebinding page has a foreign name).
   Any malformed request (token text, Host, Origin) is answered 403, never an error.
+* **Widget values** (every GUI update a client sends): checked against the widget's own value type
+  before viser casts it — a number widget takes a finite number, a text widget text, a checkbox a
+  bool, a vector a list of the same length — so a hand-made client cannot raise in the server's
+  message handler or slip NaN into a field; a refused update is dropped and recorded in
+  :data:`REFUSED_UPDATES`.
 """
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import hmac
 import http
 import ipaddress
+import math
 import secrets
 import socket
 import threading
@@ -32,6 +39,7 @@ from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
+import viser._gui_api as viser_gui
 import websockets.asyncio.server as ws_server
 
 LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
@@ -156,9 +164,71 @@ class Guard:
         return process_request
 
 
+#: The most recent GUI updates refused by :func:`update_problem` (one line each; for logs and tests).
+REFUSED_UPDATES: collections.deque[str] = collections.deque(maxlen=100)
+
+
+def _value_problem(current: Any, value: Any) -> str | None:
+    """Why ``value`` cannot replace a widget value like ``current``, or None."""
+    if current is None:
+        return None
+    if isinstance(current, bool):
+        return None if isinstance(value, bool) else "allowed true or false"
+    if isinstance(current, int | float):
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+        return None if ok else "allowed a finite number"
+    if isinstance(current, str):
+        return None if isinstance(value, str) else "allowed text"
+    if isinstance(current, tuple):
+        if not isinstance(value, list | tuple) or len(value) != len(current):
+            return f"allowed a list of {len(current)} values"
+        problems = [_value_problem(c, v) for c, v in zip(current, value, strict=True)]
+        return next((p for p in problems if p is not None), None)
+    return None
+
+
+def update_problem(state: Any, updates: Any) -> str | None:
+    """Why a client's GUI update of a widget (its state ``state``) is refused, or None."""
+    if not isinstance(updates, dict):
+        return "the update is not a mapping"
+    for name, value in updates.items():
+        if not isinstance(name, str) or name.startswith("_") or not hasattr(state, name):
+            return f"property {str(name)[:40]!r} is not one of the widget's"
+        why = _value_problem(getattr(state, name), value)
+        if why is not None:
+            return f"{name} = {repr(value)[:80]} has the wrong type: {why}"
+    return None
+
+
+def _checked_gui_updates(original: Callable[..., Any]) -> Callable[..., Any]:
+    async def handle(self: Any, client_id: Any, message: Any) -> None:
+        widget = self._gui_input_handle_from_uuid.get(message.uuid, None)
+        if widget is not None and not widget._impl.removed:
+            why = update_problem(widget._impl, message.updates)
+            if why is not None:
+                label = str(getattr(widget._impl, "label", ""))[:60]
+                REFUSED_UPDATES.append(f"client {client_id}: widget {label!r}: {why}")
+                return
+        await original(self, client_id, message)
+
+    handle.__wrapped__ = original  # type: ignore[attr-defined]
+    return handle
+
+
+def check_widget_updates() -> None:
+    """Put :func:`update_problem` in front of viser's GUI-update handler (once, for every GUI created after)."""
+    current = viser_gui.GuiApi._handle_gui_updates
+    if not hasattr(current, "__wrapped__"):
+        viser_gui.GuiApi._handle_gui_updates = _checked_gui_updates(current)  # type: ignore[method-assign]
+
+
 @contextlib.contextmanager
 def guarded(guard: Guard) -> Iterator[None]:
-    """While active, every ``websockets`` server started gets ``guard`` in front of its requests."""
+    """While active, every ``websockets`` server started gets ``guard`` in front of its requests.
+
+    Widget updates are type-checked from then on (:func:`check_widget_updates`).
+    """
+    check_widget_updates()
     with _patch_lock:
         original = ws_server.serve
 
@@ -173,4 +243,5 @@ def guarded(guard: Guard) -> Iterator[None]:
             ws_server.serve = original  # type: ignore[assignment]
 
 
-__all__ = ["COOKIE", "LOOPBACK_HOSTS", "Guard", "guarded", "new_token"]
+__all__ = ["COOKIE", "LOOPBACK_HOSTS", "REFUSED_UPDATES", "Guard", "check_widget_updates", "guarded", "new_token",
+           "update_problem"]
