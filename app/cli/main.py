@@ -35,7 +35,9 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # one line, exit 2
-        sys.stderr.write(f"error: {message}\n")
+        from app.io.numbers import one_line
+
+        sys.stderr.write(f"error: {one_line(message, 293)}\n")
         raise SystemExit(2)
 
 
@@ -159,5 +161,7 @@ def _main(argv: list[str]) -> int:
             return _run_in_thread(args)
         return int(args._run(args) or 0)
     except ValueError as exc:  # ParameterError, PresetError: bad input
-        sys.stderr.write(f"error: {exc}\n")
+        from app.io.numbers import one_line
+
+        sys.stderr.write(f"error: {one_line(exc, 293)}\n")  # ≤ 300 characters with "error: "
         return 2

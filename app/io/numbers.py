@@ -40,6 +40,23 @@ def shorten(text: object, limit: int = SHOWN_MAX) -> str:
     return flat if len(flat) <= limit else flat[: limit - 1] + "…"
 
 
+#: Longest message of a refusal [characters].
+MESSAGE_MAX = 300
+
+
+def one_line(message: object, limit: int = MESSAGE_MAX) -> str:
+    """Return a refusal as one line of at most ``limit`` characters.
+
+    Line breaks become spaces; an overlong message keeps its start (the field and value) and its
+    end (what is allowed), joined by "…".
+    """
+    flat = " ".join(str(message).split())
+    if len(flat) <= limit:
+        return flat
+    tail = (limit - 3) * 2 // 5
+    return f"{flat[: limit - 3 - tail]} … {flat[-tail:]}"
+
+
 def shown(text: object) -> str:
     """``repr`` of a value for a message, at most :data:`SHOWN_MAX` characters."""
     r = repr(str(text)) if isinstance(text, str) else repr(text)
@@ -163,6 +180,6 @@ def format_number(value: float) -> str:
     return repr(float(value))
 
 
-__all__ = ["FORMS", "SHOWN_MAX", "T_M_LIST_MAX", "NumberFormatError", "QuotedText", "format_metric",
-           "format_number", "integer_option", "number_option", "parse_T_m_list", "parse_integer", "parse_number",
-           "shorten", "shown"]
+__all__ = ["FORMS", "MESSAGE_MAX", "SHOWN_MAX", "T_M_LIST_MAX", "NumberFormatError", "QuotedText", "format_metric",
+           "format_number", "integer_option", "number_option", "one_line", "parse_T_m_list", "parse_integer",
+           "parse_number", "shorten", "shown"]

@@ -28,7 +28,7 @@ import yaml
 from app.io import units
 from app.io.atomic import write_atomic_text
 from app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
-from app.io.numbers import QuotedText, shorten
+from app.io.numbers import QuotedText, shorten, shown
 from app.io.preset_schema import (
     MODES,
     PLANT,
@@ -210,15 +210,15 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
         key, sep, text = item.partition("=")
         section, dot, name = key.strip().partition(".")
         if not sep or not dot or not name:
-            raise PresetError(f"--set {item!r} is malformed: allowed form section.field=value")
+            raise PresetError(f"--set {shown(item)} is malformed: allowed form section.field=value")
         if section == PLANT and raw.get(PLANT) is None and raw.get("mode", "position") == "position":
             raw[PLANT] = {}
         if not isinstance(raw.get(section), dict):
             known = [k for k, v in raw.items() if isinstance(v, dict)]
-            raise PresetError(f"--set {item!r}: unknown section {section!r}{hint(section, known)}")
+            raise PresetError(f"--set {shown(item)}: unknown section {shown(section)}{hint(section, known)}")
         value = plain_scalar(text, f"--set {key}") if text.strip() else None
         if value is None:
-            raise PresetError(f"--set {item!r} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
+            raise PresetError(f"--set {shown(item)} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
         aliases = units.ALIASES.get(section, {}) if section != PLANT else (
             units.ALIASES["motor"] | units.ALIASES["load"])
         target = field_of(name, aliases, [units.KE_KEY])
@@ -246,7 +246,7 @@ def resolve(name_or_path: str) -> Path:
             return candidate
     except (OSError, ValueError):  # name too long for the file system, NUL byte …
         pass
-    raise PresetError(f"preset {name_or_path!r} not found{hint(str(name_or_path), list_presets())}")
+    raise PresetError(f"preset {shown(name_or_path)} not found{hint(str(name_or_path), list_presets())}")
 
 
 def list_presets() -> list[str]:
