@@ -239,6 +239,51 @@ def test_widget_values_are_type_checked_before_viser_casts_them(served):
     assert len(refused) == len(HOSTILE_UPDATES), refused
     assert all(len(r) <= 300 for r in refused) and any("allowed a finite number" in r for r in refused)
 
+
+def _start(session: object, uuid: str, name: str, size: int, parts: int) -> dict:
+    return {"type": "FileTransferStartUpload", "source_component_uuid": uuid, "transfer_uuid": name,
+            "filename": name, "mime_type": "text/csv", "part_count": parts, "size_bytes": size}
+
+
+def test_uploads_are_refused_by_declared_size_and_overrun_while_streaming(served):
+    hostport, _, config = served
+    known, before = set(config.sessions), len(REFUSED_UPDATES)
+    box: list[object] = []
+
+    async def go() -> None:
+        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
+                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
+            await ws.send(msgspec.msgpack.encode(CAMERA))
+            for _ in range(600):
+                if set(config.sessions) - known:
+                    box.append(config.sessions[(set(config.sessions) - known).pop()])
+                    break
+                await asyncio.sleep(0.05)
+            log_uuid, preset_uuid = box[0].log_panel.upload._impl.uuid, box[0].files.upload._impl.uuid
+            msgs = [_start(box[0], log_uuid, "huge.csv", 300 * 2**20, 300),  # over 50 MB: refused at once
+                    _start(box[0], preset_uuid, "big.yaml", 2 * 2**20, 2),  # over 512 KiB for a preset
+                    _start(box[0], log_uuid, "a.csv", 40 * 2**20, 40),  # accepted, held open
+                    _start(box[0], log_uuid, "b.csv", 40 * 2**20, 40),  # 80 MB unfinished: refused
+                    _start(box[0], log_uuid, "small.csv", 10, 1),
+                    {"type": "FileTransferPart", "source_component_uuid": log_uuid, "transfer_uuid": "small.csv",
+                     "part_index": 0, "content": b"x" * 1000}]  # overruns its 10 bytes: ended
+            for m in msgs:
+                await ws.send(msgspec.msgpack.encode(m))
+            for _ in range(200):
+                if len(REFUSED_UPDATES) - before >= 4:
+                    break
+                await asyncio.sleep(0.05)
+            box.append(dict(box[0].client.gui._current_file_upload_states))
+
+    _run(go)
+    refused = list(REFUSED_UPDATES)[before:]
+    assert len(refused) == 4, refused
+    assert "huge.csv" in refused[0] and "allowed ≤ 50 MB" in refused[0]
+    assert "big.yaml" in refused[1] and "allowed ≤ 0.5 MB" in refused[1]
+    assert "b.csv" in refused[2] and "unfinished uploads" in refused[2]
+    assert "small.csv" in refused[3] and "overrun" in refused[3]
+    assert set(box[1]) == {"a.csv"}  # only the accepted transfer holds state (no parts yet)
+
 def test_hostile_client_cannot_load_a_file_through_the_preset_dropdown(served, tmp_path):
     hostport, _, config = served
     target = tmp_path / "x.yaml"

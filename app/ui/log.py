@@ -15,6 +15,7 @@ import viser
 
 from app.figures.drive_log import make_log_overlay_figure
 from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
+from app.io.numbers import one_line
 from app.io.presets import load_preset
 from app.ui.text import html_text, md_text
 from control.common.checks import ParameterError
@@ -131,7 +132,7 @@ class LogPanel:
             log = read_bytes(content, name, run=self.compare_with.value, p=self.s.params.motor.p)
             ov = overlay(log.signals, run.trace)
         except (LogError, ParameterError) as exc:
-            self.s.client.add_notification("Log rejected", str(exc), color="red", auto_close_seconds=15.0)
+            self.s.client.add_notification("Log rejected", one_line(exc), color="red", auto_close_seconds=15.0)
             return
         self.identified, self.log_name = run_identification(log, self.s.params), name
         self._show(make_log_overlay_figure(ov, html_text(name)))
@@ -152,7 +153,7 @@ class LogPanel:
         try:
             params = apply_identified(self.s.inputs.collect(), self.identified, self.log_name)
         except ValueError as exc:
-            self.s.client.add_notification("Not applied", str(exc), color="red", auto_close_seconds=12.0)
+            self.s.client.add_notification("Not applied", one_line(exc), color="red", auto_close_seconds=12.0)
             return
         self.s.inputs.populate(params)
         self.s.origin = f"{self.s.origin} + identified from {self.log_name}"

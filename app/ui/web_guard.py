@@ -21,6 +21,10 @@ puts :meth:`Guard.check` in front of viser's own ``process_request``:
   bool, a vector a list of the same length — so a hand-made client cannot raise in the server's
   message handler or slip NaN into a field; a refused update is dropped and recorded in
   :data:`REFUSED_UPDATES`.
+* **Uploads** (checked while streaming): refused by their declared size before any part is kept
+  (:func:`upload_limit`: 50 MB for a drive log, 512 KiB for preset and waveform files), a part that
+  would overrun the declared size ends the transfer, and one client's unfinished uploads together
+  may hold ≤ :data:`CLIENT_INFLIGHT_BYTES`, the server's ≤ :data:`SERVER_INFLIGHT_BYTES`.
 """
 
 from __future__ import annotations
@@ -41,6 +45,8 @@ from urllib.parse import parse_qs, urlsplit
 
 import viser._gui_api as viser_gui
 import websockets.asyncio.server as ws_server
+
+from app.io.numbers import shorten
 
 LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 COOKIE = "pmsm_token"
@@ -215,11 +221,79 @@ def _checked_gui_updates(original: Callable[..., Any]) -> Callable[..., Any]:
     return handle
 
 
+#: Largest drive-log upload [B] (as :data:`app.io.drive_log.MAX_BYTES`), and any other upload [B].
+LOG_UPLOAD_BYTES, FILE_UPLOAD_BYTES = 50 * 2**20, 512 * 2**10
+#: Most bytes one client's unfinished uploads may declare together, and all clients' [B].
+CLIENT_INFLIGHT_BYTES, SERVER_INFLIGHT_BYTES = 60 * 2**20, 200 * 2**20
+
+
+def upload_limit(mime_type: str) -> int:
+    """Largest upload [B] an upload button taking ``mime_type`` accepts (drive logs: CSV only)."""
+    kinds = str(mime_type).lower()
+    return LOG_UPLOAD_BYTES if "csv" in kinds and "yaml" not in kinds else FILE_UPLOAD_BYTES
+
+
+def upload_problem(gui: Any, client_id: Any, message: Any) -> str | None:
+    """Why an upload announced by ``message`` is refused before any of it is kept, or None."""
+    widget = gui._gui_input_handle_from_uuid.get(message.source_component_uuid, None)
+    if widget is None:
+        return None  # viser ignores it
+    size, parts = message.size_bytes, message.part_count
+    limit = upload_limit(getattr(widget._impl.props, "mime_type", ""))
+    if not isinstance(size, int) or not isinstance(parts, int) or size < 0 or parts < 0 or parts > size + 1:
+        return f"{shorten(message.filename, 60)!r}: malformed upload (size {size!r}, {parts!r} parts)"
+    if size > limit:
+        return (f"{shorten(message.filename, 60)!r} is {size / 2**20:.1f} MB: allowed ≤ {limit / 2**20:.3g} MB "
+                "for this button")
+    states = gui._current_file_upload_states.values()
+    mine = sum(int(st["total_bytes"]) for st in states if st["client_id"] == client_id)
+    everyone = sum(int(st["total_bytes"]) for st in states)
+    if mine + size > CLIENT_INFLIGHT_BYTES or everyone + size > SERVER_INFLIGHT_BYTES:
+        return (f"{shorten(message.filename, 60)!r}: too many unfinished uploads at once: wait for the "
+                "others to finish")
+    return None
+
+
+def _checked_upload_start(original: Callable[..., Any]) -> Callable[..., Any]:
+    def handle(self: Any, client_id: Any, message: Any) -> None:
+        why = upload_problem(self, client_id, message)
+        if why is None:
+            original(self, client_id, message)
+            return
+        REFUSED_UPDATES.append(f"client {client_id}: upload refused: {why}")
+        client = self._resolve_client(client_id)
+        if client is not None:
+            client.add_notification("Upload refused — nothing read", why, color="red", auto_close_seconds=15.0)
+
+    handle.__wrapped__ = original  # type: ignore[attr-defined]
+    return handle
+
+
+def _checked_upload_part(original: Callable[..., Any]) -> Callable[..., Any]:
+    def handle(self: Any, client_id: Any, message: Any) -> None:
+        state = self._current_file_upload_states.get(message.transfer_uuid)
+        if state is not None and (state["client_id"] != client_id or not isinstance(message.content, bytes)
+                                  or state["transferred_bytes"] + len(message.content) > state["total_bytes"]):
+            self._current_file_upload_states.pop(message.transfer_uuid, None)  # the parts kept are freed
+            REFUSED_UPDATES.append(f"client {client_id}: upload {shorten(state['filename'], 60)!r} ended: "
+                                   "its parts overrun the declared size")
+            return
+        original(self, client_id, message)
+
+    handle.__wrapped__ = original  # type: ignore[attr-defined]
+    return handle
+
+
+_WRAPPERS = {"_handle_gui_updates": _checked_gui_updates, "_handle_file_transfer_start": _checked_upload_start,
+             "_handle_file_transfer_part": _checked_upload_part}
+
+
 def check_widget_updates() -> None:
-    """Put :func:`update_problem` in front of viser's GUI-update handler (once, for every GUI created after)."""
-    current = viser_gui.GuiApi._handle_gui_updates
-    if not hasattr(current, "__wrapped__"):
-        viser_gui.GuiApi._handle_gui_updates = _checked_gui_updates(current)  # type: ignore[method-assign]
+    """Put the widget-value and upload checks in front of viser's handlers (once, for every GUI created after)."""
+    for name, wrap in _WRAPPERS.items():
+        current = getattr(viser_gui.GuiApi, name)
+        if not hasattr(current, "__wrapped__"):
+            setattr(viser_gui.GuiApi, name, wrap(current))
 
 
 @contextlib.contextmanager
@@ -244,4 +318,4 @@ def guarded(guard: Guard) -> Iterator[None]:
 
 
 __all__ = ["COOKIE", "LOOPBACK_HOSTS", "REFUSED_UPDATES", "Guard", "check_widget_updates", "guarded", "new_token",
-           "update_problem"]
+           "update_problem", "upload_limit", "upload_problem"]
