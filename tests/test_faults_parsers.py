@@ -83,3 +83,31 @@ def test_cli_set_reproduction_exits_2_with_one_line():
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert proc.stderr.count("\n") == 1 and "nested too deeply" in proc.stderr and len(proc.stderr) <= 300
+
+
+@pytest.mark.parametrize("name", [n for n in ATTACKS if ATTACKS[n][2] == "nested too deeply"])
+def test_pure_python_yaml_path_refuses_the_same_attacks(name, monkeypatch):
+    """Without libyaml the guarded pure-Python scanner refuses the same texts (its own counting)."""
+    from app.io import presets
+
+    monkeypatch.setattr(presets, "_CLoader", None)
+    kind, text, says = ATTACKS[name]
+    with pytest.raises(PresetError, match=says):
+        _load(kind, text)
+
+
+def test_anchors_and_aliases_refused_on_both_paths(monkeypatch):
+    from app.io import presets
+
+    text = "a: &x 1\nb: *x\n"
+    with pytest.raises(PresetError, match="anchors/aliases"):
+        presets.loads_raw(text, "a.yaml")
+    monkeypatch.setattr(presets, "_CLoader", None)
+    with pytest.raises(PresetError, match="anchors/aliases"):
+        presets.loads_raw(text, "a.yaml")
+
+
+@pytest.mark.parametrize("value", ["1.5 # note", "\ufeff1.5", "1\n 5", ">\n 1.5", "'1.5'"])
+def test_set_value_with_hidden_parts_is_refused(value):
+    with pytest.raises(PresetError, match="motor.R_s"):
+        load_preset(PAPER, [f"motor.R_s={value}"])
