@@ -36,6 +36,7 @@ from app.io.preset_schema import (
     PresetError,
     field_of,
     hint,
+    optional_sections,
     parse_plant,
     parse_preset,
     plain,
@@ -213,6 +214,8 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
             raise PresetError(f"--set {shown(item)} is malformed: allowed form section.field=value")
         if section == PLANT and raw.get(PLANT) is None and raw.get("mode", "position") == "position":
             raw[PLANT] = {}
+        if section not in raw and section in optional_sections(MODES.get(str(raw.get("mode", "position")))):
+            raw[section] = {}  # an optional section (sensors, limits) set from the command line
         if not isinstance(raw.get(section), dict):
             known = [k for k, v in raw.items() if isinstance(v, dict)]
             raise PresetError(f"--set {shown(item)}: unknown section {shown(section)}{hint(section, known)}")
@@ -221,8 +224,8 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
             raise PresetError(f"--set {shown(item)} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
         aliases = units.ALIASES.get(section, {}) if section != PLANT else (
             units.ALIASES["motor"] | units.ALIASES["load"])
-        target = field_of(name, aliases, [units.KE_KEY])
-        for other in [k for k in raw[section] if field_of(str(k), aliases, [units.KE_KEY]) == target]:
+        target = field_of(name, aliases, list(units.FLUX_KEYS))
+        for other in [k for k in raw[section] if field_of(str(k), aliases, list(units.FLUX_KEYS)) == target]:
             del raw[section][other]  # an override replaces the value in any unit form
         raw[section][name] = value
     return raw

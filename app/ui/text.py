@@ -151,15 +151,35 @@ class AnnualSavings:
 
 
 def design_markdown(dd: Any) -> str:
-    """Verdict of "Design for this drive" (:class:`sim.fdsmc.design.DriveDesign`): clean, or what prevents it."""
+    """Verdict of "Design for this drive" (:class:`sim.fdsmc.design.DriveDesign`) with the verified figures.
+
+    Clean (every check holds with the sensors at the requested T_m), not as asked (only at a longer
+    T_m) or not clean (the constraints say why); then the peak current, overshoot, in-position time
+    and standstill ripple of the verification run against their limits.
+    """
     c = dd.params.controller
-    head = ("**Design: clean** — simulated peaks within the drive's limits, on target at T_m, no chatter."
-            if dd.clean else "**Design: not clean** — see the constraints below.")
+    head = {"clean": "**Design: CLEAN** — with the sensors: limits, in-position, overshoot and ripple all hold.",
+            "not as asked": "**Design: NOT AS ASKED** — clean only at a longer T_m than requested.",
+            "not clean": "**Design: NOT CLEAN** — see the constraints below."}[dd.verdict]
     lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "
-                   f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms"]
+                   f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms, "
+                   f"T_so = {c.T_so * 1e3:.4g} ms, T_sα = {c.T_salpha * 1e3:.4g} ms"]
+    if dd.comparison is not None and dd.comparison.fdsmc is not None:
+        lines.append(_verified_figures(dd))
     lines += [f"- {'✗' if x.violated else '·'} {md_text(x.text)}" for x in dd.limiting]
     lines += [f"- note: {md_text(n)}" for n in dd.notes]
-    return "\n\n".join(lines[:2]) + "\n\n" + "\n".join(lines[2:])
+    return "\n\n".join(lines[:3]) + "\n\n" + "\n".join(lines[3:])
+
+
+def _verified_figures(dd: Any) -> str:
+    """One line of the verification run's figures against the pass criteria."""
+    from sim.fdsmc.criteria import pass_criteria  # the criteria's defaults, resolved once
+
+    m, crit = dd.comparison.fdsmc.metrics, pass_criteria(dd.params)
+    inpos = "never" if m.in_position_s is None else f"{m.in_position_s:.3g} s"
+    return (f"Verified: peak |i_dq| {m.i_peak_A:.3g} A (limit {crit.i_limit:.3g} A) · overshoot "
+            f"{m.overshoot_rad:.2g} rad (≤ {crit.overshoot:.2g}) · in position {inpos} (±{crit.in_position:.2g} rad) · "
+            f"standstill ripple {m.hold_i_q_rms_A:.2g} A rms (≤ {crit.hold_i_rms:.2g})")
 
 
 def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,

@@ -11,7 +11,7 @@ import math
 
 from control.fdsmc.derivations import Derived
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
-from control.fdsmc.model import available_voltage
+from sim.fdsmc.checks import TARGET_BAND, exceeded, run_checks, saturation_matters
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
 
 
@@ -58,7 +58,11 @@ def _chatter(run: RunResult, derived: Derived) -> str:
 
 
 def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
-    """List the simulated peaks that the real drive cannot deliver (Γ_max, available voltage, ω_b).
+    """List the simulated peaks that the real drive cannot deliver: torque, current, voltage, speed.
+
+    The limits are the drive's: :func:`~control.fdsmc.feasibility.torque_limit` (Γ_max, or K_t·i_max),
+    the hard current limit, the inverter's voltage (V_dc/√3, else √(2/3)·V_0) and the speed limit
+    (limits.omega_max, else ω_b).
 
     Parameters
     ----------
@@ -72,26 +76,16 @@ def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
     list of str
         One message per limit exceeded.
     """
-    m, motor, name = run.metrics, derived.params.motor, LABELS[run.controller]
-    out: list[str] = []
-    torque, volts, speed = m.torque_peak_Nm, m.u_peak_V, m.omega_peak_rad_s
-    u_avail = available_voltage(motor)
-    if torque is not None and torque > motor.Gamma_max:
-        out.append(f"Not feasible on the real drive ({name}): peak torque {torque:.4g} N·m > "
-                   f"Γ_max = {motor.Gamma_max:g} N·m.")
-    if volts is not None and volts > u_avail:
-        out.append(f"Not feasible on the real drive ({name}): peak |u_dq| {volts:.4g} V > "
-                   f"{u_avail:.4g} V available (√(2/3)·V_0).")
-    if speed is not None and speed > motor.omega_b:
-        out.append(f"Not feasible on the real drive ({name}): peak speed {speed:.4g} rad/s > "
-                   f"ω_b = {motor.omega_b:g} rad/s.")
-    return out
+    label = {"torque": "peak torque", "voltage": "peak |u_dq|", "speed": "peak speed", "current": "peak |i_dq|"}
+    return [f"Not feasible on the real drive ({LABELS[run.controller]}): {label[lim.name]} {v:.4g} {lim.unit} > "
+            f"{lim.label}." for lim, v in exceeded(derived.params, run.metrics)]
 
 
-#: Position error at T_m, as a fraction of |θ_dem|, beyond which a run is said to miss T_m [-]:
-#: the FDSMC is designed to arrive by T_m (2 % band); the comparator's Dodds formula (eq. 61)
-#: leaves 2.44 % by design, so it is flagged only beyond 5 %.
-TARGET_BAND = {"fdsmc": 0.02, "conventional": 0.05}
+def criteria_warnings(run: RunResult, derived: Derived) -> list[str]:
+    """List the user's pass criteria the run fails: in-position window, overshoot, standstill ripple."""
+    names = {"in_position", "overshoot", "hold_ripple"}
+    return [f"Criterion ({LABELS[run.controller]}): {c.text}" for c in run_checks(derived.params, run)
+            if c.name in names]
 
 
 def _target_missed(run: RunResult) -> str | None:
@@ -126,13 +120,14 @@ def run_warnings(comparison: Comparison) -> list[str]:
         if miss:
             out.append(miss)
         if run.controller == "fdsmc":
-            out += _saturation(run) + limit_warnings(run, comparison.derived)
+            out += _saturation(run, comparison.derived) + limit_warnings(run, comparison.derived)
+            out += criteria_warnings(run, comparison.derived)
     return out + _saving_verdicts(comparison)
 
 
-def _saturation(run: RunResult) -> list[str]:
+def _saturation(run: RunResult, derived: Derived) -> list[str]:
     sat = run.metrics.saturated_s
-    if sat > 0.0:
+    if saturation_matters(derived.params, run.metrics):
         return [f"Saturation ({LABELS[run.controller]}): voltage/current limited for {sat:.4g} s."]
     return []
 
@@ -145,7 +140,7 @@ def comparator_notes(comparison: Comparison) -> list[str]:
     run = comparison.conventional
     if run is None or not run.metrics.stable:
         return []
-    issues = _saturation(run) + limit_warnings(run, comparison.derived)
+    issues = _saturation(run, comparison.derived) + limit_warnings(run, comparison.derived)
     if not issues:
         return []
     return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."]
