@@ -42,9 +42,10 @@ MAX_CPU_S = 3.0
 CPU_PER_STEP_S = 2.0e-8
 CPU_PER_SAMPLE_S = 1.1e-7
 CPU_PER_WINDOW_SAMPLE_S = 2.0e-7
-CPU_PER_RUN_S = 5e-3
-#: Bytes of analysis temporaries per chatter-window sample, and fixed bytes per run (parameter
-#: arrays, sensor-noise tables) [B].
+CPU_PER_RUN_S = 0.025
+#: Bytes per controller sample (no full-rate array is kept: 0), of analysis temporaries per
+#: chatter-window sample, and fixed bytes per run (parameter arrays, sensor-noise tables) [B].
+MEM_PER_SAMPLE = 0
 MEM_PER_WINDOW_SAMPLE = 21
 MEM_PER_RUN = 2 * 2**20
 
@@ -55,9 +56,9 @@ def cpu_seconds(steps: int, samples: int, window: int, runs: int) -> float:
             + CPU_PER_WINDOW_SAMPLE_S * window + CPU_PER_RUN_S * runs)
 
 
-def memory_bytes(trace_bytes: int, window: int, runs: int) -> int:
-    """Predicted peak memory [B] above the idle process: traces, window temporaries, per-run arrays."""
-    return int(trace_bytes + MEM_PER_WINDOW_SAMPLE * window + MEM_PER_RUN * runs)
+def memory_bytes(trace_bytes: int, window: int, runs: int, samples: int = 0) -> int:
+    """Predicted peak memory [B] above the idle process: traces, full-rate and window arrays, per-run arrays."""
+    return int(trace_bytes + MEM_PER_SAMPLE * samples + MEM_PER_WINDOW_SAMPLE * window + MEM_PER_RUN * runs)
 
 
 class BudgetError(ParameterError):

@@ -105,15 +105,15 @@ def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUO
     """Cost of ``n_runs`` runs of one controller, from the parameters alone.
 
     Integration steps and trace bytes (the kernel's output, N_CH channels × kept points, and the
-    chatter-window buffer, 4 rows × the longer window, 8 bytes per value), and the predicted CPU
+    chatter-window buffer, WIN_ROWS rows per window × the longer window, 8 bytes per value), and the predicted CPU
     seconds and peak memory of :func:`sim.common.budget.cpu_seconds` / ``memory_bytes``.
     """
     g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
     analysed, longest = window_samples(params, g)
     steps, samples, window = n_runs * g.n_steps * g.n_sub, n_runs * g.n_steps, n_runs * analysed
-    trace = n_runs * 8 * (kn.N_CH * g.n_out + 4 * longest)
+    trace = n_runs * 8 * (kn.N_CH * g.n_out + 2 * kn.WIN_ROWS * longest)
     return budget.Cost(steps, trace, budget.cpu_seconds(steps, samples, window, n_runs),
-                       budget.memory_bytes(trace, window, n_runs))
+                       budget.memory_bytes(trace, window, n_runs, samples))
 
 
 def predict(params: DriveParams, n_runs: int = 1, **options: float) -> budget.Cost:
