@@ -249,7 +249,7 @@ def test_the_issue_budget_reproduction_is_refused_before_work(capsys):
 def test_budget_prediction_grows_with_f_s_t_m_and_substeps():
     p = load_preset("yaskawa_sgm7j_02a")
     base = grid.predict(p, 3)
-    faster = grid.predict(grid.with_field(p, "controller.f_s", 10 * float(p.controller.f_s)), 3)
+    faster = grid.predict(grid.with_field(p, "controller.f_s", 100 * float(p.controller.f_s)), 3)
     longer = grid.predict(grid.with_field(p, "manoeuvre.T_m", 2 * p.manoeuvre.T_m), 3)
     sub = grid.predict(p, 3, n_sub=8)
     assert faster.cpu_s > 3 * base.cpu_s and faster.memory_bytes > base.memory_bytes
