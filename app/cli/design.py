@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from app.cli.main import add_preset_arguments
+from app.io.atomic import write_atomic_text
 from app.io.json_data import to_json
 from app.io.presets import dumps, load_preset, to_raw
 from sim.fdsmc.checks import run_checks
@@ -86,8 +87,10 @@ def run(args: argparse.Namespace) -> int:
     dd = od.design
     out = design_json(od)
     if args.output:
-        with open(args.output, "w", encoding="utf-8") as fh:
-            fh.write(dumps(out["preset"]))
+        try:
+            write_atomic_text(args.output, dumps(out["preset"]))  # a temporary file renamed when complete
+        except OSError as exc:
+            raise ValueError(f"cannot write -o {args.output!r}: {exc.strerror or exc}") from None
     if args.json:
         print(json.dumps(out, indent=2, ensure_ascii=False))
         return 0

@@ -8,6 +8,7 @@ from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
 from app.exports.model import trace_csv
+from app.io.atomic import write_atomic_text
 from app.io.derived_view import derived_json
 from app.io.json_data import to_json
 from app.io.numbers import format_metric
@@ -85,8 +86,7 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
 def write_csv(path: str, cmp: Comparison) -> None:
     """Write the time series in the one CSV format of the exports (:func:`app.exports.model.trace_csv`)."""
     try:
-        with open(path, "w", newline="", encoding="utf-8") as fh:
-            fh.write(trace_csv(cmp))
+        write_atomic_text(path, trace_csv(cmp))  # a temporary file renamed when complete
     except OSError as exc:
         raise ParameterError(f"cannot write --csv {path!r}: {exc.strerror or exc}") from None
 

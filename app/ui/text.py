@@ -26,11 +26,21 @@ J_PER_KWH = 3.6e6
 _MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
 
 
+def html_text(text: object) -> str:
+    """Make user-provided text safe inside HTML or a Plotly label: ``& < > " '`` become entities.
+
+    The escaping of every user string (file name, column header, note, preset name or source, log
+    mapping) that goes into HTML: the page's HTML boxes, Plotly titles and legends, the HTML report.
+    """
+    return html.escape(str(text), quote=True)
+
+
 def md_text(text: object) -> str:
     """Make user-provided text safe to put in Markdown or HTML: shown literally, never as markup.
 
-    User-provided text is a preset name/source, a file name or a message quoting them; it never becomes
-    markup, links, images or code.
+    User-provided text is a preset name/source, a file name, a column header or a message quoting
+    them; it never becomes markup, links, images or code. Viser renders raw HTML inside Markdown,
+    so every user string reaching a Markdown widget goes through here.
 
     HTML special characters become entities, Markdown punctuation is backslash-escaped and line breaks become
     spaces (a name cannot start a heading or a table row).
@@ -70,7 +80,7 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
     warning…") folds it to that one line in the browser, and a second click opens it again.
     """
     extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
-                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html.escape(n)}</div>'
+                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html_text(n)}</div>'
                     for n in notes or [])
     if error is None and not items:
         return ('<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:#2b8a3e;'
@@ -78,13 +88,13 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
     parts = []
     if error is not None:
         parts.append(f'<div data-role="input-error" style="font-weight:600">⛔ Input error — nothing '
-                     f'simulated: {html.escape(error)}</div>')
+                     f'simulated: {html_text(error)}</div>')
     if items:
-        lis = "".join(f"<li>{html.escape(w)}</li>" for w in items)
+        lis = "".join(f"<li>{html_text(w)}</li>" for w in items)
         parts.append(f'<details{"" if folded else " open"} data-role="warnings-list">'
                      '<summary data-role="warnings-summary" '
                      'style="cursor:pointer;white-space:nowrap;overflow:hidden;text-overflow:ellipsis">'
-                     f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html.escape(items[0])}'
+                     f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html_text(items[0])}'
                      f'</span></summary><ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul></details>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
             'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>" + extra)
@@ -207,5 +217,5 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
 
 
 __all__ = ["AnnualSavings", "design_markdown", "annual_savings", "checked_choice", "derived_markdown",
-           "key_numbers_html", "md_text",
+           "html_text", "key_numbers_html", "md_text",
            "savings_markdown", "warnings_html"]
