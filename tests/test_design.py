@@ -15,6 +15,7 @@ from control.fdsmc.params import Controller, DriveParams, Load, Manoeuvre, Motor
 from sim.common.sensors import reading_noise
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.design import design_drive, run_checks
+from sim.fdsmc.objective import design_for
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a", "odrive_d5065_belt")
@@ -37,7 +38,7 @@ def _assert_clean_run(dd) -> None:
 
 @pytest.mark.parametrize("name", REAL)
 def test_real_presets_are_clean_as_shipped(name):
-    dd = design_drive(load_preset(name))
+    dd = design_for(load_preset(name)).design  # the default objective: net electrical input
     assert dd.clean, [c.text for c in dd.limiting]
     _assert_clean_run(dd)
     # the shipped preset already holds the design: its own run has no warning at all

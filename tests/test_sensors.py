@@ -22,6 +22,9 @@ from sim.fdsmc.design import design_drive, encoder_needed, predicted_noise
 from sim.fdsmc.engine import simulate
 
 IDEAL = ["sensors.encoder_cpr=0", "sensors.i_noise=0", "sensors.i_adc_bits=0"]
+#: The Siemens drive's loops at the torque limit (T_so = 1 ms, K recommended): a fixed case for the noise gain.
+SIEMENS_LOOPS = ["controller.T_so_ms=1", "controller.T_salpha_ms=3", "controller.K=0.043075511186974044",
+                 "controller.T_c=T_a", "controller.alpha_max_rule=torque_limit"]
 
 
 def test_encoder_reads_whole_counts_down_and_the_adc_rounds_and_clips():
@@ -59,7 +62,7 @@ def test_an_adc_needs_its_full_scale_and_sensors_need_a_sample_rate():
     (["sensors.i_noise=0.5", "sensors.encoder_cpr=131072"], "both"),
 ])
 def test_standstill_ripple_matches_the_closed_form_noise_gain(overrides, what):
-    p = load_preset("siemens_1ft7044_ak7", IDEAL + overrides)
+    p = load_preset("siemens_1ft7044_ak7", IDEAL + SIEMENS_LOOPS + overrides)
     d = derive(p)
     pred = predicted_noise(p, d)
     m = simulate(p, "fdsmc", d).metrics
@@ -68,7 +71,7 @@ def test_standstill_ripple_matches_the_closed_form_noise_gain(overrides, what):
 
 
 def test_quantization_ripple_scales_with_the_count_and_sets_the_encoder_needed():
-    p = load_preset("siemens_1ft7044_ak7", IDEAL)
+    p = load_preset("siemens_1ft7044_ak7", IDEAL + SIEMENS_LOOPS)
     d = derive(p)
     g17, g20 = (noise_gain(d.loop, "slope", p.controller.K, 2 * math.pi / 2**b, 0.0) for b in (17, 20))
     assert g17.i_q_rms == pytest.approx(8 * g20.i_q_rms, rel=1e-9)

@@ -9,11 +9,13 @@ from pathlib import Path
 from typing import Any
 
 from app.cli.main import add_preset_arguments
+from app.io.atomic import write_atomic_text
 from app.io.json_data import to_json
 from app.io.presets import dumps, load_preset, to_raw
 from sim.fdsmc.checks import run_checks
 from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.design import DriveDesign, design_drive
+from sim.fdsmc.engine import LABELS
+from sim.fdsmc.objective import OBJECTIVES, ObjectiveDesign, design_for
 
 _VERIFIED_KEYS = ("torque_peak_Nm", "i_q_peak_A", "i_peak_A", "over_i_max_s", "u_peak_V", "omega_peak_rad_s",
                   "theta_error_at_Tm_rad", "overshoot_rad", "in_position_s", "hold_i_q_rms_A", "hold_u_q_ptp_V",
@@ -25,12 +27,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_preset_arguments(p)
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
     p.add_argument("-o", "--output", metavar="FILE", help="write the designed preset (YAML) to FILE")
+    p.add_argument("--objective", choices=OBJECTIVES, default=OBJECTIVES[0],
+                   help="what the design minimises: net electrical input (default) or the paper's friction loss")
     p.add_argument("--name", help="name written in the designed preset (default: the preset's)")
     p.add_argument("--source", help="source written in the designed preset, e.g. the motor's data sheet")
 
 
-def design_json(dd: DriveDesign) -> dict[str, Any]:
+def design_json(od: ObjectiveDesign) -> dict[str, Any]:
     """Return the JSON contract of ``design --json``."""
+    dd = od.design
     c, cmp = dd.params.controller, dd.comparison
     verified: dict[str, Any] = {}
     for name in ("fdsmc", "conventional"):
@@ -40,7 +45,14 @@ def design_json(dd: DriveDesign) -> dict[str, Any]:
             verified[name] = {k: metrics[k] for k in _VERIFIED_KEYS}
             verified[name]["checks_failed"] = [c.name for c in run_checks(dd.params, run)]
     crit = pass_criteria(dd.params)
+    rec = od.recommendation
     return to_json({
+        "objective": od.objective,
+        "alpha_max_rule": c.alpha_max_rule,
+        "energies": {e.controller: {"net_electrical_J": e.net_electrical_J, "copper_J": e.copper_J,
+                                    "friction_J": e.friction_J, "checks_failed": list(e.failed)}
+                     for e in (rec.energies if rec else ())},
+        "recommended": {"controller": rec.controller, "why": rec.why} if rec else None,
         "clean": dd.clean,
         "verdict": dd.verdict,
         "as_asked": dd.as_asked,
@@ -55,6 +67,7 @@ def design_json(dd: DriveDesign) -> dict[str, Any]:
         "design": {"alpha_max": dd.derived.alpha.alpha_max, "T_m": dd.params.manoeuvre.T_m, "K": c.K,
                    "T_c": dd.derived.profile.T_c, "T_c_rule": "T_a" if c.T_c == "T_a" else "given",
                    "f_s": c.f_s, "overshoot_eta": dd.derived.alpha.overshoot, "T_so": c.T_so,
+                   "alpha_max_rule": c.alpha_max_rule,
                    "T_salpha": c.T_salpha},
         "verified": verified,
         "saving_friction_pct": cmp.saving_friction_pct if cmp else None,
@@ -70,16 +83,20 @@ def run(args: argparse.Namespace) -> int:
     params = dataclasses.replace(params, **renamed)
     if args.output and not Path(args.output).resolve().parent.is_dir():  # checked before the work
         raise ValueError(f"-o {args.output}: the folder does not exist")
-    dd = design_drive(params)
-    out = design_json(dd)
+    od = design_for(params, args.objective)
+    dd = od.design
+    out = design_json(od)
     if args.output:
-        with open(args.output, "w", encoding="utf-8") as fh:
-            fh.write(dumps(out["preset"]))
+        try:
+            write_atomic_text(args.output, dumps(out["preset"]))  # a temporary file renamed when complete
+        except OSError as exc:
+            raise ValueError(f"cannot write -o {args.output!r}: {exc.strerror or exc}") from None
     if args.json:
         print(json.dumps(out, indent=2, ensure_ascii=False))
         return 0
     d = out["design"]
-    print(f"Design for {params.name}: {dd.verdict.upper()}")
+    print(f"Design for {params.name} (objective: {od.objective}, α_max rule {d['alpha_max_rule']}): "
+          f"{dd.verdict.upper()}")
     print(f"  α_max = {d['alpha_max']:.5g} rad/s²  T_m = {d['T_m']:g} s  K = {d['K']:.4g} s/rad  "
           f"T_c = {d['T_c']:.4g} s  T_so = {d['T_so'] * 1e3:.4g} ms  T_sα = {d['T_salpha'] * 1e3:.4g} ms  "
           f"f_s = {d['f_s']}  (η = {d['overshoot_eta']:.3g})")
@@ -87,6 +104,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {'✗' if x.violated else '·'} {x.text}")
     for n in dd.notes + dd.comparator:
         print(f"  note: {n}")
+    if od.recommendation is not None:
+        print("  net electrical input: " + ", ".join(f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J"
+                                                    for e in od.recommendation.energies))
+        print(f"  recommended: {od.recommendation.why}")
     for name, v in out["verified"].items():
         inpos = "never" if v["in_position_s"] is None else f"{v['in_position_s']:.4g} s"
         print(f"  {name}: peak {v['torque_peak_Nm']:.4g} N·m, |i_dq| {v['i_peak_A']:.4g} A, {v['u_peak_V']:.4g} V; "

@@ -12,15 +12,14 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
 import sys
-import tempfile
 from pathlib import Path
 
 from app.cli.main import add_preset_arguments
 from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
 from app.exports.drive_units import ANGLE_UNITS
 from app.exports.model import FORMATS, export_files
+from app.io import atomic
 from app.io.numbers import parse_number
 from app.io.presets import load, load_with_plant
 from control.common.checks import ParameterError
@@ -68,16 +67,14 @@ def cycle_seconds(text: str | None) -> float | None:
 
 
 def write_atomic(path: Path, content: bytes) -> None:
-    """Write ``content`` to ``path`` whole: a temporary file in the same folder, then ``os.replace``."""
-    tmp = None
+    """Write ``content`` to ``path`` whole through :func:`app.io.atomic.write_atomic`.
+
+    A temporary file in the same folder, then ``os.replace`` (removed on Ctrl-C too); a write
+    error is a one-line ParameterError.
+    """
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent if str(path.parent) else ".")
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(content)
-        os.replace(tmp, path)
+        atomic.write_atomic(path, content)
     except OSError as exc:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
         raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
 

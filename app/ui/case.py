@@ -94,6 +94,9 @@ class CasePort(Protocol):
     def cancel(self) -> bool:
         """Cancel the running job; False if nothing runs."""
 
+    def on_cancel(self, hook: Callable[[], None]) -> Callable[[], None]:
+        """Run ``hook`` when the running job is cancelled or the page closed; returns its remover."""
+
     def say(self, text: str) -> None:
         """Show ``text`` (markdown) on the tab's status line."""
 

@@ -95,6 +95,10 @@ class PositionTab:
         """Cancel the running job (its result is discarded); False if nothing runs."""
         return self._worker.cancel()
 
+    def on_cancel(self, hook: Callable[[], None]) -> Callable[[], None]:
+        """Run ``hook`` when the running job is cancelled or the page closed (e.g. end a process pool)."""
+        return self._worker.on_cancel(hook)
+
     def say(self, text: str) -> None:
         """Show ``text`` on the status line."""
         self.status.content = text

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import os
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 
 import viser
@@ -155,7 +156,7 @@ class RobustnessView:
         self.run_button.disabled, self.cancel_button.visible = True, True
         try:
             result = self._run(params, spreads, samples, seed)
-        except ParameterError as exc:
+        except (ParameterError, BrokenProcessPool) as exc:  # a pool ended by Cancel is broken
             if self._cancel_requested():
                 self.status.content = (f"**Cancelled** after {self._done} of {samples} samples; the remaining "
                                        "work was cancelled and the pool shut down.")
@@ -175,11 +176,13 @@ class RobustnessView:
                               cancelled=self._cancel_requested)
         workers = os.cpu_count() or 1
         pool = ProcessPoolExecutor(workers, mp_context=get_context("spawn"))
+        unhook = self._s.on_cancel(lambda: _end_processes(pool))  # Cancel or a closed page: at once
         try:
             return robustness(params, spreads, samples, seed, pool, workers, self._progress,
                               self._cancel_requested)
         finally:
-            pool.shutdown(wait=True, cancel_futures=True)  # running chunks (≥ 0.1 s each) end, the rest never starts
+            unhook()
+            pool.shutdown(wait=True, cancel_futures=True)  # the rest never starts
 
     def show(self, result: RobustnessResult, torque_limit_Nm: float) -> None:
         """Draw the histograms and the summary table of a finished study."""
@@ -189,6 +192,12 @@ class RobustnessView:
         with contextlib.suppress(Exception):
             self.progress.value = 100.0
         self.status.content = f"Done: {result.summary['samples']} samples in {result.summary['seconds']:.1f} s."
+
+
+def _end_processes(pool: ProcessPoolExecutor) -> None:
+    """Terminate a pool's worker processes (the study was cancelled: their chunks are not waited for)."""
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.terminate()
 
 
 __all__ = ["MAX_SAMPLES", "POOL_MIN_SAMPLES", "SPREAD_FIELDS", "STUDY_MAX_STEPS", "RobustnessView", "check_study",

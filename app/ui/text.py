@@ -15,15 +15,28 @@ from typing import Any
 from app.io.derived_view import derived_rows
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
+from sim.fdsmc.criteria import pass_criteria
+from sim.fdsmc.engine import LABELS
+from sim.fdsmc.recommend import recommend
 
 _MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
+
+
+def html_text(text: object) -> str:
+    """Make user-provided text safe inside HTML or a Plotly label: ``& < > " '`` become entities.
+
+    The escaping of every user string (file name, column header, note, preset name or source, log
+    mapping) that goes into HTML: the page's HTML boxes, Plotly titles and legends, the HTML report.
+    """
+    return html.escape(str(text), quote=True)
 
 
 def md_text(text: object) -> str:
     """Make user-provided text safe to put in Markdown or HTML: shown literally, never as markup.
 
-    User-provided text is a preset name/source, a file name or a message quoting them; it never becomes
-    markup, links, images or code.
+    User-provided text is a preset name/source, a file name, a column header or a message quoting
+    them; it never becomes markup, links, images or code. Viser renders raw HTML inside Markdown,
+    so every user string reaching a Markdown widget goes through here.
 
     HTML special characters become entities, Markdown punctuation is backslash-escaped and line breaks become
     spaces (a name cannot start a heading or a table row).
@@ -49,7 +62,7 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
     warning…") folds it to that one line in the browser, and a second click opens it again.
     """
     extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
-                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html.escape(n)}</div>'
+                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html_text(n)}</div>'
                     for n in notes or [])
     if error is None and not items:
         return ('<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:#2b8a3e;'
@@ -57,13 +70,13 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
     parts = []
     if error is not None:
         parts.append(f'<div data-role="input-error" style="font-weight:600">⛔ Input error — nothing '
-                     f'simulated: {html.escape(error)}</div>')
+                     f'simulated: {html_text(error)}</div>')
     if items:
-        lis = "".join(f"<li>{html.escape(w)}</li>" for w in items)
+        lis = "".join(f"<li>{html_text(w)}</li>" for w in items)
         parts.append(f'<details{"" if folded else " open"} data-role="warnings-list">'
                      '<summary data-role="warnings-summary" '
                      'style="cursor:pointer;white-space:nowrap;overflow:hidden;text-overflow:ellipsis">'
-                     f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html.escape(items[0])}'
+                     f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html_text(items[0])}'
                      f'</span></summary><ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul></details>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
             'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>" + extra)
@@ -77,19 +90,17 @@ def _saves(pct: float | None) -> str:
 
 
 def key_numbers_html(comparison: Any) -> str:
-    """Render one line of key numbers above the overview figure.
+    """Render the key numbers above the overview figure: net electrical input first.
 
-    Savings [%], friction and electrical input energies [J] of both controllers, peak torques
-    [N·m] vs the drive's limit Γ_max (red when above).
+    Net electrical input [J] (whole run) of every simulated controller with its copper and friction
+    parts, the recommended controller (:func:`sim.fdsmc.recommend.recommend`), then the paper's
+    friction saving and the peak torques [N·m] vs the drive's limit (red when above).
     """
     f, c = comparison.fdsmc, comparison.conventional
     if f is None:
         return '<div data-role="key-numbers" style="font-size:0.9em">Not simulated (infeasible manoeuvre).</div>'
     g_max = torque_limit(comparison.derived.params)
-
-    def energy(key: str) -> str:
-        values = [None if r is None else getattr(r.metrics, key) for r in (f, c)]
-        return " / ".join("–" if v is None else f"{v:.4g}" for v in values)
+    rec = recommend(comparison.derived.params, comparison)
 
     def peak(r: Any) -> str:
         v = r.metrics.torque_peak_Nm if r is not None else None
@@ -97,10 +108,13 @@ def key_numbers_html(comparison: Any) -> str:
             return "–"
         return f'<b style="color:#c92a2a">{v:.4g} ⚠</b>' if v > g_max * 1.001 else f"{v:.4g}"
 
-    parts = [f"<b>FDSMC {_saves(comparison.saving_friction_pct)}</b> friction, "
-             f"{_saves(comparison.saving_electrical_pct)} electrical input",
-             f"friction to T_m FDSMC / conv. {energy('friction_J')} J",
-             f"electrical in {energy('electrical_in_total_J')} J",
+    energies = " · ".join(
+        f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {e.net_electrical_J:.3g} J"
+        f"{'</b>' if e.controller == rec.controller else ''} ({e.copper_J:.2g} Cu + {e.friction_J:.2g} fr.)"
+        for e in rec.energies)
+    best = f"recommended: <b>{LABELS[rec.controller]}</b>" if rec.controller else "no controller passes every check"
+    parts = [f"<b>Net electrical input</b> {energies}", best,
+             f"FDSMC {_saves(comparison.saving_friction_pct)} friction vs conventional",
              f"peak Γ {peak(f)} / {peak(c)} N·m vs Γ_max {g_max:.4g} N·m"]
     return ('<div data-role="key-numbers" style="font-size:0.88em;line-height:1.35;padding:2px 2px 4px 2px">'
             + " · ".join(parts) + "</div>")
@@ -129,8 +143,6 @@ def design_markdown(dd: Any) -> str:
 
 def _verified_figures(dd: Any) -> str:
     """One line of the verification run's figures against the pass criteria."""
-    from sim.fdsmc.criteria import pass_criteria  # the criteria's defaults, resolved once
-
     m, crit = dd.comparison.fdsmc.metrics, pass_criteria(dd.params)
     inpos = "never" if m.in_position_s is None else f"{m.in_position_s:.3g} s"
     return (f"Verified: peak |i_dq| {m.i_peak_A:.3g} A (limit {crit.i_limit:.3g} A) · overshoot "
@@ -138,4 +150,4 @@ def _verified_figures(dd: Any) -> str:
             f"standstill ripple {m.hold_i_q_rms_A:.2g} A rms (≤ {crit.hold_i_rms:.2g})")
 
 
-__all__ = ["derived_markdown", "design_markdown", "key_numbers_html", "md_text", "warnings_html"]
+__all__ = ["derived_markdown", "design_markdown", "html_text", "key_numbers_html", "md_text", "warnings_html"]

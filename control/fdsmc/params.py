@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from control.common.checks import ParameterError, check_fields, spec_field
 
-ALPHA_MAX_RULES = ("paper", "torque_limit")
+ALPHA_MAX_RULES = ("paper", "torque_limit", "min_energy")
 
 
 #: Shortest settling time of the inner loops and the observer [s]. With T_so ≥ 1 µs the observer
@@ -137,8 +137,9 @@ class Controller:
         Sliding-mode time constant of the sloped boundary segment, eq. (41) [s]; ``"T_a"``
         applies eq. (59), T_c = T_a.
     alpha_max_rule : str
-        ``"paper"`` (α_max = H·P_r/V_0, section 5) or ``"torque_limit"``
-        (α_max = (Γ_max − |Γ_Le|)/(J_r + J_L)).
+        ``"paper"`` (α_max = H·P_r/V_0, section 5), ``"torque_limit"`` (the largest α within the
+        drive's torque) or ``"min_energy"`` (the α ≤ the torque limit's that minimises the profile's
+        friction + copper loss, :mod:`control.fdsmc.profile_energy`).
     f_s : float or "continuous"
         Controller sample rate [Hz], or ``"continuous"`` to evaluate the controller continuously.
     delay_samples : int

@@ -178,7 +178,7 @@ def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
     return 2**bits if 2**bits <= ENCODER_CPR_MAX else None
 
 
-def design_drive(params: DriveParams) -> DriveDesign:
+def design_drive(params: DriveParams, alpha_rule: str = "torque_limit") -> DriveDesign:
     """Design α_max, T_m, K, T_c (and T_so, T_sα for the sensors) for ``params``'s drive; verify by simulation.
 
     Parameters
@@ -187,12 +187,16 @@ def design_drive(params: DriveParams) -> DriveDesign:
         Nameplate, load, inverter limits, sensors, pass criteria, sample rate and delay,
         T_si/T_sα/T_so and the manoeuvre (θ_dem, requested T_m). K, T_c and the α_max rule are
         replaced by the design; T_so and T_sα are lengthened where the sensors need it.
+    alpha_rule : str
+        The α_max rule of the design: ``"torque_limit"`` (the fastest profile the torque allows:
+        least friction, eqs. (47)–(60) in [1]) or ``"min_energy"`` (the profile's least friction +
+        copper, :mod:`control.fdsmc.profile_energy`).
 
     Returns
     -------
     DriveDesign
     """
-    base = _with(params, "controller", alpha_max_rule="torque_limit", T_c="T_a")
+    base = _with(params, "controller", alpha_max_rule=alpha_rule, T_c="T_a")
     first: DriveDesign | None = None
     for factor in _slowdowns(base):
         dd = _design_at(_slowed(base, factor), params)
@@ -213,7 +217,9 @@ def _slowdowns(p: DriveParams) -> list[float]:
         return [1.0]
     crit = pass_criteria(p).hold_i_rms
     for i, factor in enumerate(SENSOR_SLOWDOWN):
-        q = _slowed(p, factor)
+        q = _planned(_slowed(p, factor))
+        if q is None:
+            continue
         d = derive(q)
         if d.sample_rate is not None and not d.sample_rate.stable:
             continue
@@ -223,20 +229,27 @@ def _slowdowns(p: DriveParams) -> list[float]:
     return [SENSOR_SLOWDOWN[-1]]
 
 
+def _planned(p: DriveParams) -> DriveParams | None:
+    """``p`` at the T_m the design uses (the requested one if it fits, else the shortest that does); None if none."""
+    eta = _overshoot(p)
+    if not math.isfinite(eta):
+        return p
+    T_m = shortest_fitting_T_m(p, eta)
+    return None if T_m is None else _with(p, "manoeuvre", T_m=T_m)
+
+
 def _sensor_limited(dd: DriveDesign) -> bool:
     return not dd.params.sensors.ideal and any(c.violated and c.name in SENSOR_CHECKS for c in dd.limiting)
 
 
 def _design_at(p: DriveParams, asked: DriveParams) -> DriveDesign:
     """Choose T_m, check the sample rate, set K and T_c for ``p``'s loops, and verify."""
-    eta = _overshoot(p)
     limiting: list[Constraint] = []
-    if math.isfinite(eta):
-        T_m = shortest_fitting_T_m(p, eta)
-        if T_m is None:
-            return _refused(p, [Constraint("T_m", asked.manoeuvre.T_m, 1e4, "s", True,
-                                           "No manoeuvre time up to 1e4 s fits the speed/voltage limits.")])
-        p = _with(p, "manoeuvre", T_m=T_m)
+    planned = _planned(p)
+    if planned is None:
+        return _refused(p, [Constraint("T_m", asked.manoeuvre.T_m, 1e4, "s", True,
+                                       "No manoeuvre time up to 1e4 s fits the speed/voltage limits.")])
+    p = planned
     d = derive(p)
     rate = d.sample_rate
     if rate is not None and not rate.stable:
@@ -250,7 +263,7 @@ def _design_at(p: DriveParams, asked: DriveParams) -> DriveDesign:
 
 
 def _designed_source(source: str) -> str:
-    tag = "design: torque-limit α_max, recommended K, verified by simulation with the sensors"
+    tag = "design: α_max by its rule, recommended K, verified by simulation with the sensors"
     return source if tag in source else f"{source}; {tag}"
 
 
@@ -340,9 +353,11 @@ def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> 
 def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
     lim = torque_limit(p)
     peak = run.metrics.torque_peak_Nm or 0.0
+    a = alpha_max(p, _overshoot(p)).alpha_max
+    why = ("is set by the torque limit" if p.controller.alpha_max_rule == "torque_limit" else
+           "minimises the profile's friction + copper loss (rule min_energy) within the torque limit")
     return Constraint("torque", peak, lim, "N·m", False,
-                      f"α_max = {alpha_max(p, _overshoot(p)).alpha_max:.5g} rad/s² is set by the torque limit "
-                      f"{lim:.4g} N·m (Γ_max or i_max); simulated peak {peak:.4g} N·m.")
+                      f"α_max = {a:.5g} rad/s² {why} {lim:.4g} N·m (Γ_max or i_max); simulated peak {peak:.4g} N·m.")
 
 
 def _sensor_notes(p: DriveParams, asked: DriveParams, ng: NoiseGain | None, crit: float) -> tuple[str, ...]:
