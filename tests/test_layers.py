@@ -1,4 +1,4 @@
-"""Layers: control/ and sim/ (every sub-package) import neither viser, plotly nor yaml; only app/io/presets.py
+"""Layers: control/ and sim/ (every sub-package) import neither viser, plotly nor yaml; only app/io/yaml_text.py
 uses yaml; the page (app/ui) never imports the command line (app/cli).
 """
 
@@ -52,7 +52,7 @@ def test_only_preset_module_touches_yaml_and_only_app_touches_viser_plotly():
     for path in [p for pkg in ("control", "sim", "app") for p in ROOT.glob(f"{pkg}/**/*.py")]:
         text = path.read_text(encoding="utf-8")
         rel = path.relative_to(ROOT).as_posix()
-        if rel != "app/io/presets.py":
+        if rel != "app/io/yaml_text.py":
             assert not pat_yaml.search(text), f"{rel} imports yaml"
         if not rel.startswith("app/"):
             assert not pat_ui.search(text), f"{rel} imports viser/plotly"

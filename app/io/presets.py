@@ -1,4 +1,4 @@
-"""Preset loader and writer: the only module that reads or writes YAML.
+"""Preset loader and writer: one ``load(name_or_path, overrides, mode)``; YAML text via :mod:`app.io.yaml_text`.
 
 A preset is a YAML mapping with ``schema: 1``, ``name``, ``source``, an optional ``mode``
 (``position``, the default, or another registered mode) and one mapping per section of the
@@ -23,13 +23,11 @@ import typing
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from app.io import units
 from app.io.atomic import write_atomic_text
-from app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
+from app.io.json_data import MAX_BYTES, MAX_DEPTH, loads_json_raw  # noqa: F401 - re-exported
 from app.io.modes import mode_for
-from app.io.numbers import QuotedText, shorten, shown
+from app.io.numbers import shown
 from app.io.preset_schema import (
     MODES,
     PLANT,
@@ -43,6 +41,7 @@ from app.io.preset_schema import (
     plain,
     plant_raw,
 )
+from app.io.yaml_text import dumps, loads_any_raw, loads_raw, plain_scalar
 from app.resources import preset_dir
 from control.common.checks import field_specs
 from control.fdsmc.params import DriveParams
@@ -53,157 +52,6 @@ PRESET_DIR = preset_dir()
 DEFAULT_PRESET = "siemens_1ft7044_ak7"
 #: The FDSMC paper's drive (section 5 of [1]), for reproduction.
 PAPER_PRESET = "paper_12kw_pmsm"
-
-
-# ---- YAML front-end: text → raw mapping of texts, lists and mappings -------------------------
-def _too_deep(origin: str, mark: Any, kind: str) -> PresetError:
-    return PresetError(f"{origin} is nested too deeply at line {mark.line + 1}, column {mark.column + 1}: "
-                       f"allowed ≤ {MAX_DEPTH} levels of {kind}")
-
-
-class _TextLoader(yaml.SafeLoader):
-    """Safe YAML loader that keeps every scalar as text: no YAML 1.1 implicit typing.
-
-    Without it ``1:30`` → 90, ``017`` → 15, and ``0x10``, ``1_000``, ``yes`` → True … would be converted.
-    Numbers are parsed afterwards by :mod:`app.io.numbers` against the field types; duplicate keys and
-    explicit tags are errors. A quoted or block scalar (``"1.5"``, a ``>`` block) becomes
-    :class:`~app.io.numbers.QuotedText`, which is never a number.
-
-    The scanner counts the nesting as it reads: the ``MAX_DEPTH + 1``-th bracket or indentation level
-    is refused on the spot, so no text costs more than its size (a pre-scan can be fooled by
-    quotes and comments; the scanner cannot).
-    """
-
-    origin = "<text>"
-
-    def fetch_flow_collection_start(self, TokenClass: Any) -> None:  # noqa: N803 - PyYAML's name
-        """Refuse a bracket that would nest deeper than :data:`MAX_DEPTH`."""
-        if self.flow_level >= MAX_DEPTH:
-            raise _too_deep(self.origin, self.get_mark(), "brackets")
-        super().fetch_flow_collection_start(TokenClass)
-
-    def compose_node(self, parent: Any, index: Any) -> Any:
-        """Refuse an anchor (``&name``) or alias (``*name``) before it is composed (one pass)."""
-        event = self.peek_event()
-        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
-            raise PresetError(f"YAML anchors/aliases (*name) at line {event.start_mark.line + 1} are not allowed "
-                              "in presets: write each value out")
-        return super().compose_node(parent, index)
-
-    def add_indent(self, column: int) -> bool:
-        """Refuse a block indentation level deeper than :data:`MAX_DEPTH`."""
-        if self.indent < column and len(self.indents) >= MAX_DEPTH:
-            raise _too_deep(self.origin, self.get_mark(), "indentation")
-        return bool(super().add_indent(column))
-
-
-_TextLoader.yaml_implicit_resolvers = {}
-#: libyaml's parser (≈ 10× faster), when PyYAML was built with it: the same constructors, the nesting
-#: and anchors checked on its event stream first (:func:`_check_events`).
-_CLoader: Any = None
-if getattr(yaml, "__with_libyaml__", False):
-    _CLoader = type("_CTextLoader", (yaml.CSafeLoader,), {"yaml_implicit_resolvers": {}})
-
-
-def _loader(origin: str) -> type[_TextLoader]:
-    """:class:`_TextLoader` naming ``origin`` in its messages."""
-    return type("_OriginLoader", (_TextLoader,), {"origin": origin})
-
-
-def _check_events(text: str, origin: str) -> None:
-    """Stream libyaml's parser events: refuse anchors, aliases and nesting deeper than :data:`MAX_DEPTH`.
-
-    The parser stops at the first refusal, having read only a bounded look-ahead past it.
-    """
-    depth = 0
-    for event in yaml.parse(text, Loader=_CLoader):
-        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
-            raise PresetError(f"YAML anchors/aliases (*name) at line {event.start_mark.line + 1} are not allowed "
-                              "in presets: write each value out")
-        if isinstance(event, yaml.CollectionStartEvent):
-            depth += 1
-            if depth > MAX_DEPTH:
-                raise _too_deep(origin, event.start_mark, "nesting (brackets or indentation)")
-        elif isinstance(event, yaml.CollectionEndEvent):
-            depth -= 1
-
-
-def _load(text: str, origin: str) -> Any:
-    """YAML text → data: libyaml after its event check, else the pure-Python guarded loader."""
-    if _CLoader is None:
-        return yaml.load(text, Loader=_loader(origin))  # noqa: S506 - a SafeLoader subclass
-    _check_events(text, origin)
-    return yaml.load(text, Loader=_CLoader)  # noqa: S506 - a CSafeLoader subclass, tags refused
-
-
-def _mark(node: yaml.Node) -> str:
-    return f"line {node.start_mark.line + 1}, column {node.start_mark.column + 1}"
-
-
-def _refuse_tag(loader: _TextLoader, node: yaml.Node) -> Any:
-    raise PresetError(f"YAML tag {shorten(node.tag)!r} at {_mark(node)} is not allowed: write plain values")
-
-
-def _text(loader: _TextLoader, node: yaml.ScalarNode) -> str:
-    value = loader.construct_scalar(node)
-    return QuotedText(value) if node.style else str(value)
-
-
-def _unique_mapping(loader: _TextLoader, node: yaml.MappingNode) -> dict[Any, Any]:
-    out: dict[Any, Any] = {}
-    first: dict[Any, str] = {}
-    for key_node, value_node in node.value:
-        key = loader.construct_object(key_node, deep=True)
-        if not isinstance(key, str):
-            raise PresetError(f"key at {_mark(key_node)} is not a name: allowed text keys only")
-        key = str(key)
-        if key in out:
-            raise PresetError(f"duplicate key {shorten(key)!r} at {_mark(key_node)} (first at {first[key]}): "
-                              "allowed each key once per mapping")
-        first[key] = _mark(key_node)
-        out[key] = loader.construct_object(value_node, deep=True)
-    return out
-
-
-for _cls in filter(None, (_TextLoader, _CLoader)):
-    for _tag in ("null", "bool", "int", "float", "binary", "timestamp", "omap", "pairs", "set", "merge", "value"):
-        _cls.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
-    _cls.add_constructor(None, _refuse_tag)
-    _cls.add_constructor("tag:yaml.org,2002:map", _unique_mapping)
-    _cls.add_constructor("tag:yaml.org,2002:str", _text)
-
-
-def loads_raw(text: str, origin: str = "<text>") -> Any:
-    """Parse YAML text safely into plain data whose scalars are all text (see :class:`_TextLoader`).
-
-    Size-limited, nesting-limited by the scanner itself, no aliases, no duplicate keys.
-    """
-    origin = shorten(origin)
-    check_size(text, origin)
-    try:
-        return _load(text, origin)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise PresetError(f"{origin} is not valid YAML{where}: {shorten(problem)}: allowed plain YAML text") from None
-    except RecursionError:  # not reachable within MAX_DEPTH; kept as a last line of defence
-        raise PresetError(f"{origin} is nested too deeply: allowed ≤ {MAX_DEPTH} levels") from None
-    except PresetError as exc:  # duplicate key, tag, nesting: say where
-        raise PresetError(str(exc) if str(exc).startswith(origin) else f"{origin}: {exc}") from None
-
-
-def plain_scalar(text: str, where: str) -> Any:
-    """Parse one ``--set`` value: a plain YAML scalar or flow collection, nothing hidden.
-
-    A comment (``1.5 # x``), a byte-order mark, line folding or a block scalar would make the value
-    differ from what was typed; those are refused, naming ``where``.
-    """
-    value = loads_raw(text, where)
-    if isinstance(value, str) and not isinstance(value, QuotedText) and value != text.strip(" \t"):
-        raise PresetError(f"{where} = {shorten(text)!r} is not a plain value: allowed the value alone "
-                          "(no comment, byte-order mark, line break or YAML block syntax)")
-    return value
 
 
 def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
@@ -362,18 +210,6 @@ def loads_preset(text: str, origin: str = "<upload>") -> Any:
     return parse_preset(loads_any_raw(text, origin))
 
 
-def loads_any_raw(text: str, origin: str = "<text>") -> Any:
-    """JSON (``*.json``, or text starting with ``{``) or YAML text → plain Python data."""
-    if origin.lower().endswith(".json"):
-        return loads_json_raw(text, origin)
-    if text.lstrip().startswith("{"):  # JSON text; a YAML flow mapping falls back to YAML
-        try:
-            return loads_json_raw(text, origin)
-        except PresetError:
-            pass
-    return loads_raw(text, origin)
-
-
 def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
     """Convert a parameter object to a preset mapping.
 
@@ -389,18 +225,6 @@ def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
     if plant is not None and (true := plant_raw(params, plant)):
         raw[PLANT] = true
     return raw
-
-
-class _Dumper(yaml.SafeDumper):
-    """Safe dumper that writes :class:`QuotedText` (text read from a file) as the text it is."""
-
-
-_Dumper.add_representer(QuotedText, yaml.SafeDumper.represent_str)
-
-
-def dumps(data: Any) -> str:
-    """Any plain data → YAML text (block style, key order kept)."""
-    return yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, default_flow_style=False)
 
 
 def dumps_preset(params: Any, plant: DriveParams | None = None) -> str:
