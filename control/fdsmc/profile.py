@@ -68,6 +68,12 @@ def shortest_manoeuvre_time(delta_theta: float, alpha_max: float) -> float:
     return math.sqrt(2.0 * C_57 * abs(delta_theta) / alpha_max)
 
 
+def infeasible_T_m(T_m: float, T_m_min: float, delta_theta: float, alpha_max: float) -> str:
+    """Return the one message for a manoeuvre time below T_m,min (T_m, T_m,min [s], Δθ [rad], α_max [rad/s²])."""
+    return (f"manoeuvre.T_m = {T_m:g} s is infeasible: allowed ≥ T_m,min = {T_m_min:.4g} s "
+            f"for Δθ = {delta_theta:g} rad at α_max = {alpha_max:.5g} rad/s²")
+
+
 def peak_speed(delta_theta: float, alpha_max: float, T_m: float) -> float:
     """Peak speed ω_p of eq. (60) in [1] (the root giving ω_p = 0 for Δθ = 0).
 
@@ -95,10 +101,7 @@ def peak_speed(delta_theta: float, alpha_max: float, T_m: float) -> float:
         disc = 0.0  # T_m = T_m,min up to rounding: the double root
     if disc < 0.0:
         t_min = shortest_manoeuvre_time(delta_theta, alpha_max)
-        raise ParameterError(
-            f"manoeuvre.T_m = {T_m:g} s is infeasible: allowed ≥ T_m,min = {t_min:.4g} s "
-            f"for Δθ = {delta_theta:g} rad at α_max = {alpha_max:.5g} rad/s²"
-        )
+        raise ParameterError(infeasible_T_m(T_m, t_min, delta_theta, alpha_max))
     # Numerically stable form of (αT − √disc)/c: multiply by the conjugate.
     return 2.0 * alpha_max * abs(delta_theta) / (alpha_max * T_m + math.sqrt(disc))
 

@@ -29,6 +29,7 @@ from control.fdsmc.feasibility import current_limit
 from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams
+from control.fdsmc.profile import infeasible_T_m
 from control.fdsmc.tracking import tracking_gains
 from sim.common import budget, sensors
 from sim.common.choices import check_controller
@@ -204,9 +205,7 @@ def _reference(d: Derived, controller: str) -> np.ndarray:
 def _check_feasible(d: Derived) -> None:
     pr, T_m = d.profile, d.params.manoeuvre.T_m
     if not pr.feasible:
-        raise ParameterError(
-            f"manoeuvre.T_m = {T_m:g} s is infeasible: allowed ≥ T_m,min = {pr.T_m_min:.4g} s "
-            f"for Δθ = {pr.delta_theta:g} rad at α_max = {d.alpha.alpha_max:.5g} rad/s²")
+        raise ParameterError(infeasible_T_m(T_m, pr.T_m_min, pr.delta_theta, d.alpha.alpha_max))
 
 
 def simulate(
