@@ -61,6 +61,10 @@ def test_widget_id_script_and_plotly_flag(gui):
     va.run_script(gui, "void 0;")  # viser's own message type still exists and queues
     va.mark_plotly_js_sent(gui)
     assert va.plotly_js_sent(gui) is True and gui._setup_plotly_js is True
+    assert va.input_widget(gui, va.widget_id(text)) is text and va.widget_state(text).removed is False
+    assert va.widget_state(text).props.label == "probe" and isinstance(va.upload_states(gui), dict)
+    for name in (va.GUI_UPDATES, va.UPLOAD_START, va.UPLOAD_PART):  # the handlers web_guard wraps exist
+        assert callable(getattr(viser.GuiApi, name))
 
 
 def _viser_private_names() -> set[str]:

@@ -50,7 +50,7 @@ FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("controller", "Inver
            ("sensors", "Sensors"), ("limits", "Pass criteria"), ("manoeuvre", "Manoeuvre"))
 TC_RULES = ("T_c = T_a, eq. (59)", "T_c given below")
 FS_MODES = ("digital, sampled at f_s", "continuous")
-ALPHA_RULES = ("torque_limit", "paper")
+ALPHA_RULES = ("torque_limit", "paper", "min_energy")  # every rule of control.fdsmc.params.ALPHA_MAX_RULES
 DELAYS = ("0", "1")
 #: Optional datasheet values used only to cross-check the nameplate (label → key).
 CHECKS = (("Kt datasheet [N·m/A_rms] (optional check)", "Kt"), ("T_N rated torque [N·m] (optional check)", "T_N"))

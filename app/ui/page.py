@@ -18,8 +18,10 @@ import viser
 from app.threads import limit_blas_threads
 from app.ui.bldc_tab import add_bldc_tab
 from app.ui.case import Case, CaseState
+from app.ui.files import FilesPanel
 from app.ui.inputs import InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
+from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
 from app.ui.position_tab import PositionTab, comparison_or_derived
 from app.ui.results import ResultsPanel
@@ -138,6 +140,16 @@ class Session:
     def inputs(self) -> InputsPanel:
         """The position tab's inputs."""
         return self.tab.inputs
+
+    @property
+    def files(self) -> FilesPanel:
+        """The position tab's files panel (export, import)."""
+        return self.tab.files
+
+    @property
+    def log_panel(self) -> LogPanel:
+        """The position tab's drive-log panel."""
+        return self.tab.log_panel
 
     @property
     def preset(self) -> viser.GuiDropdownHandle:

@@ -13,7 +13,11 @@ The page needs four things viser's public API does not offer:
 * **a script run in the page** (:func:`run_script`, viser's own ``RunJavascriptMessage``);
 * **plotly.js sent by the page** (:func:`plotly_js_sent`, :func:`mark_plotly_js_sent`: viser's
   ``GuiApi._setup_plotly_js`` flag, so ``add_plotly`` does not send its full bundle);
-* **a widget's DOM id** (:func:`widget_id`: the uuid the page's CSS and scripts address).
+* **a widget's DOM id** (:func:`widget_id`: the uuid the page's CSS and scripts address);
+* **checks in front of viser's message handlers** (:func:`wrap_gui_handler`, used by
+  :mod:`app.ui.web_guard`: widget values type-checked, uploads bounded) and what they read: a
+  widget by uuid (:func:`input_widget`), its state (:func:`widget_state`), the uploads in flight
+  (:func:`upload_states`), the client of a message (:func:`resolve_client`).
 
 A viser upgrade is checked here and in ``tests/test_viser_adapter.py`` only.
 """
@@ -24,6 +28,7 @@ import dataclasses
 from typing import Any, Protocol
 
 import viser
+import viser._gui_api as _viser_gui
 from viser import _messages
 
 from app.figures.plain import blank_json
@@ -87,5 +92,38 @@ def widget_id(handle: Any) -> str:
     return str(handle._impl.uuid)
 
 
-__all__ = ["WRITTEN_FOR", "add_figure", "figure_json_of", "mark_plotly_js_sent", "plotly_js_sent", "run_script",
-           "set_figure_json", "widget_id"]
+#: viser's ``GuiApi`` message handlers that :mod:`app.ui.web_guard` puts its checks in front of.
+GUI_UPDATES = "_handle_gui_updates"
+UPLOAD_START, UPLOAD_PART = "_handle_file_transfer_start", "_handle_file_transfer_part"
+
+
+def wrap_gui_handler(name: str, wrap: Any) -> None:
+    """Put ``wrap(handler)`` in front of viser's ``GuiApi`` handler ``name``, once (every GUI created after)."""
+    current = getattr(_viser_gui.GuiApi, name)
+    if not hasattr(current, "__wrapped__"):
+        setattr(_viser_gui.GuiApi, name, wrap(current))
+
+
+def input_widget(gui: Any, uuid: Any) -> Any | None:
+    """Return the input widget of ``gui`` with ``uuid`` (None if unknown)."""
+    return gui._gui_input_handle_from_uuid.get(uuid, None)
+
+
+def widget_state(widget: Any) -> Any:
+    """Return a widget's state: its ``props`` (value, label, mime_type …) and ``removed`` flag."""
+    return widget._impl
+
+
+def upload_states(gui: Any) -> dict[str, Any]:
+    """Return ``gui``'s uploads in flight: transfer id → state (client_id, filename, total/transferred bytes)."""
+    return gui._current_file_upload_states
+
+
+def resolve_client(gui: Any, client_id: Any) -> Any | None:
+    """Return the client handle of ``client_id`` (None if gone)."""
+    return gui._resolve_client(client_id)
+
+
+__all__ = ["GUI_UPDATES", "UPLOAD_PART", "UPLOAD_START", "WRITTEN_FOR", "add_figure", "figure_json_of",
+           "input_widget", "mark_plotly_js_sent", "plotly_js_sent", "resolve_client", "run_script",
+           "set_figure_json", "upload_states", "widget_id", "widget_state", "wrap_gui_handler"]

@@ -43,10 +43,19 @@ from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
-import viser._gui_api as viser_gui
 import websockets.asyncio.server as ws_server
 
 from app.io.numbers import shorten
+from app.ui.viser_adapter import (
+    GUI_UPDATES,
+    UPLOAD_PART,
+    UPLOAD_START,
+    input_widget,
+    resolve_client,
+    upload_states,
+    widget_state,
+    wrap_gui_handler,
+)
 
 LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 COOKIE = "pmsm_token"
@@ -208,11 +217,11 @@ def update_problem(state: Any, updates: Any) -> str | None:
 
 def _checked_gui_updates(original: Callable[..., Any]) -> Callable[..., Any]:
     async def handle(self: Any, client_id: Any, message: Any) -> None:
-        widget = self._gui_input_handle_from_uuid.get(message.uuid, None)
-        if widget is not None and not widget._impl.removed:
-            why = update_problem(widget._impl, message.updates)
+        widget = input_widget(self, message.uuid)
+        if widget is not None and not widget_state(widget).removed:
+            why = update_problem(widget_state(widget), message.updates)
             if why is not None:
-                label = str(getattr(widget._impl, "label", ""))[:60]
+                label = str(getattr(widget_state(widget), "label", ""))[:60]
                 REFUSED_UPDATES.append(f"client {client_id}: widget {label!r}: {why}")
                 return
         await original(self, client_id, message)
@@ -235,17 +244,17 @@ def upload_limit(mime_type: str) -> int:
 
 def upload_problem(gui: Any, client_id: Any, message: Any) -> str | None:
     """Why an upload announced by ``message`` is refused before any of it is kept, or None."""
-    widget = gui._gui_input_handle_from_uuid.get(message.source_component_uuid, None)
+    widget = input_widget(gui, message.source_component_uuid)
     if widget is None:
         return None  # viser ignores it
     size, parts = message.size_bytes, message.part_count
-    limit = upload_limit(getattr(widget._impl.props, "mime_type", ""))
+    limit = upload_limit(getattr(widget_state(widget).props, "mime_type", ""))
     if not isinstance(size, int) or not isinstance(parts, int) or size < 0 or parts < 0 or parts > size + 1:
         return f"{shorten(message.filename, 60)!r}: malformed upload (size {size!r}, {parts!r} parts)"
     if size > limit:
         return (f"{shorten(message.filename, 60)!r} is {size / 2**20:.1f} MB: allowed ≤ {limit / 2**20:.3g} MB "
                 "for this button")
-    states = gui._current_file_upload_states.values()
+    states = upload_states(gui).values()
     mine = sum(int(st["total_bytes"]) for st in states if st["client_id"] == client_id)
     everyone = sum(int(st["total_bytes"]) for st in states)
     if mine + size > CLIENT_INFLIGHT_BYTES or everyone + size > SERVER_INFLIGHT_BYTES:
@@ -261,7 +270,7 @@ def _checked_upload_start(original: Callable[..., Any]) -> Callable[..., Any]:
             original(self, client_id, message)
             return
         REFUSED_UPDATES.append(f"client {client_id}: upload refused: {why}")
-        client = self._resolve_client(client_id)
+        client = resolve_client(self, client_id)
         if client is not None:
             client.add_notification("Upload refused — nothing read", why, color="red", auto_close_seconds=15.0)
 
@@ -271,10 +280,10 @@ def _checked_upload_start(original: Callable[..., Any]) -> Callable[..., Any]:
 
 def _checked_upload_part(original: Callable[..., Any]) -> Callable[..., Any]:
     def handle(self: Any, client_id: Any, message: Any) -> None:
-        state = self._current_file_upload_states.get(message.transfer_uuid)
+        state = upload_states(self).get(message.transfer_uuid)
         if state is not None and (state["client_id"] != client_id or not isinstance(message.content, bytes)
                                   or state["transferred_bytes"] + len(message.content) > state["total_bytes"]):
-            self._current_file_upload_states.pop(message.transfer_uuid, None)  # the parts kept are freed
+            upload_states(self).pop(message.transfer_uuid, None)  # the parts kept are freed
             REFUSED_UPDATES.append(f"client {client_id}: upload {shorten(state['filename'], 60)!r} ended: "
                                    "its parts overrun the declared size")
             return
@@ -284,16 +293,13 @@ def _checked_upload_part(original: Callable[..., Any]) -> Callable[..., Any]:
     return handle
 
 
-_WRAPPERS = {"_handle_gui_updates": _checked_gui_updates, "_handle_file_transfer_start": _checked_upload_start,
-             "_handle_file_transfer_part": _checked_upload_part}
+_WRAPPERS = {GUI_UPDATES: _checked_gui_updates, UPLOAD_START: _checked_upload_start, UPLOAD_PART: _checked_upload_part}
 
 
 def check_widget_updates() -> None:
     """Put the widget-value and upload checks in front of viser's handlers (once, for every GUI created after)."""
     for name, wrap in _WRAPPERS.items():
-        current = getattr(viser_gui.GuiApi, name)
-        if not hasattr(current, "__wrapped__"):
-            setattr(viser_gui.GuiApi, name, wrap(current))
+        wrap_gui_handler(name, wrap)
 
 
 @contextlib.contextmanager
