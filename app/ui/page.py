@@ -50,7 +50,7 @@ class AppConfig:
         """Return the comparison of the start-up preset (computed on first use)."""
         with self._lock:
             if self._initial is None:
-                self._initial = comparison_or_derived(self.params)
+                self._initial = comparison_or_derived(self.params, optimum=True)  # the toggle's default
             return self._initial
 
 

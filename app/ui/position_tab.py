@@ -32,9 +32,12 @@ from app.ui.verdict_panel import VerdictPanel
 from app.ui.worker import Cancelled, Worker
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
+from sim.fdsmc.objective import OBJECTIVES, design_for
 from sim.fdsmc.verdicts import T_c_advice, recommended_K
+
+#: The page's words for the design objectives (same order as :data:`sim.fdsmc.objective.OBJECTIVES`).
+OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")
 
 
 def comparison_or_derived(params: DriveParams, optimum: bool = False) -> Comparison:
@@ -151,6 +154,9 @@ class PositionTab:
                                             hint="α_max, T_m, K and T_c for this nameplate, load and inverter, "
                                                  "verified by simulation")
         self.design_button.on_click(lambda _: self.design())
+        self.objective = gui.add_dropdown("Design objective", OBJECTIVE_LABELS,
+                                          hint="net electrical input (copper + friction): the α that draws least; "
+                                               "friction: the paper's profile at the torque limit")
         self.design_note = gui.add_markdown("")
         self.optimum = OptimumToggle(gui, self.simulate)
         self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
@@ -195,7 +201,9 @@ class PositionTab:
 
     def _run_design(self, params: DriveParams) -> None:
         self.status.content = "Designing and verifying…"
-        dd = design_drive(params)
+        objective = OBJECTIVES[OBJECTIVE_LABELS.index(checked_choice(self.objective.value, OBJECTIVE_LABELS,
+                                                                     "Design objective"))]
+        dd = design_for(params, objective).design
         self.inputs.populate(dd.params)
         self._recentre = True
         comparison = (None if self.optimum.wanted else dd.comparison) or comparison_or_derived(
@@ -342,4 +350,4 @@ class PositionTab:
         return comparison
 
 
-__all__ = ["PositionTab", "comparison_or_derived"]
+__all__ = ["OBJECTIVE_LABELS", "PositionTab", "comparison_or_derived"]
