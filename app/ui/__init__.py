@@ -1,1 +1,1 @@
-"""The viser web page: session, input fields, results, replay, scene, tuning, log and BLDC tabs, worker."""
+"""The viser web page: page (server, layout, tabs), position_tab and bldc_tab, the case and its port, panels, worker."""
