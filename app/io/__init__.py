@@ -1,1 +1,1 @@
-"""Files and units: yaml_text (the only YAML reader/writer), presets, modes, units and display units, numbers, drive logs."""
+"""Files and units: yaml_text (the only YAML reader/writer), presets, modes, units, numbers, drive logs."""
