@@ -61,10 +61,16 @@ PAPER_K_REC = ["controller.K=0.3"]  # the recommended K of the paper preset (0.3
 #: Real sensors: a 17-bit encoder, 0.05 A rms noise, a 12-bit ADC of ±60 A (with 8192 counts the
 #: real-motor presets chatter at standstill: the simulator says so, and such a loop is chaotic).
 SENSORS = ["sensors.encoder_cpr=131072", "sensors.i_noise=0.05", "sensors.i_adc_bits=12", "sensors.i_adc_range=60"]
+#: The loops the cases were measured with, pinned: the torque-limit α (whose peak touches the hard
+#: current limit) and each preset's design for it, independent of later re-designs of the presets.
+SIEMENS_LOOPS = ["controller.alpha_max_rule=torque_limit", "controller.T_so_ms=1", "controller.T_salpha_ms=3",
+                 "controller.K=0.043075511186974044", "controller.T_c=T_a"]
+YASKAWA_04A_LOOPS = ["controller.alpha_max_rule=torque_limit", "controller.K=0.014854420229048012",
+                     "controller.T_c=0.02164492066201568"]
 CASES = {
     "paper_limits": ("paper_12kw_pmsm", PAPER_K_REC + ["controller.delay_samples=1", "controller.V_dc=300",
                                                       "controller.i_max=40"]),
-    "siemens_sensors": ("siemens_1ft7044_ak7", SENSORS),
+    "siemens_sensors": ("siemens_1ft7044_ak7", SENSORS + SIEMENS_LOOPS),
 }
 
 
@@ -89,7 +95,7 @@ def test_float32_closed_loop_reaches_the_same_place(tmp_path):
     Measured (17-bit encoder, noise, ADC), relative to each peak: θ_r 2.2e-5, ω_r 8e-4, i_q 1.1e-2,
     E_friction 4.5e-5, E_electrical 2.0e-3.
     """
-    params = load_preset("yaskawa_sgm7j_04a", SENSORS)
+    params = load_preset("yaskawa_sgm7j_04a", SENSORS + YASKAWA_04A_LOOPS)
     err = _run_closed_loop(tmp_path, params, True)
     assert err["theta_r"] < 1e-4 and err["E_friction"] < 1e-4, err
     assert err["E_copper"] < 1e-3 and err["E_electrical"] < 5e-3, err

@@ -20,6 +20,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from control.fdsmc.trapezoid import CascadeGains, TrapezoidTiming, cascade_gains, trapezoid_timing
+from sim.fdsmc.criteria import drive_current
 from sim.fdsmc.engine import Comparison, simulate
 
 #: Cycle time of a continuous-time case's setpoint table [s].
@@ -38,7 +39,8 @@ class StockSettings:
     L_d, L_q : float             Phase inductances [H].
     psi_pm : float               Ψ_PM [Wb].
     p : int                      Pole pairs [-].
-    current_limit : float        Peak phase current (|i_q|) limit [A].
+    current_limit : float        Peak phase current limit [A]: the hard limit the simulation enforces,
+                                 min(i_max, Γ_max/K_t) (Γ_max/K_t without an inverter limit).
     speed_limit : float          The drive's hard speed limit, max(ω_b, |ω_c|) [rad/s].
     current_bandwidth : float    Current-loop bandwidth 3/T_si [rad/s].
     cycle_s : float              The drive's cycle time [s].
@@ -64,8 +66,7 @@ def stock_settings(cmp: Comparison) -> StockSettings:
     m, c = p.motor, p.controller
     tr = trapezoid_timing(p.manoeuvre.theta_dem, d.alpha.alpha_max, p.manoeuvre.T_m)
     gains = cascade_gains(d.conventional.g1, d.conventional.g2, p.J_total)
-    kt = 1.5 * m.p * m.psi_pm
-    i_lim = c.i_max if c.i_max > 0.0 else m.Gamma_max / kt
+    i_lim = drive_current(p)  # the simulated hard limit min(i_max, Γ_max/K_t), else Γ_max/K_t
     cycle = CONTINUOUS_CYCLE_S if c.is_continuous else 1.0 / float(c.f_s)
     return StockSettings(tr, gains, m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, i_lim, max(m.omega_b, abs(tr.omega_c)),
                          3.0 / c.T_si, cycle)
