@@ -1,6 +1,6 @@
 """Print the per-preset table of docs/drives/odrive.md: the stock route's settings and simulated energies.
 
-    .venv/bin/python scripts/stock_table.py
+.venv/bin/python scripts/stock_table.py
 """
 
 from __future__ import annotations
