@@ -103,28 +103,26 @@ def parse_integer(text: str, field: str) -> int:
     return int(value)
 
 
-def number_option(option: str) -> Callable[[str], float]:
-    """Return an argparse ``type`` for a numeric CLI option: :func:`parse_number`, one-line error."""
+def _option(convert: Callable[[str, str], float], option: str, kind: str) -> Callable[[str], float]:
+    """Return an argparse ``type`` that converts with ``convert`` and reports a one-line error."""
     def parse(text: str) -> float:
         try:
-            return parse_number(text, option)
+            return convert(text, option)
         except NumberFormatError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
 
-    parse.__name__ = "number"
+    parse.__name__ = kind
     return parse
+
+
+def number_option(option: str) -> Callable[[str], float]:
+    """Return an argparse ``type`` for a numeric CLI option: :func:`parse_number`, one-line error."""
+    return _option(parse_number, option, "number")
 
 
 def integer_option(option: str) -> Callable[[str], int]:
     """Return an argparse ``type`` for a whole-number CLI option: :func:`parse_integer`, one-line error."""
-    def parse(text: str) -> int:
-        try:
-            return parse_integer(text, option)
-        except NumberFormatError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-
-    parse.__name__ = "integer"
-    return parse
+    return _option(parse_integer, option, "integer")  # type: ignore[return-value]
 
 
 #: Longest list of manoeuvre times one sweep takes [-].

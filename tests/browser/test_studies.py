@@ -54,7 +54,7 @@ def _meta(page: Any, fid: str) -> dict[str, Any] | None:
 
 
 def test_optimum_is_drawn_and_its_energy_bar_is_below_both_others(page):
-    page.get_by_text("Show the minimum-energy optimum").click()
+    # shown by default: the optimum is simulated with every Simulate
     page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && "
                            "e.layout.meta && e.layout.meta.id === 'phase_plane' && "
                            "e.data.some(t => t.name === 'Optimum trajectory'))")
