@@ -1,10 +1,10 @@
 """Write the two example drive logs of tests/data/ reproducibly (seeded).
 
 Both come from :mod:`sim.drivelog.synthetic`: a drive tuned for the paper's 12 kW motor
-(``app/presets/paper_12kw_pmsm.yaml`` with ``LOG_OVERRIDES``) controls a plant with other
+(``presets/paper_12kw_pmsm.yaml`` with ``LOG_OVERRIDES``) controls a plant with other
 parameters (``TRUE_MOTOR``, ``TRUE_LOAD``): 120 ms of motor-ID d-axis current injection at
 standstill (i_d,dem steps of 15 ms: ±10 A three times, 5 A, 0 A), then a 3 rad move in 0.45 s
-(``app/presets/example_log_drive.yaml``); 10 kHz, one-sample delay,
+(``presets/example_log_drive.yaml``); 10 kHz, one-sample delay,
 σ = 50 mA current noise, 12-bit ADC over ±100 A, 14-bit encoder, 10 mV voltage resolution.
 
 * ``drive_log_dq.csv``: dq signals, units in the header names (``t [ms]``, ``theta_r [rad]`` …).

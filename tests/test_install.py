@@ -52,6 +52,7 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".numba_cache")
     for pkg in ("app", "control", "sim"):
         shutil.copytree(ROOT / pkg, src / pkg, ignore=ignore)
+    shutil.copytree(ROOT / "presets", src / "presets", ignore=ignore)
     shutil.copy(ROOT / "pyproject.toml", src / "pyproject.toml")
     dist = base / "dist"
     build = [sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(dist), str(src)]
@@ -88,7 +89,7 @@ def test_the_installed_package_is_the_one_imported_with_its_data(installed: dict
     where, has_log, names = r.stdout.splitlines()
     assert Path(where).is_relative_to(installed["venv"])
     assert has_log == "True"
-    assert names.split(",") == sorted(p.stem for p in (ROOT / "app" / "presets").glob("*.yaml"))
+    assert names.split(",") == sorted(p.stem for p in (ROOT / "presets").glob("*.yaml"))
 
 
 def test_console_entry_point_serve_help(installed: dict[str, Path]) -> None:

@@ -17,8 +17,9 @@ def test_example_log_is_the_tests_copy() -> None:
     assert example_log().read_bytes() == (ROOT / "tests" / "data" / example_log().name).read_bytes()
 
 
-def test_presets_come_from_the_package() -> None:
-    assert PRESET_DIR == preset_dir() == ROOT / "app" / "presets"
+def test_presets_come_from_the_top_level_folder_of_a_clone() -> None:
+    # the product's layout: presets/ at the top; a wheel installs them as data files (tests/test_install.py)
+    assert PRESET_DIR == preset_dir() == ROOT / "presets"
     assert (PRESET_DIR / "paper_12kw_pmsm.yaml").is_file()
 
 

@@ -87,7 +87,7 @@ MAX_NAME = 1024
 
 
 def resolve(name_or_path: str) -> Path:
-    """Preset name (file stem in ``app/presets/``) or path (YAML or JSON) → path; a clear error if absent."""
+    """Preset name (file stem in ``presets/``) or path (YAML or JSON) → path; a clear error if absent."""
     if len(name_or_path) > MAX_NAME:
         raise PresetError(f"preset name {name_or_path[:40]!r}… has {len(name_or_path)} characters: "
                           f"allowed ≤ {MAX_NAME}")
@@ -137,7 +137,7 @@ def load(name_or_path: str = DEFAULT_PRESET, overrides: typing.Iterable[str] = (
     Parameters
     ----------
     name_or_path : str
-        A shipped preset's name (``app/presets/NAME.yaml``) or a YAML/JSON file path.
+        A shipped preset's name (``presets/NAME.yaml``) or a YAML/JSON file path.
     overrides : iterable of str
         ``section.field=value`` overrides (unit-suffixed keys allowed), applied before validation.
     mode : str or None
