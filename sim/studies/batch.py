@@ -84,16 +84,31 @@ def setup(params: DriveParams, d: Derived, controller: str, plant: DriveParams, 
                  windows, steps)
 
 
-def hysteretic_changes_rows(r: np.ndarray, hyst: float) -> np.ndarray:
-    """Per row of ``r``: :func:`sim.fdsmc.metrics.hysteretic_sign_changes` (samples within ±hyst ignored)."""
-    keep = np.abs(r) > hyst
-    col = np.arange(r.shape[1])
-    last = np.maximum.accumulate(np.where(keep, col, -1), axis=1)  # last kept column ≤ j
-    prev = np.concatenate((np.full((r.shape[0], 1), -1), last[:, :-1]), axis=1)
-    s = np.sign(r)
-    rows = np.arange(r.shape[0])[:, None]
-    changed = keep & (prev >= 0) & (s != s[rows, np.maximum(prev, 0)])
-    return np.count_nonzero(changed, axis=1)
+@njit(cache=True, nogil=True)
+def chatter_stats(a: np.ndarray, n: int, hyst: float) -> tuple[np.ndarray, np.ndarray]:
+    """Peak-to-peak [rad/s²] and hysteretic sign changes [-] of each row's high-pass part.
+
+    Row by row the arithmetic of :func:`sim.fdsmc.metrics.detect_chatter`: r = a − the centred
+    moving average of ``n`` samples (edges padded, running sum in the same order as ``np.cumsum``),
+    the sign changes of r counting only samples beyond ±``hyst`` (the same numbers: tests).
+    """
+    rows, m = a.shape
+    ptp, changes = np.zeros(rows), np.zeros(rows, dtype=np.int64)
+    lo = n // 2
+    c = np.zeros(m + n)
+    for i in range(rows):
+        for k in range(m + n - 1):  # running sum of the edge-padded row
+            c[k + 1] = c[k] + a[i, min(max(k - lo, 0), m - 1)]
+        r_min, r_max, last, count = np.inf, -np.inf, 0.0, 0
+        for k in range(m):
+            r = a[i, k] - (c[k + n] - c[k]) / n
+            r_min, r_max = min(r_min, r), max(r_max, r)
+            if abs(r) > hyst:
+                s = np.sign(r)
+                count += 1 if last != 0.0 and s != last else 0
+                last = s
+        ptp[i], changes[i] = r_max - r_min, count
+    return ptp, changes
 
 
 def chatter_rows(t: np.ndarray, alpha_dem: np.ndarray, window: tuple[float, float], alpha_max: float) -> np.ndarray:
@@ -106,13 +121,8 @@ def chatter_rows(t: np.ndarray, alpha_dem: np.ndarray, window: tuple[float, floa
     sel = (t >= t0) & (t <= t1)
     if np.count_nonzero(sel) < 8 or t1 <= t0:
         return np.zeros(alpha_dem.shape[0], dtype=bool)
-    a = alpha_dem[:, sel]
     n = max(1, int(round(CHATTER_SMOOTHING_S / float(np.median(np.diff(t[sel]))))))
-    padded = np.pad(a, ((0, 0), (n // 2, n - 1 - n // 2)), mode="edge")
-    c = np.concatenate((np.zeros((a.shape[0], 1)), np.cumsum(padded, axis=1)), axis=1)
-    r = a - (c[:, n:] - c[:, :-n]) / n
-    ptp = np.max(r, axis=1) - np.min(r, axis=1)
-    changes = hysteretic_changes_rows(r, CHATTER_HYSTERESIS_FRACTION * alpha_max)
+    ptp, changes = chatter_stats(np.ascontiguousarray(alpha_dem[:, sel]), n, CHATTER_HYSTERESIS_FRACTION * alpha_max)
     return (ptp > CHATTER_PTP_FRACTION * alpha_max) & (changes >= CHATTER_MIN_SIGN_CHANGES)
 
 
