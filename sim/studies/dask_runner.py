@@ -67,11 +67,6 @@ def warm() -> float:
     return time.perf_counter() - t0
 
 
-def identity() -> dict[str, Any]:
-    """Return what :func:`connect` asks every worker: its source hash, the seconds its kernels took to load."""
-    return {"hash": local_hash(), "warm_s": warm()}
-
-
 def tune_allocator() -> bool:
     """Keep freed arrays in glibc's heap (undo ``MALLOC_TRIM_THRESHOLD_``); False where not glibc."""
     try:
@@ -156,6 +151,7 @@ class DaskExecutor:
     def __init__(self, client: Any, address: str, no_worker_s: float, workers: int) -> None:
         self.client, self.address, self.no_worker_s, self.workers = client, address, no_worker_s, workers
         self.run_id, self._n = uuid.uuid4().hex[:8], 0
+        self.warm_s: dict[str, float] = {}  # worker → seconds its kernels took to load
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> DaskChunk:
         """Submit one chunk (key ``robustness-RUN-chunk-J``, never deduplicated)."""
@@ -212,18 +208,20 @@ def connect(address: str, no_worker_s: float = NO_WORKER_S, tuned: bool = True) 
 
 
 def _check_workers(ex: DaskExecutor, tuned: bool) -> None:
+    """Wait for a worker, refuse other source (before anything is compiled), then tune and warm."""
     try:
         ex.client.wait_for_workers(1, timeout=ex.no_worker_s)
     except TimeoutError:
         raise ExecutorError(ex.no_workers_message()) from None
-    if tuned:
-        ex.client.register_plugin(worker_plugin())
-    found = ex.client.run(identity)
+    found = ex.client.run(local_hash)
     mine = local_hash()
-    bad = {addr: i["hash"] for addr, i in found.items() if i["hash"] != mine}
+    bad = {addr: h for addr, h in found.items() if h != mine}
     if bad:
         addr, h = next(iter(bad.items()))
         raise ExecutorError(f"the Dask cluster at {ex.address} is refused: worker {addr} runs source {h} "
                             f"({len(bad)} of {len(found)} differ) but this client runs {mine}: allowed only "
                             "workers with the same control/ and sim/ (install the same commit everywhere)")
-    ex.workers = len(found)
+    if tuned:
+        ex.client.register_plugin(worker_plugin())
+    ex.warm_s = ex.client.run(warm)
+    ex.workers = len(ex.warm_s)
