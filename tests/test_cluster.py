@@ -216,3 +216,34 @@ def test_no_scheduler_is_one_line_and_exit_2(capsys):
                  "--cluster-timeout", "1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'")
+
+
+_PAGE = """
+import json, os, sys
+from types import SimpleNamespace
+from app.io.presets import load_preset
+from app.io.study_inputs import parse_spreads
+from app.ui.studies_robustness import SCHEDULER_ENV, RobustnessView
+from sim.studies import dask_runner
+from sim.studies.robustness import robustness
+used = []
+connect = dask_runner.connect
+dask_runner.connect = lambda address, *a: used.append(address) or connect(address, *a)
+view = RobustnessView.__new__(RobustnessView)
+view._done, view.progress, view.status = 0, SimpleNamespace(value=0.0), SimpleNamespace(content="")
+view._s = SimpleNamespace(worker=SimpleNamespace(checkpoint=lambda: None))
+params = load_preset("siemens_1ft7044_ak7")
+spreads = parse_spreads(["plant.J_L=0.001:0.004,plant.R_s=±20%"])
+res = view._run(params, spreads, 80, 5)
+print(json.dumps({"used": used, "env": os.environ[SCHEDULER_ENV], "done": view._done,
+                  "same": res.runs == robustness(params, spreads, 80, 5).runs}))
+"""
+
+
+def test_the_page_runs_large_studies_on_the_configured_cluster(cluster):
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "PMSM_DASK_SCHEDULER": cluster.address}
+    r = subprocess.run([sys.executable, "-c", _PAGE], capture_output=True, text=True, cwd=ROOT, env=env,
+                       timeout=600, check=False)
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert out["used"] == [cluster.address] and out["done"] == 80 and out["same"]
