@@ -1,24 +1,32 @@
-"""``python -m app export PRESET [--set …] --format yaml|json|c|csv|html [-o PATH]``.
+"""``python -m app export PRESET [--set …] --format FORMAT [-o PATH] [--force]``.
 
 Writes the same files as the page's Export menu (:func:`app.exports.model.export_files`): for ``c``,
 PATH is a folder receiving ``fdsmc_controller.h`` and ``.c``; otherwise PATH is the file
-(default: ``<name>.<format>`` in the current folder).
+(default: ``<name>.<format>`` here; the stock-drive formats ``<name>.odrive.json``,
+``<name>.moteus.cfg``, ``<name>.vesc.xml``, ``<name>.setpoints.csv``). Every format is refused,
+naming the failed checks, when the simulated design is not clean; ``--force`` writes it with the
+failed checks inside. Files are written whole (a temporary file, then ``os.replace``).
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import sys
+import tempfile
 from pathlib import Path
 
 from app.cli.main import add_preset_arguments
+from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
+from app.exports.drive_units import ANGLE_UNITS
 from app.exports.model import FORMATS, export_files
+from app.io.numbers import parse_number
 from app.io.preset_modes import load_mode_preset
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison, compare
+from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Comparison, compare
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -29,20 +37,57 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="output file (folder for --format c); default <name>.<format> here (c: this folder)")
     p.add_argument("--name", help="name written in the file and used for its file name (default: the preset's)")
     p.add_argument("--source", help="source written in the file, e.g. the motor's data sheet")
+    p.add_argument("--force", action="store_true",
+                   help="write a design that is not clean, with the failed checks inside the file")
+    p.add_argument("--angle-unit", choices=tuple(ANGLE_UNITS), default="rad",
+                   help="angle unit of --format setpoints (default rad)")
+    p.add_argument("--cycle-ms", metavar="MS",
+                   help="cycle time of --format setpoints [ms] (default the drive's 1/f_s; 1 ms if continuous)")
 
 
-def case(params: DriveParams) -> Comparison:
-    """Both controllers simulated (the derivations alone when the manoeuvre is infeasible)."""
+def case(params: DriveParams, fmt: str = "yaml") -> Comparison:
+    """Return the simulated case (the derivations alone when the manoeuvre is infeasible).
+
+    The stock-drive formats also simulate the stock route and the tracked optimum (their energies
+    go into the file's header).
+    """
     d = derive(params)
-    return compare(params, derived=d) if d.profile.feasible else Comparison(d, None, None, None, None)
+    if not d.profile.feasible:
+        return Comparison(d, None, None, None, None)
+    return compare(params, COMPARATORS if fmt in DRIVE_FORMATS else CONTROLLERS, derived=d)
+
+
+def cycle_seconds(text: str | None) -> float | None:
+    """``--cycle-ms`` → seconds; a one-line error naming the option, the value and the range."""
+    if text is None:
+        return None
+    ms = parse_number(text, "--cycle-ms")
+    if not ms > 0.0:
+        raise ParameterError(f"--cycle-ms = {text!r} is not allowed: a time > 0 ms")
+    return ms * 1e-3
+
+
+def write_atomic(path: Path, content: bytes) -> None:
+    """Write ``content`` to ``path`` whole: a temporary file in the same folder, then ``os.replace``."""
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent if str(path.parent) else ".")
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(content)
+        os.replace(tmp, path)
+    except OSError as exc:
+        if tmp is not None and os.path.exists(tmp):
+            os.unlink(tmp)
+        raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
 
 def run(args: argparse.Namespace) -> int:
-    """Load, simulate, write the export; prints the paths written."""
+    """Load, simulate, pass the gate, write the export; prints the paths written."""
     params = load_mode_preset(args.preset, args.overrides, mode="position")
     renamed = {k: v for k, v in (("name", args.name), ("source", args.source)) if v is not None}
     params = dataclasses.replace(params, **renamed)
-    files = export_files(args.format, case(params))
+    options = ExportOptions(args.force, args.angle_unit, cycle_seconds(args.cycle_ms))
+    files = export_files(args.format, case(params, args.format), options)
     if args.format == "c":
         folder = Path(args.output or ".")
         if folder.exists() and not folder.is_dir():
@@ -53,9 +98,6 @@ def run(args: argparse.Namespace) -> int:
         ((name, content),) = files.items()
         targets = {Path(args.output or name): content}
     for path, content in targets.items():
-        try:
-            path.write_bytes(content)
-        except OSError as exc:
-            raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
+        write_atomic(path, content)
         sys.stdout.write(f"wrote {path} ({len(content)} bytes)\n")
     return 0

@@ -1,4 +1,4 @@
-"""Command-line interface: ``python -m app {derive,simulate,export,table1,bench,serve,bldc} …``.
+"""Command-line interface: ``python -m app {derive,simulate,export,import-drive,table1,bench,serve,bldc} …``.
 
 Each sub-command lives in its own module exposing ``add_arguments(parser)`` and
 ``run(args) -> int``. Bad input exits with code 2 and one clear line on stderr, never a traceback.
@@ -27,6 +27,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "multiaxis": ("app.cli.multiaxis", "axes that must finish together: common T_m, designs, energies"),
     "dutycycle": ("app.cli.duty", "a duty cycle of moves with dwells: energy per cycle and per year"),
     "robustness": ("app.cli.robustness", "Monte-Carlo robustness to plant values the controller does not know"),
+    "import-drive": ("app.cli.import_drive", "import a stock drive's file (ODrive, moteus, VESC) into a preset"),
 }
 
 

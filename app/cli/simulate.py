@@ -13,7 +13,7 @@ from app.io.json_data import to_json
 from app.io.numbers import format_metric
 from app.io.plant_overrides import load_model_and_plant
 from control.common.checks import ParameterError
-from sim.fdsmc.engine import Comparison, compare
+from sim.fdsmc.engine import COMPARATORS, Comparison, compare
 from sim.fdsmc.optimum_gap import saving_vs_optimum
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
@@ -46,9 +46,9 @@ SUMMARY = (
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``simulate``."""
     add_preset_arguments(p)
-    p.add_argument("--controller", choices=("fdsmc", "conventional", "optimum", "both", "all"), default="all",
-                   help="which run(s): both = FDSMC and conventional, all = both and the tracked "
-                        "minimum-energy optimum (default all)")
+    p.add_argument("--controller", choices=("fdsmc", "conventional", "optimum", "stock", "both", "all"),
+                   default="all", help="which run(s): both = FDSMC and conventional, all = both, the tracked "
+                                       "minimum-energy optimum and the stock drive's trapezoid (default all)")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
     p.add_argument("--csv", metavar="FILE", help="write the time series (CSV: controller column, units in the headers)")
 
@@ -62,11 +62,11 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     entries gain ``saving_vs_optimum_pct`` (see :func:`saving_vs_optimum`).
     """
     out: dict[str, Any] = {"derived": derived_json(cmp.derived)}
-    for run in (cmp.fdsmc, cmp.conventional, cmp.optimum):
+    for run in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock):
         if run is not None:
             out[run.controller] = to_json(run.metrics)
     if cmp.optimum is not None:
-        for run in (cmp.fdsmc, cmp.conventional):
+        for run in (cmp.fdsmc, cmp.conventional, cmp.stock):
             if run is not None:
                 out[run.controller]["saving_vs_optimum_pct"] = saving_vs_optimum(run, cmp.optimum)
     out["saving_friction_pct"] = cmp.saving_friction_pct
@@ -87,7 +87,7 @@ def write_csv(path: str, cmp: Comparison) -> None:
 
 def print_summary(cmp: Comparison) -> None:
     """Side-by-side table of the runs, savings, warnings and explanations."""
-    runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum) if r is not None]
+    runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock) if r is not None]
     p = cmp.derived.params
     print(f"Preset: {p.name}  T_m = {p.manoeuvre.T_m:g} s, θ_dem = {p.manoeuvre.theta_dem:g} rad, "
           f"f_s = {p.controller.f_s}, K = {p.controller.K:g} s/rad\n")
@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         check_writable(args.csv, "--csv")
     params, plant = load_model_and_plant(args.preset, args.overrides)
-    ctrls = {"both": ("fdsmc", "conventional"), "all": ("fdsmc", "conventional", "optimum")}.get(
+    ctrls = {"both": ("fdsmc", "conventional"), "all": COMPARATORS}.get(
         args.controller, (args.controller,))
     cmp = compare(params, ctrls, plant=plant)
     if args.csv:

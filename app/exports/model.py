@@ -10,7 +10,16 @@
   export → import → export gives identical bytes;
 * ``c``: the C99 controller module (:mod:`app.exports.c_module`);
 * ``csv``: the time series of both runs (:func:`trace_csv`);
-* ``html``: the offline report (:mod:`app.exports.html`).
+* ``html``: the offline report (:mod:`app.exports.html`);
+* ``odrive`` / ``moteus`` / ``vesc`` / ``setpoints``: the files a stock drive loads
+  (:mod:`app.exports.drive_files`): the same move as a trapezoid and the comparator's gains as the
+  drive's cascade, each with a header naming the preset, the tool's version, the verdicts, a hash of
+  the parameters and the simulated energy of the stock route next to FDSMC and the optimum.
+
+Every format passes one gate (:func:`app.exports.provenance.gate`): a design whose simulated FDSMC
+run fails a check of :func:`sim.fdsmc.design.run_checks` is refused, naming the failed checks,
+unless ``force``; a forced file carries the failed checks inside (``verdicts.failed_checks`` in
+YAML/JSON, a comment block in C, CSV and the stock-drive files, a banner in HTML).
 
 Files are named after the case's ``name``; no date is written, so exports are reproducible.
 """
@@ -22,11 +31,14 @@ import json
 import re
 import zipfile
 from dataclasses import dataclass
+from html import escape
 from typing import Any
 
 import numpy as np
 
 from app.exports.c_module import TOOL, controller_files
+from app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
+from app.exports.provenance import check_text, failed_checks, gate, verdict_lines
 from app.io.derived_view import derived_rows
 from app.io.json_data import to_json
 from app.io.presets import SCHEMA, annotate_units, dumps, to_raw
@@ -36,7 +48,9 @@ from control.fdsmc.derivations import Derived
 from sim.fdsmc.engine import Comparison
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
-FORMATS = ("yaml", "json", "c", "csv", "html")
+FORMATS = ("yaml", "json", "c", "csv", "html") + tuple(DRIVE_FORMATS)
+#: Options of an export when none are given (not forced, setpoints in rad at the drive's cycle).
+DEFAULT_OPTIONS = ExportOptions()
 
 
 @dataclass(frozen=True)
@@ -88,7 +102,8 @@ def verdicts(cmp: Comparison) -> dict[str, Any]:
     return {"feasible": bool(d.profile.feasible), "warnings": list(d.warnings),
             "run_warnings": run_warnings(cmp), "comparator_notes": comparator_notes(cmp),
             "saving_friction_pct": cmp.saving_friction_pct,
-            "saving_electrical_pct": cmp.saving_electrical_pct}
+            "saving_electrical_pct": cmp.saving_electrical_pct,
+            "failed_checks": [check_text(c) for c in failed_checks(cmp)]}
 
 
 def parameter_data(cmp: Comparison) -> dict[str, Any]:
@@ -158,34 +173,55 @@ def safe_stem(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "drive"
 
 
-def export_files(fmt: str, cmp: Comparison) -> dict[str, bytes]:
+def _warned(fmt: str, text: str, failed: list) -> str:
+    """``text`` with the failed checks written inside (a forced export); unchanged when clean."""
+    if not failed:
+        return text
+    lines = verdict_lines(failed)
+    if fmt == "c":
+        return "/* " + "\n * ".join(lines) + "\n */\n" + text
+    if fmt == "csv":
+        return "".join(f"# {line}\n" for line in lines) + text
+    if fmt == "html":
+        banner = "<div class=\"not-clean\"><p>" + "<br>".join(escape(line) for line in lines) + "</p></div>"
+        return text.replace("<body>", "<body>" + banner, 1)
+    return text
+
+
+def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPTIONS) -> dict[str, bytes]:
     """File name → content of one export format for the case ``cmp`` (see the module doc).
 
     Raises
     ------
     ParameterError
-        For an unknown format, a C export in continuous mode, or a CSV without a run.
+        For an unknown format; :class:`~app.exports.provenance.ExportRefusedError` naming the failed
+        checks when the design is not clean and not ``options.force``; a C export in continuous
+        mode, a CSV or stock-drive file without a run.
     """
+    if fmt not in FORMATS:
+        raise ParameterError(f"format = {fmt!r} is not allowed: one of {', '.join(FORMATS)}")
+    failed = gate(fmt, cmp, options.force)
     stem = safe_stem(cmp.derived.params.name)
+    if fmt in DRIVE_FORMATS:
+        name, text = drive_file(fmt, cmp, failed, stem, options)
+        return {name: text.encode("utf-8")}
     if fmt == "c":
         files = controller_files(cmp.derived.params, cmp.derived, SCHEMA)
-        return {name: text.encode("utf-8") for name, text in files.items()}
+        return {name: _warned(fmt, text, failed).encode("utf-8") for name, text in files.items()}
     if fmt == "html":
         from app.exports.html import html_report  # plotly: imported only when a report is made
 
-        return {f"{stem}.html": html_report(cmp).encode("utf-8")}
+        return {f"{stem}.html": _warned(fmt, html_report(cmp), failed).encode("utf-8")}
     writers = {"yaml": parameter_yaml, "json": parameter_json, "csv": trace_csv}
-    if fmt not in writers:
-        raise ParameterError(f"format = {fmt!r} is not allowed: one of {', '.join(FORMATS)}")
-    return {f"{stem}.{fmt}": writers[fmt](cmp).encode("utf-8")}
+    return {f"{stem}.{fmt}": _warned(fmt, writers[fmt](cmp), failed).encode("utf-8")}
 
 
-def export_download(fmt: str, cmp: Comparison) -> tuple[str, bytes]:
+def export_download(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPTIONS) -> tuple[str, bytes]:
     """Return one downloadable file: the single export file, or a zip of the C module's header and source.
 
     The zip is named ``<name>_fdsmc_controller.zip``.
     """
-    files = export_files(fmt, cmp)
+    files = export_files(fmt, cmp, options)
     if len(files) == 1:
         return next(iter(files.items()))
     buf = io.BytesIO()

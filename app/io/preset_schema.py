@@ -112,7 +112,7 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
     hints = typing.get_type_hints(cls)
     names = [f.name for f in dataclasses.fields(cls)]
     aliases = units.aliases_of(cls)  # the unit-suffixed keys declared by the field specs
-    extra = [units.KE_KEY] if "psi_pm" in names else []
+    extra = list(units.FLUX_KEYS) if "psi_pm" in names else []
     allowed = names + list(aliases) + extra
     values: dict[str, Any] = {}
     for key, value in raw.items():
@@ -133,7 +133,7 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
                 p = 0
             if p < 1:
                 raise PresetError(f"{section}.{key} needs a valid {section}.p (pole pairs) beside it")
-            values[target] = units.ke_vrms_krpm_to_psi_pm(ke, p)
+            values[target] = units.FLUX_KEYS[key](ke, p)
         else:
             raise PresetError(f"unknown key {section}.{key}{hint(key, allowed)}")
         if sum(1 for k in raw if field_of(str(k), aliases, extra) == target) > 1:
@@ -178,7 +178,10 @@ def parse_preset(raw: Any) -> Any:
             raise PresetError(f"unknown top-level key {key!r}{hint(str(key), allowed)}")
     hints = typing.get_type_hints(cls)
     kwargs: dict[str, Any] = {}
+    optional = optional_sections(cls)
     for name in sections:
+        if name not in raw and name in optional:
+            continue  # an optional section (sensors, limits): its defaults
         if name not in raw:
             raise PresetError(f"missing section {name!r} (allowed sections: {', '.join(sections)})")
         kwargs[name] = _parse_section(hints[name], raw[name], name)
@@ -193,6 +196,13 @@ def parse_preset(raw: Any) -> Any:
     return params
 
 
+def optional_sections(cls: type) -> tuple[str, ...]:
+    """Sections of a mode's dataclass that a preset may leave out (they have defaults, e.g. ``sensors``)."""
+    if not dataclasses.is_dataclass(cls):
+        return ()
+    return tuple(f.name for f in dataclasses.fields(cls) if dataclasses.is_dataclass(f.default))
+
+
 def plant_fields() -> dict[str, str]:
     """Every key a plant section accepts (SI names, unit-suffixed aliases, Ke) → ``motor``/``load``."""
     out: dict[str, str] = {}
@@ -200,7 +210,7 @@ def plant_fields() -> dict[str, str]:
     for section in PLANT_SECTIONS:
         names = [f.name for f in dataclasses.fields(hints[section]) if f.name != "steps"]
         out.update(dict.fromkeys(names + list(units.ALIASES.get(section, {})), section))
-    out[units.KE_KEY] = "motor"
+    out.update(dict.fromkeys(units.FLUX_KEYS, "motor"))
     return out
 
 
@@ -237,7 +247,7 @@ def parse_plant(raw: Any, params: DriveParams) -> DriveParams | None:
     for section in PLANT_SECTIONS:
         base = getattr(params, section)
         aliases = units.ALIASES.get(section, {})
-        given = {field_of(k, aliases, [units.KE_KEY]) for k in split[section]}
+        given = {field_of(k, aliases, list(units.FLUX_KEYS)) for k in split[section]}
         if len(given) < len(split[section]):
             raise PresetError(f"plant gives a {section} field more than once (SI and unit-suffixed forms): "
                               f"{', '.join(split[section])}")

@@ -34,6 +34,7 @@ from app.io.preset_schema import (
     PresetError,
     field_of,
     hint,
+    optional_sections,
     parse_plant,
     parse_preset,
     plain,
@@ -165,6 +166,8 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
             raise PresetError(f"--set {item!r} is malformed: allowed form section.field=value")
         if section == PLANT and raw.get(PLANT) is None and raw.get("mode", "position") == "position":
             raw[PLANT] = {}
+        if section not in raw and section in optional_sections(MODES.get(str(raw.get("mode", "position")))):
+            raw[section] = {}  # an optional section (sensors, limits) set from the command line
         if not isinstance(raw.get(section), dict):
             known = [k for k, v in raw.items() if isinstance(v, dict)]
             raise PresetError(f"--set {item!r}: unknown section {section!r}{hint(section, known)}")
@@ -173,8 +176,8 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
             raise PresetError(f"--set {item!r} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
         aliases = units.ALIASES.get(section, {}) if section != PLANT else (
             units.ALIASES["motor"] | units.ALIASES["load"])
-        target = field_of(name, aliases, [units.KE_KEY])
-        for other in [k for k in raw[section] if field_of(str(k), aliases, [units.KE_KEY]) == target]:
+        target = field_of(name, aliases, list(units.FLUX_KEYS))
+        for other in [k for k in raw[section] if field_of(str(k), aliases, list(units.FLUX_KEYS)) == target]:
             del raw[section][other]  # an override replaces the value in any unit form
         raw[section][name] = value
     return raw

@@ -116,6 +116,21 @@ def ke_vrms_krpm_to_psi_pm(Ke_Vrms_krpm: float, p: int) -> float:
     return Ke_Vrms_krpm * math.sqrt(2.0 / 3.0) / (p * rpm_to_rad_s(1000.0))
 
 
+def arms_to_amplitude(I_rms: float) -> float:
+    """RMS value of a sinusoidal phase current [A_rms] → its amplitude [A] (the dq current scale): ×√2."""
+    return I_rms * math.sqrt(2.0)
+
+
+def amplitude_to_arms(I: float) -> float:
+    """Amplitude of a sinusoidal phase current [A] → its RMS value [A_rms]: inverse of :func:`arms_to_amplitude`."""
+    return I / math.sqrt(2.0)
+
+
+def _identity(x: float) -> float:
+    """Return the value itself: the key suffix only states the unit the field already has."""
+    return x
+
+
 def kgcm2_to_kgm2(J_kgcm2: float) -> float:
     """Inertia [kg·cm²] → [kg·m²]."""
     return J_kgcm2 * 1e-4
@@ -140,6 +155,10 @@ CONVERSIONS: dict[str, tuple[Callable[[float], float], Callable[[float], float]]
     "deg": (deg_to_rad, rad_to_deg),
     "rev": (rev_to_rad, rad_to_rev),
     "kg·cm²": (kgcm2_to_kgm2, kgm2_to_kgcm2),
+    # a datasheet's rms current for a field that holds the amplitude (controller.i_max_Arms)
+    "Arms": (arms_to_amplitude, amplitude_to_arms),
+    # a field that already holds an rms value in A (sensors.i_noise_A_rms): the suffix only states it
+    "A_rms": (_identity, _identity),
 }
 #: Key suffix of a unit whose name is not an identifier (``J_r_kgcm2``).
 KEY_SUFFIX = {"kg·cm²": "kgcm2"}
@@ -161,9 +180,17 @@ def alias_key(name: str, unit: str) -> str:
 
 
 def aliases_of(cls: type) -> dict[str, Alias]:
-    """Unit-suffixed keys of a parameter dataclass, from its field specs."""
-    return {alias_key(name, u): Alias(name, CONVERSIONS[u][0], u)
-            for name, spec in field_specs(cls).items() for u in spec.loader_units}
+    """Unit-suffixed keys of a parameter dataclass, from its field specs.
+
+    Besides each spec's loader units, a key may name the SI unit itself when it is a plain word
+    (``limits.in_position_rad``, ``limits.hold_i_rms_A``): the value is taken as it is.
+    """
+    table = {alias_key(name, u): Alias(name, CONVERSIONS[u][0], u)
+             for name, spec in field_specs(cls).items() for u in spec.loader_units}
+    for name, spec in field_specs(cls).items():
+        if spec.unit.isidentifier():
+            table.setdefault(alias_key(name, spec.unit), Alias(name, _identity, spec.unit))
+    return table
 
 
 def sections(cls: type, prefix: str = "") -> Iterator[tuple[str, type]]:
@@ -216,6 +243,29 @@ ALIASES: dict[str, dict[str, Alias]] = {path: table for path, tp in SECTION_CLAS
 
 #: Keys needing more than one field to convert (Ke needs the pole pairs).
 KE_KEY = "Ke_Vrms_krpm"
+
+
+def kv_rpm_per_v_to_psi_pm(Kv_rpm_per_V: float, p: int) -> float:
+    """Speed constant Kv [rpm per V] → Ψ_PM [Wb] (amplitude-invariant dq).
+
+    Kv is the speed per volt of line-to-line **peak** back-EMF (the hobby/robotics convention; ODrive's
+    torque_constant = 8.27/Kv follows from it). The line-to-line peak at mechanical speed ω is
+    √3·p·ω·Ψ_PM, so Ψ_PM = 1/(√3·p·Kv·2π/60); then Kt = (3/2)·p·Ψ_PM = 8.27/Kv [N·m/A].
+    """
+    return 1.0 / (math.sqrt(3.0) * p * rpm_to_rad_s(Kv_rpm_per_V))
+
+
+def psi_pm_to_kv_rpm_per_v(psi_pm: float, p: int) -> float:
+    """Ψ_PM [Wb] → Kv [rpm per V line-to-line peak]; inverse of :func:`kv_rpm_per_v_to_psi_pm`."""
+    return rad_s_to_rpm(1.0 / (math.sqrt(3.0) * p * psi_pm))
+
+
+#: Keys that give Ψ_PM through the pole pairs: key → converter (value, p) → Ψ_PM [Wb].
+FLUX_KEYS: dict[str, Callable[[float, int], float]] = {
+    KE_KEY: lambda x, p: ke_vrms_krpm_to_psi_pm(x, p),
+    "Kv_rpm_per_V": lambda x, p: kv_rpm_per_v_to_psi_pm(x, p),
+    "Kt_Nm_per_Arms": lambda x, p: kt_nm_per_arms_to_psi_pm(x, p),
+}
 
 def kt_nm_per_arms_to_psi_pm(Kt_Nm_Arms: float, p: int) -> float:
     """Torque constant Kt [N·m per A_rms] → Ψ_PM [Wb] (amplitude-invariant dq, i_d = 0).

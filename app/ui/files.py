@@ -4,7 +4,9 @@ Downloads go to the one client that asked (``client.send_file_download``) and ar
 export model shared with the CLI (:func:`app.exports.model.export_download`), so the page and
 ``python -m app export`` write the same bytes. An export describes the simulated case; when the
 inputs shown differ from it (edited but not simulated) the export is refused with a message naming
-the uncommitted fields. An upload (YAML or JSON) is validated by the same loader as the CLI
+the uncommitted fields. An export of a design that is not clean
+is refused with the failed checks named, unless "Export even if not clean" is ticked. An upload
+(YAML or JSON) is validated by the same loader as the CLI
 (:func:`app.io.presets.loads_preset`); a bad file gets a notification naming the problem and
 changes nothing.
 """
@@ -17,6 +19,7 @@ from typing import Any
 
 import viser
 
+from app.exports.drive_files import ExportOptions
 from app.exports.model import export_download, safe_stem
 from app.io.preset_schema import PresetError
 from app.io.presets import MAX_BYTES, loads_preset, to_raw
@@ -32,6 +35,10 @@ EXPORTS = {
     "C controller module (.h + .c, zip)": "c",
     "Time series (CSV)": "csv",
     "HTML report (offline)": "html",
+    "ODrive 0.5 backup (JSON)": "odrive",
+    "moteus config (key value)": "moteus",
+    "VESC motor config (XML)": "vesc",
+    "Setpoint table (CSV)": "setpoints",
 }
 
 
@@ -116,6 +123,9 @@ class FilesPanel:
         with gui.add_folder("Export", expand_by_default=False):
             self.name = gui.add_text("Name (file name)", params.name)
             self.source = gui.add_text("Source", params.source)
+            self.force = gui.add_checkbox("Export even if not clean", False,
+                                          hint="Write a design whose simulated run fails a check, with the failed "
+                                               "checks inside the file (the CLI's --force)")
             self.buttons = {}
             for label, fmt in EXPORTS.items():
                 button = gui.add_button(label, icon=viser.Icon.DOWNLOAD)
@@ -124,7 +134,8 @@ class FilesPanel:
 
     def _export(self, fmt: str) -> None:
         try:
-            name, content = export_download(fmt, renamed(self._state(), self.name.value, self.source.value))
+            name, content = export_download(fmt, renamed(self._state(), self.name.value, self.source.value),
+                                            ExportOptions(force=bool(self.force.value)))
         except (ExportRefusedError, ParameterError) as exc:
             self._client.add_notification("Not exported", str(exc), color="yellow", auto_close_seconds=12.0)
             return

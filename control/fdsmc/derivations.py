@@ -175,7 +175,8 @@ def _warnings(
             f"η = {alpha.overshoot:.3g}, friction at ω_p and load) exceeds the drive's {feas.Gamma_max:.4g} N·m."
         )
     if not feas.speed_ok:
-        w.append(f"Peak speed ω_p = {feas.omega_p:.4g} rad/s exceeds the base speed ω_b = {feas.omega_b:g} rad/s.")
+        w.append(f"Peak speed ω_p = {feas.omega_p:.4g} rad/s exceeds the speed limit {feas.omega_b:g} rad/s "
+                 "(limits.omega_max, else ω_b).")
     if not feas.voltage_ok:
         w.append(
             f"Voltage needed at ω_p with the peak torque, {feas.u_needed_peak:.4g} V, exceeds the "

@@ -33,6 +33,22 @@ def torque_limit(params: DriveParams) -> float:
     return min(g, torque_constant(params.motor) * i_max) if i_max > 0.0 else g
 
 
+def current_limit(params: DriveParams) -> float:
+    """Return the hard limit on |i_dq| the drive enforces [A]; 0 = none (the paper, ``controller.i_max`` = 0).
+
+    A drive set up for its motor never commands more current than the motor's peak torque needs:
+    min(i_max, Γ_max/K_t) with K_t = (3/2)·p·Ψ_PM of eq. (5) in [1] (i_d = 0). Where K_t·i_max > Γ_max
+    the motor's torque, not the inverter, sets the limit.
+    """
+    i_max = params.controller.i_max
+    return min(i_max, params.motor.Gamma_max / torque_constant(params.motor)) if i_max > 0.0 else 0.0
+
+
+def speed_limit(params: DriveParams) -> float:
+    """Return the largest allowed |ω_r| [rad/s]: the motor's maximum speed ``limits.omega_max``, else ω_b."""
+    return params.limits.omega_max or params.motor.omega_b
+
+
 def voltage_limit(params: DriveParams) -> float:
     """Largest |u_dq| [V]: V_dc/√3 of the inverter (space-vector limit) when given, else √(2/3)·V_0."""
     V_dc = params.controller.V_dc
@@ -127,8 +143,8 @@ class Feasibility:
     Attributes
     ----------
     omega_p : float            Peak speed [rad/s].
-    omega_b : float            Base speed [rad/s].
-    speed_ok : bool            ω_p ≤ ω_b.
+    omega_b : float            Speed limit [rad/s]: the maximum speed n_max, else the base speed ω_b.
+    speed_ok : bool            ω_p ≤ the speed limit.
     torque_needed : float      Peak torque: η·α_max·J_total + F_v·ω_p + |Γ_Le| [N·m].
     Gamma_max : float          The drive's torque limit, Γ_max or i_max's torque [N·m].
     torque_ok : bool           torque_needed ≤ Gamma_max (within LIMIT_TOLERANCE).
@@ -186,8 +202,8 @@ def feasibility(params: DriveParams, alpha: AlphaMax, omega_p: float) -> Feasibi
     u_avail = voltage_limit(params)
     return Feasibility(
         omega_p=omega_p,
-        omega_b=m.omega_b,
-        speed_ok=not exceeds(omega_p, m.omega_b),
+        omega_b=speed_limit(params),
+        speed_ok=not exceeds(omega_p, speed_limit(params)),
         torque_needed=peak,
         Gamma_max=lim,
         torque_ok=not exceeds(peak, lim),

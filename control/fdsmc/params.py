@@ -146,7 +146,9 @@ class Controller:
     V_dc : float
         Inverter DC-link voltage [V]; limits |u_dq| ≤ V_dc/√3. 0 = ideal inverter (the paper).
     i_max : float
-        Inverter current limit on |i_q| [A]. 0 = none (the paper).
+        Inverter current limit: amplitude of the phase current, |i_dq| ≤ i_max (amplitude-invariant
+        dq) [A]; a datasheet's A_rms value is √2 times smaller (loader key ``i_max_Arms``). 0 = none
+        (the paper).
     """
 
     T_si: float = spec_field("s", T_MIN_S, 10.0, low_open=False, label="T_si current settling", display="ms")
@@ -160,8 +162,8 @@ class Controller:
                                   label="f_s sample rate", display="kHz")
     delay_samples: int = spec_field("samples", 0, 1, default=0, integer=True, label="Computation delay")
     V_dc: float = spec_field("V", 0.0, 1e5, default=0.0, low_open=False, label="V_dc inverter DC link (0 = ideal)")
-    i_max: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False,
-                              label="i_max inverter peak current (0 = none)")
+    i_max: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False, aliases=("Arms",),
+                              label="i_max inverter current amplitude (0 = none)")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
@@ -205,13 +207,96 @@ class Manoeuvre:
                                  f"{THETA_DEM_MIN:g} ≤ |value| ≤ 1e+06 rad")
 
 
-__all__ = ["ALPHA_MAX_RULES", "Controller", "DriveParams", "Load", "LoadStep", "Manoeuvre", "Motor",
-           "ParameterError", "T_MIN_S", "THETA_DEM_MIN"]
+#: Largest encoder resolution [counts per mechanical revolution] (2³¹: a 31-bit absolute encoder).
+ENCODER_CPR_MAX = 2**31
+
+
+@dataclass(frozen=True)
+class Sensors:
+    """What the digital controller measures: a quantized encoder and noisy, quantized currents.
+
+    The controller (FDC laws, observer, current limit) sees only these signals; the simulated
+    physics stays exact. The noise is a seeded, reproducible sequence.
+
+    Attributes
+    ----------
+    encoder_cpr : int
+        Encoder counts per mechanical revolution [-] (e.g. 8192, 2²⁰); 0 = ideal (no quantization).
+        The controller sees θ_r quantized down to a whole count: 2π/cpr·floor(θ_r·cpr/2π).
+    i_noise : float
+        Current-measurement noise, rms of each measured phase-current component i_d, i_q [A].
+    i_adc_bits : int
+        Resolution of the current ADC [bits]; 0 = ideal.
+    i_adc_range : float
+        Full-scale amplitude of the current ADC, ±i_adc_range [A] (needed when ``i_adc_bits`` > 0);
+        one step is 2·i_adc_range/2^bits and readings clip at the full scale.
+    seed : int
+        Seed of the noise sequence [-].
+    """
+
+    encoder_cpr: int = spec_field("counts/rev", 0, ENCODER_CPR_MAX, default=0, integer=True,
+                                  label="Encoder counts per rev (0 = ideal)")
+    i_noise: float = spec_field("A", 0.0, 1e4, default=0.0, low_open=False, aliases=("A_rms",),
+                                label="Current noise [rms] (0 = none)")
+    i_adc_bits: int = spec_field("bits", 0, 24, default=0, integer=True, label="Current ADC bits (0 = ideal)")
+    i_adc_range: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False, label="Current ADC full scale ±")
+    seed: int = spec_field("-", 0, 2**31 - 1, default=1, integer=True, label="Noise seed")
+
+    def __post_init__(self) -> None:
+        """Check every field's range; an ADC resolution needs its full scale."""
+        check_fields(self, "sensors")
+        if self.i_adc_bits > 0 and self.i_adc_range <= 0.0:
+            raise ParameterError(f"sensors.i_adc_range = {self.i_adc_range!r} A is out of range with "
+                                 f"sensors.i_adc_bits = {self.i_adc_bits}: allowed > 0 A (the ADC's full scale)")
+
+    @property
+    def ideal(self) -> bool:
+        """True when the controller measures θ_r, i_d and i_q exactly."""
+        return self.encoder_cpr == 0 and self.i_noise == 0.0 and self.i_adc_bits == 0
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The commissioning engineer's pass criteria; 0 selects the documented default.
+
+    Attributes
+    ----------
+    omega_max : float
+        Largest allowed |ω_r|: the motor's maximum speed n_max [rad/s]; 0 = the rated speed ω_b.
+    in_position : float
+        In-position window ±[rad] around θ_dem; 0 = ±10 encoder counts (an ideal encoder: ±10 counts
+        of a 2²⁰ encoder, 6.0e-5 rad).
+    overshoot : float
+        Largest allowed overshoot beyond θ_dem [rad]; 0 = the in-position window.
+    hold_i_rms : float
+        Largest allowed rms ripple of i_q while holding θ_dem [A]; 0 = 5 % of the drive's current
+        limit (i_max, else Γ_max/Kt).
+    """
+
+    omega_max: float = spec_field("rad/s", 0.0, 1e5, default=0.0, low_open=False, display="rpm",
+                                  label="n_max maximum speed (0 = rated)")
+    in_position: float = spec_field("rad", 0.0, 1e3, default=0.0, low_open=False, aliases=("deg",),
+                                    label="In-position window ± (0 = 10 counts)")
+    overshoot: float = spec_field("rad", 0.0, 1e3, default=0.0, low_open=False, aliases=("deg",),
+                                  label="Overshoot limit (0 = in-position window)")
+    hold_i_rms: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False,
+                                   label="Standstill i_q ripple limit [rms] (0 = 5 % of i_max)")
+
+    def __post_init__(self) -> None:
+        """Check every field's range: a ParameterError names the field, the value and the allowed range."""
+        check_fields(self, "limits")
+
+
+__all__ = ["ALPHA_MAX_RULES", "ENCODER_CPR_MAX", "Controller", "DriveParams", "Limits", "Load", "LoadStep",
+           "Manoeuvre", "Motor", "ParameterError", "Sensors", "T_MIN_S", "THETA_DEM_MIN"]
 
 
 @dataclass(frozen=True)
 class DriveParams:
-    """Everything one FDSMC commissioning case needs: motor, load, controller, manoeuvre."""
+    """Everything one FDSMC commissioning case needs: motor, load, controller, manoeuvre.
+
+    ``sensors`` and ``limits`` are optional sections (ideal sensors, default pass criteria).
+    """
 
     motor: Motor
     load: Load
@@ -219,6 +304,14 @@ class DriveParams:
     manoeuvre: Manoeuvre
     name: str = "custom"
     source: str = "user input"
+    sensors: Sensors = Sensors()
+    limits: Limits = Limits()
+
+    def __post_init__(self) -> None:
+        """Sensor models need a sampled controller (measurements are taken at the sample instants)."""
+        if not self.sensors.ideal and self.controller.is_continuous:
+            raise ParameterError("controller.f_s = 'continuous' cannot be used with sensors (encoder_cpr, i_noise, "
+                                 "i_adc_bits): allowed a sample rate in Hz, or ideal sensors")
 
     @property
     def J_total(self) -> float:

@@ -15,6 +15,15 @@ The choices, each from the drive model rather than a fudge factor:
 * K: the recommended K (gain margin 2 below the chatter limit of the sampled loop at the drive's
   f_s and delay, :mod:`control.fdsmc.loop_analysis`); halved while the simulation still chatters.
 * T_c: T_a (eq. (59)) unless the sloped segment is then poorly damped; then T_c,min.
+* T_so, T_sα for the sensors: the standstill ripple the encoder's quantization and the current
+  noise cause is predicted in closed form (:func:`control.fdsmc.noise.noise_gain`); where it exceeds
+  the user's criterion, the observer and acceleration loop are slowed (the same factor on both)
+  until it does not, and the setting is then verified by simulation **with the sensors**.
+* T_m stretched by 3 % steps (up to 6) where the verified peak speed or voltage exceeds its limit by
+  the inner loops' lag; the design then says it is **not as asked**.
+
+Verdicts: *clean* (every check of :mod:`sim.fdsmc.checks` holds at the requested T_m), *not as
+asked* (they hold only at a longer T_m than requested) or *not clean* (the constraints say why).
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -26,41 +35,34 @@ import math
 from dataclasses import dataclass
 
 from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.feasibility import alpha_max, exceeds, feasibility, torque_limit, voltage_limit
+from control.fdsmc.feasibility import alpha_max, feasibility, torque_limit
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
 from control.fdsmc.loop_model import LoopModel
 from control.fdsmc.model import model_coefficients
+from control.fdsmc.noise import NoiseGain, noise_gain
 from control.fdsmc.observer import observer_gains
-from control.fdsmc.params import DriveParams
+from control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
 from control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
 from control.fdsmc.transient import acceleration_overshoot
+from sim.common import sensors
+from sim.fdsmc.checks import TARGET_BAND, Constraint, run_checks
+from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import Comparison, RunResult, compare
-from sim.fdsmc.verdicts import TARGET_BAND, comparator_notes
+from sim.fdsmc.verdicts import comparator_notes
 
 #: Most K halvings while the verified run still chatters [-].
 MAX_K_HALVINGS = 4
+#: Factors applied to T_so and T_sα when the sensors' ripple exceeds the criterion [-].
+SENSOR_SLOWDOWN = (1.0, 1.5, 2.25, 3.4, 5.0, 7.6, 11.4)
+#: The predicted ripple a candidate may have, as a fraction of the criterion (the prediction is
+#: within ≈ 20 % of the simulation, ``tests/test_noise_gain.py``) [-].
+PREDICTION_MARGIN = 0.8
+#: T_m stretch per step and the most steps when the verified speed/voltage peak exceeds its limit.
+T_M_STRETCH, MAX_STRETCHES = 1.03, 6
+#: Checks that slower observer and acceleration loops can mend (the sensors' noise amplified).
+SENSOR_CHECKS = frozenset({"hold_ripple", "in_position", "current_time", "chatter", "saturation"})
 
-
-@dataclass(frozen=True)
-class Constraint:
-    """A constraint that binds the design or prevents a clean one.
-
-    Attributes
-    ----------
-    name : str        Short key, e.g. ``"torque"``, ``"sample_rate"``, ``"T_m"``.
-    value : float     The design's (or simulation's) value [unit].
-    limit : float     The limit it is compared with [unit].
-    unit : str
-    violated : bool   True when it prevents a clean design; False when it only binds.
-    text : str        One sentence: what binds and, when violated, what would fix it.
-    """
-
-    name: str
-    value: float
-    limit: float
-    unit: str
-    violated: bool
-    text: str
+__all__ = ["Constraint", "DriveDesign", "TARGET_BAND", "design_drive", "run_checks", "shortest_fitting_T_m"]
 
 
 @dataclass(frozen=True)
@@ -71,11 +73,15 @@ class DriveDesign:
     ----------
     params : DriveParams            The designed inputs (a complete preset).
     derived : Derived               Their derivations.
-    comparison : Comparison | None  The verification runs (None when not simulated).
-    clean : bool                    True when the FDSMC run passed every check.
+    comparison : Comparison | None  The verification runs, with the sensors (None when not simulated).
+    clean : bool                    True when the FDSMC run passed every check at the requested T_m.
     limiting : tuple of Constraint  Binding and violated constraints.
     notes : tuple of str            Statements that do not make the design unclean.
-    comparator : tuple of str       Where the conventional comparator exceeds the drive's limits.
+    comparator : tuple of str       Where the conventional comparator fails the drive's checks.
+    as_asked : bool                 False when the requested T_m had to be lengthened.
+    noise : NoiseGain or None       Predicted standstill ripple of the designed loop.
+    encoder_cpr_needed : int or None  Smallest power-of-two encoder resolution whose quantization
+                                    alone keeps the predicted ripple within the criterion [counts/rev].
     """
 
     params: DriveParams
@@ -85,6 +91,16 @@ class DriveDesign:
     limiting: tuple[Constraint, ...]
     notes: tuple[str, ...]
     comparator: tuple[str, ...] = ()
+    as_asked: bool = True
+    noise: NoiseGain | None = None
+    encoder_cpr_needed: int | None = None
+
+    @property
+    def verdict(self) -> str:
+        """``"clean"``, ``"not as asked"`` (clean only at a longer T_m) or ``"not clean"``."""
+        if any(c.violated for c in self.limiting):
+            return "not clean"
+        return "clean" if self.as_asked else "not as asked"
 
 
 def _with(params: DriveParams, section: str, **changes: object) -> DriveParams:
@@ -92,7 +108,7 @@ def _with(params: DriveParams, section: str, **changes: object) -> DriveParams:
 
 
 def _fits(params: DriveParams, eta: float, T_m: float) -> bool:
-    """Profile exists, ω_p ≤ ω_b and the voltage at ω_p fits, for manoeuvre time ``T_m`` [s]."""
+    """Profile exists, ω_p within the speed limit and the voltage at ω_p fits, for manoeuvre time ``T_m`` [s]."""
     p = _with(params, "manoeuvre", T_m=T_m)
     a = alpha_max(p, eta)
     if T_m < shortest_manoeuvre_time(p.manoeuvre.theta_dem, a.alpha_max):
@@ -143,32 +159,83 @@ def _gain_and_T_c(params: DriveParams, d: Derived) -> DriveParams:
     return _with(params, "controller", K=K, T_c=T_c)
 
 
+def predicted_noise(p: DriveParams, d: Derived) -> NoiseGain | None:
+    """Standstill ripple of ``p``'s FDSMC loop from its sensors (None for a continuous controller)."""
+    if d.loop.f_s is None:
+        return None
+    se = p.sensors
+    i_rms = math.hypot(se.i_noise, sensors.adc_step(se) / math.sqrt(12.0))
+    return noise_gain(d.loop, "slope", p.controller.K, sensors.encoder_step(se), i_rms)
+
+
+def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
+    """Smallest power-of-two counts per rev whose quantization alone gives ≤ ``criterion`` [A] of ripple."""
+    if noise is None or not math.isfinite(noise.i_q_per_rad) or noise.i_q_per_rad <= 0.0:
+        return None
+    cpr = 2.0 * math.pi * noise.i_q_per_rad / criterion
+    bits = max(0, math.ceil(math.log2(cpr)))
+    return 2**bits if 2**bits <= ENCODER_CPR_MAX else None
+
+
 def design_drive(params: DriveParams) -> DriveDesign:
-    """Design α_max, T_m, K and T_c for ``params``'s drive and verify the result by simulation.
+    """Design α_max, T_m, K, T_c (and T_so, T_sα for the sensors) for ``params``'s drive; verify by simulation.
 
     Parameters
     ----------
     params : DriveParams
-        Nameplate, load, inverter limits, sample rate and delay, T_si/T_sα/T_so and the manoeuvre
-        (θ_dem, requested T_m). K, T_c and the α_max rule are replaced by the design.
+        Nameplate, load, inverter limits, sensors, pass criteria, sample rate and delay,
+        T_si/T_sα/T_so and the manoeuvre (θ_dem, requested T_m). K, T_c and the α_max rule are
+        replaced by the design; T_so and T_sα are lengthened where the sensors need it.
 
     Returns
     -------
     DriveDesign
     """
-    p = _with(params, "controller", alpha_max_rule="torque_limit", T_c="T_a")
+    base = _with(params, "controller", alpha_max_rule="torque_limit", T_c="T_a")
+    first: DriveDesign | None = None
+    for factor in _slowdowns(base):
+        dd = _design_at(_slowed(base, factor), params)
+        first = first or dd
+        if dd.comparison is not None and not _sensor_limited(dd):
+            return dd
+    return first if first is not None else _design_at(base, params)
+
+
+def _slowed(p: DriveParams, factor: float) -> DriveParams:
+    c = p.controller
+    return _with(p, "controller", T_so=c.T_so * factor, T_salpha=c.T_salpha * factor)
+
+
+def _slowdowns(p: DriveParams) -> list[float]:
+    """Return the slowdown factors to verify: from the first whose predicted ripple meets the criterion on."""
+    if p.sensors.ideal or p.controller.is_continuous:
+        return [1.0]
+    crit = pass_criteria(p).hold_i_rms
+    for i, factor in enumerate(SENSOR_SLOWDOWN):
+        q = _slowed(p, factor)
+        d = derive(q)
+        if d.sample_rate is not None and not d.sample_rate.stable:
+            continue
+        ng = predicted_noise(_gain_and_T_c(q, d), d)
+        if ng is not None and ng.i_q_rms <= PREDICTION_MARGIN * crit:
+            return list(SENSOR_SLOWDOWN[i:])
+    return [SENSOR_SLOWDOWN[-1]]
+
+
+def _sensor_limited(dd: DriveDesign) -> bool:
+    return not dd.params.sensors.ideal and any(c.violated and c.name in SENSOR_CHECKS for c in dd.limiting)
+
+
+def _design_at(p: DriveParams, asked: DriveParams) -> DriveDesign:
+    """Choose T_m, check the sample rate, set K and T_c for ``p``'s loops, and verify."""
     eta = _overshoot(p)
     limiting: list[Constraint] = []
     if math.isfinite(eta):
         T_m = shortest_fitting_T_m(p, eta)
         if T_m is None:
-            return _refused(p, [Constraint("T_m", params.manoeuvre.T_m, 1e4, "s", True,
+            return _refused(p, [Constraint("T_m", asked.manoeuvre.T_m, 1e4, "s", True,
                                            "No manoeuvre time up to 1e4 s fits the speed/voltage limits.")])
-        if T_m != params.manoeuvre.T_m:
-            limiting.append(Constraint("T_m", params.manoeuvre.T_m, T_m, "s", False,
-                                       f"Requested T_m = {params.manoeuvre.T_m:g} s is infeasible on this drive; "
-                                       f"the shortest feasible is {T_m:.4g} s (used)."))
-            p = _with(p, "manoeuvre", T_m=T_m)
+        p = _with(p, "manoeuvre", T_m=T_m)
     d = derive(p)
     rate = d.sample_rate
     if rate is not None and not rate.stable:
@@ -177,12 +244,12 @@ def design_drive(params: DriveParams) -> DriveDesign:
             "sample_rate", float(rate.f_s or 0.0), float(rate.f_s_min or math.inf), "Hz", True,
             f"f_s = {rate.f_s:g} Hz is too slow for T_so/T_sα (sampled loop unstable, spectral radius "
             f"{rate.spectral_radius:.4f}): use {need}, or longer T_so and T_sα.")])
-    p = dataclasses.replace(_gain_and_T_c(p, d), source=_designed_source(params.source))
-    return _verify(p, limiting)
+    p = dataclasses.replace(_gain_and_T_c(p, d), source=_designed_source(asked.source))
+    return _verify(p, asked)
 
 
 def _designed_source(source: str) -> str:
-    tag = "design: torque-limit α_max, recommended K, verified by simulation"
+    tag = "design: torque-limit α_max, recommended K, verified by simulation with the sensors"
     return source if tag in source else f"{source}; {tag}"
 
 
@@ -190,20 +257,46 @@ def _refused(p: DriveParams, limiting: list[Constraint]) -> DriveDesign:
     return DriveDesign(p, derive(p), None, False, tuple(limiting), ())
 
 
-def _verify(p: DriveParams, limiting: list[Constraint]) -> DriveDesign:
-    """Simulate; halve K while the FDSMC run chatters; collect the checks."""
+def _simulate(p: DriveParams) -> tuple[DriveParams, Derived, Comparison]:
+    """Simulate; halve K while the FDSMC run chatters."""
     for _ in range(MAX_K_HALVINGS + 1):
         d = derive(p)
         cmp = compare(p, derived=d)
         if cmp.fdsmc is None or not cmp.fdsmc.metrics.chatter:
             break
         p = _with(p, "controller", K=p.controller.K / 2.0)
-    if cmp.fdsmc is None:  # infeasible after all: derive's warnings say why
-        return _refused(p, limiting + [Constraint("T_m", p.manoeuvre.T_m, d.profile.T_m_min, "s", True,
-                                                  "The manoeuvre is infeasible at the designed α_max.")])
-    limiting = limiting + [_torque_binding(p, cmp.fdsmc)] + run_checks(p, cmp.fdsmc)
-    clean = not any(c.violated for c in limiting)
-    return DriveDesign(p, d, cmp, clean, tuple(limiting), _notes(d), tuple(comparator_notes(cmp)))
+    return p, d, cmp
+
+
+def _verify(p: DriveParams, asked: DriveParams) -> DriveDesign:
+    """Simulate with the sensors; stretch T_m while only speed/voltage fail; collect the checks."""
+    for _ in range(MAX_STRETCHES + 1):
+        p, d, cmp = _simulate(p)
+        if cmp.fdsmc is None:  # infeasible after all: derive's warnings say why
+            return _refused(p, [Constraint("T_m", p.manoeuvre.T_m, d.profile.T_m_min, "s", True,
+                                           "The manoeuvre is infeasible at the designed α_max.")])
+        failed = {c.name for c in run_checks(p, cmp.fdsmc)}
+        if not failed or not failed <= {"speed", "voltage"}:
+            break
+        q = _with(p, "manoeuvre", T_m=_round_up(p.manoeuvre.T_m * T_M_STRETCH))
+        p = _gain_and_T_c(q, derive(q))
+    return _result(p, d, cmp, asked)
+
+
+def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> DriveDesign:
+    assert cmp.fdsmc is not None
+    T_asked, T_m = asked.manoeuvre.T_m, p.manoeuvre.T_m
+    limiting = [] if T_m == T_asked else [Constraint(
+        "T_m", T_asked, T_m, "s", False, f"Requested T_m = {T_asked:g} s is not feasible with these limits; "
+                                         f"the shortest that passes is {T_m:.4g} s (used): not as asked.")]
+    limiting += [_torque_binding(p, cmp.fdsmc)] + run_checks(p, cmp.fdsmc)
+    ng = predicted_noise(p, d)
+    crit = pass_criteria(p).hold_i_rms
+    as_asked = T_m == T_asked
+    clean = as_asked and not any(c.violated for c in limiting)
+    notes = _notes(d) + _sensor_notes(p, asked, ng, crit)
+    return DriveDesign(p, d, cmp, clean, tuple(limiting), notes, tuple(comparator_notes(cmp)), as_asked, ng,
+                       encoder_needed(ng, crit))
 
 
 def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
@@ -214,36 +307,17 @@ def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
                       f"{lim:.4g} N·m (Γ_max or i_max); simulated peak {peak:.4g} N·m.")
 
 
-def run_checks(p: DriveParams, run: RunResult) -> list[Constraint]:
-    """Return the simulated run's violations of the drive's limits, the arrival band and chatter."""
-    m = run.metrics
-    if not m.stable:
-        return [Constraint("stable", 1.0, 0.0, "-", True, f"Unstable run: {m.reason}.")]
-    out: list[Constraint] = []
-    i_max = p.controller.i_max
-    peaks = [("torque", m.torque_peak_Nm, torque_limit(p), "N·m", "lower T_m demand or a larger motor"),
-             ("voltage", m.u_peak_V, voltage_limit(p), "V", "a longer T_m (lower ω_p) or a higher V_dc"),
-             ("speed", m.omega_peak_rad_s, p.motor.omega_b, "rad/s", "a longer T_m")]
-    if i_max > 0.0:
-        peaks.append(("current", m.i_q_peak_A, i_max, "A", "a larger inverter"))
-    for name, peak, lim, unit, fix in peaks:
-        v = peak or 0.0
-        if exceeds(v, lim):
-            out.append(Constraint(name, v, lim, unit, True, f"Simulated peak {name} {v:.4g} {unit} > {lim:.4g} "
-                                                            f"{unit}: needs {fix}."))
-    sat = m.saturated_s
-    if sat > 0.0:
-        out.append(Constraint("saturation", sat, 0.0, "s", True,
-                              f"The inverter limits the voltage/current for {sat:.3g} s."))
-    frac = TARGET_BAND[run.controller]
-    err, band = abs(m.theta_error_at_Tm_rad or 0.0), frac * abs(p.manoeuvre.theta_dem)
-    if err > band:
-        out.append(Constraint("arrival", err, band, "rad", True, f"Position error {err:.4g} rad at T_m is outside "
-                                                                 f"the {100 * frac:g} % band ({band:.4g} rad)."))
-    if m.chatter:
-        out.append(Constraint("chatter", p.controller.K, 0.0, "s/rad", True,
-                              f"Still chatters at K = {p.controller.K:.4g} s/rad."))
-    return out
+def _sensor_notes(p: DriveParams, asked: DriveParams, ng: NoiseGain | None, crit: float) -> tuple[str, ...]:
+    out = []
+    c, a = p.controller, asked.controller
+    if c.T_so != a.T_so:
+        out.append(f"T_so {a.T_so * 1e3:.4g} → {c.T_so * 1e3:.4g} ms and T_sα {a.T_salpha * 1e3:.4g} → "
+                   f"{c.T_salpha * 1e3:.4g} ms: slower observer and acceleration loop for the sensors' noise.")
+    if ng is not None and math.isfinite(ng.i_q_rms):
+        need = encoder_needed(ng, crit)
+        out.append(f"Predicted standstill ripple {ng.i_q_rms:.3g} A rms of i_q, {ng.u_q_rms:.3g} V rms of u_q "
+                   f"(criterion {crit:.3g} A)" + (f"; the encoder needs ≥ {need} counts/rev." if need else "."))
+    return tuple(out)
 
 
 def _notes(d: Derived) -> tuple[str, ...]:

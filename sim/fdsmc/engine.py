@@ -24,12 +24,24 @@ import numpy as np
 
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
+from control.fdsmc.feasibility import current_limit
+from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams
-from sim.common import budget
+from sim.common import budget, sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
-from sim.fdsmc.grid import CONTINUOUS_STEP_S, MAX_POINTS, check_budget, load_steps, run_cost, time_grid, with_field
+from sim.fdsmc.criteria import pass_criteria
+from sim.fdsmc.grid import (
+    CONTINUOUS_STEP_S,
+    MAX_POINTS,
+    check_budget,
+    continuous_step,
+    load_steps,
+    run_cost,
+    time_grid,
+    with_field,
+)
 from sim.fdsmc.metrics import (
     RunMetrics,
     WindowSamples,
@@ -41,9 +53,12 @@ from sim.fdsmc.metrics import (
 CONTROLLERS = ("fdsmc", "conventional")
 #: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
 #: (:mod:`control.fdsmc.optimum`); the kernel's P_CTRL is the index in this tuple.
-COMPARATORS = CONTROLLERS + ("optimum",)
+COMPARATORS = CONTROLLERS + ("optimum", "stock")
 #: The name each simulated outer loop goes by in messages, tables and figures.
-LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum"}
+LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum", "stock": "Stock trapezoid"}
+#: The kernel's outer law (P_CTRL) of each comparator: the stock drive (a trapezoid tracked by the
+#: P–PI cascade without its integrator, :mod:`control.fdsmc.trapezoid`) is the reference-tracking law.
+KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 2.0, "stock": 2.0}
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
@@ -105,7 +120,7 @@ class Comparison:
 
     ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
     ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
-    ``optimum`` is the tracked minimum-energy move, when asked for.
+    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for.
     """
 
     derived: Derived
@@ -114,6 +129,7 @@ class Comparison:
     saving_friction_pct: float | None
     saving_electrical_pct: float | None
     optimum: RunResult | None = None
+    stock: RunResult | None = None
 
 
 @dataclass(frozen=True)
@@ -130,11 +146,13 @@ class Table1Row:
 
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
-                    plant: DriveParams | None = None) -> np.ndarray:
+                    plant: DriveParams | None = None, T_step: float | None = None) -> np.ndarray:
     """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.kernel`).
 
     ``params``/``d`` are the controller's model; ``plant`` (default: the same) gives the true
     motor and load values the simulated drive has (R_s, L_d, L_q, Ψ_PM, p, J_r, J_L, F_v, Γ_Le).
+    ``T_step`` [s] is the interval the current limit predicts over: the sample period (default
+    1/f_s), or the integration step of the continuous mode (default :func:`continuous_step`).
     """
     c, ctrl = d.coefficients, params.controller
     pl = params if plant is None else plant
@@ -149,19 +167,33 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
     prm[[kn.P_RS, kn.P_LD, kn.P_LQ, kn.P_PSI, kn.P_P, kn.P_JR]] = (
         m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, m.J_r)
     prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (pl.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
-    prm[kn.P_CTRL] = COMPARATORS.index(controller)
+    prm[kn.P_CTRL] = KERNEL_LAW[controller]
     pr, o = d.profile, d.observer
     prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
     prm[[kn.P_G1, kn.P_G2]] = (d.conventional.g1, d.conventional.g2)
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
-    prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), ctrl.i_max)  # 0 = no limit
+    prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), current_limit(params))  # 0 = no limit
     prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
     m = params.motor
     w_scale = max(m.omega_b, pr.omega_p, abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
     i_scale = max(m.Gamma_max, d.alpha.torque_needed) / torque_constant(m)
     prm[[kn.P_WLIM, kn.P_ILIM]] = (20.0 * w_scale, 100.0 * i_scale)
+    _pack_sensors(prm, params, d, T_step)
     return prm
+
+
+def _pack_sensors(prm: np.ndarray, params: DriveParams, d: Derived, T_step: float | None) -> None:
+    """Sensor steps, the current predictor's factors over ``T_step`` and the in-position window."""
+    se, c = params.sensors, d.coefficients
+    prm[[kn.P_ENC, kn.P_INOISE, kn.P_ISTEP, kn.P_IFS]] = (
+        sensors.encoder_step(se), se.i_noise, sensors.adc_step(se), se.i_adc_range)
+    if T_step is None:
+        ctrl = params.controller
+        T_step = continuous_step(params) if ctrl.is_continuous else 1.0 / float(ctrl.f_s)
+    prm[[kn.P_PHID, kn.P_GMID]] = decay_factors(c.A, T_step)
+    prm[[kn.P_PHIQ, kn.P_GMIQ]] = decay_factors(c.D, T_step)
+    prm[kn.P_INPOS] = pass_criteria(params).in_position
 
 
 def _observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -172,7 +204,12 @@ def _observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _reference(d: Derived, controller: str) -> np.ndarray:
-    """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum, else zeros."""
+    """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum or trapezoid, else zeros."""
+    if controller == "stock":
+        from control.fdsmc.trapezoid import trapezoid_reference, trapezoid_timing
+
+        tr = trapezoid_timing(d.params.manoeuvre.theta_dem, d.alpha.alpha_max, d.params.manoeuvre.T_m)
+        return np.ascontiguousarray(trapezoid_reference(tr))
     if controller != "optimum":
         return np.zeros((3, 2))
     from control.fdsmc.optimum import tracked_move  # imports cvxpy only when limits are active
@@ -207,7 +244,8 @@ def simulate(
         The commissioning case.
     controller : str
         ``"fdsmc"`` (eqs. 41–46 in [1]), ``"conventional"`` (eq. 62 sign-corrected) or
-        ``"optimum"`` (the minimum-energy move of :mod:`control.fdsmc.optimum`, tracked).
+        ``"optimum"`` (the minimum-energy move of :mod:`control.fdsmc.optimum`, tracked) or ``"stock"``
+        (the trapezoid of :mod:`control.fdsmc.trapezoid` tracked by the stock drive's cascade).
     derived : Derived or None
         ``derive(params)`` if already computed.
     n_sub : int
@@ -235,22 +273,24 @@ def simulate(
     d = derive(params) if derived is None else derived
     _check_feasible(d)
     g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
-    prm = pack_parameters(params, d, controller, plant)
+    T_step = g.h * g.n_sub
+    prm = pack_parameters(params, d, controller, plant, T_step)
     step_t, step_v = load_steps(params if plant is None else plant)
     Phi, Gam, Lo = _observer_arrays(d)
     out = np.zeros((kn.N_CH, g.n_out))
     info = np.zeros(kn.N_INFO)
-    T_step = g.h * g.n_sub
     windows = chatter_windows(params, d, controller, g.n_steps * T_step)
     steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
-    win = np.zeros((2 * len(steps), max(n for _, n in steps)))
+    win = np.zeros((kn.WIN_ROWS * len(steps), max(n for _, n in steps)))
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
-                  params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller))
+                  params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller),
+                  sensors.noise_table(params.sensors))
     trace = _trace(out[:, : int(info[kn.I_NOUT])])
-    samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, win[2 * j, :n], win[2 * j + 1, :n])
+    rows = kn.WIN_ROWS
+    samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, *win[rows * j: rows * (j + 1), :n])
                for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
-    met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, info, plant)
+    met = run_metrics(params, d, controller, trace.t, trace.theta_r, samples, info, plant, T_step=T_step)
     return RunResult(controller, trace, met)
 
 
@@ -268,16 +308,17 @@ def run_steps(
     """
     check_controller(controller, COMPARATORS)
     d = derive(params) if derived is None else derived
-    prm = pack_parameters(params, d, controller)
-    step_t, step_v = load_steps(params)
-    Phi, Gam, Lo = _observer_arrays(d)
     cont = params.controller.is_continuous
     h = h_continuous if cont else 1.0 / float(params.controller.f_s) / n_sub
+    prm = pack_parameters(params, d, controller, T_step=h if cont else h * n_sub)
+    step_t, step_v = load_steps(params)
+    Phi, Gam, Lo = _observer_arrays(d)
     out = np.zeros((kn.N_CH, 1))
     info = np.zeros(kn.N_INFO)
     kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
                   params.controller.delay_samples, int(n_steps) + 1, out, info,
-                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller))
+                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller),
+                  sensors.noise_table(params.sensors))
     return info[kn.I_END: kn.I_END + kn.N_X].copy()
 
 
@@ -340,7 +381,7 @@ def compare(
     runs |= {c: f.result() for c, f in futures.items()}
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
-                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"))
+                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"))
 
 
 def table1_sweep(

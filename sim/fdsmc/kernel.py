@@ -6,6 +6,10 @@ version of the same step, built from the laws in :mod:`control`, and the tests c
 agree. Formulas (see [1], the FDSMC paper):
 
 * plant: eqs. (1)–(3) with the mechanics of eq. (4b), Γ_em of eq. (5), Γ_L of eq. (4a);
+* sensors (digital mode): the controller sees the encoder's whole counts of θ_r and noisy,
+  quantized i_d, i_q (:mod:`sim.common.sensors`); the plant stays exact;
+* inverter: the hard, predictive |i_dq| ≤ i_max and |u_dq| ≤ u_max of
+  :func:`control.fdsmc.inverter.limit_voltage`;
 * FDC: eqs. (7), (9), (10), (14) with ω̂_r, L̂0, L̂1 from the observer;
 * observer: eq. (15) corrected (e_o = θ_r − θ̂_r, dθ̂/dt = ω̂ + K1·e_o); digital mode uses the
   ZOH-exact prediction form x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·e_o[k];
@@ -23,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from control.fdsmc import conventional, fdc, inverter, sliding_mode
+from sim.common import sensors
 
 # ---- prm indices -------------------------------------------------------------------------
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
@@ -31,7 +36,11 @@ from control.fdsmc import conventional, fdc, inverter, sliding_mode
 # The plant's own coefficients A…G of eqs. (1)–(2) (its true R_s, L_d, L_q, Ψ_PM): P_A…P_G are the
 # controller's model of them. P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT, P_FV are the plant's.
 (P_PA, P_PB, P_PC, P_PD, P_PE, P_PF, P_PG) = range(39, 46)
-N_PRM = 46
+# Sensors (sim.common.sensors): encoder step [rad], current noise rms, ADC step and full scale [A];
+# the current predictor's ZOH factors over one sample (control.fdsmc.inverter.decay_factors); the
+# in-position window [rad] of the pass criteria.
+(P_ENC, P_INOISE, P_ISTEP, P_IFS, P_PHID, P_GMID, P_PHIQ, P_GMIQ, P_INPOS) = range(46, 55)
+N_PRM = 55
 
 # ---- state indices -----------------------------------------------------------------------
 (X_ID, X_IQ, X_TH, X_W, X_EF, X_ECU, X_EEL, X_EMOT, X_ELOAD, X_THH, X_WH, X_L0, X_L1) = range(13)
@@ -47,15 +56,24 @@ N_CH = len(CHANNELS)
 (I_NOUT, I_FAILED, I_TFAIL, I_TSAT, I_PW, I_PIQ, I_PU, I_PTQ, I_PID, I_TM_HIT) = range(10)
 I_SNAP = 10  # then N_X values of the state interpolated at T_m
 I_END = I_SNAP + N_X  # then N_X values of the final state
-N_INFO = I_END + N_X
+# Peak |i_dq| [A]; time |i_dq| > i_max [s]; last sample time outside the in-position window [s]
+# (−1: never); largest overshoot beyond θ_dem [rad].
+(I_PIDQ, I_TOVER, I_TOUT, I_OVS) = range(I_END + N_X, I_END + N_X + 4)
+N_INFO = I_OVS + 1
+#: Rows of ``win`` per chatter window: α_dem [rad/s²], ω_r [rad/s], i_q [A], u_q [V] (applied).
+WIN_ROWS = 4
 
 
-_FM = {"nsz", "arcp", "contract", "afn", "reassoc"}
+# No fast-math: the compiled kernel computes every operation in the order written, IEEE-exactly,
+# as the same code run as plain Python (NUMBA_DISABLE_JIT=1) does. A chattering loop with a
+# quantized encoder is chaotic — last-bit differences (fused multiply-adds, re-association) grow
+# into different trajectories — so only bit-identical arithmetic lets both agree on every metric
+# and flag (tests/test_compiled_vs_python.py).
 # The hot path works on tuples of scalars (plant p = the first X_THH states, observer o = the
 # last four) and every helper is inlined into run_kernel (inline="always"), so numba keeps the
 # states in registers. The earlier array-based version (states in small arrays, stores inside
 # the loop) took ≈ 240 ns per 20 kHz sample; this one ≈ 75 ns (``python -m app bench``).
-_helper = njit(cache=True, error_model="numpy", fastmath=_FM, inline="always")
+_helper = njit(cache=True, error_model="numpy", inline="always")
 
 
 @_helper
@@ -109,20 +127,41 @@ def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0:
 
 
 @_helper
-def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
-                  prm: np.ndarray) -> tuple[float, float, bool]:
-    """Apply the optional inverter limits of :func:`control.fdsmc.inverter.limit_voltage`; return u_d, u_q, flag."""
-    return inverter.limit_voltage(u_d, u_q, i_d, i_q, omega_hat, prm[P_IMAX], prm[P_UMAX], prm[P_C], prm[P_D],
-                                  prm[P_E], prm[P_G])
+def predict_currents(i_d: float, i_q: float, omega_hat: float, u: tuple, prm: np.ndarray) -> tuple[float, float]:
+    """Currents [A] one sample on with the voltages u held: :func:`control.fdsmc.inverter.predict_currents`."""
+    return inverter.predict_currents(i_d, i_q, omega_hat, u[0], u[1], prm[P_PHID], prm[P_GMID], prm[P_PHIQ],
+                                     prm[P_GMIQ], prm[P_B], prm[P_C], prm[P_E], prm[P_F], prm[P_G])
 
 
 @_helper
-def control_output(t: float, p: tuple, o: tuple, prm: np.ndarray,
+def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
+                  prm: np.ndarray) -> tuple[float, float, bool]:
+    """Apply the inverter limits of :func:`control.fdsmc.inverter.limit_voltage`; return u_d, u_q, flag."""
+    return inverter.limit_voltage(u_d, u_q, i_d, i_q, omega_hat, prm[P_IMAX], prm[P_UMAX], prm[P_PHID],
+                                  prm[P_GMID], prm[P_PHIQ], prm[P_GMIQ], prm[P_B], prm[P_C], prm[P_E],
+                                  prm[P_F], prm[P_G])
+
+
+@_helper
+def measure(k: int, p: tuple, prm: np.ndarray, noise: np.ndarray) -> tuple[float, float, float]:
+    """Return what the controller reads at sample k: (θ_r [rad], i_d, i_q [A]) through :mod:`sim.common.sensors`."""
+    j = k % noise.shape[1]
+    return (sensors.encoder_angle(p[X_TH], prm[P_ENC]),
+            sensors.adc_current(p[X_ID], noise[0, j], prm[P_INOISE], prm[P_ISTEP], prm[P_IFS]),
+            sensors.adc_current(p[X_IQ], noise[1, j], prm[P_INOISE], prm[P_ISTEP], prm[P_IFS]))
+
+
+@_helper
+def control_output(t: float, y: tuple, i0: tuple, o: tuple, prm: np.ndarray,
                    ref: np.ndarray) -> tuple[float, float, float, float, float, bool]:
-    """u_d, u_q [V], α_dem, α [rad/s²], S [rad/s], saturated, from measured i and estimates."""
+    """u_d, u_q [V], α_dem, α [rad/s²], S [rad/s], limited, from the readings y and the estimates o.
+
+    ``i0`` are the currents [A] at the start of the sample the voltages will act over (the readings,
+    or their prediction over a computation delay): the current limit's starting point.
+    """
     alpha_dem, S = outer_law(t, o[0], o[1], prm, ref)
-    u_d, u_q, alpha = fdc_voltages(alpha_dem, p[X_ID], p[X_IQ], o[1], o[2], o[3], prm)
-    u_d, u_q, sat = limit_voltage(u_d, u_q, p[X_ID], p[X_IQ], o[1], prm)
+    u_d, u_q, alpha = fdc_voltages(alpha_dem, y[1], y[2], o[1], o[2], o[3], prm)
+    u_d, u_q, sat = limit_voltage(u_d, u_q, i0[0], i0[1], o[1], prm)
     return u_d, u_q, alpha_dem, alpha, S, sat
 
 
@@ -199,8 +238,9 @@ def rk4_plant(t: float, h: float, p: tuple, u_d: float, u_q: float, prm: np.ndar
 @_helper
 def full_rhs(t: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
              step_v: np.ndarray, ref: np.ndarray) -> tuple:
-    """Continuous mode: plant and observer derivatives with the controller inside."""
-    u_d, u_q, _, _, _, _ = control_output(t, p, o, prm, ref)
+    """Continuous mode: plant and observer derivatives with the controller inside (ideal sensors)."""
+    i = (p[X_ID], p[X_IQ])
+    u_d, u_q, _, _, _, _ = control_output(t, (p[X_TH], p[X_ID], p[X_IQ]), i, o, prm, ref)
     return plant_rhs(t, p, u_d, u_q, prm, step_t, step_v), observer_rhs(p, o, prm)
 
 
@@ -222,10 +262,10 @@ def _row4(M: np.ndarray, i: int, o: tuple) -> float:
 
 
 @_helper
-def observer_update(p: tuple, o: tuple, a_em: float, Phi: np.ndarray, Gam: np.ndarray,
+def observer_update(theta_m: float, o: tuple, a_em: float, Phi: np.ndarray, Gam: np.ndarray,
                     Lo: np.ndarray) -> tuple[float, float, float, float]:
-    """Discrete observer x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·(θ_r[k] − θ̂_r[k])."""
-    e_o = p[X_TH] - o[0]
+    """Discrete observer x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·(θ_r,meas[k] − θ̂_r[k])."""
+    e_o = theta_m - o[0]
     return (Gam[0] * a_em + Lo[0] * e_o + _row4(Phi, 0, o),
             Gam[1] * a_em + Lo[1] * e_o + _row4(Phi, 1, o),
             Gam[2] * a_em + Lo[2] * e_o + _row4(Phi, 2, o),
@@ -248,11 +288,22 @@ def record(row: np.ndarray, t: float, p: tuple, o: tuple, u: tuple, prm: np.ndar
 
 @_helper
 def peaks(pk: tuple, p: tuple, u_d: float, u_q: float, prm: np.ndarray) -> tuple:
-    """Return the running peaks updated with this step (|ω_r|, |i_q|, |u_dq|, |Γ_em|, |i_d|)."""
+    """Return the running peaks updated with this step (|ω_r|, |i_q|, |u_dq|, |Γ_em|, |i_d|, |i_dq|)."""
     return (max(pk[0], abs(p[X_W])), max(pk[1], abs(p[X_IQ])),
             max(pk[2], math.sqrt(u_d * u_d + u_q * u_q)),
             max(pk[3], abs(electromagnetic_torque(p[X_ID], p[X_IQ], prm))),
-            max(pk[4], abs(p[X_ID])))
+            max(pk[4], abs(p[X_ID])), max(pk[5], math.sqrt(p[X_ID] * p[X_ID] + p[X_IQ] * p[X_IQ])))
+
+
+@_helper
+def position_checks(pc: tuple, t: float, p: tuple, dt: float, prm: np.ndarray) -> tuple:
+    """Update (time over i_max [s], last time outside the in-position window [s], overshoot [rad]) at t."""
+    i_dq = math.sqrt(p[X_ID] * p[X_ID] + p[X_IQ] * p[X_IQ])
+    over = prm[P_IMAX] > 0.0 and i_dq > prm[P_IMAX]
+    err = p[X_TH] - prm[P_THDEM]
+    out = abs(err) > prm[P_INPOS]
+    return (pc[0] + (dt if over else 0.0), t if out else pc[1],
+            max(pc[2], err if prm[P_THDEM] > 0.0 else -err))
 
 
 @_helper
@@ -278,53 +329,66 @@ def store_state(info: np.ndarray, at: int, p: tuple, o: tuple, w: float, p0: tup
 
 
 @_helper
-def step_sample(t: float, p: tuple, o: tuple, hold: tuple, continuous: bool, delay: int,
-                prm: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray, ref: np.ndarray):
-    """Run the controller (and, digital, the observer update) at one sample or continuous step.
+def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: bool, delay: int,
+                prm: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray, ref: np.ndarray,
+                noise: np.ndarray):
+    """Run the controller (and, digital, the observer update) at sample k or one continuous step.
 
     Returns (voltages applied over the step, new observer state, new held voltages, the
-    recorded outputs (u_d, u_q, α_dem, α̂, S), saturated flag).
+    recorded outputs (u_d, u_q, α_dem, α̂, S), limited flag). Digital: the controller reads the
+    sensors (:func:`measure`); with a computation delay the current limit starts from the
+    currents predicted at the end of the held voltages' sample.
     """
-    u_d, u_q, a_dem, a_hat, S, sat = control_output(t, p, o, prm, ref)
     if continuous:
+        y = (p[X_TH], p[X_ID], p[X_IQ])
+        u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, (y[1], y[2]), o, prm, ref)
         return (u_d, u_q), o, hold, (u_d, u_q, a_dem, a_hat, S), sat
+    y = measure(k, p, prm, noise)
+    i0 = predict_currents(y[1], y[2], o[1], hold, prm) if delay == 1 else (y[1], y[2])
+    u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, i0, o, prm, ref)
     if delay == 1:
         hold, (u_d, u_q) = (u_d, u_q), hold
-    a_em = (prm[P_H] + prm[P_K] * p[X_ID]) * p[X_IQ]
-    return (u_d, u_q), observer_update(p, o, a_em, Phi, Gam, Lo), hold, (u_d, u_q, a_dem, a_hat, S), sat
+    a_em = (prm[P_H] + prm[P_K] * y[1]) * y[2]
+    return (u_d, u_q), observer_update(y[0], o, a_em, Phi, Gam, Lo), hold, (u_d, u_q, a_dem, a_hat, S), sat
 
 
-@njit(cache=True, nogil=True, error_model="numpy", fastmath=_FM)
+@njit(cache=True, nogil=True, error_model="numpy")
 def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray,
                Gam: np.ndarray, Lo: np.ndarray, continuous: bool, h: float, n_steps: int,
                n_sub: int, delay: int, decim: int, out: np.ndarray, info: np.ndarray,
-               k_win: np.ndarray, win: np.ndarray, ref: np.ndarray) -> None:
+               k_win: np.ndarray, win: np.ndarray, ref: np.ndarray, noise: np.ndarray) -> None:
     """Integrate one run from rest; fills ``out`` (N_CH × samples) and ``info`` (I_* indices).
 
     ``ref`` (3 × n: θ_ref, ω_ref, α_ref on equally spaced nodes over [0, T_m]) is read only by the
     reference-tracking outer law (``prm[P_CTRL]`` = 2); pass a 3 × 2 array of zeros otherwise.
 
-    For each window j, rows 2j and 2j + 1 of ``win`` receive α_dem and ω_r of every step
-    k_win[j] … k_win[j] + n − 1 at full resolution (the chatter test's windows, independent of
-    the trace decimation).
+    For each window j, rows WIN_ROWS·j … WIN_ROWS·j + 3 of ``win`` receive α_dem, ω_r, i_q and the
+    applied u_q of every step k_win[j] … k_win[j] + n − 1 at full resolution (the chatter and
+    standstill-ripple windows, independent of the trace decimation). ``noise`` is the sensors'
+    standard-normal table (:func:`sim.common.sensors.noise_table`).
 
     Digital mode: ``n_steps`` samples of period n_sub·h; controller and observer at each
     sample, voltages held (one sample later if ``delay``), n_sub RK4 substeps in between.
     Continuous mode: ``n_steps`` RK4 steps of size h with the controller inside the RHS.
     """
     p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    o, hold, pk = (0.0, 0.0, 0.0, 0.0), (0.0, 0.0), (0.0, 0.0, 0.0, 0.0, 0.0)
+    o, hold, pk = (0.0, 0.0, 0.0, 0.0), (0.0, 0.0), (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    pc = (0.0, -1.0, 0.0)
     n_out, t, t_sat, T_m, hit = 0, 0.0, 0.0, prm[P_TM], False
     info[:] = 0.0
     for k in range(n_steps):
-        u, o_next, hold, rec, sat = step_sample(t, p, o, hold, continuous, delay, prm, Phi, Gam, Lo, ref)
+        u, o_next, hold, rec, sat = step_sample(k, t, p, o, hold, continuous, delay, prm, Phi, Gam, Lo, ref,
+                                                noise)
         if k % decim == 0 and n_out < out.shape[1]:
             record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
             n_out += 1
         for j in range(k_win.size):
-            if 0 <= k - k_win[j] < win.shape[1]:
-                win[2 * j, k - k_win[j]], win[2 * j + 1, k - k_win[j]] = rec[2], p[X_W]
+            i = k - k_win[j]
+            if 0 <= i < win.shape[1]:
+                r = WIN_ROWS * j
+                win[r, i], win[r + 1, i], win[r + 2, i], win[r + 3, i] = rec[2], p[X_W], p[X_IQ], u[1]
         pk = peaks(pk, p, u[0], u[1], prm)
+        pc = position_checks(pc, t, p, h * n_sub, prm)
         t_sat += h * n_sub if sat else 0.0
         p0, o, t0 = p, o_next, t
         for _ in range(n_sub):
@@ -340,5 +404,9 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
             info[I_FAILED], info[I_TFAIL] = 1.0, t
             break
     info[I_NOUT], info[I_TSAT], info[I_TM_HIT] = n_out, t_sat, 1.0 if hit else 0.0
-    info[I_PW], info[I_PIQ], info[I_PU], info[I_PTQ], info[I_PID] = pk
+    pc = position_checks(pc, t, p, 0.0, prm)  # the final state counts too: outside at the end → inf
+    if pc[1] == t:
+        pc = (pc[0], math.inf, pc[2])
+    info[I_PW], info[I_PIQ], info[I_PU], info[I_PTQ], info[I_PID], info[I_PIDQ] = pk
+    info[I_TOVER], info[I_TOUT], info[I_OVS] = pc
     store_state(info, I_END, p, o, 1.0, p)

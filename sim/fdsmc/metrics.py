@@ -14,6 +14,7 @@ K or of a poorly damped sloped segment — not a single transient.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,12 +36,17 @@ CHATTER_MAX_WINDOW_S = 0.25
 
 @dataclass(frozen=True)
 class WindowSamples:
-    """Full-resolution samples of one chatter window (t0, t1) [s]: t [s], α_dem [rad/s²], ω_r [rad/s]."""
+    """Full-resolution samples of one window (t0, t1) [s].
+
+    t [s], α_dem [rad/s²], ω_r [rad/s], i_q [A] (true), u_q [V] (applied).
+    """
 
     window: tuple[float, float]
     t: np.ndarray
     alpha_dem: np.ndarray
     omega_r: np.ndarray
+    i_q: np.ndarray
+    u_q: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -123,9 +129,18 @@ class RunMetrics:
     t_2pct_first_s, t_2pct_settle_s : float or None
         First entry into, and settling in, the 2 % band around θ_dem [s].
     theta_error_at_Tm_rad, overshoot_rad, theta_dem_rad : float or None
-        θ_r(T_m) − θ_dem, overshoot beyond θ_dem, the demand [rad].
+        θ_r(T_m) − θ_dem, overshoot beyond θ_dem (at every sample), the demand [rad].
     omega_peak_rad_s, i_q_peak_A, i_d_peak_A, u_peak_V, torque_peak_Nm : float or None
         Peaks of |ω_r| [rad/s], |i_q|, |i_d| [A], |u_dq| [V], |Γ| [N·m].
+    i_peak_A : float or None
+        Peak of the true current vector |i_dq| [A].
+    over_i_max_s : float or None
+        Time the true |i_dq| exceeded the hard current limit min(i_max, Γ_max/K_t) [s] (0 without one).
+    hold_i_q_rms_A, hold_u_q_ptp_V : float or None
+        While holding θ_dem (the ``hold`` window): rms ripple of i_q about its mean [A] and the
+        peak-to-peak of the applied u_q [V].
+    in_position_s : float or None
+        First time θ_r is inside the in-position window for good [s]; None if it ends outside.
     saturated_s : float
         Time the inverter limited the voltage or current [s].
     chatter : bool
@@ -168,6 +183,11 @@ class RunMetrics:
     i_d_peak_A: float | None
     u_peak_V: float | None
     torque_peak_Nm: float | None
+    i_peak_A: float | None
+    over_i_max_s: float | None
+    hold_i_q_rms_A: float | None
+    hold_u_q_ptp_V: float | None
+    in_position_s: float | None
     saturated_s: float
     chatter: bool
     chatter_phase: str | None
@@ -196,8 +216,31 @@ def response_metrics(
         "t_2pct_first_s": signals.first_entry_time(t, theta_r, theta_dem, band),
         "t_2pct_settle_s": signals.settling_time(t, theta_r, theta_dem, band),
         "theta_error_at_Tm_rad": theta_at_Tm - theta_dem,
-        "overshoot_rad": signals.overshoot(theta_r, 0.0, theta_dem),
     }
+
+
+def kernel_checks(info: np.ndarray, T_step: float) -> dict[str, float | None]:
+    """Return the current, in-position and overshoot figures the kernel tracks at every sample (RunMetrics fields).
+
+    Parameters
+    ----------
+    info : numpy.ndarray  The kernel's summary (``I_*`` of :mod:`sim.fdsmc.kernel`).
+    T_step : float        Sample period (integration step in continuous mode) [s].
+    """
+    t_out = float(info[kn.I_TOUT])
+    return {
+        "i_peak_A": float(info[kn.I_PIDQ]),
+        "over_i_max_s": float(info[kn.I_TOVER]),
+        "overshoot_rad": float(info[kn.I_OVS]),
+        "in_position_s": None if math.isinf(t_out) else (0.0 if t_out < 0.0 else t_out + T_step),
+    }
+
+
+def hold_ripple(s: WindowSamples) -> dict[str, float | None]:
+    """Standstill ripple in the ``hold`` window: rms of i_q about its mean [A], peak-to-peak of u_q [V]."""
+    if s.i_q.size < 2:
+        return {"hold_i_q_rms_A": None, "hold_u_q_ptp_V": None}
+    return {"hold_i_q_rms_A": float(np.std(s.i_q)), "hold_u_q_ptp_V": float(np.ptp(s.u_q))}
 
 
 def energy_metrics(params: DriveParams, info: np.ndarray) -> dict[str, float]:
@@ -281,12 +324,13 @@ def chatter_window_steps(window: tuple[float, float], T_step: float, n_steps: in
 
 def run_metrics(
     params: DriveParams, d: Derived, controller: str, t: np.ndarray, theta_r: np.ndarray,
-    samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None,
+    samples: dict[str, WindowSamples], info: np.ndarray, plant: DriveParams | None = None, *,
+    T_step: float,
 ) -> RunMetrics:
     """Return all metrics of one run.
 
     They come from the (decimated) trace, the full-resolution chatter-window ``samples`` and the kernel's
-    ``info`` vector.
+    ``info`` vector; ``T_step`` [s] is the sample period (the in-position time's resolution).
 
     Energies without suffix are over [0, T_m], ``_total`` over the whole run. For a diverged run
     every number becomes None, ``stable`` False and ``reason`` says why. Stored energies use the
@@ -301,7 +345,7 @@ def run_metrics(
     phase = None if failed else next((name for name, v in verdicts.items() if v.chatter), None)
     cv = verdicts[phase or "cruise"]
     figures: dict[str, float | None] = {
-        **energies, **resp,
+        **energies, **resp, **kernel_checks(info, T_step), **hold_ripple(samples["hold"]),
         "omega_peak_rad_s": float(info[kn.I_PW]),
         "i_q_peak_A": float(info[kn.I_PIQ]),
         "i_d_peak_A": float(info[kn.I_PID]),

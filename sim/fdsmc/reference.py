@@ -18,9 +18,11 @@ import numpy as np
 from control.fdsmc import fdc
 from control.fdsmc.conventional import conventional_law
 from control.fdsmc.derivations import Derived
-from control.fdsmc.inverter import limit_voltage
+from control.fdsmc.feasibility import current_limit
+from control.fdsmc.inverter import decay_factors, limit_voltage, predict_currents
 from control.fdsmc.params import DriveParams
 from control.fdsmc.sliding_mode import smc_law
+from sim.common import sensors
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,13 @@ class ReferenceDrive:
         self.x = np.zeros(7)
         self.xh = np.zeros(4)
         self.t = 0.0
+        self.k = 0  # sample number: the index into the sensors' noise table
         self.u_hold = (0.0, 0.0)
+        se = params.sensors
+        self.noise = sensors.noise_table(se)
+        self.enc_step, self.adc_step = sensors.encoder_step(se), sensors.adc_step(se)
+        T = d.observer_discrete.T_s if d.observer_discrete is not None else 0.0
+        self.decay = decay_factors(self.c.A, T) + decay_factors(self.c.D, T)  # (φ_d, γ_d, φ_q, γ_q)
 
     def gamma_le(self, t: float) -> float:
         """External load torque Γ_Le(t) [N·m]."""
@@ -71,10 +79,22 @@ class ReferenceDrive:
                 g = s.Gamma_Le
         return g + ld.Gamma_Le_ramp * t
 
-    def voltages(self, x: np.ndarray, xh: np.ndarray) -> tuple[float, float]:
-        """u_d, u_q [V] of eqs. (9), (14) with the outer law, from i_d, i_q and the estimates."""
+    def measure(self, x: np.ndarray) -> tuple[float, float, float]:
+        """Return the readings (θ_r [rad], i_d, i_q [A]) of the sensors at the current sample."""
+        se, j = self.p.sensors, self.k % self.noise.shape[1]
+        adc = [sensors.adc_current(x[i], self.noise[i, j], se.i_noise, self.adc_step, se.i_adc_range)
+               for i in (0, 1)]
+        return sensors.encoder_angle(x[2], self.enc_step), adc[0], adc[1]
+
+    def voltages(self, y: tuple[float, float, float], xh: np.ndarray,
+                 i0: tuple[float, float] | None = None) -> tuple[float, float]:
+        """u_d, u_q [V] of eqs. (9), (14) with the outer law and the inverter limits.
+
+        ``y`` are the readings (θ_r, i_d, i_q); ``i0`` the currents the limit starts from (default
+        the readings).
+        """
         d, c, ctrl = self.d, self.c, self.p.controller
-        i_d, i_q = x[0], x[1]
+        i_d, i_q = y[1], y[2]
         th_h, w_h, L0, L1 = xh
         th_dem = self.p.manoeuvre.theta_dem
         if self.controller == "fdsmc":
@@ -86,7 +106,9 @@ class ReferenceDrive:
         u_d = fdc.direct_axis_voltage(i_d, i_q, w_h, c, ctrl.T_si)
         u_q = fdc.quadrature_axis_voltage(a_dem, alpha, i_d, i_q, w_h, u_d, L1, c, ctrl.T_salpha)
         u_max = ctrl.V_dc / math.sqrt(3.0)
-        u_d, u_q, _ = limit_voltage(u_d, u_q, i_d, i_q, w_h, ctrl.i_max, u_max, c.C, c.D, c.E, c.G)
+        i0 = (i_d, i_q) if i0 is None else i0
+        u_d, u_q, _ = limit_voltage(u_d, u_q, i0[0], i0[1], w_h, current_limit(self.p), u_max, *self.decay,
+                                    c.B, c.C, c.E, c.F, c.G)
         return u_d, u_q
 
     def plant(self, t: float, x: np.ndarray, u_d: float, u_q: float) -> np.ndarray:
@@ -114,11 +136,12 @@ class ReferenceDrive:
 
     def _continuous_rhs(self, t: float, z: np.ndarray) -> np.ndarray:
         x, xh = z[:7], z[7:]
-        u_d, u_q = self.voltages(x, xh)
+        u_d, u_q = self.voltages((x[2], x[0], x[1]), xh)
         return np.concatenate([self.plant(t, x, u_d, u_q), self.observer(x, xh)])
 
     def step_continuous(self, h: float) -> None:
         """One RK4 step [s] with the controller evaluated inside the right-hand side."""
+        self.decay = decay_factors(self.c.A, h) + decay_factors(self.c.D, h)  # the limit predicts over h
         z, t = np.concatenate([self.x, self.xh]), self.t
         k1 = self._continuous_rhs(t, z)
         k2 = self._continuous_rhs(t + h / 2, z + h / 2 * k1)
@@ -131,11 +154,16 @@ class ReferenceDrive:
         """One controller sample: control, observer update, n_sub RK4 substeps with held u."""
         od = self.d.observer_discrete
         assert od is not None
-        u = self.voltages(self.x, self.xh)
+        y, c = self.measure(self.x), self.c
+        i0 = None
+        if self.p.controller.delay_samples == 1:  # the limit starts where the held voltages leave the currents
+            i0 = predict_currents(y[1], y[2], self.xh[1], *self.u_hold, *self.decay, c.B, c.C, c.E, c.F, c.G)
+        u = self.voltages(y, self.xh, i0)
         if self.p.controller.delay_samples == 1:
             u, self.u_hold = self.u_hold, u
-        a_em = (self.c.H + self.c.K * self.x[0]) * self.x[1]
-        e_o = self.x[2] - self.xh[0]
+        a_em = (c.H + c.K * y[1]) * y[2]
+        e_o = y[0] - self.xh[0]
+        self.k += 1
         self.xh = od.Phi @ self.xh + od.Gamma * a_em + od.L * e_o
         h = od.T_s / n_sub
         for _ in range(n_sub):

@@ -10,8 +10,9 @@ from __future__ import annotations
 import math
 
 from control.fdsmc.derivations import Derived
+from control.fdsmc.feasibility import current_limit, exceeds, speed_limit, torque_limit, voltage_limit
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
-from control.fdsmc.model import available_voltage
+from sim.fdsmc.checks import TARGET_BAND, run_checks
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
 
 
@@ -58,7 +59,11 @@ def _chatter(run: RunResult, derived: Derived) -> str:
 
 
 def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
-    """List the simulated peaks that the real drive cannot deliver (Γ_max, available voltage, ω_b).
+    """List the simulated peaks that the real drive cannot deliver: torque, current, voltage, speed.
+
+    The limits are the drive's: :func:`~control.fdsmc.feasibility.torque_limit` (Γ_max, or K_t·i_max),
+    the hard current limit, the inverter's voltage (V_dc/√3, else √(2/3)·V_0) and the speed limit
+    (limits.omega_max, else ω_b).
 
     Parameters
     ----------
@@ -72,26 +77,23 @@ def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
     list of str
         One message per limit exceeded.
     """
-    m, motor, name = run.metrics, derived.params.motor, LABELS[run.controller]
-    out: list[str] = []
-    torque, volts, speed = m.torque_peak_Nm, m.u_peak_V, m.omega_peak_rad_s
-    u_avail = available_voltage(motor)
-    if torque is not None and torque > motor.Gamma_max:
-        out.append(f"Not feasible on the real drive ({name}): peak torque {torque:.4g} N·m > "
-                   f"Γ_max = {motor.Gamma_max:g} N·m.")
-    if volts is not None and volts > u_avail:
-        out.append(f"Not feasible on the real drive ({name}): peak |u_dq| {volts:.4g} V > "
-                   f"{u_avail:.4g} V available (√(2/3)·V_0).")
-    if speed is not None and speed > motor.omega_b:
-        out.append(f"Not feasible on the real drive ({name}): peak speed {speed:.4g} rad/s > "
-                   f"ω_b = {motor.omega_b:g} rad/s.")
-    return out
+    m, p, name = run.metrics, derived.params, LABELS[run.controller]
+    t_lim, i_lim, u_lim, w_lim = torque_limit(p), current_limit(p), voltage_limit(p), speed_limit(p)
+    t_name = "Γ_max" if t_lim == p.motor.Gamma_max else "K_t·i_max"
+    checks = [("peak torque", m.torque_peak_Nm, "N·m", f"{t_name} = {t_lim:.4g} N·m", t_lim),
+              ("peak |u_dq|", m.u_peak_V, "V", f"{u_lim:.4g} V available", u_lim),
+              ("peak speed", m.omega_peak_rad_s, "rad/s", f"the speed limit {w_lim:g} rad/s", w_lim)]
+    if i_lim > 0.0:
+        checks.append(("peak |i_dq|", m.i_peak_A, "A", f"the current limit {i_lim:.4g} A", i_lim))
+    return [f"Not feasible on the real drive ({name}): {what} {v:.4g} {unit} > {text}."
+            for what, v, unit, text, lim in checks if v is not None and exceeds(v, lim)]
 
 
-#: Position error at T_m, as a fraction of |θ_dem|, beyond which a run is said to miss T_m [-]:
-#: the FDSMC is designed to arrive by T_m (2 % band); the comparator's Dodds formula (eq. 61)
-#: leaves 2.44 % by design, so it is flagged only beyond 5 %.
-TARGET_BAND = {"fdsmc": 0.02, "conventional": 0.05}
+def criteria_warnings(run: RunResult, derived: Derived) -> list[str]:
+    """List the user's pass criteria the run fails: in-position window, overshoot, standstill ripple, i_max."""
+    names = {"in_position", "overshoot", "hold_ripple", "current_time"}
+    return [f"Criterion ({LABELS[run.controller]}): {c.text}" for c in run_checks(derived.params, run)
+            if c.name in names]
 
 
 def _target_missed(run: RunResult) -> str | None:
@@ -127,6 +129,7 @@ def run_warnings(comparison: Comparison) -> list[str]:
             out.append(miss)
         if run.controller == "fdsmc":
             out += _saturation(run) + limit_warnings(run, comparison.derived)
+            out += criteria_warnings(run, comparison.derived)
     return out + _saving_verdicts(comparison)
 
 

@@ -24,7 +24,7 @@ SEG_X = kn.N_X
 def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, ref_off: np.ndarray,
               step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray,
               continuous: bool, h: float, n_sub: int, delay: int, decim: int, out: np.ndarray,
-              seg_info: np.ndarray) -> int:
+              seg_info: np.ndarray, noise: np.ndarray) -> int:
     """Integrate the whole cycle from rest.
 
     Returns the number of trace points written to ``out`` (N_CH × points, every ``decim``-th
@@ -33,6 +33,7 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
     Segment j lasts ``seg_steps[j]`` samples (digital; RK4 steps in continuous mode) with the
     parameters ``prm_all[j]`` and the reference ``ref_all[:, ref_off[j]:ref_off[j + 1]]``.
     ``seg_info[j]`` receives the kernel state (``X_*`` of :mod:`sim.fdsmc.kernel`) at its end.
+    ``noise`` is the sensors' table (:func:`sim.common.sensors.noise_table`), read by sample number.
     """
     p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     o, hold = (0.0, 0.0, 0.0, 0.0), (0.0, 0.0)
@@ -42,8 +43,8 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
         ref = ref_all[:, ref_off[j]: ref_off[j + 1]]
         t_start = t
         for _ in range(seg_steps[j]):
-            u, o_next, hold, rec, sat = kn.step_sample(t - t_start, p, o, hold, continuous, delay, prm,
-                                                       Phi, Gam, Lo, ref)
+            u, o_next, hold, rec, sat = kn.step_sample(k_all, t - t_start, p, o, hold, continuous, delay, prm,
+                                                       Phi, Gam, Lo, ref, noise)
             if k_all % decim == 0 and n_out < out.shape[1]:
                 kn.record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
                 n_out += 1

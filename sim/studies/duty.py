@@ -24,6 +24,7 @@ import numpy as np
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.params import DriveParams
+from sim.common import sensors
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.engine import pack_parameters
 from sim.fdsmc.grid import continuous_step, plant_substeps
@@ -173,7 +174,7 @@ def cycle_run(params: DriveParams, moves: Sequence[Move], controller: str) -> Cy
     out = np.zeros((kn.N_CH, total // decim + 1))
     seg = np.zeros((len(moves), kn.N_X))
     n = run_cycle(prm_all, steps, ref_all, off, step_t, step_v, Phi, Gam, Lo, continuous, h, sub,
-                  params.controller.delay_samples, decim, out, seg)
+                  params.controller.delay_samples, decim, out, seg, sensors.noise_table(params.sensors))
     chans = {name: out[kn.CHANNELS.index(name), : abs(n) - (1 if n < 0 else 0)]
              for name in ("t", "theta_r", "omega_r", "E_electrical")}
     if n < 0:

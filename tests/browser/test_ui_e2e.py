@@ -96,6 +96,12 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
     _wait_phase_omega_p(page, derive(uploaded).profile.omega_p)
     assert field(page, "T_m manoeuvre time [s]").input_value() == "1.8"
     page.get_by_text("Export", exact=True).click()
+    downloads: list[object] = []
+    page.on("download", lambda d: downloads.append(d))
+    page.get_by_role("button", name="Drive parameters (YAML)").click()  # the paper's K = 1000 is not clean
+    page.get_by_text(re.compile(r"export --format yaml refused: .*chatter")).wait_for(timeout=10000)
+    assert downloads == []
+    page.get_by_label("Export even if not clean").check()
     name, exported = _download(page, "Drive parameters (YAML)")
     assert name == "imported_case.yaml" and loads_preset(exported.decode(), "export.yaml") == uploaded
     name, archive = _download(page, "C controller module (.h + .c, zip)")

@@ -1,0 +1,63 @@
+"""``python -m app import-drive FILE --format odrive|moteus|vesc --base PRESET -o preset.yaml``.
+
+Reads a stock drive's own file (ODrive backup JSON, moteus configuration dump, VESC mcconf XML) and
+writes a preset: the base preset with the file's motor data (:func:`app.exports.drive_import.import_drive`).
+Every key of the file that is not imported is listed (on the terminal and in the preset's header
+comment). The preset is written whole (a temporary file, then ``os.replace``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from pathlib import Path
+
+from app.cli.export import write_atomic
+from app.cli.main import check_writable
+from app.exports.drive_import import IMPORT_FORMATS, import_drive
+from app.io.preset_modes import load_mode_preset
+from app.io.presets import MAX_BYTES, dumps, to_raw
+from control.common.checks import ParameterError
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``import-drive``."""
+    p.add_argument("file", metavar="FILE", help="the drive's file: ODrive backup JSON, moteus config dump, VESC XML")
+    p.add_argument("--format", choices=IMPORT_FORMATS, required=True, help="the file's format")
+    p.add_argument("--base", metavar="PRESET", required=True,
+                   help="preset giving everything the file does not (nameplate, load, controller, move)")
+    p.add_argument("-o", "--output", metavar="FILE", required=True, help="preset file to write (YAML)")
+    p.add_argument("--name", help="name of the new preset (default: the file's stem)")
+
+
+def read_text(path: str) -> str:
+    """Return the file's UTF-8 text; a one-line error naming the file when it cannot be read."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise ParameterError(f"FILE {path!r} cannot be read: {exc.strerror or exc}") from None
+    if len(data) > MAX_BYTES:
+        raise ParameterError(f"FILE {path!r} is {len(data) // 1024} KiB: allowed ≤ {MAX_BYTES // 1024} KiB")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ParameterError(f"FILE {path!r} is not UTF-8 text: allowed a text file") from None
+
+
+def run(args: argparse.Namespace) -> int:
+    """Import, write the preset, list what was imported, kept and not imported."""
+    check_writable(args.output, "-o")
+    base = load_mode_preset(args.base, (), mode="position")
+    result = import_drive(read_text(args.file), args.format, base, args.file)
+    name = args.name or Path(args.file).stem
+    params = dataclasses.replace(result.params, name=name,
+                                 source=f"motor data imported from {args.format} file {Path(args.file).name} "
+                                        f"onto preset {base.name}")
+    notes = ([f"imported: {x}" for x in result.imported] + [f"kept from {base.name}: {x}" for x in result.kept]
+             + [f"not imported ({len(result.not_imported)} keys): " + ", ".join(result.not_imported)])
+    head = "".join(f"# {line}\n" for line in [f"python -m app import-drive {args.file} --format {args.format} "
+                                              f"--base {args.base}"] + notes)
+    write_atomic(Path(args.output), (head + dumps(to_raw(params))).encode("utf-8"))
+    sys.stdout.write("\n".join(notes) + f"\nwrote {args.output}\n")
+    return 0

@@ -1,0 +1,113 @@
+"""mjbots moteus: the ``key value`` configuration ``moteus_tool --restore-config`` loads, and its strict parser.
+
+A moteus configuration dump (``conf enumerate``, ``moteus_tool --dump-config``) is one ``key value``
+per line; ``--restore-config`` sends every non-empty line as ``conf set key value``. The keys and
+units are those of moteus' ``docs/reference.md`` (configurable parameters) and the firmware's
+``fw/bldc_servo_structs.h``: the position PID in N·m per output revolution (kp), N·m/s per
+revolution (ki), N·m per revolution/s (kd); the trajectory limits in rev/s and rev/s² at the
+output, after ``motor_position.rotor_to_output_ratio`` (written as 1: this tool's load is referred
+to the rotor); ``motor.poles`` counts poles, not pole pairs; ``servo.inertia_feedforward`` in kg·m².
+
+moteus runs a parallel PID, not a cascade: kp = g1·J, kd = g2·J with the inertia feed-forward is
+exactly the tracking law the "stock" comparator simulates; ki and its clamp ``ilimit`` are the
+documented integrator choice of :mod:`control.fdsmc.trapezoid` (not simulated).
+
+The header is written as ``#`` lines, which moteus_tool would send as commands: strip them first
+(``grep -v '^#' FILE > restore.cfg``, see docs/drives/moteus.md). :func:`parse_moteus` accepts them.
+"""
+
+from __future__ import annotations
+
+import re
+
+from app.exports.drive_units import (
+    per_rad_to_per_turn,
+    pole_pairs_to_poles,
+    poles_to_pole_pairs,
+    psi_from_kv,
+    rad_to_turn,
+    torque_constant,
+)
+from app.exports.stock import StockSettings
+from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from control.common.checks import ParameterError
+
+_REF = "moteus docs/reference.md, configurable parameters"
+_FW = "moteus fw/bldc_servo_structs.h"
+#: Every key written, with its moteus type and unit.
+KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
+    VendorKey("motor.poles", "int", "-", f"{_FW}: BldcServoMotor::poles (uint8, poles)"),
+    VendorKey("motor.resistance_ohm", "float", "Ohm", f"{_FW}: BldcServoMotor::resistance_ohm"),
+    VendorKey("servo.max_current_A", "float", "A", f"{_REF}: servo.max_current_A (phase current)"),
+    VendorKey("servo.pid_position.kp", "float", "Nm/rev", f"{_REF}: servo.pid_position kp, Nm per rotation"),
+    VendorKey("servo.pid_position.ki", "float", "Nm/s/rev", f"{_REF}: servo.pid_position ki, Nm/s per rotation"),
+    VendorKey("servo.pid_position.kd", "float", "Nm/(rev/s)", f"{_REF}: servo.pid_position kd, Nm per rotation/s"),
+    VendorKey("servo.pid_position.ilimit", "float", "Nm", f"{_REF}: servo.pid_position ilimit, Nm"),
+    VendorKey("servo.default_velocity_limit", "float", "rev/s", f"{_REF}: servo.default_velocity_limit", True),
+    VendorKey("servo.default_accel_limit", "float", "rev/s^2", f"{_REF}: servo.default_accel_limit", True),
+    VendorKey("servo.inertia_feedforward", "float", "kg*m^2", f"{_REF}: servo.inertia_feedforward"),
+    VendorKey("motor_position.rotor_to_output_ratio", "float", "-", f"{_REF}: motor_position.rotor_to_output_ratio"),
+)}
+#: Keys only read on import (written by moteus' own calibration): Kv and the dq inductances.
+READ_KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
+    VendorKey("motor.Kv", "float", "rpm/V", f"{_FW}: BldcServoMotor::Kv"),
+    VendorKey("motor.inductance_d_H", "float", "H", f"{_FW}: BldcServoMotor::inductance_d_H"),
+    VendorKey("motor.inductance_q_H", "float", "H", f"{_FW}: BldcServoMotor::inductance_q_H"),
+)}
+#: The integrator clamp as a fraction of the torque limit [-] (documented choice).
+ILIMIT_FRACTION = 0.1
+_LINE = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*) (\S+)$")
+
+
+def moteus_values(s: StockSettings) -> dict[str, float]:
+    """Every written key → value in moteus' units (the one conversion from SI)."""
+    g, tr = s.gains, s.trapezoid
+    torque_lim = torque_constant(s.psi_pm, s.p) * s.current_limit
+    values = [pole_pairs_to_poles(s.p), s.R_s, s.current_limit, per_rad_to_per_turn(g.kp),
+              per_rad_to_per_turn(g.ki), per_rad_to_per_turn(g.kd), ILIMIT_FRACTION * torque_lim,
+              rad_to_turn(abs(tr.omega_c)), rad_to_turn(tr.alpha), g.inertia, 1.0]
+    return dict(zip(KEYS, values, strict=True))
+
+
+def moteus_text(s: StockSettings, header: list[str]) -> str:
+    """Return the configuration text: ``# `` header lines, then one ``key value`` per line."""
+    lines = [f"# {h}" for h in header]
+    lines.append("# moteus: grep -v '^#' THIS_FILE > restore.cfg && moteus_tool -t 1 --restore-config restore.cfg")
+    for key, v in moteus_values(s).items():
+        lines.append(f"{key} {int(v) if KEYS[key].kind != 'float' else fmt_float(v)}")
+    return "\n".join(lines) + "\n"
+
+
+def parse_moteus(text: str) -> VendorFile:
+    """Strict parser of a moteus configuration dump: ``key value`` lines, ``#`` comments, nothing else.
+
+    Raises
+    ------
+    ParameterError
+        Naming the line for anything but ``key value``, a duplicated key or a known key of the wrong type.
+    """
+    pairs, comment = [], []
+    for n, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            comment.append(stripped.lstrip("#").strip())
+            continue
+        m = _LINE.match(stripped)
+        if m is None:
+            raise ParameterError(f"moteus line {n} = {stripped[:60]!r} is not allowed: 'key value' (one space)")
+        raw = m.group(2)
+        pairs.append((m.group(1), raw.lower() if raw.lower() == "nan" else raw))
+    return vendor_file(pairs, {**KEYS, **READ_KEYS}, comment)
+
+
+def moteus_motor(f: VendorFile) -> tuple[float, float | None, float | None, float | None, int, float]:
+    """R_s [Ω], L_d, L_q [H] (None if absent), Ψ_PM [Wb] (None without Kv), p [-], i_max [A]."""
+    p = poles_to_pole_pairs(f.require("motor.poles", "the pole count"), "motor.poles")
+    kv = f.get("motor.Kv")
+    if kv is not None and not kv > 0.0:
+        raise ParameterError(f"motor.Kv = {kv!r} rpm/V is not allowed: allowed > 0 rpm/V (a calibrated motor)")
+    psi = psi_from_kv(kv, p) if kv is not None else None
+    return (f.require("motor.resistance_ohm", "the phase resistance [Ohm]"), f.get("motor.inductance_d_H"),
+            f.get("motor.inductance_q_H"), psi, p, f.require("servo.max_current_A", "the current limit [A]"))

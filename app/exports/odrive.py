@@ -1,0 +1,133 @@
+"""ODrive (firmware 0.5.x): the backup JSON ``odrivetool restore-config FILE`` loads, and its strict parser.
+
+``odrivetool backup-config`` writes the device's ``config`` objects as nested JSON: every object
+that has a ``config`` child keeps its path (``{"axis0": {"motor": {"config": {...}}}}``), the leaves
+are the properties of ``odrive-interface.yaml`` (fw 0.5.x) in their declared types and units; enums
+are integers (ControlMode POSITION_CONTROL = 3, InputMode TRAP_TRAJ = 5). :func:`odrive_json` writes
+axis 0's motor constants, current limit, the P–PI cascade (pos_gain, vel_gain, vel_integrator_gain,
+inertia feed-forward, speed limit) and the trapezoidal planner's limits (turn, turn/s, turn/s²),
+with a ``_comment`` key holding the header (odrivetool reports it as "property not found" and
+restores the rest). Firmware 0.6.x moved the motor settings to ``axis0.config.motor`` and is not
+written.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+from app.exports.drive_units import per_rad_to_per_turn, psi_from_torque_constant, rad_to_turn, torque_constant
+from app.exports.stock import StockSettings
+from app.exports.vendor_keys import VendorFile, VendorKey, vendor_file
+from control.common.checks import ParameterError
+
+_IF = "odrive-interface.yaml (fw 0.5.x)"
+#: Every key written, with its ODrive type and unit (units as the interface file states them, those
+#: of the motor config from the ODrive docs' parameter reference).
+KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
+    VendorKey("axis0.motor.config.pole_pairs", "int", "-", f"{_IF}: ODrive.Motor config pole_pairs int32"),
+    VendorKey("axis0.motor.config.phase_resistance", "float", "Ohm", f"{_IF}: phase_resistance float32"),
+    VendorKey("axis0.motor.config.phase_inductance", "float", "H", f"{_IF}: phase_inductance float32"),
+    VendorKey("axis0.motor.config.torque_constant", "float", "Nm/A", f"{_IF}: torque_constant float32"),
+    VendorKey("axis0.motor.config.current_lim", "float", "A", f"{_IF}: current_lim float32"),
+    VendorKey("axis0.controller.config.control_mode", "enum", "-", f"{_IF}: ControlMode (3 = POSITION_CONTROL)"),
+    VendorKey("axis0.controller.config.input_mode", "enum", "-", f"{_IF}: InputMode (5 = TRAP_TRAJ)"),
+    VendorKey("axis0.controller.config.pos_gain", "float", "(turn/s) / turn", f"{_IF}: pos_gain"),
+    VendorKey("axis0.controller.config.vel_gain", "float", "Nm/(turn/s)", f"{_IF}: vel_gain"),
+    VendorKey("axis0.controller.config.vel_integrator_gain", "float", "Nm/(turn/s * s)", f"{_IF}: vel_integrator_gain"),
+    VendorKey("axis0.controller.config.vel_limit", "float", "turn/s", f"{_IF}: controller vel_limit"),
+    VendorKey("axis0.controller.config.inertia", "float", "Nm/(turn/s^2)", f"{_IF}: inertia"),
+    VendorKey("axis0.trap_traj.config.vel_limit", "float", "turn/s", f"{_IF}: TrapezoidalTrajectory vel_limit"),
+    VendorKey("axis0.trap_traj.config.accel_limit", "float", "turn/s^2", f"{_IF}: accel_limit"),
+    VendorKey("axis0.trap_traj.config.decel_limit", "float", "turn/s^2", f"{_IF}: decel_limit"),
+)}
+CONTROL_MODE_POSITION_CONTROL = 3
+INPUT_MODE_TRAP_TRAJ = 5
+
+
+def odrive_values(s: StockSettings) -> dict[str, float]:
+    """Every written key → value in ODrive's units (the one conversion from SI)."""
+    tr, g = s.trapezoid, s.gains
+    accel = rad_to_turn(tr.alpha)
+    values = [s.p, s.R_s, 0.5 * (s.L_d + s.L_q), torque_constant(s.psi_pm, s.p), s.current_limit,
+              CONTROL_MODE_POSITION_CONTROL, INPUT_MODE_TRAP_TRAJ, g.pos_gain, per_rad_to_per_turn(g.vel_gain),
+              per_rad_to_per_turn(g.vel_integrator_gain), rad_to_turn(s.speed_limit), per_rad_to_per_turn(g.inertia),
+              rad_to_turn(abs(tr.omega_c)), accel, accel]
+    return dict(zip(KEYS, values, strict=True))
+
+
+def _nest(flat: dict[str, Any]) -> dict[str, Any]:
+    tree: dict[str, Any] = {}
+    for key, value in flat.items():
+        node = tree
+        *path, leaf = key.split(".")
+        for part in path:
+            node = node.setdefault(part, {})
+        node[leaf] = value
+    return tree
+
+
+def odrive_json(s: StockSettings, header: list[str]) -> str:
+    """Return the backup JSON (``_comment`` first, then the ``axis0`` tree), floats to 9 significant digits."""
+    flat = {k: (int(v) if KEYS[k].kind != "float" else float(f"{v:.9g}")) for k, v in odrive_values(s).items()}
+    data = {"_comment": header + ["ODrive fw 0.5.x: odrivetool restore-config THIS_FILE (units: turn, turn/s, "
+                                  "turn/s², N·m; the motor must still be calibrated)"]}
+    data.update(_nest(flat))
+    return json.dumps(data, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+
+
+def _leaves(node: Any, prefix: str = "") -> list[tuple[str, Any]]:
+    if isinstance(node, dict):
+        out: list[tuple[str, Any]] = []
+        for k, v in node.items():
+            out += _leaves(v, f"{prefix}.{k}" if prefix else str(k))
+        return out
+    return [(prefix, node)]
+
+
+def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    keys = [k for k, _ in pairs]
+    dup = next((k for k in keys if keys.count(k) > 1), None)
+    if dup is not None:
+        raise ParameterError(f"ODrive JSON key {dup!r} is given more than once: allowed once")
+    return dict(pairs)
+
+
+def parse_odrive(text: str, origin: str = "<odrive>") -> VendorFile:
+    """Strict parser of an ODrive backup JSON (fw 0.5.x): the known keys typed, every other leaf listed.
+
+    ``Infinity``/``NaN`` (which odrivetool writes for disabled limits) are accepted only for keys
+    this tool does not use. The ``_comment`` key is the file's comment.
+
+    Raises
+    ------
+    ParameterError
+        For text that is not a JSON object, a duplicated key, or a known key of the wrong type.
+    """
+    try:
+        data = json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=lambda c: float(c))
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"{origin} is not valid JSON at line {exc.lineno}: {exc.msg}") from None
+    if not isinstance(data, dict) or "axis0" not in data:
+        raise ParameterError(f"{origin} is not an ODrive backup: allowed a JSON object with an 'axis0' object")
+    comment = data.pop("_comment", [])
+    if isinstance(comment, str):
+        comment = [comment]
+    pairs = _leaves(data)
+    for key, raw in pairs:
+        if key in KEYS and (isinstance(raw, str) or isinstance(raw, float) and not math.isfinite(raw)):
+            what = f"a finite number in {KEYS[key].unit}" if KEYS[key].kind == "float" else "an integer"
+            raise ParameterError(f"{key} = {raw!r} is not allowed: {what} (a JSON number)")
+    return vendor_file(pairs, KEYS, (str(c) for c in comment))
+
+
+def odrive_motor(f: VendorFile) -> tuple[float, float, float, int, float]:
+    """R_s [Ω], L [H], Ψ_PM [Wb], p [-], i_max [A] of a parsed backup (axis 0)."""
+    p = int(f.require("axis0.motor.config.pole_pairs", "the pole pairs"))
+    if p < 1:
+        raise ParameterError(f"axis0.motor.config.pole_pairs = {p} is not allowed: allowed ≥ 1")
+    kt = f.require("axis0.motor.config.torque_constant", "the torque constant [Nm/A]")
+    return (f.require("axis0.motor.config.phase_resistance", "the phase resistance [Ohm]"),
+            f.require("axis0.motor.config.phase_inductance", "the phase inductance [H]"),
+            psi_from_torque_constant(kt, p), p, f.require("axis0.motor.config.current_lim", "the current limit [A]"))

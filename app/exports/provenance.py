@@ -1,0 +1,107 @@
+"""What every export says about itself, and the gate every export passes.
+
+* :func:`parameter_hash`: one pure hash of the inputs (SHA-256 of the preset's canonical JSON, first
+  16 hex digits): two files with the same hash were made from the same inputs.
+* :func:`failed_checks`: the clean verdict of the simulated FDSMC run,
+  ``[c for c in run_checks(params, comparison.fdsmc) if c.violated]`` (:func:`sim.fdsmc.design.run_checks`);
+  an infeasible manoeuvre (no run) fails the ``T_m`` check.
+* :func:`gate`: refuses an export of a design that is not clean, naming the failed checks, unless
+  ``force`` (then the checks are written inside the file).
+* :func:`header_lines`: the header of the stock-drive files: preset, tool version, parameter hash,
+  verdicts and the simulated energies of FDSMC, the optimum and the stock route.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib.metadata
+import json
+from collections.abc import Sequence
+
+from app.exports.c_module import TOOL
+from app.io.json_data import to_json
+from app.io.presets import to_raw
+from control.common.checks import ParameterError
+from sim.fdsmc.design import Constraint, run_checks
+from sim.fdsmc.engine import Comparison, RunResult
+
+
+class ExportRefusedError(ParameterError):
+    """An export of a design that is not clean (``--force`` writes it with the warnings inside)."""
+
+
+def tool_version() -> str:
+    """Return ``"<tool> <version>"`` (the installed package's version, else ``unknown``)."""
+    try:
+        version = importlib.metadata.version("pmsm-commissioning")
+    except importlib.metadata.PackageNotFoundError:
+        version = "unknown"
+    return f"{TOOL} {version}"
+
+
+def parameter_hash(params: object) -> str:
+    """Return the first 16 hex digits of SHA-256 over the inputs' canonical JSON (sorted keys, SI values)."""
+    text = json.dumps(to_json(to_raw(params)), sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()[:16]
+
+
+def failed_checks(cmp: Comparison) -> list[Constraint]:
+    """Return the violated checks of the simulated FDSMC run (empty: the design is clean)."""
+    params = cmp.derived.params
+    if cmp.fdsmc is None:
+        pr = cmp.derived.profile
+        return [Constraint("T_m", params.manoeuvre.T_m, pr.T_m_min, "s", True,
+                           f"The manoeuvre is infeasible: T_m = {params.manoeuvre.T_m:g} s < "
+                           f"T_m,min = {pr.T_m_min:.4g} s, nothing was simulated.")]
+    return [c for c in run_checks(params, cmp.fdsmc) if c.violated]
+
+
+def check_text(c: Constraint) -> str:
+    """One line naming a failed check: ``name: value unit (limit …) — text``."""
+    return f"{c.name}: {c.value:.4g} {c.unit} (limit {c.limit:.4g} {c.unit}) — {c.text.rstrip('.')}"
+
+
+def gate(fmt: str, cmp: Comparison, force: bool) -> list[Constraint]:
+    """Return the failed checks; raise :class:`ExportRefusedError` naming them unless ``force``."""
+    failed = failed_checks(cmp)
+    if failed and not force:
+        names = "; ".join(check_text(c) for c in failed)
+        raise ExportRefusedError(f"export --format {fmt} refused: the design of {cmp.derived.params.name!r} is not "
+                                 f"clean — {names}. Fix the design (python -m app design …) or export with "
+                                 "--force to write it with these warnings inside")
+    return failed
+
+
+def verdict_lines(failed: Sequence[Constraint]) -> list[str]:
+    """Return the verdict as text lines: clean, or NOT CLEAN (forced) and each failed check."""
+    if not failed:
+        return ["verdict: clean (simulated FDSMC run within the drive's limits, on time, no chatter)"]
+    return ["verdict: NOT CLEAN — written with --force; failed checks:"] + [f"  {check_text(c)}" for c in failed]
+
+
+def _energy(run: RunResult | None) -> str:
+    if run is None:
+        return "not simulated"
+    m = run.metrics
+    if not m.stable:
+        return f"unstable ({m.reason})"
+    return (f"net electrical {m.electrical_in_total_J:.5g} J (friction {m.friction_total_J:.5g} J, "
+            f"copper {m.copper_total_J:.5g} J), peak torque {m.torque_peak_Nm:.4g} N·m")
+
+
+def header_lines(cmp: Comparison, failed: Sequence[Constraint]) -> list[str]:
+    """Header of a stock-drive file (no date: the same inputs give the same bytes)."""
+    p = cmp.derived.params
+    lines = [f"preset: {p.name} — {p.source}", f"written by: {tool_version()}",
+             f"parameter hash: {parameter_hash(p)} (SHA-256 of the inputs' canonical JSON)"]
+    lines += verdict_lines(failed)
+    lines += [f"design warning: {w}" for w in cmp.derived.warnings]
+    lines += [f"simulated whole-run energy, {name}: {_energy(run)}" for name, run in
+              (("FDSMC", cmp.fdsmc), ("tracked optimum", cmp.optimum), ("stock route (this file)", cmp.stock))]
+    if cmp.stock is not None:
+        # the stock run checked against the same limits and the FDSMC's 2 % arrival band
+        stock = [c for c in run_checks(p, dataclasses.replace(cmp.stock, controller="fdsmc")) if c.violated]
+        lines += ["stock route within the drive's limits and on time (2 % band at T_m)"] if not stock else \
+            [f"stock route exceeds: {check_text(c)}" for c in stock]
+    return lines

@@ -1,0 +1,116 @@
+"""VESC: the motor part of an mcconf XML ``vesc_tool --setMcConf FILE.xml`` (or VESC Tool's "Load XML") loads.
+
+VESC Tool saves the motor configuration as ``<MCConfiguration>`` with a ``<ConfigVersion>`` and one
+element per parameter of ``parameters_mcconf.xml`` (the firmware's ``mc_configuration`` in
+``datatypes.h``), each value in the stored (SI) unit, not the editor's scaled one: ``foc_motor_r``
+[Ω] (shown in mΩ), ``foc_motor_l`` and ``foc_motor_ld_lq_diff`` [H] (shown in µH; L is the mean of
+L_d and L_q, the difference L_q − L_d), ``foc_motor_flux_linkage`` [Wb] (shown in mWb; the
+amplitude-invariant Ψ_PM), ``l_current_max``/``l_current_min`` [A] (motor current), ``si_motor_poles``
+(poles, not pole pairs), ``foc_current_kp`` [V/A] and ``foc_current_ki`` [V/(A·s)] (the current PI,
+bandwidth 3/T_si: kp = L·ω_c, ki = R·ω_c, VESC Tool's own rule).
+
+VESC has no position trajectory planner: only the motor part is written; the move itself needs
+the setpoint table (:mod:`app.exports.setpoints`) fed by a host, or the C module.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from xml.sax.saxutils import escape
+
+from app.exports.drive_units import pole_pairs_to_poles, poles_to_pole_pairs
+from app.exports.stock import StockSettings
+from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from control.common.checks import ParameterError
+
+_DOC = "VESC Tool res/config parameters_mcconf.xml (fw 5.03+ / 6.x)"
+#: Root element and version element of VESC Tool's mcconf XML.
+ROOT, VERSION_TAG = "MCConfiguration", "ConfigVersion"
+#: The ConfigVersion written (VESC Tool's mcconf XML version field).
+CONFIG_VERSION = 2
+#: Every key written, with its VESC type and stored unit.
+KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
+    VendorKey("motor_type", "enum", "-", f"{_DOC}: motor_type (2 = FOC)"),
+    VendorKey("l_current_max", "float", "A", f"{_DOC}: l_current_max, Motor Current Max"),
+    VendorKey("l_current_min", "float", "A", f"{_DOC}: l_current_min, Motor Current Max Brake (negative)"),
+    VendorKey("foc_motor_r", "float", "Ohm", f"{_DOC}: foc_motor_r, Motor Resistance"),
+    VendorKey("foc_motor_l", "float", "H", f"{_DOC}: foc_motor_l, Motor Inductance (mean of Ld, Lq)"),
+    VendorKey("foc_motor_ld_lq_diff", "float", "H", f"{_DOC}: foc_motor_ld_lq_diff, Lq − Ld"),
+    VendorKey("foc_motor_flux_linkage", "float", "Wb", f"{_DOC}: foc_motor_flux_linkage"),
+    VendorKey("si_motor_poles", "int", "-", f"{_DOC}: si_motor_poles, Motor Poles"),
+    VendorKey("foc_current_kp", "float", "V/A", f"{_DOC}: foc_current_kp, Current Controller Kp"),
+    VendorKey("foc_current_ki", "float", "V/(A*s)", f"{_DOC}: foc_current_ki, Current Controller Ki"),
+)}
+FOC = 2
+
+
+def vesc_values(s: StockSettings) -> dict[str, float]:
+    """Every written key → value in VESC's stored units (the one conversion from SI)."""
+    L = 0.5 * (s.L_d + s.L_q)
+    values = [FOC, s.current_limit, -s.current_limit, s.R_s, L, s.L_q - s.L_d, s.psi_pm, pole_pairs_to_poles(s.p),
+              L * s.current_bandwidth, s.R_s * s.current_bandwidth]
+    return dict(zip(KEYS, values, strict=True))
+
+
+def vesc_xml(s: StockSettings, header: list[str]) -> str:
+    """Return the mcconf XML: declaration, the header as an XML comment, ``<MCConfiguration>`` with the motor part."""
+    note = header + ["VESC: motor part only (VESC has no position trajectory planner); load it in VESC Tool "
+                     "(Motor Settings, Load XML) or with vesc_tool's setMcConf option, see docs/drives/vesc.md"]
+    body = "\n".join(f"    {escape(line).replace('--', '- -')}" for line in note)
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', f"<!--\n{body}\n-->", f"<{ROOT}>",
+             f"    <{VERSION_TAG}>{CONFIG_VERSION}</{VERSION_TAG}>"]
+    for key, v in vesc_values(s).items():
+        text = str(int(v)) if KEYS[key].kind != "float" else fmt_float(v)
+        lines.append(f"    <{key}>{text}</{key}>")
+    lines.append(f"</{ROOT}>")
+    return "\n".join(lines) + "\n"
+
+
+def parse_vesc(text: str, origin: str = "<mcconf>") -> VendorFile:
+    """Strict parser of an mcconf XML: root ``MCConfiguration``, a ``ConfigVersion``, flat scalar elements.
+
+    Raises
+    ------
+    ParameterError
+        For malformed XML, another root, a missing ConfigVersion, a nested or duplicated element,
+        or a known key of the wrong type.
+    """
+    if "<!DOCTYPE" in text or "<!ENTITY" in text:
+        raise ParameterError(f"{origin}: a DOCTYPE or ENTITY is not allowed in an mcconf XML")
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ParameterError(f"{origin} is not well-formed XML: {exc}") from None
+    if root.tag != ROOT:
+        raise ParameterError(f"{origin}: root element <{root.tag}> is not allowed: <{ROOT}>")
+    version = root.find(VERSION_TAG)
+    if version is None:
+        raise ParameterError(f"{origin}: <{VERSION_TAG}> is missing: an mcconf XML states its version")
+    pairs = []
+    for el in root:
+        if len(el):
+            raise ParameterError(f"<{el.tag}> has child elements: allowed a flat list of values")
+        if el.tag != VERSION_TAG:
+            pairs.append((el.tag, (el.text or "").strip()))
+    comment = tuple(line.strip() for line in _comments(text))
+    return vendor_file(pairs, KEYS, comment)
+
+
+def _comments(text: str) -> list[str]:
+    out: list[str] = []
+    start = text.find("<!--")
+    while start >= 0:
+        end = text.find("-->", start)
+        out += text[start + 4: end].strip().splitlines()
+        start = text.find("<!--", end)
+    return out
+
+
+def vesc_motor(f: VendorFile) -> tuple[float, float, float, float, int, float]:
+    """R_s [Ω], L_d, L_q [H], Ψ_PM [Wb], p [-], i_max [A] of a parsed mcconf."""
+    L = f.require("foc_motor_l", "the motor inductance [H]")
+    diff = f.get("foc_motor_ld_lq_diff") or 0.0
+    p = poles_to_pole_pairs(f.require("si_motor_poles", "the pole count"), "si_motor_poles")
+    return (f.require("foc_motor_r", "the motor resistance [Ohm]"), L - 0.5 * diff, L + 0.5 * diff,
+            f.require("foc_motor_flux_linkage", "the flux linkage [Wb]"), p,
+            f.require("l_current_max", "the motor current limit [A]"))

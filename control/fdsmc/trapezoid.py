@@ -1,0 +1,139 @@
+"""The same move for a stock drive: a symmetric trapezoid and the comparator's gains as a P–PI cascade.
+
+A stock drive (ODrive, moteus, an industrial servo) plans a trapezoidal speed profile and tracks it
+with a cascaded position (P) / speed (PI) loop. This module gives both for the manoeuvre of [1]:
+
+* the symmetric trapezoid at the designed acceleration α whose cruise ends the move at T_m
+  (:func:`trapezoid_timing`, :func:`trapezoid_samples`):
+
+      T_a = (T_m − √(T_m² − 4·|Δθ|/α)) / 2,   ω_c = α·T_a,   |Δθ| = ω_c·(T_m − T_a);
+
+* its ideal-tracking friction integral ∫ω² dt = ω_c²·(T_m − 4·T_a/3) (:func:`trapezoid_omega_square_integral`);
+* the comparator's gains g1, g2 of eq. (61) in [1] as a P–PI cascade (:func:`cascade_gains`):
+  pos_gain = g1/g2 [1/s], vel_gain = g2·J [N·m·s/rad]. Without the speed integrator the cascade
+  with inertia feed-forward J·α_ref is exactly the tracking law α_ref + g1·(θ_ref − θ) + g2·(ω_ref − ω)
+  (:func:`control.fdsmc.conventional.tracking_demand`), which the simulator runs as the "stock" comparator.
+
+The speed integrator is a documented choice, not part of eq. (61): its zero is placed at
+``INTEGRATOR_ZERO_FRACTION`` of the double pole a = g2/2, a decade below the position loop, so that
+it removes a steady load torque slowly without changing the move (it is not simulated).
+
+[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.common.checks import ParameterError
+
+#: Integrator zero of the stock speed PI as a fraction of the comparator's double pole a = g2/2 [-].
+INTEGRATOR_ZERO_FRACTION = 0.1
+#: Nodes of the reference the simulator tracks (equally spaced over [0, T_m]) [-].
+REFERENCE_NODES = 4001
+
+
+@dataclass(frozen=True)
+class TrapezoidTiming:
+    """A symmetric rest-to-rest trapezoid.
+
+    Attributes
+    ----------
+    delta_theta : float  Move [rad] (signed).
+    alpha : float        Acceleration and deceleration magnitude [rad/s²].
+    T_a : float          Acceleration (and deceleration) time [s].
+    T_m : float          Move time [s].
+    omega_c : float      Cruise speed [rad/s] (signed like Δθ).
+    """
+
+    delta_theta: float
+    alpha: float
+    T_a: float
+    T_m: float
+    omega_c: float
+
+
+@dataclass(frozen=True)
+class CascadeGains:
+    """A P–PI position/speed cascade with inertia feed-forward (SI units).
+
+    Attributes
+    ----------
+    pos_gain : float              Speed demand per position error [1/s].
+    vel_gain : float              Torque per speed error [N·m·s/rad].
+    vel_integrator_gain : float   Torque per integrated speed error [N·m/rad].
+    inertia : float               Torque feed-forward per demanded acceleration [kg·m²].
+    kp : float                    The same law as a parallel PID on position: torque per position error [N·m/rad].
+    kd : float                    Torque per speed error of the parallel PID [N·m·s/rad] (= vel_gain).
+    ki : float                    Torque per integrated position error of the parallel PID [N·m/(rad·s)].
+    """
+
+    pos_gain: float
+    vel_gain: float
+    vel_integrator_gain: float
+    inertia: float
+    kp: float
+    kd: float
+    ki: float
+
+
+def trapezoid_timing(delta_theta: float, alpha: float, T_m: float) -> TrapezoidTiming:
+    """Return the symmetric trapezoid at ``alpha`` [rad/s²] that moves ``delta_theta`` [rad] in ``T_m`` [s].
+
+    T_a = (T_m − √(T_m² − 4·|Δθ|/α))/2 (the cruise speed ω_c = α·T_a ends the move at T_m).
+
+    Raises
+    ------
+    ParameterError
+        When α ≤ 0 or T_m is shorter than the triangular move 2·√(|Δθ|/α).
+    """
+    if not alpha > 0.0:
+        raise ParameterError(f"trapezoid alpha = {alpha!r} rad/s² is not allowed: allowed > 0 rad/s²")
+    disc = T_m * T_m - 4.0 * abs(delta_theta) / alpha
+    if disc < 0.0:
+        raise ParameterError(f"manoeuvre.T_m = {T_m:g} s is too short for a trapezoid at {alpha:.5g} rad/s²: "
+                             f"allowed ≥ {2.0 * math.sqrt(abs(delta_theta) / alpha):.5g} s")
+    T_a = 0.5 * (T_m - math.sqrt(disc))
+    return TrapezoidTiming(delta_theta, alpha, T_a, T_m, math.copysign(alpha * T_a, delta_theta))
+
+
+def trapezoid_samples(tr: TrapezoidTiming, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """θ [rad], ω [rad/s], α [rad/s²] of the trapezoid at times ``t`` [s] (at rest at Δθ after T_m)."""
+    t = np.clip(np.asarray(t, dtype=float), 0.0, tr.T_m)
+    a = math.copysign(tr.alpha, tr.delta_theta)
+    t_d = tr.T_m - tr.T_a  # start of the deceleration
+    acc, dec = t < tr.T_a, t > t_d
+    alpha = np.where(acc, a, np.where(dec, -a, 0.0))
+    omega = np.where(acc, a * t, np.where(dec, a * (tr.T_m - t), tr.omega_c))
+    theta = np.where(acc, 0.5 * a * t * t,
+                     np.where(dec, tr.delta_theta - 0.5 * a * (tr.T_m - t) ** 2,
+                              0.5 * a * tr.T_a ** 2 + tr.omega_c * (t - tr.T_a)))
+    alpha = np.where(t >= tr.T_m, 0.0, alpha)
+    return theta, omega, alpha
+
+
+def trapezoid_reference(tr: TrapezoidTiming, n: int = REFERENCE_NODES) -> np.ndarray:
+    """Return the 3 × n rows (θ_ref, ω_ref, α_ref) on equal nodes over [0, T_m] (the simulator's reference)."""
+    return np.vstack(trapezoid_samples(tr, np.linspace(0.0, tr.T_m, int(n))))
+
+
+def trapezoid_omega_square_integral(tr: TrapezoidTiming) -> float:
+    """∫ω² dt over the move [rad²/s]: ω_c²·(T_m − 4·T_a/3) (ideal tracking; friction = F_v times this)."""
+    return tr.omega_c ** 2 * (tr.T_m - 4.0 * tr.T_a / 3.0)
+
+
+def cascade_gains(g1: float, g2: float, J: float) -> CascadeGains:
+    """Return the comparator's gains of eq. (61) in [1] as a P–PI cascade for inertia ``J`` [kg·m²].
+
+    pos_gain = g1/g2 [1/s], vel_gain = g2·J [N·m·s/rad], inertia feed-forward J; the speed
+    integrator's zero at ``INTEGRATOR_ZERO_FRACTION``·g2/2: vel_integrator_gain = vel_gain·zero
+    [N·m/rad]. The parallel PID of the same law: kp = g1·J, kd = g2·J, ki = kp·zero.
+    """
+    if not (g1 > 0.0 and g2 > 0.0 and J > 0.0):
+        raise ParameterError(f"cascade gains need g1, g2, J > 0: got g1 = {g1!r}, g2 = {g2!r}, J = {J!r}")
+    zero = INTEGRATOR_ZERO_FRACTION * 0.5 * g2
+    vel_gain, kp = g2 * J, g1 * J
+    return CascadeGains(g1 / g2, vel_gain, vel_gain * zero, J, kp, vel_gain, kp * zero)

@@ -1,0 +1,70 @@
+"""The pass criteria a simulated design is judged by, with their defaults resolved.
+
+A commissioning engineer sets them in the ``limits`` section (:class:`control.fdsmc.params.Limits`);
+a field left at 0 takes the default stated there, resolved here once for the kernel, the metrics,
+the verdicts and the design.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from control.fdsmc.feasibility import current_limit, speed_limit
+from control.fdsmc.model import torque_constant
+from control.fdsmc.params import DriveParams
+
+#: Default in-position window [encoder counts].
+IN_POSITION_COUNTS = 10
+#: Encoder resolution the default window assumes for an ideal encoder [counts per rev]: 2²⁰.
+IDEAL_ENCODER_CPR = 2**20
+#: Default standstill ripple limit as a fraction of the drive's current limit [-].
+HOLD_RIPPLE_FRACTION = 0.05
+
+
+@dataclass(frozen=True)
+class PassCriteria:
+    """Resolved pass criteria of one case (SI units).
+
+    Attributes
+    ----------
+    omega_max : float     Largest allowed |ω_r| [rad/s].
+    in_position : float   In-position window ± around θ_dem [rad].
+    overshoot : float     Largest allowed overshoot beyond θ_dem [rad].
+    hold_i_rms : float    Largest allowed rms ripple of i_q at standstill [A].
+    i_limit : float       The drive's current limit [A]: i_max, else Γ_max/Kt.
+    """
+
+    omega_max: float
+    in_position: float
+    overshoot: float
+    hold_i_rms: float
+    i_limit: float
+
+
+def drive_current(params: DriveParams) -> float:
+    """Return the drive's current limit [A].
+
+    The hard limit of :func:`control.fdsmc.feasibility.current_limit`, else the current of Γ_max
+    (Γ_max/K_t, eq. (5) in [1]).
+    """
+    return current_limit(params) or params.motor.Gamma_max / torque_constant(params.motor)
+
+
+def pass_criteria(params: DriveParams) -> PassCriteria:
+    """Return the pass criteria of ``params`` with every 0 (default) replaced as documented in ``Limits``."""
+    lim, cpr = params.limits, params.sensors.encoder_cpr
+    count = 2.0 * math.pi / (cpr if cpr > 0 else IDEAL_ENCODER_CPR)
+    window = lim.in_position if lim.in_position > 0.0 else IN_POSITION_COUNTS * count
+    i_lim = drive_current(params)
+    return PassCriteria(
+        omega_max=speed_limit(params),
+        in_position=window,
+        overshoot=lim.overshoot if lim.overshoot > 0.0 else window,
+        hold_i_rms=lim.hold_i_rms if lim.hold_i_rms > 0.0 else HOLD_RIPPLE_FRACTION * i_lim,
+        i_limit=i_lim,
+    )
+
+
+__all__ = ["HOLD_RIPPLE_FRACTION", "IDEAL_ENCODER_CPR", "IN_POSITION_COUNTS", "PassCriteria", "drive_current",
+           "pass_criteria"]
