@@ -31,16 +31,17 @@ def test_plant_equal_to_model_changes_nothing():
 
 
 def test_plant_override_changes_the_drive_not_the_controller():
-    """A heavier true load than the controller assumes: the same design, more torque and energy;
-    the energy balance closes with the plant's inertia.
+    """A heavier true load than the controller assumes: the same design, the torque held at the
+    drive's hard current limit for longer (its peak no lower), more copper energy; the energy
+    balance closes with the plant's inertia.
     """
     params, plant = load_model_and_plant(PRESET, ["plant.J_L=0.004"])
     assert pytest.approx(2.172e-3) == params.load.J_L and plant.load.J_L == 0.004
     nominal, heavy = compare(params), compare(params, plant=plant)
     assert heavy.derived.alpha.alpha_max == nominal.derived.alpha.alpha_max
     f0, f1 = nominal.fdsmc.metrics, heavy.fdsmc.metrics
-    assert f1.torque_peak_Nm > 1.1 * f0.torque_peak_Nm
-    assert f1.copper_J > f0.copper_J
+    assert f1.torque_peak_Nm >= f0.torque_peak_Nm
+    assert f1.copper_J > 1.5 * f0.copper_J
     assert abs(f1.energy_balance_residual_pct) < 0.5
 
 

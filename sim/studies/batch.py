@@ -28,7 +28,7 @@ from numba import njit, prange
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
 from control.fdsmc.params import DriveParams
-from sim.common import signals
+from sim.common import sensors, signals
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.engine import CONTROLLERS, _observer_arrays, _reference, pack_parameters
 from sim.fdsmc.grid import CONTINUOUS_STEP_S, TimeGrid, load_steps, time_grid
@@ -50,26 +50,27 @@ _T, _THETA, _ALPHA_DEM = kn.CHANNELS.index("t"), kn.CHANNELS.index("theta_r"), k
 def run_batch(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray, Gam: np.ndarray,
               Lo: np.ndarray, continuous: bool, h: float, n_steps: int, n_sub: int, delay: int, decim: int,
               out: np.ndarray, info: np.ndarray, k_win: np.ndarray, win: np.ndarray, ref: np.ndarray,
-              n: int) -> None:
+              noise: np.ndarray, n: int) -> None:
     """Run :func:`sim.fdsmc.kernel.run_kernel` for rows 0 … n − 1 of ``prm`` (one sample each).
 
     ``prm`` (samples × N_PRM), ``out`` (samples × N_CH × points), ``info`` (samples × N_INFO) and
-    ``win`` (samples × 2·windows × steps) stack the kernel's per-run arrays; the other arguments are
-    shared and mean what they mean for ``run_kernel`` (SI units).
+    ``win`` (samples × WIN_ROWS·windows × steps) stack the kernel's per-run arrays; the other arguments
+    are shared and mean what they mean for ``run_kernel`` (SI units).
     """
     for i in prange(n):
         kn.run_kernel(prm[i], step_t, step_v, Phi, Gam, Lo, continuous, h, n_steps, n_sub, delay, decim,
-                      out[i], info[i], k_win, win[i], ref)
+                      out[i], info[i], k_win, win[i], ref, noise)
 
 
 @dataclass(frozen=True)
 class Setup:
-    """What every sample of one controller shares: grid, observer, load steps, chatter windows."""
+    """What every sample of one controller shares: grid, observer, load steps, sensors, chatter windows."""
 
     controller: str
     grid: TimeGrid
     arrays: tuple[np.ndarray, ...]  # step_t, step_v, Phi, Gam, Lo
     ref: np.ndarray
+    noise: np.ndarray  # the sensors' noise table (the model's sensors, as simulate())
     windows: tuple[tuple[float, float], ...]  # cruise, hold [s]
     steps: tuple[tuple[int, int], ...]  # first step, number of steps of each window [-]
 
@@ -81,7 +82,7 @@ def setup(params: DriveParams, d: Derived, controller: str, plant: DriveParams, 
     windows = tuple(chatter_windows(params, d, controller, g.n_steps * T_step).values())
     steps = tuple(chatter_window_steps(w, T_step, g.n_steps) for w in windows)
     return Setup(controller, g, (*load_steps(plant), *_observer_arrays(d)), _reference(d, controller),
-                 windows, steps)
+                 sensors.noise_table(params.sensors), windows, steps)
 
 
 @njit(cache=True, nogil=True)
@@ -128,17 +129,17 @@ def chatter_rows(t: np.ndarray, alpha_dem: np.ndarray, window: tuple[float, floa
 
 def _buffers(s: Setup, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return (np.zeros((n, kn.N_CH, s.grid.n_out)), np.zeros((n, kn.N_INFO)),
-            np.zeros((n, 2 * len(s.steps), max(k for _, k in s.steps))))
+            np.zeros((n, kn.WIN_ROWS * len(s.steps), max(k for _, k in s.steps))))
 
 
 def _run(params: DriveParams, d: Derived, s: Setup, plants: list[DriveParams],
          bufs: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
     """Fill the first len(plants) rows of the buffers with the runs of ``s.controller`` on ``plants``."""
     out, info, win = bufs
-    prm = np.stack([pack_parameters(params, d, s.controller, p) for p in plants])
     g, k_win = s.grid, np.array([k0 for k0, _ in s.steps], dtype=np.int64)
+    prm = np.stack([pack_parameters(params, d, s.controller, p, g.h * g.n_sub) for p in plants])
     run_batch(prm, *s.arrays, g.continuous, g.h, g.n_steps, g.n_sub, params.controller.delay_samples,
-              g.decim, out, info, k_win, win, s.ref, len(plants))
+              g.decim, out, info, k_win, win, s.ref, s.noise, len(plants))
 
 
 def _metrics(params: DriveParams, d: Derived, s: Setup, plants: list[DriveParams],
@@ -148,7 +149,7 @@ def _metrics(params: DriveParams, d: Derived, s: Setup, plants: list[DriveParams
     n, T_step, theta_dem = len(plants), s.grid.h * s.grid.n_sub, params.manoeuvre.theta_dem
     chatter = np.zeros(n, dtype=bool)
     for j, (w, (k0, m)) in enumerate(zip(s.windows, s.steps, strict=True)):
-        chatter |= chatter_rows((k0 + np.arange(m)) * T_step, win[:n, 2 * j, :m], w, d.alpha.alpha_max)
+        chatter |= chatter_rows((k0 + np.arange(m)) * T_step, win[:n, kn.WIN_ROWS * j, :m], w, d.alpha.alpha_max)
     rows = []
     for i, plant in enumerate(plants):
         x = info[i]

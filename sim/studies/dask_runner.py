@@ -63,7 +63,7 @@ def warm() -> float:
     z1 = np.zeros(0)
     run_batch(np.zeros((1, kn.N_PRM)), z1, z1, np.zeros((4, 4)), np.zeros(4), np.zeros(4), False, 1e-4, 1, 1,
               0, 1, np.zeros((1, kn.N_CH, 1)), np.zeros((1, kn.N_INFO)), np.zeros(1, dtype=np.int64),
-              np.zeros((1, 2, 1)), np.zeros((3, 2)), 0)
+              np.zeros((1, kn.WIN_ROWS, 1)), np.zeros((3, 2)), np.zeros((2, 1)), 0)
     return time.perf_counter() - t0
 
 
