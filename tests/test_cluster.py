@@ -247,3 +247,42 @@ def test_the_page_runs_large_studies_on_the_configured_cluster(cluster):
     assert r.returncode == 0, r.stderr[-2000:]
     out = json.loads(r.stdout.strip().splitlines()[-1])
     assert out["used"] == [cluster.address] and out["done"] == 80 and out["same"]
+
+
+def test_a_lost_scheduler_is_one_line_and_exit_2(cluster, tmp_path):
+    run = CliRun(cluster.address, 4000, tmp_path / "r.parquet", "--cluster-timeout", "5")
+    run.wait_for(100)
+    cluster.procs[0].send_signal(signal.SIGKILL)  # the scheduler
+    rc, out, err = run.finish()
+    last = err.replace("\r", "\n").strip().splitlines()[-1]
+    assert rc == 2 and out == "" and "Traceback" not in err
+    assert last.startswith("error: robustness run stopped after ")
+    assert f"lost the Dask scheduler at {cluster.address}" in last
+    _, _, meta = read_parquet(tmp_path / "r.parquet")
+    assert meta["complete"] is False and meta["completed_samples"] >= 100
+
+
+_KILLER = """
+import os, sys
+from sim.studies.dask_runner import connect
+from sim.studies.runner import ExecutorError
+def kill_my_worker(x):
+    os._exit(1)
+with connect(sys.argv[1], 60.0) as ex:
+    try:
+        ex.submit(kill_my_worker, 1).result()
+    except ExecutorError as exc:
+        print(exc)
+"""
+
+
+def test_a_task_that_kills_its_workers_is_one_line(cluster):
+    """distributed.scheduler.allowed-failures = 3: the fourth lost worker gives up the task (KilledWorker)."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    r = subprocess.run([sys.executable, "-c", _KILLER, cluster.address], capture_output=True, text=True, cwd=ROOT,
+                       env=env, timeout=600, check=False)
+    assert r.returncode == 0, r.stderr[-2000:]
+    line = r.stdout.strip()
+    assert "\n" not in line and line.startswith(f"chunk 0 killed the workers that ran it on the Dask cluster at "
+                                                f"{cluster.address} (KilledWorker: ")
+    assert line.endswith("allowed fewer than distributed.scheduler.allowed-failures losses per task")

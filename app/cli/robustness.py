@@ -87,12 +87,23 @@ def _check(args: argparse.Namespace) -> None:
             check_writable(path, opt)  # before hours of simulation, not after
 
 
+def _quiet_dask() -> None:
+    """Silence Dask's own client logging: a lost cluster is reported in one line, not its reconnect tracebacks."""
+    import logging
+
+    import distributed  # noqa: F401 — configures its loggers, which are then raised to CRITICAL
+
+    for name in [n for n in logging.root.manager.loggerDict if n.split(".")[0] in ("distributed", "tornado")]:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
 def _compute(args: argparse.Namespace) -> RobustnessResult:
     params, plant = load_model_and_plant(args.preset, args.overrides)  # plant: the nominal plant
     spreads = parse_spreads(args.spread)
     if args.scheduler:
         from sim.studies.dask_runner import connect
 
+        _quiet_dask()
         with connect(args.scheduler, args.cluster_timeout) as ex:
             return robustness(params, spreads, args.samples, args.seed, ex, ex.workers, _progress, plant=plant)
     if args.workers == 1:

@@ -4,12 +4,13 @@ Imports dask only inside its functions (``control/`` and ``sim/`` stay importabl
 :func:`connect` opens a client on a running ``dask scheduler`` and:
 
 * waits at most ``no_worker_s`` for a worker (else :class:`~sim.studies.runner.ExecutorError`);
+* compares each worker's :func:`sim.source_hash` with the client's, before anything is compiled:
+  a worker running other source is refused, by name;
 * registers :func:`worker_plugin` (unless ``tuned=False``): on every worker, now and joining later,
   glibc's allocator keeps freed trace buffers for reuse (Dask's nanny starts workers with
   ``MALLOC_TRIM_THRESHOLD_=65536``, which turns every ≥ 128 KiB array into a fresh ``mmap`` and
   its page faults) and the statistical profiler is stopped (it samples every thread each 10 ms);
-* loads the compiled kernels on every worker (``client.run``) and compares each worker's
-  :func:`sim.source_hash` with the client's: a worker running other source is refused, by name;
+* loads the compiled kernels on every worker (``client.run``);
 * submits each chunk with ``pure=False`` under a key holding the run and chunk index (two equal
   chunks are two tasks), and the task checks the source hash again (a worker restarted later).
 
@@ -23,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import functools
+import threading
 import time
 import uuid
 from collections.abc import Callable
@@ -78,13 +80,17 @@ def tune_allocator() -> bool:
 
 
 def tune_worker(worker: Any) -> None:
-    """Allocator kept, statistical profiler stopped, kernels loaded: the worker plugin's setup."""
+    """Keep the allocator's freed memory and stop the statistical profiler: the worker plugin's setup.
+
+    The kernels are not loaded here (that would block the worker's event loop for a compilation
+    on a worker without a cache): :func:`connect` loads them with ``client.run``, a worker that
+    joins later loads them with its first chunk.
+    """
     tune_allocator()
     for name in ("profile", "profile-cycle"):
         pc = worker.periodic_callbacks.pop(name, None)
         if pc is not None:
             pc.stop()
-    warm()
 
 
 def worker_plugin() -> Any:
@@ -123,22 +129,42 @@ class DaskChunk:
         from distributed import KilledWorker
         from distributed.client import CancelledError
 
-        since: float | None = None
-        while True:
+        box: dict[str, Any] = {}
+        self._watch(box)
+        try:
+            if "error" in box:
+                raise box["error"]
+            return box["value"]
+        except KilledWorker as exc:
+            raise ExecutorError(f"chunk {self.index} killed the workers that ran it on the Dask cluster at "
+                                f"{self._ex.address} ({_line(exc)}): allowed fewer than "
+                                "distributed.scheduler.allowed-failures losses per task") from None
+        except SourceMismatchError as exc:
+            raise ExecutorError(str(exc)) from None
+        except (CancelledError, OSError) as exc:
+            raise ExecutorError(self._ex.lost_message(exc)) from None
+
+    def _watch(self, box: dict[str, Any]) -> None:
+        """Fetch the result into ``box`` on a helper thread, asking the scheduler for workers every POLL_S.
+
+        A finished result whose worker dies before it is fetched is "lost" again and recomputed, so
+        the fetch itself is watched; it is never awaited with a timeout (an abandoned timed wait
+        leaves a pending coroutine that logs a traceback when the run is given up). A fetch still
+        blocked when the run is abandoned ends when the client closes.
+        """
+        def fetch() -> None:
             try:
-                return self.future.result(timeout=POLL_S)
-            except TimeoutError:
-                since = None if self._ex.worker_count() else since or time.monotonic()
-                if since is not None and time.monotonic() - since > self._ex.no_worker_s:
-                    raise ExecutorError(self._ex.no_workers_message()) from None
-            except KilledWorker as exc:
-                raise ExecutorError(f"chunk {self.index} killed the workers that ran it on the Dask cluster at "
-                                    f"{self._ex.address} ({_line(exc)}): allowed fewer than "
-                                    "distributed.scheduler.allowed-failures losses per task") from None
-            except SourceMismatchError as exc:
-                raise ExecutorError(str(exc)) from None
-            except (CancelledError, OSError) as exc:
-                raise ExecutorError(self._ex.lost_message(exc)) from None
+                box["value"] = self.future.result()
+            except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
+                box["error"] = exc
+
+        helper = threading.Thread(target=fetch, name=f"fetch-chunk-{self.index}", daemon=True)
+        helper.start()
+        since: float | None = None
+        while helper.join(POLL_S) is None and helper.is_alive():
+            since = None if self._ex.worker_count() else since or time.monotonic()
+            if since is not None and time.monotonic() - since > self._ex.no_worker_s:
+                raise ExecutorError(self._ex.no_workers_message())
 
     def cancel(self) -> None:
         """Release the task."""
@@ -198,12 +224,18 @@ def connect(address: str, no_worker_s: float = NO_WORKER_S, tuned: bool = True) 
     except (OSError, TimeoutError) as exc:
         raise ExecutorError(f"cannot reach the Dask scheduler at {address!r} ({_line(exc)}): allowed the address "
                             "tcp://HOST:PORT of a running `dask scheduler`") from None
+    from distributed.client import CancelledError
+
     ex = DaskExecutor(client, address, no_worker_s, 0)
     try:
         _check_workers(ex, tuned)
-    except BaseException:
+    except ExecutorError:
         ex.close()
         raise
+    except (Exception, CancelledError) as exc:  # a worker or the scheduler lost while checking
+        ex.close()
+        raise ExecutorError(f"the Dask cluster at {address} failed while its workers were checked and warmed "
+                            f"({_line(exc)}): allowed a cluster whose workers stay up") from None
     return ex
 
 
