@@ -48,12 +48,28 @@ def figure(label: str, values: list[float], unit: str) -> float:
     return m
 
 
-def rate(run: Callable[[], object], n: int, repeat: int) -> list[float]:
+def cpu_s(pids: list[int]) -> float:
+    """CPU seconds (user + system) the processes ``pids`` have used so far."""
+    import psutil
+
+    total = 0.0
+    for pid in pids:
+        t = psutil.Process(pid).cpu_times()
+        total += t.user + t.system
+    return total
+
+
+def rate(run: Callable[[], object], n: int, repeat: int, pids: Callable[[], list[int]] = list,
+         cpu: list[float] | None = None) -> list[float]:
+    """Samples/s of ``repeat`` runs of n samples; the workers' CPU ms per sample appended to ``cpu``."""
     out = []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        procs = pids()
+        c0, t0 = cpu_s(procs), time.perf_counter()
         run()
         out.append(n / (time.perf_counter() - t0))
+        if cpu is not None:
+            cpu.append((cpu_s(procs) - c0) / n * 1e3)
     return out
 
 
@@ -80,8 +96,11 @@ def pool_rates(params, spreads, n: int, repeat: int) -> dict[int, float]:
     for w in (1, 2):
         with RetryingPool(w) as pool:
             [f.result() for f in [pool.submit(simulate_chunk, params, [{}]) for _ in range(2 * w)]]
+            cpu: list[float] = []
             rates[w] = figure(f"local pool, {w} worker(s)", rate(
-                lambda p=pool, w=w: robustness(params, spreads, n, 1, p, w), n, repeat), "samples/s")
+                lambda p=pool, w=w: robustness(params, spreads, n, 1, p, w), n, repeat, pool.processes, cpu),
+                "samples/s")
+            figure(f"   its workers' CPU per sample, {w} worker(s)", cpu, "ms")
     print(f"pool scaling 2 vs 1 worker: {rates[2] / rates[1]:.2f}×  (target ≥ 1.9×)")
     return rates
 
@@ -101,6 +120,13 @@ def start_cluster(tmp: pathlib.Path) -> tuple[str, list[subprocess.Popen]]:
     return json.loads(file.read_text(encoding="utf-8"))["address"], procs
 
 
+def worker_pids(nannies: list[int]) -> list[int]:
+    """The worker processes under the nannies (their pids change when a worker is restarted)."""
+    import psutil
+
+    return [c.pid for n in nannies for c in psutil.Process(n).children(recursive=True)]
+
+
 def dask_rates(params, spreads, n: int, repeat: int, pool2: float) -> None:
     from sim.studies.dask_runner import connect, worker_plugin
 
@@ -108,18 +134,22 @@ def dask_rates(params, spreads, n: int, repeat: int, pool2: float) -> None:
         address, procs = start_cluster(pathlib.Path(tmp))
         try:
             got: dict[bool, list[float]] = {False: [], True: []}
+            cpu: dict[bool, list[float]] = {False: [], True: []}
+            nannies = [p.pid for p in procs[1:]]
             for _ in range(repeat):
                 for tuned in (False, True):
                     with connect(address, tuned=tuned) as ex:
                         ex.client.wait_for_workers(2, timeout=120)
                         robustness(params, spreads, 40, 2, ex, 2)  # every worker has run a chunk
-                        got[tuned] += rate(lambda e=ex: robustness(params, spreads, n, 1, e, 2), n, 1)
+                        got[tuned] += rate(lambda e=ex: robustness(params, spreads, n, 1, e, 2), n, 1,
+                                           lambda: worker_pids(nannies), cpu[tuned])
                         if tuned:  # back to the nanny's environment for the next untuned figure
                             ex.client.unregister_worker_plugin(worker_plugin().name)
                             ex.client.restart()
             for tuned in (False, True):
                 r = figure(f"Dask, 2 workers, {'tuned' if tuned else 'Dask defaults'}", got[tuned], "samples/s")
                 print(f"   = {r / pool2:.2f}× the 2-worker pool (target ≥ 0.9×)")
+                figure(f"   workers' CPU per sample, {'tuned' if tuned else 'Dask defaults'}", cpu[tuned], "ms")
         finally:
             for p in reversed(procs):
                 p.terminate()
