@@ -14,7 +14,9 @@ import pytest
 from app.io.presets import load_preset
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
+from control.fdsmc.feasibility import current_limit
 from control.fdsmc.params import DriveParams, LoadStep
+from sim.fdsmc.checks import run_checks
 from sim.fdsmc.engine import compare, simulate
 
 
@@ -224,17 +226,25 @@ def test_one_sample_delay_still_reaches_target(paper_params):
 
 
 def test_inverter_limits_are_respected_and_reported(paper_params):
-    """|u_dq| ≤ V_dc/√3 and |i_q| ≲ i_max; time saturated > 0; energy balance still closes."""
+    """|u_dq| ≤ V_dc/√3 and |i_dq| ≤ the hard limit; time limited > 0; the energy balance still closes.
+
+    The paper's drive has Γ_max = 40 N·m: with an inverter of i_max = 100 A the hard limit is
+    min(i_max, Γ_max/K_t) = 40/(1.5·5·0.38) = 14.0 A — the move needs ≈ 400 N·m, so it is limited
+    nearly throughout, and the checks say the run misses its target.
+    """
     p = _recommended(_with(paper_params, "controller", V_dc=700.0, i_max=100.0))
+    assert current_limit(p) == pytest.approx(40.0 / (1.5 * 5 * 0.38))
     ideal = compare(_recommended(paper_params))
     cmp = compare(p)
     for run, free in ((cmp.fdsmc, ideal.fdsmc), (cmp.conventional, ideal.conventional)):
         m = run.metrics
-        assert free.metrics.saturated_s == 0.0 and m.saturated_s > 0.0
+        assert free.metrics.saturated_s == 0.0 and m.saturated_s > 0.5 * p.manoeuvre.T_m
         assert m.u_peak_V <= 700.0 / math.sqrt(3.0) * (1 + 1e-9)
-        assert m.i_q_peak_A < 106.0  # the limit holds di_q/dt = 0 one sample late at most
+        # the limit predicts one sample ahead with ω_r and the dq coupling held: 1e-6 of overshoot seen
+        assert m.i_peak_A <= current_limit(p) * (1 + 1e-4)
         assert m.energy_balance_residual_pct < 0.1
-    assert abs(cmp.fdsmc.metrics.theta_error_at_Tm_rad) < 0.02 * p.manoeuvre.theta_dem
+    names = {c.name for c in run_checks(p, cmp.fdsmc)}
+    assert {"saturation", "arrival"} <= names
 
 
 def test_hysteretic_sign_changes_counts_half_cycles_and_ignores_small_noise():

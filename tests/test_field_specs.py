@@ -163,7 +163,7 @@ def test_position_page_field_shows_spec_label_unit_and_range(field):
 
 def test_position_page_covers_every_top_level_number_field():
     on_page = {f.key for f in PAGE_POSITION} | {"controller.delay_samples"}  # delay: a dropdown
-    spec_keys = {f"{sec}.{n}" for sec in ("motor", "load", "controller", "manoeuvre")
+    spec_keys = {f"{sec}.{n}" for sec in ("motor", "load", "controller", "sensors", "limits", "manoeuvre")
                  for n in field_specs(units.SECTION_CLASSES[sec])}
     assert spec_keys == on_page
     spec = units.spec_of("controller.delay_samples")

@@ -204,3 +204,54 @@ def test_subprocess_one_line_exit_2():
     r = subprocess.run([sys.executable, "-m", "app", "bldc", "paper_12kw_pmsm"], capture_output=True,
                        text=True, check=False, cwd=Path(__file__).resolve().parent.parent)
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+
+
+LONG = "x" * 5000
+
+
+@pytest.mark.parametrize("argv", [
+    ["derive", "paper_12kw_pmsm", "--set", f"motor.R_s={LONG}"],
+    ["derive", "paper_12kw_pmsm", "--set", f"{LONG}=1"],
+    ["derive", "paper_12kw_pmsm", "--set", f"motor.{LONG}=1"],
+    ["derive", "paper_12kw_pmsm", "--set", "motor.R_s=" + "1" * 5000],
+    ["derive", LONG[:1000]],
+    ["dutycycle", "paper_12kw_pmsm", "x.yaml", "--price", LONG],
+])
+def test_every_refusal_is_one_line_of_at_most_300_characters(argv, capsys):
+    with pytest.raises(SystemExit) if "--price" in argv else _no_raise() as _:
+        code = main(argv)
+        assert code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and len(err.rstrip("\n")) <= 300 and "x" * 81 not in err, err
+
+
+class _no_raise:  # noqa: N801 - a context manager used like pytest.raises
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc: object) -> bool:
+        return False
+
+
+def test_long_file_key_is_shortened(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(PAPER + f"\n{'k' * 1000}: 1\n", encoding="utf-8")
+    err = _fails(["derive", str(path)], capsys, "unknown top-level key")
+    assert len(err) <= 301 and "k" * 81 not in err
+
+
+def test_the_issue_budget_reproduction_is_refused_before_work(capsys):
+    err = _fails(["simulate", "yaskawa_sgm7j_02a", "--set", "controller.f_s_kHz=1e4", "--set", "manoeuvre.T_m=1.0"],
+                 capsys, "too large", "s CPU", "allowed ≤ 3 s, 256 MiB", "controller.f_s = 1e+07 Hz → largest accepted")
+    assert len(err) <= 301
+
+
+def test_budget_prediction_grows_with_f_s_t_m_and_substeps():
+    p = load_preset("yaskawa_sgm7j_02a")
+    base = grid.predict(p, 3)
+    faster = grid.predict(grid.with_field(p, "controller.f_s", 100 * float(p.controller.f_s)), 3)
+    longer = grid.predict(grid.with_field(p, "manoeuvre.T_m", 2 * p.manoeuvre.T_m), 3)
+    sub = grid.predict(p, 3, n_sub=8)
+    assert faster.cpu_s > 3 * base.cpu_s and faster.memory_bytes > base.memory_bytes
+    assert longer.cpu_s > base.cpu_s and sub.cpu_s > base.cpu_s and sub.steps > 2 * base.steps
+    assert base.fits and not grid.predict(grid.with_field(p, "controller.f_s", 1e7), 3).fits

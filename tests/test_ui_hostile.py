@@ -20,7 +20,7 @@ import websockets
 from app.io.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
 from app.ui.session import create_server
 from app.ui.text import checked_choice, md_text
-from app.ui.web_guard import COOKIE, Guard
+from app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
 from app.ui.worker import Cancelled, Worker
 from control.common.checks import ParameterError
 
@@ -120,6 +120,40 @@ def test_token_required_when_not_on_loopback():
         server.stop()
 
 
+
+def _raw_status(hostport: str, path: bytes, host: bytes | None = None) -> int:
+    """Status code of a GET written byte by byte (any bytes in the path and Host header)."""
+    import socket
+
+    h, port = hostport.rsplit(":", 1)
+    with socket.create_connection((h, int(port)), timeout=10) as s:
+        s.sendall(b"GET " + path + b" HTTP/1.1\r\nHost: " + (host or hostport.encode()) + b"\r\n\r\n")
+        return int(s.recv(64).split(b" ", 2)[1])
+
+
+def test_token_mode_checks_host_one_token_parameter_and_any_token_text_is_403():
+    guard = Guard.for_host("0.0.0.0", token="s3cret-token")
+    server, _ = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, host="127.0.0.1", port=free_port(),
+                              scene_3d=False, guard=guard)
+    try:
+        hostport = f"127.0.0.1:{server.get_port()}"
+        ok = f"{COOKIE}=s3cret-token"
+        assert _http_status(f"http://{hostport}/", {"Cookie": ok})[0] == 200
+        # DNS rebinding with a leaked cookie: a foreign host name is refused even with the token
+        assert _http_status(f"http://{hostport}/", {"Cookie": ok, "Host": "evil.example"})[0] == 403
+        assert _ws_status(hostport, "http://evil.example", {"Cookie": ok, "Host": "evil.example"}) == "403"
+        assert _http_status(f"http://{hostport}/", {"Cookie": ok, "Host": "192.0.2.7:8080"})[0] == 200  # LAN IP
+        # one token parameter only, in either order
+        assert _http_status(f"http://{hostport}/?token=s3cret-token&token=x")[0] == 403
+        assert _http_status(f"http://{hostport}/?token=x&token=s3cret-token")[0] == 403
+        for token in (b"%FF%FE", b"\xc3\xa9t\xc3\xa9", b"%00", b"%ED%A0%80", b"a" * 5000, b"[", b"%25"):
+            assert _raw_status(hostport, b"/?token=" + token) == 403, token
+        for host in (b"[", b"\xff\xfe", b"a:b:c", b"[::1", b"x" * 3000):
+            assert _raw_status(hostport, b"/?token=s3cret-token", host) in (400, 403), host
+        assert all(len(r) <= 300 for r in guard.refused)
+    finally:
+        server.stop()
+
 CAMERA = {"type": "ViewerCameraMessage", "wxyz": [1.0, 0.0, 0.0, 0.0], "position": [0.0, 0.0, 1.0],
           "fov": 1.0, "near": 0.01, "far": 100.0, "image_height": 600, "image_width": 800,
           "look_at": [0.0, 0.0, 0.0], "up_direction": [0.0, 0.0, 1.0]}
@@ -165,6 +199,90 @@ def _send_update(hostport: str, config: object, handle_of: str, value: str, wait
     assert done.is_set()
     return session_box[0]
 
+
+HOSTILE_UPDATES = [("results.cycles", {"value": "abc"}), ("results.cycles", {"value": float("nan")}),
+                   ("results.cycles", {"value": True}), ("results.cycles", {"value": [1, 2]}),
+                   ("inputs.alpha_rule", {"value": 5}), ("results.cycles", {"nonexistent": 1}),
+                   ("results.cycles", {"__class__": 1}), ("results.cycles", ["value", 1])]
+
+
+def test_widget_values_are_type_checked_before_viser_casts_them(served):
+    hostport, _, config = served
+    known, before = set(config.sessions), len(REFUSED_UPDATES)
+    box: list[object] = []
+
+    async def go() -> None:
+        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
+                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
+            await ws.send(msgspec.msgpack.encode(CAMERA))
+            for _ in range(600):
+                if set(config.sessions) - known:
+                    box.append(config.sessions[(set(config.sessions) - known).pop()])
+                    break
+                await asyncio.sleep(0.05)
+            session = box[0]
+            for path, updates in [*HOSTILE_UPDATES, ("results.cycles", {"value": 601.0})]:  # last: a valid one
+                handle = session
+                for attr in path.split("."):
+                    handle = getattr(handle, attr)
+                await ws.send(msgspec.msgpack.encode({"type": "GuiUpdateMessage", "uuid": handle._impl.uuid,
+                                                      "updates": updates}))
+            for _ in range(200):  # updates are handled in order: the valid one last
+                if session.results.cycles.value == 601.0:
+                    break
+                await asyncio.sleep(0.05)
+
+    _run(go)
+    session = box[0]
+    assert session.results.cycles.value == 601.0 and session.inputs.alpha_rule.value != 5
+    refused = list(REFUSED_UPDATES)[before:]
+    assert len(refused) == len(HOSTILE_UPDATES), refused
+    assert all(len(r) <= 300 for r in refused) and any("allowed a finite number" in r for r in refused)
+
+
+def _start(session: object, uuid: str, name: str, size: int, parts: int) -> dict:
+    return {"type": "FileTransferStartUpload", "source_component_uuid": uuid, "transfer_uuid": name,
+            "filename": name, "mime_type": "text/csv", "part_count": parts, "size_bytes": size}
+
+
+def test_uploads_are_refused_by_declared_size_and_overrun_while_streaming(served):
+    hostport, _, config = served
+    known, before = set(config.sessions), len(REFUSED_UPDATES)
+    box: list[object] = []
+
+    async def go() -> None:
+        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
+                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
+            await ws.send(msgspec.msgpack.encode(CAMERA))
+            for _ in range(600):
+                if set(config.sessions) - known:
+                    box.append(config.sessions[(set(config.sessions) - known).pop()])
+                    break
+                await asyncio.sleep(0.05)
+            log_uuid, preset_uuid = box[0].log_panel.upload._impl.uuid, box[0].files.upload._impl.uuid
+            msgs = [_start(box[0], log_uuid, "huge.csv", 300 * 2**20, 300),  # over 50 MB: refused at once
+                    _start(box[0], preset_uuid, "big.yaml", 2 * 2**20, 2),  # over 512 KiB for a preset
+                    _start(box[0], log_uuid, "a.csv", 40 * 2**20, 40),  # accepted, held open
+                    _start(box[0], log_uuid, "b.csv", 40 * 2**20, 40),  # 80 MB unfinished: refused
+                    _start(box[0], log_uuid, "small.csv", 10, 1),
+                    {"type": "FileTransferPart", "source_component_uuid": log_uuid, "transfer_uuid": "small.csv",
+                     "part_index": 0, "content": b"x" * 1000}]  # overruns its 10 bytes: ended
+            for m in msgs:
+                await ws.send(msgspec.msgpack.encode(m))
+            for _ in range(200):
+                if len(REFUSED_UPDATES) - before >= 4:
+                    break
+                await asyncio.sleep(0.05)
+            box.append(dict(box[0].client.gui._current_file_upload_states))
+
+    _run(go)
+    refused = list(REFUSED_UPDATES)[before:]
+    assert len(refused) == 4, refused
+    assert "huge.csv" in refused[0] and "allowed ≤ 50 MB" in refused[0]
+    assert "big.yaml" in refused[1] and "allowed ≤ 0.5 MB" in refused[1]
+    assert "b.csv" in refused[2] and "unfinished uploads" in refused[2]
+    assert "small.csv" in refused[3] and "overrun" in refused[3]
+    assert set(box[1]) == {"a.csv"}  # only the accepted transfer holds state (no parts yet)
 
 def test_hostile_client_cannot_load_a_file_through_the_preset_dropdown(served, tmp_path):
     hostport, _, config = served

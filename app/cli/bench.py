@@ -22,6 +22,7 @@ from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 from app.cli.bldc import bench_figure
 from app.cli.main import add_preset_arguments
+from app.io.numbers import integer_option
 from app.io.preset_modes import load_mode_preset
 from app.io.presets import load_preset
 from control.fdsmc.derivations import clear_caches, derive
@@ -34,7 +35,8 @@ from sim.fdsmc.reference import run_reference
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``bench``."""
     add_preset_arguments(p, default="paper_12kw_pmsm")
-    p.add_argument("--repeat", type=int, default=7, help="repetitions of each figure (median; at least 5)")
+    p.add_argument("--repeat", type=integer_option("--repeat"), default=7,
+                   help="repetitions of each figure (median; at least 5)")
     p.add_argument("--smoke", action="store_true",
                    help="one repetition of each figure: checks that every figure runs (not figures of record)")
 

@@ -3,16 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 from typing import Any
 
 from app.cli.main import add_preset_arguments
+from app.io.atomic import write_atomic_text
 from app.io.json_data import to_json
 from app.io.presets import dumps, load_preset, to_raw
-from sim.fdsmc.design import DriveDesign, design_drive
+from sim.fdsmc.checks import run_checks
+from sim.fdsmc.criteria import pass_criteria
+from sim.fdsmc.engine import LABELS
+from sim.fdsmc.objective import OBJECTIVES, ObjectiveDesign, design_for
 
-_VERIFIED_KEYS = ("torque_peak_Nm", "i_q_peak_A", "u_peak_V", "omega_peak_rad_s", "theta_error_at_Tm_rad",
+_VERIFIED_KEYS = ("torque_peak_Nm", "i_q_peak_A", "i_peak_A", "over_i_max_s", "u_peak_V", "omega_peak_rad_s",
+                  "theta_error_at_Tm_rad", "overshoot_rad", "in_position_s", "hold_i_q_rms_A", "hold_u_q_ptp_V",
                   "chatter", "saturated_s", "stable", "friction_J", "electrical_in_J")
 
 
@@ -21,10 +27,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_preset_arguments(p)
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
     p.add_argument("-o", "--output", metavar="FILE", help="write the designed preset (YAML) to FILE")
+    p.add_argument("--objective", choices=OBJECTIVES, default=OBJECTIVES[0],
+                   help="what the design minimises: net electrical input (default) or the paper's friction loss")
+    p.add_argument("--name", help="name written in the designed preset (default: the preset's)")
+    p.add_argument("--source", help="source written in the designed preset, e.g. the motor's data sheet")
 
 
-def design_json(dd: DriveDesign) -> dict[str, Any]:
+def design_json(od: ObjectiveDesign) -> dict[str, Any]:
     """Return the JSON contract of ``design --json``."""
+    dd = od.design
     c, cmp = dd.params.controller, dd.comparison
     verified: dict[str, Any] = {}
     for name in ("fdsmc", "conventional"):
@@ -32,16 +43,32 @@ def design_json(dd: DriveDesign) -> dict[str, Any]:
         if run is not None:
             metrics = to_json(run.metrics)
             verified[name] = {k: metrics[k] for k in _VERIFIED_KEYS}
-            verified[name]["i_peak_A"] = verified[name]["i_q_peak_A"]
+            verified[name]["checks_failed"] = [c.name for c in run_checks(dd.params, run)]
+    crit = pass_criteria(dd.params)
+    rec = od.recommendation
     return to_json({
+        "objective": od.objective,
+        "alpha_max_rule": c.alpha_max_rule,
+        "energies": {e.controller: {"net_electrical_J": e.net_electrical_J, "copper_J": e.copper_J,
+                                    "friction_J": e.friction_J, "checks_failed": list(e.failed)}
+                     for e in (rec.energies if rec else ())},
+        "recommended": {"controller": rec.controller, "why": rec.why} if rec else None,
         "clean": dd.clean,
+        "verdict": dd.verdict,
+        "as_asked": dd.as_asked,
+        "criteria": {"omega_max_rad_s": crit.omega_max, "in_position_rad": crit.in_position,
+                     "overshoot_rad": crit.overshoot, "hold_i_rms_A": crit.hold_i_rms},
+        "noise": None if dd.noise is None else {"hold_i_q_rms_A": dd.noise.i_q_rms, "hold_u_q_rms_V": dd.noise.u_q_rms},
+        "encoder_cpr_needed": dd.encoder_cpr_needed,
         "limiting": [{"name": x.name, "value": x.value, "limit": x.limit, "unit": x.unit,
                       "violated": x.violated, "text": x.text} for x in dd.limiting],
         "notes": list(dd.notes),
         "comparator_notes": list(dd.comparator),
         "design": {"alpha_max": dd.derived.alpha.alpha_max, "T_m": dd.params.manoeuvre.T_m, "K": c.K,
                    "T_c": dd.derived.profile.T_c, "T_c_rule": "T_a" if c.T_c == "T_a" else "given",
-                   "f_s": c.f_s, "overshoot_eta": dd.derived.alpha.overshoot},
+                   "f_s": c.f_s, "overshoot_eta": dd.derived.alpha.overshoot, "T_so": c.T_so,
+                   "alpha_max_rule": c.alpha_max_rule,
+                   "T_salpha": c.T_salpha},
         "verified": verified,
         "saving_friction_pct": cmp.saving_friction_pct if cmp else None,
         "saving_electrical_pct": cmp.saving_electrical_pct if cmp else None,
@@ -52,25 +79,38 @@ def design_json(dd: DriveDesign) -> dict[str, Any]:
 def run(args: argparse.Namespace) -> int:
     """Design, verify and print (table or JSON); optionally write the designed preset."""
     params = load_preset(args.preset, args.overrides)
+    renamed = {k: v for k, v in (("name", args.name), ("source", args.source)) if v is not None}
+    params = dataclasses.replace(params, **renamed)
     if args.output and not Path(args.output).resolve().parent.is_dir():  # checked before the work
         raise ValueError(f"-o {args.output}: the folder does not exist")
-    dd = design_drive(params)
-    out = design_json(dd)
+    od = design_for(params, args.objective)
+    dd = od.design
+    out = design_json(od)
     if args.output:
-        with open(args.output, "w", encoding="utf-8") as fh:
-            fh.write(dumps(out["preset"]))
+        try:
+            write_atomic_text(args.output, dumps(out["preset"]))  # a temporary file renamed when complete
+        except OSError as exc:
+            raise ValueError(f"cannot write -o {args.output!r}: {exc.strerror or exc}") from None
     if args.json:
         print(json.dumps(out, indent=2, ensure_ascii=False))
         return 0
     d = out["design"]
-    print(f"Design for {params.name}: {'CLEAN' if dd.clean else 'NOT CLEAN'}")
+    print(f"Design for {params.name} (objective: {od.objective}, α_max rule {d['alpha_max_rule']}): "
+          f"{dd.verdict.upper()}")
     print(f"  α_max = {d['alpha_max']:.5g} rad/s²  T_m = {d['T_m']:g} s  K = {d['K']:.4g} s/rad  "
-          f"T_c = {d['T_c']:.4g} s  f_s = {d['f_s']}  (η = {d['overshoot_eta']:.3g})")
+          f"T_c = {d['T_c']:.4g} s  T_so = {d['T_so'] * 1e3:.4g} ms  T_sα = {d['T_salpha'] * 1e3:.4g} ms  "
+          f"f_s = {d['f_s']}  (η = {d['overshoot_eta']:.3g})")
     for x in dd.limiting:
         print(f"  {'✗' if x.violated else '·'} {x.text}")
     for n in dd.notes + dd.comparator:
         print(f"  note: {n}")
+    if od.recommendation is not None:
+        print("  net electrical input: " + ", ".join(f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J"
+                                                    for e in od.recommendation.energies))
+        print(f"  recommended: {od.recommendation.why}")
     for name, v in out["verified"].items():
-        print(f"  {name}: peak {v['torque_peak_Nm']:.4g} N·m, {v['i_q_peak_A']:.4g} A, {v['u_peak_V']:.4g} V; "
-              f"error at T_m {v['theta_error_at_Tm_rad']:.3g} rad; chatter {v['chatter']}")
+        inpos = "never" if v["in_position_s"] is None else f"{v['in_position_s']:.4g} s"
+        print(f"  {name}: peak {v['torque_peak_Nm']:.4g} N·m, |i_dq| {v['i_peak_A']:.4g} A, {v['u_peak_V']:.4g} V; "
+              f"error at T_m {v['theta_error_at_Tm_rad']:.3g} rad; overshoot {v['overshoot_rad']:.3g} rad; "
+              f"in position {inpos}; standstill ripple {v['hold_i_q_rms_A']:.3g} A rms; chatter {v['chatter']}")
     return 0

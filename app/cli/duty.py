@@ -15,7 +15,7 @@ from typing import Any
 
 from app.cli.main import add_preset_arguments
 from app.io.json_data import to_json
-from app.io.numbers import parse_number
+from app.io.numbers import number_option, parse_number
 from app.io.presets import load_preset, loads_raw
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
@@ -28,9 +28,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``dutycycle``."""
     add_preset_arguments(p)
     p.add_argument("file", metavar="FILE", help="YAML list of moves {theta_dem, T_m, dwell}")
-    p.add_argument("--cycles-per-hour", type=float, default=3600.0, help="cycles per hour (default 3600)")
-    p.add_argument("--hours-per-year", type=float, default=4000.0, help="operating hours per year (default 4000)")
-    p.add_argument("--price", type=float, default=0.25, help="energy price per kWh (default 0.25)")
+    p.add_argument("--cycles-per-hour", type=number_option("--cycles-per-hour"), default=3600.0,
+                   help="cycles per hour (default 3600)")
+    p.add_argument("--hours-per-year", type=number_option("--hours-per-year"), default=4000.0,
+                   help="operating hours per year (default 4000)")
+    p.add_argument("--price", type=number_option("--price"), default=0.25, help="energy price per kWh (default 0.25)")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
 
 

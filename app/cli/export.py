@@ -12,17 +12,17 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
 import sys
-import tempfile
 from pathlib import Path
 
 from app.cli.main import add_preset_arguments
 from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
 from app.exports.drive_units import ANGLE_UNITS
 from app.exports.model import FORMATS, export_files
+from app.io import atomic
 from app.io.numbers import parse_number
 from app.io.preset_modes import load_mode_preset
+from app.io.presets import load_preset_and_plant
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
@@ -68,22 +68,25 @@ def cycle_seconds(text: str | None) -> float | None:
 
 
 def write_atomic(path: Path, content: bytes) -> None:
-    """Write ``content`` to ``path`` whole: a temporary file in the same folder, then ``os.replace``."""
-    tmp = None
+    """Write ``content`` to ``path`` whole through :func:`app.io.atomic.write_atomic`.
+
+    A temporary file in the same folder, then ``os.replace`` (removed on Ctrl-C too); a write
+    error is a one-line ParameterError.
+    """
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent if str(path.parent) else ".")
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(content)
-        os.replace(tmp, path)
+        atomic.write_atomic(path, content)
     except OSError as exc:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
         raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
 
 def run(args: argparse.Namespace) -> int:
     """Load, simulate, pass the gate, write the export; prints the paths written."""
     params = load_mode_preset(args.preset, args.overrides, mode="position")
+    _, plant = load_preset_and_plant(args.preset, args.overrides)
+    if plant is not None:  # the files carry the controller's model; the drive's true values are not theirs
+        raise ParameterError("plant: export writes the controller's model (motor, load, controller); a plant "
+                             "section or --set plant.* (the drive's true values) is not exported: allowed none — "
+                             "simulate it with `python -m app simulate`, or move the values into motor/load")
     renamed = {k: v for k, v in (("name", args.name), ("source", args.source)) if v is not None}
     params = dataclasses.replace(params, **renamed)
     options = ExportOptions(args.force, args.angle_unit, cycle_seconds(args.cycle_ms))

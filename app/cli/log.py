@@ -13,6 +13,7 @@ from typing import Any
 
 from app.io.drive_log import DriveLog, read_log, run_identification
 from app.io.json_data import to_json
+from app.io.numbers import number_option
 from app.io.presets import DEFAULT_PRESET, load_preset, loads_log_mapping
 from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
@@ -30,7 +31,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--mapping", metavar="YAML", help="column mapping, lines 'column: signal [unit]'")
     p.add_argument("--run", choices=CONTROLLERS, help="which run of a file holding several; also the "
                    "controller simulated for the overlay (default fdsmc)")
-    p.add_argument("--t0", type=float, metavar="SECONDS", help="move start in the log [s] (default: detected)")
+    p.add_argument("--t0", type=number_option("--t0"), metavar="SECONDS",
+                   help="move start in the log [s] (default: detected)")
     p.add_argument("--identify", action="store_true", help="identify R_s, L_d, L_q, Ψ_PM, J_total, F_v, Γ_Le")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
 

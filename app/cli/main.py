@@ -10,8 +10,11 @@ import argparse
 import importlib
 import importlib.util
 import os
+import signal
 import sys
+import threading
 from pathlib import Path
+from typing import Any, NoReturn
 
 #: sub-command → (module, help)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -33,7 +36,9 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # one line, exit 2
-        sys.stderr.write(f"error: {message}\n")
+        from app.io.numbers import one_line
+
+        sys.stderr.write(f"error: {one_line(message, 293)}\n")
         raise SystemExit(2)
 
 
@@ -87,17 +92,77 @@ def check_writable(path: str, option: str) -> None:
         raise ValueError(f"{option} {path!r} is not a writable file: allowed a new or writable file")
 
 
+#: Commands run in a worker thread while the main thread only waits, so that Ctrl-C or SIGTERM is
+#: answered within 1 s even while a compiled kernel runs (the kernels release the GIL). ``serve`` and
+#: ``robustness`` keep the main thread (their servers and pools handle signals themselves).
+THREADED = frozenset({"derive", "design", "simulate", "export", "import-drive", "table1", "bench", "bldc", "log",
+                      "multiaxis", "dutycycle"})
+#: Exit code after Ctrl-C or SIGTERM (128 + SIGINT, as a shell reports it).
+INTERRUPTED = 130
+
+
+def _raise_interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def _run_in_thread(args: argparse.Namespace) -> int:
+    """Run the command in a daemon thread; the main thread waits in short slices (signals stay prompt)."""
+    box: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            box["rc"] = int(args._run(args) or 0)
+        except BaseException as exc:  # noqa: BLE001 - handed to the main thread as it is
+            box["exc"] = exc
+
+    worker = threading.Thread(target=target, name=f"cli-{args.command}", daemon=True)
+    worker.start()
+    while worker.is_alive():
+        worker.join(0.05)
+    if "exc" in box:
+        raise box["exc"]
+    return int(box["rc"])
+
+
+def _stop_interrupted() -> NoReturn:
+    """Remove files being written, say so in one line, exit 130 at once (threads are not waited for)."""
+    from app.io.atomic import discard_partial
+
+    discard_partial()
+    try:
+        sys.stdout.flush()
+        sys.stderr.write("interrupted: stopped; no partial file was left\n")
+        sys.stderr.flush()
+    finally:
+        os._exit(INTERRUPTED)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; returns the process exit code."""
+    """Run the CLI; returns the process exit code (130 at once on Ctrl-C or SIGTERM, from a real process)."""
+    in_main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt) if in_main else None
+    try:
+        return _main(sys.argv[1:] if argv is None else argv)
+    except KeyboardInterrupt:
+        if argv is None:  # ``python -m app``: end the process now, whatever threads still run
+            _stop_interrupted()
+        return INTERRUPTED
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: list[str]) -> int:
     from app.threads import limit_blas_threads
 
     limit_blas_threads()  # before the sub-command imports numpy: then it costs nothing
-    argv = sys.argv[1:] if argv is None else argv
     args = build_parser(chosen_command(argv) or "").parse_args(argv)  # "": --help alone imports none
     try:
+        if args.command in THREADED:
+            return _run_in_thread(args)
         return int(args._run(args) or 0)
     except ValueError as exc:  # ParameterError, PresetError: bad input
-        sys.stderr.write(f"error: {exc}\n")
+        from app.io.numbers import one_line
+
+        sys.stderr.write(f"error: {one_line(exc, 293)}\n")  # ≤ 300 characters with "error: "
         return 2
-    except KeyboardInterrupt:
-        return 130

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from app.io.json_data import to_json
+from app.io.numbers import number_option
 from app.io.presets import loads_raw
 from app.io.study_inputs import parse_axes
 from control.common.checks import ParameterError
@@ -24,7 +25,7 @@ from sim.studies.multiaxis import MultiAxisResult, coordinate
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``multiaxis``."""
     p.add_argument("file", metavar="FILE", help="YAML list of axes (preset, set, name)")
-    p.add_argument("--T-m", dest="T_m", type=float, default=None,
+    p.add_argument("--T-m", dest="T_m", type=number_option("--T-m"), default=None,
                    help="requested common manoeuvre time [s] (default: the shortest all axes can do)")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
 

@@ -12,6 +12,7 @@ import ipaddress
 import sys
 import time
 
+from app.io.numbers import integer_option
 from app.io.preset_modes import load_mode_preset
 from app.io.presets import DEFAULT_PRESET
 from app.ui.web_guard import Guard, new_token
@@ -22,7 +23,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``serve``."""
     p.add_argument("--host", default="127.0.0.1",
                    help="address to bind (default 127.0.0.1, this machine only; 0.0.0.0 = all interfaces)")
-    p.add_argument("--port", type=int, default=8080, help="TCP port (default 8080; the next free one if taken)")
+    p.add_argument("--port", type=integer_option("--port"), default=8080,
+                   help="TCP port (default 8080; the next free one if taken)")
     p.add_argument("--preset", default=DEFAULT_PRESET,
                    help=f"start-up preset name or YAML path (default {DEFAULT_PRESET})")
     p.add_argument("--no-3d", action="store_true", help="do not show the 3D rotor view")

@@ -8,13 +8,15 @@ from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
 from app.exports.model import trace_csv
+from app.io.atomic import write_atomic_text
 from app.io.derived_view import derived_json
 from app.io.json_data import to_json
 from app.io.numbers import format_metric
 from app.io.plant_overrides import load_model_and_plant
 from control.common.checks import ParameterError
-from sim.fdsmc.engine import COMPARATORS, Comparison, compare
+from sim.fdsmc.engine import COMPARATORS, LABELS, Comparison, compare
 from sim.fdsmc.optimum_gap import saving_vs_optimum
+from sim.fdsmc.recommend import recommend, runs_of
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
@@ -69,6 +71,11 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
         for run in (cmp.fdsmc, cmp.conventional, cmp.stock):
             if run is not None:
                 out[run.controller]["saving_vs_optimum_pct"] = saving_vs_optimum(run, cmp.optimum)
+    rec = recommend(cmp.derived.params, cmp)
+    for e in rec.energies:
+        out[e.controller]["net_electrical_J"] = e.net_electrical_J
+        out[e.controller]["checks_failed"] = list(e.failed)
+    out["recommended"] = {"controller": rec.controller, "why": rec.why}
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["run_warnings"] = run_warnings(cmp)
@@ -79,18 +86,22 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
 def write_csv(path: str, cmp: Comparison) -> None:
     """Write the time series in the one CSV format of the exports (:func:`app.exports.model.trace_csv`)."""
     try:
-        with open(path, "w", newline="", encoding="utf-8") as fh:
-            fh.write(trace_csv(cmp))
+        write_atomic_text(path, trace_csv(cmp))  # a temporary file renamed when complete
     except OSError as exc:
         raise ParameterError(f"cannot write --csv {path!r}: {exc.strerror or exc}") from None
 
 
 def print_summary(cmp: Comparison) -> None:
     """Side-by-side table of the runs, savings, warnings and explanations."""
-    runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock) if r is not None]
+    runs = runs_of(cmp)
     p = cmp.derived.params
     print(f"Preset: {p.name}  T_m = {p.manoeuvre.T_m:g} s, θ_dem = {p.manoeuvre.theta_dem:g} rad, "
           f"f_s = {p.controller.f_s}, K = {p.controller.K:g} s/rad\n")
+    rec = recommend(p, cmp)
+    print("Net electrical input, whole run: " + ", ".join(
+        f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J (copper {e.copper_J:.3g}, friction {e.friction_J:.3g})"
+        for e in rec.energies))
+    print(f"Recommended: {LABELS.get(rec.controller or '', 'none')}. {rec.why}\n")
     print(f"{'':40s}" + "".join(f"{r.controller:>16s}" for r in runs))
     for key, label, unit in SUMMARY:
         head = label + (f" [{unit}]" if unit else "")

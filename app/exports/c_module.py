@@ -1,31 +1,49 @@
 """C99 controller module generator: ``fdsmc_controller.h`` and ``fdsmc_controller.c``.
 
 The constants come from one derived design (:class:`control.fdsmc.derivations.Derived`): motor model,
-coefficients A…M of eqs. (1)–(4) in [1], FDC settling times, sliding-mode K, T_c, ω_p, α_max, the
-comparator's g1, g2, the inverter limits, the computation delay and the discrete observer at the
-drive's f_s — the observer in a scaled state-space form (:func:`scaled_observer`) so that float32
-firmware is accurate. The C code itself is in :mod:`app.exports.c_template`.
+coefficients A…M of eqs. (1)–(4) in [1], FDC settling times, sliding-mode K, the designed move's T_c and
+ω_p, α_max, the comparator's g1, g2, the inverter limits, the computation delay, the encoder resolution
+and the discrete observer at the drive's f_s in a scaled state-space form (:func:`scaled_observer`) so
+that float32 firmware is accurate. They are written twice: as ``#define FDSMC_<NAME>`` with unit and
+reference (documentation, and for the integrator's code) and as the ``const fdsmc_params FDSMC_DESIGN``
+the step reads (with precomputed products and reciprocals). The C code is in
+:mod:`app.exports.c_template`; every text goes through :func:`app.exports.c_text.c_string`.
+
+The header carries the verdict (:class:`Verdict`): an unverified or not clean design stops the
+compiler with ``#error`` unless ``FDSMC_ACCEPT_UNCLEAN`` equals the design's :func:`parameter_hash`.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from app.exports.c_design import design_constants, design_initializer, encoder_counts_per_rev
+from app.exports.c_text import c_string
+from app.io.json_data import to_json
+from app.io.presets import to_raw
 from app.io.units import spec_of
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
 
-from .c_template import HEADER, SOURCE
+from .c_source import LIMIT_CODE, SOURCE
+from .c_template import HEADER
 
 TOOL = "pmsm-commissioning (FDSMC)"
 #: File names of the generated module.
 HEADER_NAME, SOURCE_NAME = "fdsmc_controller.h", "fdsmc_controller.c"
+
+#: Why a continuous-mode case has no C export.
+CONTINUOUS_REFUSED = ("controller.f_s = 'continuous' cannot be exported as C firmware: "
+                      "allowed a sample rate in Hz (100 … 1e7)")
 
 
 @dataclass(frozen=True)
@@ -58,6 +76,38 @@ class ScaledObserver:
     L: np.ndarray
 
 
+@dataclass(frozen=True)
+class Verdict:
+    """What the header says about the design's verification.
+
+    Attributes
+    ----------
+    verified : bool
+        True when the tool simulated the design (the FDSMC run exists).
+    failed : tuple of (str, str)
+        (name, text) of each violated check of :func:`sim.fdsmc.design.run_checks`; empty when clean.
+    """
+
+    verified: bool
+    failed: tuple[tuple[str, str], ...] = ()
+
+    @property
+    def clean(self) -> bool:
+        """True when verified and no check failed."""
+        return self.verified and not self.failed
+
+
+#: The verdict of a module made without a simulation: it does not compile unless accepted.
+UNVERIFIED = Verdict(False, (("unverified", "The design was not simulated by the tool."),))
+
+
+def verdict_of(checks: Sequence | None) -> Verdict:
+    """Verdict from :func:`sim.fdsmc.design.run_checks` (objects with .name, .text, .violated); None: unverified."""
+    if checks is None:
+        return UNVERIFIED
+    return Verdict(True, tuple((c.name, c.text) for c in checks if c.violated))
+
+
 def scaled_observer(d: Derived) -> ScaledObserver:
     """Return the derived discrete observer in coordinates where each state is the angle it moves in one sample.
 
@@ -71,12 +121,16 @@ def scaled_observer(d: Derived) -> ScaledObserver:
     """
     od = d.observer_discrete
     if od is None:
-        raise ParameterError("controller.f_s = 'continuous' cannot be exported as C firmware: "
-                             "allowed a sample rate in Hz (100 … 1e7)")
+        raise ParameterError(CONTINUOUS_REFUSED)
     f_s, J_r = 1.0 / od.T_s, d.params.motor.J_r
     scale = np.array([1.0, f_s, f_s**2 * J_r, f_s**3 * J_r])
     Phi = od.Phi * scale[np.newaxis, :] / scale[:, np.newaxis]
-    return ScaledObserver(scale, Phi, od.Gamma * f_s**2 / scale, od.L / scale)
+    Gamma = od.Gamma * f_s**2 / scale
+    # The float C advances the angle in counts and leaves out the zero terms of the chain of integrators.
+    if not (np.array_equal(Phi[:, 0], [1.0, 0.0, 0.0, 0.0]) and not np.tril(Phi, -1).any() and not Gamma[2:].any()):
+        raise ParameterError("the discrete observer is not an upper-triangular chain (Φ column 0 = (1, 0, 0, 0), "
+                             "Γ = (g0, g1, 0, 0)): the C module cannot export it")
+    return ScaledObserver(scale, Phi, Gamma, od.L / scale)
 
 
 #: Constants that are inputs of the preset: C name → ``section.field`` (unit and range from its spec).
@@ -89,12 +143,12 @@ INPUT_KEYS: dict[str, str] = {
 }
 
 
-#: Non-ASCII unit and range symbols → their C-comment spelling.
+#: Non-ASCII unit and range symbols → their ASCII spelling.
 _ASCII_UNITS = (("Ω", "Ohm"), ("·", "*"), ("²", "^2"), ("≤", "<="), ("≥", ">="), ("…", "..."))
 
 
 def c_unit(text: str) -> str:
-    """Spell a unit or range text in ASCII for a C comment, e.g. ``"kg·m²"`` → ``"kg*m^2"``."""
+    """Spell a unit or range text in ASCII, e.g. ``"kg·m²"`` → ``"kg*m^2"``."""
     for old, new in _ASCII_UNITS:
         text = text.replace(old, new)
     return text
@@ -127,13 +181,13 @@ def _loop_constants(params: DriveParams, d: Derived) -> list[CConstant]:
             _input("T_SALPHA", params, "acceleration settling time, eq. (13)"),
             _input("T_SO", params, "observer settling time, eq. (17)"),
             _input("K_BL", params, "boundary-layer gain K, eq. (45)"),
-            CConstant("T_C", pr.T_c, "s", "sliding-mode time constant, eqs. (41), (59)"),
-            CConstant("OMEGA_P", pr.omega_p, "rad/s", "peak speed, eq. (60)"),
+            CConstant("T_C", pr.T_c, "s", "designed move's sliding-mode time constant, eqs. (41), (59)"),
+            CConstant("OMEGA_P", pr.omega_p, "rad/s", "designed move's peak speed, eq. (60)"),
             CConstant("ALPHA_MAX", d.alpha.alpha_max, "rad/s^2", f"acceleration limit ({d.alpha.rule} rule)"),
             CConstant("G1", d.conventional.g1, "1/s^2", "comparator gain, eq. (61)"),
             CConstant("G2", d.conventional.g2, "1/s", "comparator gain, eq. (61)"),
-            _input("THETA_DEM", params, "designed manoeuvre angle"),
-            _input("T_M", params, "designed manoeuvre time")]
+            _input("THETA_DEM", params, "designed manoeuvre angle (information: moves are set at run time)"),
+            _input("T_M", params, "designed manoeuvre time (information)")]
 
 
 def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
@@ -144,25 +198,23 @@ def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     assert od is not None
     f_s, u_max = 1.0 / od.T_s, ctrl.V_dc / math.sqrt(3.0)
     k = [CConstant("F_S", f_s, "Hz", "sample rate"), CConstant("T_S", od.T_s, "s", "sample period"),
-         CConstant("F_S2", f_s**2, "1/s^2", "f_s^2 (observer scaling)"),
-         CConstant("F_S3", f_s**3, "1/s^3", "f_s^3 (observer scaling)"),
-         CConstant("T_S2", od.T_s**2, "s^2", "T_s^2 (observer scaling)"),
          _input("DELAY_SAMPLES", params, "computation delay"),
          CConstant("OBS_Q", d.observer.q, "1/s", "observer bandwidth 15/(2*T_so), eq. (17)"),
          CConstant("OBS_Z_POLE", od.z_pole, "-", "discrete observer pole exp(-q*T_s), four-fold")]
     k += [CConstant(f"OBS_L{i + 1}", float(v), u, "discrete observer gain (unscaled, information)")
           for i, (v, u) in enumerate(zip(od.L, ("-", "1/s", "N*m/rad", "N*m/(rad*s)"), strict=True))]
     return k + [_input("V_DC", params, "DC link (0 = ideal inverter)"),
-                CConstant("U_MAX", u_max, "V", "|u_dq| limit V_dc/sqrt(3)"),
-                CConstant("HAS_U_MAX", int(u_max > 0.0), "-", "voltage limit active", integer=True),
-                _input("I_MAX", params, "|i_q| limit (0 = none)"),
-                CConstant("HAS_I_MAX", int(ctrl.i_max > 0.0), "-", "current limit active", integer=True),
-                _input("GAMMA_MAX", params, "motor torque limit (information)")]
+                CConstant("U_MAX", u_max, "V", "|u_dq| limit V_dc/sqrt(3) (0 = none)"),
+                _input("I_MAX", params, "inverter current amplitude (0 = none)"),
+                _input("GAMMA_MAX", params, "motor torque limit (information)"),
+                CConstant("COUNTS_PER_REV", encoder_counts_per_rev(params), "1/rev",
+                          "encoder counts per mechanical revolution", integer=True)]
 
 
 def controller_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     """Every constant the controller module defines, in SI units, in header order."""
-    return _model_constants(params, d) + _loop_constants(params, d) + _sampling_constants(params, d)
+    runtime = [CConstant(n, v, u, r) for n, v, u, r in design_constants(params, d)]
+    return _model_constants(params, d) + _loop_constants(params, d) + _sampling_constants(params, d) + runtime
 
 
 def c_literal(x: float) -> str:
@@ -173,34 +225,66 @@ def c_literal(x: float) -> str:
     return text if any(ch in text for ch in ".e") else text + ".0"
 
 
-def _ascii(text: str) -> str:
-    """Comment-safe ASCII: non-ASCII as '?', and no comment terminator."""
-    return text.encode("ascii", "replace").decode("ascii").replace("*/", "* /")
+def _comment(text: str) -> str:
+    """Return the tool's own reference text for a comment: ASCII as is when plainly safe, else :func:`c_string`."""
+    text = c_unit(text)
+    plain = text.isascii() and text.isprintable() and not any(s in text for s in ("*/", "/*", "//", "??", "\\"))
+    return text if plain else c_string(text)
 
 
 def _define(k: CConstant) -> str:
     value = str(int(k.value)) if k.integer else f"((fdsmc_real){c_literal(k.value)})"
-    return f"#define FDSMC_{k.name:<13} {value:<32} /* [{k.unit}] {_ascii(k.ref)} */"
+    return f"#define FDSMC_{k.name:<15} {value:<32} /* [{_comment(k.unit)}] {_comment(k.ref)} */"
 
 
-def controller_header(params: DriveParams, d: Derived, schema: int) -> str:
-    """Text of ``fdsmc_controller.h`` for the derived design ``d`` of ``params``."""
+def parameter_hash(params: DriveParams) -> str:
+    """Hash of a preset's inputs: 16 hex digits of SHA-256 over the canonical JSON of the preset.
+
+    The same inputs give the same hash whether exported as YAML, JSON or C (the loader reads
+    every format back to the same :class:`DriveParams`), so the hash ties a ``.h`` to its file.
+    """
+    text = json.dumps(to_json(to_raw(params)), sort_keys=True, separators=(",", ":"), ensure_ascii=True,
+                      allow_nan=False)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()[:16]
+
+
+def _gate_texts(v: Verdict, hash_value: str) -> dict[str, str]:
+    """Header placeholders of the verdict gate."""
+    names = ", ".join(n for n, _ in v.failed)
+    if v.clean:
+        verdict = "CLEAN -- the simulated FDSMC run of this design passed every check."
+    else:
+        verdict = ("UNVERIFIED" if not v.verified else "NOT CLEAN") + " -- this header stops the build (#error)" \
+                  " unless FDSMC_ACCEPT_UNCLEAN is defined as FDSMC_PARAM_HASH. Failed checks:"
+    checks = "".join(f" *   {c_string(f'{n}: {t}')}\n" for n, t in v.failed)
+    error = (f"fdsmc_controller.h: design {'not verified' if not v.verified else 'not clean'} (failed: {names});"
+             f" see the header; to build it anyway define FDSMC_ACCEPT_UNCLEAN={hash_value}")
+    return {"verdict": verdict, "checks": checks, "verified": str(int(v.verified)), "clean": str(int(v.clean)),
+            "failed": c_string(names), "error_text": c_string(error)}
+
+
+def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED,
+                      inputs: DriveParams | None = None) -> str:
+    """Text of ``fdsmc_controller.h`` for the derived design ``d`` of ``params``.
+
+    ``inputs``: the preset as entered, whose :func:`parameter_hash` the header carries (default ``params``;
+    the export passes the entered preset when ``params`` has θ_dem rounded to a count).
+    """
     defines = "\n".join(_define(k) for k in controller_constants(params, d))
-    return HEADER.substitute(tool=TOOL, name=_ascii(params.name),
-                             source=_ascii(params.source), schema=schema, constants=defines)
-
-
-def _row(values: np.ndarray) -> str:
-    return ", ".join(f"R_({c_literal(v)})" for v in values)
+    h = parameter_hash(params if inputs is None else inputs)
+    return HEADER.substitute(tool=TOOL, name=c_string(params.name), source=c_string(params.source), schema=schema,
+                             constants=defines, hash_text=h, hash_value=f"0x{h}u", **_gate_texts(verdict, f"0x{h}u"))
 
 
 def controller_source(params: DriveParams, d: Derived) -> str:
     """Text of ``fdsmc_controller.c`` for the derived design ``d`` of ``params``."""
     so = scaled_observer(d)
-    phi = ",\n".join(f"    {{{_row(r)}}}" for r in so.Phi)
-    return SOURCE.substitute(name=_ascii(params.name), phi=phi, gamma=_row(so.Gamma), gain=_row(so.L))
+    return SOURCE.substitute(name=c_string(params.name), design=design_initializer(params, d, so, c_literal),
+                             limit_code=LIMIT_CODE)
 
 
-def controller_files(params: DriveParams, d: Derived, schema: int) -> dict[str, str]:
-    """File name → text of the controller module (header and source)."""
-    return {HEADER_NAME: controller_header(params, d, schema), SOURCE_NAME: controller_source(params, d)}
+def controller_files(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED,
+                     inputs: DriveParams | None = None) -> dict[str, str]:
+    """File name → text of the controller module (header and source); unverified unless ``verdict`` says."""
+    return {HEADER_NAME: controller_header(params, d, schema, verdict, inputs),
+            SOURCE_NAME: controller_source(params, d)}

@@ -3,15 +3,21 @@
 The module is compiled with the system C compiler (``cc``) into a shared object and called through
 :mod:`ctypes` — standard library, no build step or extra package — once per controller sample,
 between the RK4 steps of :class:`sim.fdsmc.plant.PlantInTheLoop` (the plant integration of the
-simulator's digital mode). Agreement = max |C − simulator| / max |simulator| over the run, per
-signal (error relative to the signal's peak), at every sample.
+simulator's digital mode). The C module takes the angle as encoder counts: the harness feeds it what
+the simulator's controller reads (:func:`readings`: the encoder's whole counts of θ_r, the currents with
+the seeded noise and ADC of :mod:`sim.common.sensors`), sets the move with the demand rounded to a count,
+and the simulator runs on the same demand and encoder (:func:`count_params`). Agreement = max |C − simulator|
+/ max |simulator| over the run, per signal (error relative to the signal's peak), at every sample.
 
-``python -m app.exports.c_verify`` prints the figures for the paper preset (double and float32 builds).
+``python -m app.exports.c_verify`` prints the figures for the paper preset and the real-motor presets.
 """
 
 from __future__ import annotations
 
 import ctypes
+import dataclasses
+import math
+import re
 import shutil
 import subprocess
 import tempfile
@@ -19,10 +25,12 @@ from pathlib import Path
 
 import numpy as np
 
-from app.exports.c_module import controller_files
-from app.io.presets import SCHEMA, load_preset
+from app.exports.c_design import encoder_counts_per_rev
+from app.exports.c_module import Verdict, controller_files
+from app.io.presets import SCHEMA, list_presets, load_preset
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
+from sim.common import sensors
 from sim.fdsmc.engine import simulate
 from sim.fdsmc.plant import PlantInTheLoop
 
@@ -37,51 +45,119 @@ def compiler() -> str | None:
     return shutil.which("cc") or shutil.which("gcc")
 
 
-def write_module(folder: Path, params: DriveParams) -> None:
-    """Generate ``fdsmc_controller.h``/``.c`` for ``params`` into ``folder``."""
-    for name, text in controller_files(params, derive(params), SCHEMA).items():
+def count_params(params: DriveParams) -> tuple[DriveParams, int]:
+    """Return the case as the firmware runs it, and the demand in counts.
+
+    θ_dem is rounded to a whole encoder count; an ideal encoder becomes the module's resolution
+    (:data:`app.exports.c_design.IDEAL_COUNTS_PER_REV`), so that the simulator reads the same counts.
+    """
+    cpr = encoder_counts_per_rev(params)
+    se = dataclasses.replace(params.sensors, encoder_cpr=cpr)
+    step = sensors.encoder_step(se)
+    count = round(params.manoeuvre.theta_dem / step)
+    man = dataclasses.replace(params.manoeuvre, theta_dem=count * step)
+    return dataclasses.replace(params, manoeuvre=man, sensors=se), count
+
+
+def readings(params: DriveParams, k: int, theta: float, i_d: float, i_q: float,
+             noise: np.ndarray) -> tuple[int, float, float]:
+    """Return what the controller reads at sample k: (encoder count, i_d [A], i_q [A]), as the simulator's sensors.
+
+    ``noise`` is :func:`sim.common.sensors.noise_table` of ``params.sensors``; the encoder must not be ideal.
+    """
+    se, j = params.sensors, k % noise.shape[1]
+    i_step = sensors.adc_step(se)
+    return (math.floor(theta / sensors.encoder_step(se)),
+            sensors.adc_current(i_d, noise[0, j], se.i_noise, i_step, se.i_adc_range),
+            sensors.adc_current(i_q, noise[1, j], se.i_noise, i_step, se.i_adc_range))
+
+
+def write_module(folder: Path, params: DriveParams, verdict: Verdict | None = None) -> None:
+    """Generate ``fdsmc_controller.h``/``.c`` for ``params`` into ``folder`` (unverified unless ``verdict``)."""
+    kw = {} if verdict is None else {"verdict": verdict}
+    for name, text in controller_files(params, derive(params), SCHEMA, **kw).items():
         (folder / name).write_text(text, encoding="utf-8")
 
 
+def accept_flag(folder: Path) -> str:
+    """``-DFDSMC_ACCEPT_UNCLEAN=<hash>``: the explicit acceptance of the module in ``folder``."""
+    text = (folder / "fdsmc_controller.h").read_text(encoding="utf-8")
+    match = re.search(r"#define FDSMC_PARAM_HASH (0x[0-9a-f]+u)", text)
+    assert match, "no FDSMC_PARAM_HASH in the header"
+    return f"-DFDSMC_ACCEPT_UNCLEAN={match.group(1)}"
+
+
 def build(folder: Path, single: bool) -> ctypes.CDLL:
-    """Compile the module in ``folder`` (float32 if ``single``) as a shared object and load it."""
+    """Compile the module in ``folder`` (float32 if ``single``, the gate accepted) as a shared object and load it."""
     cc = compiler()
     if cc is None:
         raise RuntimeError("no C compiler (cc) found: scripts/ensure_cc.sh installs it")
     so = folder / ("libfdsmc_f.so" if single else "libfdsmc_d.so")
     defines = ["-DFDSMC_USE_FLOAT"] if single else []
-    subprocess.run([cc, *CFLAGS, *defines, "-shared", "-fPIC", "-O2", str(folder / "fdsmc_controller.c"),
-                    "-o", str(so), "-lm"], check=True, capture_output=True, text=True)
+    subprocess.run([cc, *CFLAGS, *defines, accept_flag(folder), "-shared", "-fPIC", "-O2",
+                    str(folder / "fdsmc_controller.c"), "-o", str(so), "-lm"],
+                   check=True, capture_output=True, text=True)
     return ctypes.CDLL(str(so))
 
 
-def _types(single: bool) -> tuple[type, type, type, type]:
-    real, angle = (ctypes.c_float if single else ctypes.c_double), ctypes.c_double
+class CModule:
+    """ctypes view of one compiled module: its structs and functions (``single``: float32 build)."""
 
-    class State(ctypes.Structure):
-        _fields_ = [("z0", angle), ("z", real * 3), ("theta_ref", angle), ("u_hold", real * 2)]
+    def __init__(self, lib: ctypes.CDLL, single: bool) -> None:
+        real = ctypes.c_float if single else ctypes.c_double
+        i32, u32 = ctypes.c_int32, ctypes.c_uint32
 
-    class Output(ctypes.Structure):
-        _fields_ = [("u_d", real), ("u_q", real), ("theta_hat", angle), ("omega_hat", real),
-                    ("Gamma_L_hat", real), ("alpha_dem", real), ("S", real), ("saturated", ctypes.c_int)]
+        class Status(ctypes.Structure):
+            _fields_ = [("fault", u32), ("fault_sample", u32), ("samples", u32), ("saturated_samples", u32),
+                        ("e_o_peak", real), ("last_move", i32)]
 
-    return real, angle, State, Output
+        observer = ([("n0", i32), ("f0", real), ("z", real * 3)] if single
+                    else [("theta_dem_rad", ctypes.c_double), ("x", ctypes.c_double * 4)])
+
+        class State(ctypes.Structure):
+            _fields_ = [("p", ctypes.c_void_p), ("theta_dem", i32), *observer, ("u_hold", real * 2),
+                        ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
+                        ("status", Status)]
+
+        class Output(ctypes.Structure):
+            _fields_ = [("u_d", real), ("u_q", real), ("theta_re", real), ("omega_hat", real),
+                        ("Gamma_L_hat", real), ("alpha_dem", real), ("S", real), ("saturated", i32), ("fault", u32)]
+
+        self.lib, self.State, self.Output = lib, State, Output
+        self.design = ctypes.addressof(ctypes.c_char.in_dll(lib, "FDSMC_DESIGN"))
+        ps = ctypes.POINTER(State)
+        lib.fdsmc_init.argtypes = [ps, ctypes.c_void_p, i32]
+        lib.fdsmc_set_move.argtypes, lib.fdsmc_set_move.restype = [ps, i32, real], i32
+        for f in (lib.fdsmc_step, lib.fdsmc_step_conventional):
+            f.argtypes = [ps, i32, real, real, ctypes.POINTER(Output)]
+        lib.fdsmc_electrical_angle.argtypes, lib.fdsmc_electrical_angle.restype = [i32, i32], real
+
+    def new_state(self, theta_r0: int = 0) -> ctypes.Structure:
+        """Return an initialised state at the count ``theta_r0``."""
+        s = self.State()
+        self.lib.fdsmc_init(ctypes.byref(s), self.design, theta_r0)
+        return s
 
 
 def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller: str = "fdsmc") -> np.ndarray:
-    """Plant states [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, …] at every sample, C module in the loop."""
-    real, angle, State, Output = _types(single)
+    """Plant states [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, …] at every sample, C module in the loop.
+
+    ``params`` as :func:`count_params` returns them; the move is set at run time (``fdsmc_set_move``
+    to θ_dem in counts, in T_m); the module reads the sensors of :func:`readings`.
+    """
+    m = CModule(lib, single)
+    state, out = m.new_state(0), m.Output()
+    _, count = count_params(params)
+    rc = lib.fdsmc_set_move(ctypes.byref(state), count, params.manoeuvre.T_m)
+    if rc != 0:
+        raise RuntimeError(f"fdsmc_set_move refused the designed move: status {rc}")
     step = lib.fdsmc_step if controller == "fdsmc" else lib.fdsmc_step_conventional
-    lib.fdsmc_init.argtypes = [ctypes.POINTER(State), angle]
-    step.argtypes = [ctypes.POINTER(State), angle, real, real, angle, ctypes.POINTER(Output)]
-    state, out = State(), Output()
-    lib.fdsmc_init(ctypes.byref(state), 0.0)
-    plant, theta_dem = PlantInTheLoop(params), params.manoeuvre.theta_dem
+    plant, noise = PlantInTheLoop(params), sensors.noise_table(params.sensors)
     rows = np.zeros((plant.n_samples, len(plant.x)))
     for k in range(plant.n_samples):
         x = plant.x
         rows[k] = x
-        step(ctypes.byref(state), x[2], x[0], x[1], theta_dem, ctypes.byref(out))
+        step(ctypes.byref(state), *readings(params, k, x[2], x[0], x[1], noise), ctypes.byref(out))
         plant.step(out.u_d, out.u_q)
     return rows
 
@@ -97,21 +173,50 @@ def agreement(params: DriveParams, rows: np.ndarray, controller: str = "fdsmc") 
 
 
 def measure(params: DriveParams, single: bool, controller: str = "fdsmc") -> dict[str, float]:
-    """Generate, compile, run and compare one build for ``params``."""
+    """Generate, compile, run and compare one build for ``params`` (demand rounded to a count)."""
+    params, _ = count_params(params)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         write_module(folder, params)
         return agreement(params, closed_loop(build(folder, single), single, params, controller), controller)
 
 
+def replay(folder: Path, single: bool) -> float:
+    """Build and run the export's host test program in ``folder``; returns max |u − u_sim| / peak |u| [-]."""
+    cc = compiler()
+    if cc is None:
+        raise RuntimeError("no C compiler (cc) found: scripts/ensure_cc.sh installs it")
+    defines = ["-DFDSMC_USE_FLOAT"] if single else []
+    subprocess.run([cc, *CFLAGS, *defines, accept_flag(folder), "-O2", "fdsmc_test.c", "fdsmc_controller.c", "-lm",
+                    "-o", "fdsmc_test"], cwd=folder, check=True, capture_output=True, text=True)
+    out = subprocess.run(["./fdsmc_test"], cwd=folder, capture_output=True, text=True).stdout
+    return float(out.split("peak |u| = ")[1].split()[0])
+
+
 def main() -> None:
-    """Print the agreement figures of the paper preset (paper K and recommended K)."""
-    for label, sets in (("paper preset, K = 1000", []), ("paper preset, recommended K = 0.3", ["controller.K=0.3"])):
-        params = load_preset("paper_12kw_pmsm", sets)
+    """Print closed-loop agreement (both builds) and the golden-vector replay, paper and real-motor presets.
+
+    The real-motor presets run with their own sensors (encoder, current noise, ADC).
+    """
+    from app.exports.c_vectors import c_files  # the vectors module imports this one
+    from sim.fdsmc.design import run_checks
+    from sim.fdsmc.engine import compare
+
+    cases = [("paper, K = 1000", "paper_12kw_pmsm", []), ("paper, K = 0.3", "paper_12kw_pmsm", ["controller.K=0.3"])]
+    cases += [(n, n, []) for n in list_presets()
+              if n != "paper_12kw_pmsm" and isinstance(load_preset(n), DriveParams)]
+    for label, preset, sets in cases:
+        params = load_preset(preset, sets)
+        cmp = compare(params)
+        with tempfile.TemporaryDirectory() as tmp:
+            for name, text in c_files(cmp, run_checks(params, cmp.fdsmc), force=True).items():
+                (Path(tmp) / name).write_text(text, encoding="utf-8")
+            same = [replay(Path(tmp), single) for single in (False, True)]
         for single in (False, True):
             err = measure(params, single)
-            text = "  ".join(f"{k} {v:.2e}" for k, v in err.items())
-            print(f"{label:36s} {'float32' if single else 'double ':8s} {text}")
+            text = "  ".join(f"{k} {v:.1e}" for k, v in err.items())
+            print(f"{label:20s} {'float32' if single else 'double':7s} closed loop: {text}; same readings: "
+                  f"u {same[single]:.1e}", flush=True)
 
 
 if __name__ == "__main__":

@@ -36,7 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from app.exports.c_module import TOOL, controller_files
+from app.exports.c_module import TOOL
+from app.exports.c_vectors import c_files
 from app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
 from app.exports.provenance import check_text, failed_checks, gate, verdict_lines
 from app.io.derived_view import derived_rows
@@ -45,6 +46,7 @@ from app.io.presets import SCHEMA, annotate_units, dumps, to_raw
 from app.io.units import SI_UNITS
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
+from sim.fdsmc.checks import run_checks
 from sim.fdsmc.engine import Comparison
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
@@ -205,8 +207,9 @@ def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPT
     if fmt in DRIVE_FORMATS:
         name, text = drive_file(fmt, cmp, failed, stem, options)
         return {name: text.encode("utf-8")}
-    if fmt == "c":
-        files = controller_files(cmp.derived.params, cmp.derived, SCHEMA)
+    if fmt == "c":  # the gate above has refused an unclean design unless forced; the header gates the build
+        checks = run_checks(cmp.derived.params, cmp.fdsmc) if cmp.fdsmc is not None else None
+        files = c_files(cmp, checks, force=True)
         return {name: _warned(fmt, text, failed).encode("utf-8") for name, text in files.items()}
     if fmt == "html":
         from app.exports.html import html_report  # plotly: imported only when a report is made

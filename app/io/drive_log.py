@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from app.io import units
+from app.io.numbers import FORMS, NumberFormatError, parse_number, shorten, shown
 from control.fdsmc.identification import Identification, identify
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.kernel import CHANNELS
@@ -36,6 +37,10 @@ from sim.fdsmc.kernel import CHANNELS
 MAX_BYTES = 50 * 1024 * 1024
 #: Most data rows accepted [-].
 MAX_ROWS = 2_000_000
+#: Cell texts that mark a gap (refused by :func:`_check_finite`, which counts them).
+_GAPS = frozenset({"", "nan", "inf", "infinity"})
+#: Shortest sample interval accepted [s] (1 GHz).
+MIN_SAMPLE_S = 1e-9
 #: Fewest data rows accepted [-].
 MIN_ROWS = 20
 #: Largest sample interval accepted, relative to the median one [-] (larger is a gap).
@@ -136,8 +141,8 @@ def _signal_name(name: str) -> str:
 
 def _is_number(text: str) -> bool:
     try:
-        float(text)
-    except ValueError:
+        parse_number(text, "cell")
+    except NumberFormatError:
         return False
     return True
 
@@ -223,23 +228,29 @@ def _parse_rows(lines: list[str], line_no: list[int], delim: str, width: int, us
     """Read the used columns as floats: numpy's fast reader, or a row-by-row scan naming the bad cell."""
     if all(ln.count(delim) == width - 1 for ln in lines):
         try:
-            return np.loadtxt(lines, delimiter=delim, usecols=[c.index for c in used], ndmin=2, dtype=float)
+            return np.loadtxt(lines, delimiter=delim, usecols=[c.index for c in used], ndmin=2, dtype=float,
+                              comments=None)  # "#" lines are gone already; a "#" in a cell is no number
         except ValueError:
             pass  # an empty or non-numeric cell: the scan names it
     return _scan_rows(lines, line_no, delim, width, used)
 
 
 def _scan_rows(lines: list[str], line_no: list[int], delim: str, width: int, used: list[_Column]) -> np.ndarray:
-    data = np.empty((len(lines), len(used)))
-    for r, row in enumerate(csv.reader(lines, delimiter=delim)):
-        if len(row) != width:
-            raise LogError(f"line {line_no[r]}: {len(row)} fields, the header has {width}")
-        for j, c in enumerate(used):
-            cell = row[c.index].strip()
-            try:
-                data[r, j] = float(cell) if cell else math.nan
-            except ValueError:
-                raise LogError(f"line {line_no[r]}, column {c.header!r}: {cell!r} is not a number") from None
+    data, r = np.empty((len(lines), len(used))), 0
+    try:
+        for r, row in enumerate(csv.reader(lines, delimiter=delim)):
+            if len(row) != width:
+                raise LogError(f"line {line_no[r]}: {len(row)} fields, the header has {width}")
+            for j, c in enumerate(used):
+                cell = row[c.index].strip()
+                try:  # the one number grammar (ASCII digits only); gaps and NaN/inf: counted by _check_finite
+                    data[r, j] = math.nan if cell.lower().lstrip("+-") in _GAPS else parse_number(cell, "cell")
+                except NumberFormatError:
+                    raise LogError(f"line {line_no[r]}, column {shown(c.header)}: {shown(cell)} is not a number: "
+                                   f"allowed {FORMS}") from None
+    except csv.Error as exc:  # e.g. an unterminated quote swallowing the rest of the file
+        raise LogError(f"line {line_no[min(r, len(line_no) - 1)] if line_no else 1}: not valid CSV "
+                       f"({shorten(exc, 80)}): allowed one row per line, quotes closed") from None
     return data
 
 
@@ -259,6 +270,9 @@ def _check_time(t: np.ndarray, line_no: list[int], header: str) -> float:
         raise LogError(f"column {header!r}: time does not increase at line {line_no[k + 1]} "
                        f"({t[k + 1]:g} after {t[k]:g}): the rows must be sorted by time, without repeats")
     T_s = float(np.median(dt))
+    if not T_s >= MIN_SAMPLE_S:
+        raise LogError(f"column {shown(header)}: sample interval {T_s:.3g} s: allowed ≥ {MIN_SAMPLE_S:g} s "
+                       "(is the time column's unit right?)")
     k = int(np.argmax(dt))
     if dt[k] > GAP_RATIO * T_s:
         raise LogError(f"column {header!r}: gap of {dt[k]:.6g} s before line {line_no[k + 1]} (sample period "
@@ -327,6 +341,15 @@ def _rows_of_run(lines: list[str], line_no: list[int], delim: str, header: list[
 def parse_log(text: str, name: str = "<log>", *, mapping: dict[str, str] | None = None, run: str | None = None,
               p: int | None = None) -> DriveLog:
     """Validate and convert a log's text (see the module docstring); raises :class:`LogError`."""
+    try:
+        return _parse_log(text, name, mapping=mapping, run=run, p=p)
+    except csv.Error as exc:  # an unterminated quote swallowing the rest of the file, a NUL byte …
+        raise LogError(f"{shown(name)} is not valid CSV ({shorten(exc, 80)}): allowed one row per line, "
+                       "every quote closed") from None
+
+
+def _parse_log(text: str, name: str, *, mapping: dict[str, str] | None, run: str | None,
+               p: int | None) -> DriveLog:
     if len(text) > MAX_BYTES:
         raise LogError(f"{name} is {len(text) / 2**20:.1f} MB: allowed ≤ {MAX_BYTES // 2**20} MB")
     header, lines, delim, line_no = _body(text)

@@ -17,7 +17,7 @@ import typing
 from typing import Any
 
 from app.io import units
-from app.io.numbers import NumberFormatError, parse_integer, parse_number
+from app.io.numbers import NumberFormatError, parse_integer, parse_number, shorten, shown
 from control.bldc.params import BldcParams
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
@@ -73,7 +73,7 @@ def number_of(name: str, value: Any, tp: type) -> Any:
     except NumberFormatError as exc:
         raise PresetError(str(exc)) from None
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
+        raise PresetError(f"{name} = {shown(value)} has the wrong type: allowed {_describe(tp)}")
     if tp is int:  # 4.0 → 4; 2.5, nan … go to the dataclass, which names the allowed range
         return int(value) if math.isfinite(value) and float(value).is_integer() else value
     return float(value)
@@ -84,7 +84,7 @@ def _coerce(name: str, value: Any, tp: Any) -> Any:
     if tp in (float, int):
         return number_of(name, value, tp)
     if tp is str and isinstance(value, str):
-        return value
+        return str(value)  # plain text, whether the file quoted it or not
     if isinstance(tp, types.UnionType):  # e.g. float | str: a number, else the keyword text
         args = typing.get_args(tp)
         if float in args and isinstance(value, str) and str in args:
@@ -102,7 +102,7 @@ def _coerce(name: str, value: Any, tp: Any) -> Any:
         if item is float:  # a list of numbers, e.g. a sampled back-EMF period
             return tuple(_coerce(f"{name}[{i}]", v, float) for i, v in enumerate(value))
         return tuple(_parse_section(item, v, f"{name}[{i}]") for i, v in enumerate(value))
-    raise PresetError(f"{name} = {value!r} has the wrong type: allowed {_describe(tp)}")
+    raise PresetError(f"{name} = {shown(value)} has the wrong type: allowed {_describe(tp)}")
 
 
 def _parse_section(cls: type, raw: Any, section: str) -> Any:
@@ -135,7 +135,7 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
                 raise PresetError(f"{section}.{key} needs a valid {section}.p (pole pairs) beside it")
             values[target] = units.FLUX_KEYS[key](ke, p)
         else:
-            raise PresetError(f"unknown key {section}.{key}{hint(key, allowed)}")
+            raise PresetError(f"unknown key {shorten(f'{section}.{key}')}{hint(key, allowed)}")
         if sum(1 for k in raw if field_of(str(k), aliases, extra) == target) > 1:
             raise PresetError(f"{section}.{target} is given more than once (SI and unit-suffixed forms)")
     missing = [
@@ -169,13 +169,13 @@ def parse_preset(raw: Any) -> Any:
     raw = migrate(raw)
     mode = raw.get("mode", "position")
     if mode not in MODES:
-        raise PresetError(f"mode = {mode!r} is not known{hint(str(mode), list(MODES))}")
+        raise PresetError(f"mode = {shown(mode)} is not known{hint(str(mode), list(MODES))}")
     cls = MODES[mode]
     sections = [f.name for f in dataclasses.fields(cls) if f.name not in ("name", "source")]
     allowed = list(_TOP_KEYS) + list(_EXPORT_KEYS) + list(sections) + ([PLANT] if cls is DriveParams else [])
     for key in raw:
         if key not in allowed:
-            raise PresetError(f"unknown top-level key {key!r}{hint(str(key), allowed)}")
+            raise PresetError(f"unknown top-level key {shown(key)}{hint(str(key), allowed)}")
     hints = typing.get_type_hints(cls)
     kwargs: dict[str, Any] = {}
     optional = optional_sections(cls)
@@ -240,7 +240,7 @@ def parse_plant(raw: Any, params: DriveParams) -> DriveParams | None:
     split: dict[str, dict[str, Any]] = {s: {} for s in PLANT_SECTIONS}
     for key, value in block.items():
         if str(key) not in known:
-            raise PresetError(f"unknown key plant.{key}{hint(str(key), list(known))}")
+            raise PresetError(f"unknown key {shorten(f'plant.{key}')}{hint(str(key), list(known))}")
         split[known[str(key)]][str(key)] = value
     hints = typing.get_type_hints(DriveParams)
     parts: dict[str, Any] = {}

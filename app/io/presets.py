@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import copy
 import functools
-import json
 import re
 import typing
 from pathlib import Path
@@ -27,6 +26,9 @@ from typing import Any
 import yaml
 
 from app.io import units
+from app.io.atomic import write_atomic_text
+from app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
+from app.io.numbers import QuotedText, shorten, shown
 from app.io.preset_schema import (
     MODES,
     PLANT,
@@ -44,7 +46,6 @@ from control.common.checks import field_specs
 from control.fdsmc.params import DriveParams
 
 PRESET_DIR = Path(__file__).resolve().parents[2] / "presets"
-MAX_BYTES = 256 * 1024
 #: The page's start-up preset: a real catalogue servo with a verified clean design.
 DEFAULT_PRESET = "siemens_1ft7044_ak7"
 #: The FDSMC paper's drive (section 5 of [1]), for reproduction.
@@ -52,10 +53,9 @@ PAPER_PRESET = "paper_12kw_pmsm"
 
 
 # ---- YAML front-end: text → raw mapping of texts, lists and mappings -------------------------
-#: Deepest nesting of brackets / block indentation levels a preset may have (presets need 4).
-MAX_DEPTH = 32
-#: Widest indentation of a line [columns] (bounds block nesting the same way).
-MAX_INDENT = 128
+def _too_deep(origin: str, mark: Any, kind: str) -> PresetError:
+    return PresetError(f"{origin} is nested too deeply at line {mark.line + 1}, column {mark.column + 1}: "
+                       f"allowed ≤ {MAX_DEPTH} levels of {kind}")
 
 
 class _TextLoader(yaml.SafeLoader):
@@ -63,11 +63,74 @@ class _TextLoader(yaml.SafeLoader):
 
     Without it ``1:30`` → 90, ``017`` → 15, and ``0x10``, ``1_000``, ``yes`` → True … would be converted.
     Numbers are parsed afterwards by :mod:`app.io.numbers` against the field types; duplicate keys and
-    explicit tags are errors.
+    explicit tags are errors. A quoted or block scalar (``"1.5"``, a ``>`` block) becomes
+    :class:`~app.io.numbers.QuotedText`, which is never a number.
+
+    The scanner counts the nesting as it reads: the ``MAX_DEPTH + 1``-th bracket or indentation level
+    is refused on the spot, so no text costs more than its size (a pre-scan can be fooled by
+    quotes and comments; the scanner cannot).
     """
+
+    origin = "<text>"
+
+    def fetch_flow_collection_start(self, TokenClass: Any) -> None:  # noqa: N803 - PyYAML's name
+        """Refuse a bracket that would nest deeper than :data:`MAX_DEPTH`."""
+        if self.flow_level >= MAX_DEPTH:
+            raise _too_deep(self.origin, self.get_mark(), "brackets")
+        super().fetch_flow_collection_start(TokenClass)
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        """Refuse an anchor (``&name``) or alias (``*name``) before it is composed (one pass)."""
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
+            raise PresetError(f"YAML anchors/aliases (*name) at line {event.start_mark.line + 1} are not allowed "
+                              "in presets: write each value out")
+        return super().compose_node(parent, index)
+
+    def add_indent(self, column: int) -> bool:
+        """Refuse a block indentation level deeper than :data:`MAX_DEPTH`."""
+        if self.indent < column and len(self.indents) >= MAX_DEPTH:
+            raise _too_deep(self.origin, self.get_mark(), "indentation")
+        return bool(super().add_indent(column))
 
 
 _TextLoader.yaml_implicit_resolvers = {}
+#: libyaml's parser (≈ 10× faster), when PyYAML was built with it: the same constructors, the nesting
+#: and anchors checked on its event stream first (:func:`_check_events`).
+_CLoader: Any = None
+if getattr(yaml, "__with_libyaml__", False):
+    _CLoader = type("_CTextLoader", (yaml.CSafeLoader,), {"yaml_implicit_resolvers": {}})
+
+
+def _loader(origin: str) -> type[_TextLoader]:
+    """:class:`_TextLoader` naming ``origin`` in its messages."""
+    return type("_OriginLoader", (_TextLoader,), {"origin": origin})
+
+
+def _check_events(text: str, origin: str) -> None:
+    """Stream libyaml's parser events: refuse anchors, aliases and nesting deeper than :data:`MAX_DEPTH`.
+
+    The parser stops at the first refusal, having read only a bounded look-ahead past it.
+    """
+    depth = 0
+    for event in yaml.parse(text, Loader=_CLoader):
+        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
+            raise PresetError(f"YAML anchors/aliases (*name) at line {event.start_mark.line + 1} are not allowed "
+                              "in presets: write each value out")
+        if isinstance(event, yaml.CollectionStartEvent):
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise _too_deep(origin, event.start_mark, "nesting (brackets or indentation)")
+        elif isinstance(event, yaml.CollectionEndEvent):
+            depth -= 1
+
+
+def _load(text: str, origin: str) -> Any:
+    """YAML text → data: libyaml after its event check, else the pure-Python guarded loader."""
+    if _CLoader is None:
+        return yaml.load(text, Loader=_loader(origin))  # noqa: S506 - a SafeLoader subclass
+    _check_events(text, origin)
+    return yaml.load(text, Loader=_CLoader)  # noqa: S506 - a CSafeLoader subclass, tags refused
 
 
 def _mark(node: yaml.Node) -> str:
@@ -75,7 +138,12 @@ def _mark(node: yaml.Node) -> str:
 
 
 def _refuse_tag(loader: _TextLoader, node: yaml.Node) -> Any:
-    raise PresetError(f"YAML tag {node.tag!r} at {_mark(node)} is not allowed: write plain values")
+    raise PresetError(f"YAML tag {shorten(node.tag)!r} at {_mark(node)} is not allowed: write plain values")
+
+
+def _text(loader: _TextLoader, node: yaml.ScalarNode) -> str:
+    value = loader.construct_scalar(node)
+    return QuotedText(value) if node.style else str(value)
 
 
 def _unique_mapping(loader: _TextLoader, node: yaml.MappingNode) -> dict[Any, Any]:
@@ -85,74 +153,54 @@ def _unique_mapping(loader: _TextLoader, node: yaml.MappingNode) -> dict[Any, An
         key = loader.construct_object(key_node, deep=True)
         if not isinstance(key, str):
             raise PresetError(f"key at {_mark(key_node)} is not a name: allowed text keys only")
+        key = str(key)
         if key in out:
-            raise PresetError(f"duplicate key {key!r} at {_mark(key_node)} (first at {first[key]}): "
+            raise PresetError(f"duplicate key {shorten(key)!r} at {_mark(key_node)} (first at {first[key]}): "
                               "allowed each key once per mapping")
         first[key] = _mark(key_node)
         out[key] = loader.construct_object(value_node, deep=True)
     return out
 
 
-for _tag in ("null", "bool", "int", "float", "binary", "timestamp", "omap", "pairs", "set", "merge", "value"):
-    _TextLoader.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
-_TextLoader.add_constructor(None, _refuse_tag)
-_TextLoader.add_constructor("tag:yaml.org,2002:map", _unique_mapping)
-
-
-def check_structure(text: str, origin: str) -> None:
-    """Cheap pre-scan before parsing: bracket nesting ≤ MAX_DEPTH, indentation ≤ MAX_INDENT.
-
-    Deeply nested flow collections (``[[[[…]]]]``) make a YAML parser's time grow faster than
-    the text; this linear scan refuses them first. Quotes and comments are skipped.
-    """
-    depth = 0
-    for number, line in enumerate(text.splitlines(), 1):
-        indent = len(line) - len(line.lstrip(" -"))
-        if indent > MAX_INDENT:
-            raise PresetError(f"{origin} line {number} is indented {indent} columns: allowed ≤ {MAX_INDENT}")
-        quote = ""
-        for ch in line:
-            if quote:
-                quote = "" if ch == quote else quote
-            elif ch in "'\"":
-                quote = ch
-            elif ch == "#":
-                break
-            elif ch in "[{":
-                depth += 1
-                if depth > MAX_DEPTH:
-                    raise PresetError(f"{origin} is nested too deeply at line {number}: allowed ≤ {MAX_DEPTH} "
-                                      "levels of brackets")
-            elif ch in "]}":
-                depth = max(0, depth - 1)
-
-
-def _check_no_aliases(text: str) -> None:
-    for event in yaml.parse(text, Loader=_TextLoader):
-        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:  # &name too
-            raise PresetError("YAML anchors/aliases (*name) are not allowed in presets")
+for _cls in filter(None, (_TextLoader, _CLoader)):
+    for _tag in ("null", "bool", "int", "float", "binary", "timestamp", "omap", "pairs", "set", "merge", "value"):
+        _cls.add_constructor(f"tag:yaml.org,2002:{_tag}", _refuse_tag)
+    _cls.add_constructor(None, _refuse_tag)
+    _cls.add_constructor("tag:yaml.org,2002:map", _unique_mapping)
+    _cls.add_constructor("tag:yaml.org,2002:str", _text)
 
 
 def loads_raw(text: str, origin: str = "<text>") -> Any:
     """Parse YAML text safely into plain data whose scalars are all text (see :class:`_TextLoader`).
 
-    Size-limited, shallow, no aliases, no duplicate keys.
+    Size-limited, nesting-limited by the scanner itself, no aliases, no duplicate keys.
     """
-    if len(text) > MAX_BYTES or len(text.encode("utf-8", "replace")) > MAX_BYTES:
-        raise PresetError(f"{origin} is too large: allowed ≤ {MAX_BYTES // 1024} KiB")
-    check_structure(text, origin)
+    origin = shorten(origin)
+    check_size(text, origin)
     try:
-        _check_no_aliases(text)
-        return yaml.load(text, Loader=_TextLoader)  # noqa: S506 - a SafeLoader subclass
+        return _load(text, origin)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise PresetError(f"{origin} is not valid YAML{where}: {problem}: allowed plain YAML text") from None
-    except RecursionError:
+        raise PresetError(f"{origin} is not valid YAML{where}: {shorten(problem)}: allowed plain YAML text") from None
+    except RecursionError:  # not reachable within MAX_DEPTH; kept as a last line of defence
         raise PresetError(f"{origin} is nested too deeply: allowed ≤ {MAX_DEPTH} levels") from None
-    except PresetError as exc:  # duplicate key, tag: say where
-        raise PresetError(f"{origin}: {exc}") from None
+    except PresetError as exc:  # duplicate key, tag, nesting: say where
+        raise PresetError(str(exc) if str(exc).startswith(origin) else f"{origin}: {exc}") from None
+
+
+def plain_scalar(text: str, where: str) -> Any:
+    """Parse one ``--set`` value: a plain YAML scalar or flow collection, nothing hidden.
+
+    A comment (``1.5 # x``), a byte-order mark, line folding or a block scalar would make the value
+    differ from what was typed; those are refused, naming ``where``.
+    """
+    value = loads_raw(text, where)
+    if isinstance(value, str) and not isinstance(value, QuotedText) and value != text.strip(" \t"):
+        raise PresetError(f"{where} = {shorten(text)!r} is not a plain value: allowed the value alone "
+                          "(no comment, byte-order mark, line break or YAML block syntax)")
+    return value
 
 
 def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
@@ -163,17 +211,17 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
         key, sep, text = item.partition("=")
         section, dot, name = key.strip().partition(".")
         if not sep or not dot or not name:
-            raise PresetError(f"--set {item!r} is malformed: allowed form section.field=value")
+            raise PresetError(f"--set {shown(item)} is malformed: allowed form section.field=value")
         if section == PLANT and raw.get(PLANT) is None and raw.get("mode", "position") == "position":
             raw[PLANT] = {}
         if section not in raw and section in optional_sections(MODES.get(str(raw.get("mode", "position")))):
             raw[section] = {}  # an optional section (sensors, limits) set from the command line
         if not isinstance(raw.get(section), dict):
             known = [k for k, v in raw.items() if isinstance(v, dict)]
-            raise PresetError(f"--set {item!r}: unknown section {section!r}{hint(section, known)}")
-        value = loads_raw(text, f"--set {key}") if text.strip() else None
+            raise PresetError(f"--set {shown(item)}: unknown section {shown(section)}{hint(section, known)}")
+        value = plain_scalar(text, f"--set {key}") if text.strip() else None
         if value is None:
-            raise PresetError(f"--set {item!r} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
+            raise PresetError(f"--set {shown(item)} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
         aliases = units.ALIASES.get(section, {}) if section != PLANT else (
             units.ALIASES["motor"] | units.ALIASES["load"])
         target = field_of(name, aliases, list(units.FLUX_KEYS))
@@ -201,7 +249,7 @@ def resolve(name_or_path: str) -> Path:
             return candidate
     except (OSError, ValueError):  # name too long for the file system, NUL byte …
         pass
-    raise PresetError(f"preset {name_or_path!r} not found{hint(str(name_or_path), list_presets())}")
+    raise PresetError(f"preset {shown(name_or_path)} not found{hint(str(name_or_path), list_presets())}")
 
 
 def list_presets() -> list[str]:
@@ -262,31 +310,6 @@ def loads_preset(text: str, origin: str = "<upload>") -> Any:
     return parse_preset(loads_any_raw(text, origin))
 
 
-def loads_json_raw(text: str, origin: str = "<text>") -> Any:
-    """Parse a JSON preset or drive parameter file (size-limited) into plain Python data."""
-    if len(text.encode("utf-8", "replace")) > MAX_BYTES:
-        raise PresetError(f"{origin} is too large: allowed ≤ {MAX_BYTES // 1024} KiB")
-    check_structure(text, origin)
-    try:
-        return json.loads(text, parse_constant=_no_constant, object_pairs_hook=_unique_keys)
-    except json.JSONDecodeError as exc:
-        raise PresetError(f"{origin} is not valid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}") from None
-    except RecursionError:
-        raise PresetError(f"{origin} is nested too deeply") from None
-
-
-def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    keys = [k for k, _ in pairs]
-    dup = next((k for k in keys if keys.count(k) > 1), None)
-    if dup is not None:
-        raise PresetError(f"key {dup!r} is given more than once in a JSON object: allowed once")
-    return dict(pairs)
-
-
-def _no_constant(name: str) -> Any:
-    raise PresetError(f"{name} is not allowed in a preset: allowed finite numbers")
-
-
 def loads_any_raw(text: str, origin: str = "<text>") -> Any:
     """JSON (``*.json``, or text starting with ``{``) or YAML text → plain Python data."""
     if origin.lower().endswith(".json"):
@@ -316,9 +339,16 @@ def to_raw(params: Any, plant: DriveParams | None = None) -> dict[str, Any]:
     return raw
 
 
+class _Dumper(yaml.SafeDumper):
+    """Safe dumper that writes :class:`QuotedText` (text read from a file) as the text it is."""
+
+
+_Dumper.add_representer(QuotedText, yaml.SafeDumper.represent_str)
+
+
 def dumps(data: Any) -> str:
     """Any plain data → YAML text (block style, key order kept)."""
-    return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=False)
+    return yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, default_flow_style=False)
 
 
 def dumps_preset(params: Any, plant: DriveParams | None = None) -> str:
@@ -356,7 +386,7 @@ def annotate_units(text: str) -> str:
 
 def save_preset(params: Any, path: str | Path, plant: DriveParams | None = None) -> None:
     """Write a parameter object (and optional plant) as a preset file."""
-    Path(path).write_text(dumps_preset(params, plant), encoding="utf-8")
+    write_atomic_text(path, dumps_preset(params, plant))
 
 
 __all__ = [

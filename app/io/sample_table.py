@@ -9,10 +9,12 @@ run's seed, sample count and spreads in the file's metadata.
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 from typing import Any
 
+from app.io.atomic import write_atomic, write_atomic_text
 from sim.studies.robustness import CONTROLLERS, METRICS, RobustnessResult
 
 #: SI unit of each per-sample column, by the key's last part (plant fields and metrics).
@@ -46,11 +48,12 @@ def rows(res: RobustnessResult) -> list[list[Any]]:
 
 def write_csv(path: str | Path, res: RobustnessResult) -> None:
     """One row per sample; the header names the columns (units in :data:`UNITS`)."""
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow([name for name, _ in columns(res)])
-        for row in rows(res):
-            w.writerow([repr(v) if isinstance(v, float) else v for v in row])
+    out = io.StringIO(newline="")
+    w = csv.writer(out)
+    w.writerow([name for name, _ in columns(res)])
+    for row in rows(res):
+        w.writerow([repr(v) if isinstance(v, float) else v for v in row])
+    write_atomic_text(path, out.getvalue())  # a temporary file renamed when complete
 
 
 def write_parquet(path: str | Path, res: RobustnessResult, meta: dict[str, Any] | None = None) -> None:
@@ -70,7 +73,9 @@ def write_parquet(path: str | Path, res: RobustnessResult, meta: dict[str, Any] 
         fields.append(pa.field(name, kind, nullable=True, metadata={"unit": unit}))
         arrays.append(pa.array(values, type=kind))
     schema = pa.schema(fields, metadata={"robustness": json.dumps(meta or {}, ensure_ascii=False)})
-    pq.write_table(pa.Table.from_arrays(arrays, schema=schema), str(path))
+    sink = pa.BufferOutputStream()
+    pq.write_table(pa.Table.from_arrays(arrays, schema=schema), sink)
+    write_atomic(path, sink.getvalue().to_pybytes())  # a temporary file renamed when complete
 
 
 def read_parquet(path: str | Path) -> tuple[dict[str, list[Any]], dict[str, str], dict[str, Any]]:

@@ -159,9 +159,12 @@ CONVERSIONS: dict[str, tuple[Callable[[float], float], Callable[[float], float]]
     "Arms": (arms_to_amplitude, amplitude_to_arms),
     # a field that already holds an rms value in A (sensors.i_noise_A_rms): the suffix only states it
     "A_rms": (_identity, _identity),
+    # line-to-line winding values of a star winding are twice the per-phase value (motor.R_s_LL_Ohm)
+    "Ω LL": (lambda R_LL: R_LL / 2.0, lambda R: 2.0 * R),
+    "mH LL": (lambda L_LL_mH: mH_to_H(L_LL_mH) / 2.0, lambda L: 2.0 * H_to_mH(L)),
 }
 #: Key suffix of a unit whose name is not an identifier (``J_r_kgcm2``).
-KEY_SUFFIX = {"kg·cm²": "kgcm2"}
+KEY_SUFFIX = {"kg·cm²": "kgcm2", "Ω LL": "LL_Ohm", "mH LL": "LL_mH"}
 
 
 def to_si(x: float, unit: str) -> float:
@@ -260,9 +263,13 @@ def psi_pm_to_kv_rpm_per_v(psi_pm: float, p: int) -> float:
     return rad_s_to_rpm(1.0 / (math.sqrt(3.0) * p * psi_pm))
 
 
-#: Keys that give Ψ_PM through the pole pairs: key → converter (value, p) → Ψ_PM [Wb].
+#: Keys that give Ψ_PM through the pole pairs: key → converter (value, p) → Ψ_PM [Wb]. Ke is the
+#: line-to-line rms value unless the key says peak (×√2 less) or phase (×√3 more than LL).
 FLUX_KEYS: dict[str, Callable[[float, int], float]] = {
     KE_KEY: lambda x, p: ke_vrms_krpm_to_psi_pm(x, p),
+    "Ke_Vpk_krpm": lambda x, p: ke_vrms_krpm_to_psi_pm(x / math.sqrt(2.0), p),
+    "Ke_ph_Vrms_krpm": lambda x, p: ke_vrms_krpm_to_psi_pm(x * math.sqrt(3.0), p),
+    "Ke_ph_Vpk_krpm": lambda x, p: ke_vrms_krpm_to_psi_pm(x * math.sqrt(1.5), p),
     "Kv_rpm_per_V": lambda x, p: kv_rpm_per_v_to_psi_pm(x, p),
     "Kt_Nm_per_Arms": lambda x, p: kt_nm_per_arms_to_psi_pm(x, p),
 }

@@ -68,12 +68,16 @@ UNIT_GROUPS: dict[str, tuple[Unit, ...]] = {
              Unit("Ke [V_rms LL/krpm]", lambda x, p: units.ke_vrms_krpm_to_psi_pm(x, p),
                   lambda x, p: units.psi_pm_to_ke_vrms_krpm(x, p)),
              Unit("Kt [N·m/A_rms]", lambda x, p: units.kt_nm_per_arms_to_psi_pm(x, p),
-                  lambda x, p: units.psi_pm_to_kt_nm_per_arms(x, p))),
+                  lambda x, p: units.psi_pm_to_kt_nm_per_arms(x, p)),
+             Unit("Kv [rpm/V LL peak]", lambda x, p: units.kv_rpm_per_v_to_psi_pm(x, p),
+                  lambda x, p: units.psi_pm_to_kv_rpm_per_v(x, p))),
+    "current": (Unit("A peak"),
+                Unit("A_rms", lambda x, _p: units.to_si(x, "Arms"), lambda x, _p: units.from_si(x, "Arms"))),
     "resistance": (_winding("per phase", 1.0, "motor.R_s"), _winding("line-to-line", 2.0, "motor.R_s")),
     "inductance": (_winding("per phase", 1.0, "motor.L_d"), _winding("line-to-line", 2.0, "motor.L_d")),
 }
 SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), ("inertia", "Inertia unit"),
-             ("angle", "Move unit"))
+             ("angle", "Move unit"), ("current", "i_max given as"))
 
 
 @dataclass(frozen=True)
@@ -138,14 +142,18 @@ FIELDS: tuple[Field, ...] = (
     Field("motor", "psi_pm", "flux"), Field("motor", "p"), Field("motor", "R_s", "resistance"),
     Field("motor", "L_d", "inductance"), Field("motor", "L_q", "inductance"), Field("motor", "J_r", "inertia"),
     Field("load", "J_L", "inertia"), Field("load", "F_v"), Field("load", "Gamma_Le"), Field("load", "Gamma_Le_ramp"),
-    Field("controller", "V_dc"), Field("controller", "i_max"), Field("controller", "T_si"),
+    Field("controller", "V_dc"), Field("controller", "i_max", "current"), Field("controller", "T_si"),
     Field("controller", "T_salpha"), Field("controller", "T_so"), Field("controller", "K"),
+    Field("sensors", "encoder_cpr"), Field("sensors", "i_noise"), Field("sensors", "i_adc_bits"),
+    Field("sensors", "i_adc_range"), Field("sensors", "seed"),
+    Field("limits", "omega_max"), Field("limits", "in_position"), Field("limits", "overshoot"),
+    Field("limits", "hold_i_rms"),
     Field("manoeuvre", "theta_dem", "angle"), Field("manoeuvre", "T_m"),
 )
 #: Inputs with a keyword alternative (a dropdown beside them): T_c ('T_a' rule) and f_s ('continuous').
 T_C, F_S = Field("controller", "T_c"), Field("controller", "f_s")
 FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("controller", "Inverter and controller"),
-           ("manoeuvre", "Manoeuvre"))
+           ("sensors", "Sensors"), ("limits", "Pass criteria"), ("manoeuvre", "Manoeuvre"))
 TC_RULES = ("T_c = T_a, eq. (59)", "T_c given below")
 FS_MODES = ("digital, sampled at f_s", "continuous")
 ALPHA_RULES = ("torque_limit", "paper")
@@ -200,7 +208,8 @@ class InputsPanel:
         self.populate(params)
 
     def _selectors(self, section: str) -> None:
-        wanted = {"motor": ("flux", "resistance", "inertia"), "manoeuvre": ("angle",)}.get(section, ())
+        wanted = {"motor": ("flux", "resistance", "inertia"), "controller": ("current",),
+                  "manoeuvre": ("angle",)}.get(section, ())
         for group, title in SELECTORS:
             if group in wanted:
                 handle = self._gui.add_dropdown(title, tuple(u.label for u in UNIT_GROUPS[group]))

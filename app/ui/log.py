@@ -15,7 +15,9 @@ import viser
 
 from app.figures.drive_log import make_log_overlay_figure
 from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
+from app.io.numbers import one_line
 from app.io.presets import load_preset
+from app.ui.text import html_text, md_text
 from control.common.checks import ParameterError
 from control.fdsmc.identification import Identification
 from control.fdsmc.params import DriveParams
@@ -30,15 +32,16 @@ TARGETS = {"R_s": ("motor", "R_s"), "L_d": ("motor", "L_d"), "L_q": ("motor", "L
 
 
 def overlay_markdown(log: DriveLog, ov: Overlay) -> str:
-    """Summary of the import and the overlay errors (SI units)."""
-    lines = [f"**{log.name}**: {log.signals['t'].size} samples at {1.0 / log.T_s:.6g} Hz, move start "
+    """Summary of the import and the overlay errors (SI units); the file name and notes are user text."""
+    lines = [f"**{md_text(log.name)}**: {log.signals['t'].size} samples at {1.0 / log.T_s:.6g} Hz, move start "
              f"t0 = {ov.t0:.4g} s ({'detected' if ov.t0_detected else 'given'}).", "",
              "| signal | RMS error | peak error | unit |", "|---|---|---|---|"]
-    lines += [f"| {e.signal} | {e.rms_error:.4g} | {e.peak_error:.4g} | {e.unit} |" for e in ov.errors]
+    lines += [f"| {md_text(e.signal)} | {e.rms_error:.4g} | {e.peak_error:.4g} | {md_text(e.unit)} |"
+              for e in ov.errors]
     if ov.energy_measured_J is not None:
         lines += ["", f"Electrical input energy: measured **{ov.energy_measured_J:.4g} J**, simulated "
                       f"**{ov.energy_simulated_J:.4g} J**."]
-    lines += [f"\n_{note}_" for note in log.notes]
+    lines += [f"\n_{md_text(note)}_" for note in log.notes]
     return "\n".join(lines)
 
 
@@ -47,10 +50,10 @@ def identified_markdown(r: Identification) -> str:
     lines = ["| parameter | value | std. error | 95 % interval | unit |", "|---|---|---|---|---|"]
     for e in r.estimates:
         if e.refused is not None:
-            lines.append(f"| {e.name} | refused | | {e.refused} | {e.unit} |")
+            lines.append(f"| {md_text(e.name)} | refused | | {md_text(e.refused)} | {md_text(e.unit)} |")
         else:
-            lines.append(f"| {e.name} | {e.value:.5g} | {e.stderr:.3g} | "
-                         f"[{e.ci95[0]:.5g}, {e.ci95[1]:.5g}] | {e.unit} |")
+            lines.append(f"| {md_text(e.name)} | {e.value:.5g} | {e.stderr:.3g} | "
+                         f"[{e.ci95[0]:.5g}, {e.ci95[1]:.5g}] | {md_text(e.unit)} |")
     if r.voltage_delay_samples is not None:
         lines.append(f"\nVoltage delay {r.voltage_delay_samples} sample(s); residuals "
                      f"{r.residual_electrical_V or 0:.3g} V, {r.residual_mechanical_Nm or 0:.3g} N·m.")
@@ -129,10 +132,10 @@ class LogPanel:
             log = read_bytes(content, name, run=self.compare_with.value, p=self.s.params.motor.p)
             ov = overlay(log.signals, run.trace)
         except (LogError, ParameterError) as exc:
-            self.s.client.add_notification("Log rejected", str(exc), color="red", auto_close_seconds=15.0)
+            self.s.client.add_notification("Log rejected", one_line(exc), color="red", auto_close_seconds=15.0)
             return
         self.identified, self.log_name = run_identification(log, self.s.params), name
-        self._show(make_log_overlay_figure(ov, name))
+        self._show(make_log_overlay_figure(ov, html_text(name)))
         self.table.content = identified_markdown(self.identified)
         self.apply.visible = any(e.value is not None for e in self.identified.estimates)
         self.summary.content = overlay_markdown(log, ov)
@@ -150,7 +153,7 @@ class LogPanel:
         try:
             params = apply_identified(self.s.inputs.collect(), self.identified, self.log_name)
         except ValueError as exc:
-            self.s.client.add_notification("Not applied", str(exc), color="red", auto_close_seconds=12.0)
+            self.s.client.add_notification("Not applied", one_line(exc), color="red", auto_close_seconds=12.0)
             return
         self.s.inputs.populate(params)
         self.s.origin = f"{self.s.origin} + identified from {self.log_name}"

@@ -158,10 +158,7 @@ class RobustnessView:
         self.run_button.disabled, self.cancel_button.visible = True, True
         try:
             result = self._run(params, spreads, samples, seed)
-        except (ExecutorError, IncompleteRunError) as exc:
-            self._fail(str(exc))
-            return
-        except ParameterError as exc:
+        except (ParameterError, ExecutorError, IncompleteRunError) as exc:  # a pool ended by Cancel fails
             if self._cancel_requested():
                 self.status.content = (f"**Cancelled** after {self._done} of {samples} samples; the remaining "
                                        "work was cancelled and the pool shut down.")
@@ -190,11 +187,13 @@ class RobustnessView:
                                   self._cancel_requested)
         workers = os.cpu_count() or 1
         pool = RetryingPool(workers)
+        unhook = self._s.worker.on_cancel(pool.terminate)  # Cancel or a closed page: at once, no retry
         try:
             return robustness(params, spreads, samples, seed, pool, workers, self._progress,
                               self._cancel_requested)
         finally:
-            pool.shutdown(wait=True, cancel_futures=True)  # running chunks (≥ 0.1 s each) end, the rest never starts
+            unhook()
+            pool.shutdown(wait=True, cancel_futures=True)  # the rest never starts
 
     def show(self, result: RobustnessResult, torque_limit_Nm: float) -> None:
         """Draw the histograms and the summary table of a finished study."""

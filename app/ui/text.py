@@ -15,6 +15,9 @@ from app.io.derived_view import derived_rows
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
+from sim.fdsmc.criteria import pass_criteria
+from sim.fdsmc.engine import LABELS
+from sim.fdsmc.recommend import recommend
 
 #: Joules per kilowatt-hour [J/kWh].
 J_PER_KWH = 3.6e6
@@ -23,11 +26,21 @@ J_PER_KWH = 3.6e6
 _MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
 
 
+def html_text(text: object) -> str:
+    """Make user-provided text safe inside HTML or a Plotly label: ``& < > " '`` become entities.
+
+    The escaping of every user string (file name, column header, note, preset name or source, log
+    mapping) that goes into HTML: the page's HTML boxes, Plotly titles and legends, the HTML report.
+    """
+    return html.escape(str(text), quote=True)
+
+
 def md_text(text: object) -> str:
     """Make user-provided text safe to put in Markdown or HTML: shown literally, never as markup.
 
-    User-provided text is a preset name/source, a file name or a message quoting them; it never becomes
-    markup, links, images or code.
+    User-provided text is a preset name/source, a file name, a column header or a message quoting
+    them; it never becomes markup, links, images or code. Viser renders raw HTML inside Markdown,
+    so every user string reaching a Markdown widget goes through here.
 
     HTML special characters become entities, Markdown punctuation is backslash-escaped and line breaks become
     spaces (a name cannot start a heading or a table row).
@@ -67,7 +80,7 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
     warning…") folds it to that one line in the browser, and a second click opens it again.
     """
     extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
-                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html.escape(n)}</div>'
+                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html_text(n)}</div>'
                     for n in notes or [])
     if error is None and not items:
         return ('<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:#2b8a3e;'
@@ -75,13 +88,13 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
     parts = []
     if error is not None:
         parts.append(f'<div data-role="input-error" style="font-weight:600">⛔ Input error — nothing '
-                     f'simulated: {html.escape(error)}</div>')
+                     f'simulated: {html_text(error)}</div>')
     if items:
-        lis = "".join(f"<li>{html.escape(w)}</li>" for w in items)
+        lis = "".join(f"<li>{html_text(w)}</li>" for w in items)
         parts.append(f'<details{"" if folded else " open"} data-role="warnings-list">'
                      '<summary data-role="warnings-summary" '
                      'style="cursor:pointer;white-space:nowrap;overflow:hidden;text-overflow:ellipsis">'
-                     f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html.escape(items[0])}'
+                     f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html_text(items[0])}'
                      f'</span></summary><ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul></details>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
             'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>" + extra)
@@ -95,19 +108,17 @@ def _saves(pct: float | None) -> str:
 
 
 def key_numbers_html(comparison: Any) -> str:
-    """Render one line of key numbers above the overview figure.
+    """Render the key numbers above the overview figure: net electrical input first.
 
-    Savings [%], friction and electrical input energies [J] of both controllers, peak torques
-    [N·m] vs the drive's limit Γ_max (red when above).
+    Net electrical input [J] (whole run) of every simulated controller with its copper and friction
+    parts, the recommended controller (:func:`sim.fdsmc.recommend.recommend`), then the paper's
+    friction saving and the peak torques [N·m] vs the drive's limit (red when above).
     """
     f, c = comparison.fdsmc, comparison.conventional
     if f is None:
         return '<div data-role="key-numbers" style="font-size:0.9em">Not simulated (infeasible manoeuvre).</div>'
     g_max = torque_limit(comparison.derived.params)
-
-    def energy(key: str) -> str:
-        values = [None if r is None else getattr(r.metrics, key) for r in (f, c)]
-        return " / ".join("–" if v is None else f"{v:.4g}" for v in values)
+    rec = recommend(comparison.derived.params, comparison)
 
     def peak(r: Any) -> str:
         v = r.metrics.torque_peak_Nm if r is not None else None
@@ -115,10 +126,13 @@ def key_numbers_html(comparison: Any) -> str:
             return "–"
         return f'<b style="color:#c92a2a">{v:.4g} ⚠</b>' if v > g_max * 1.001 else f"{v:.4g}"
 
-    parts = [f"<b>FDSMC {_saves(comparison.saving_friction_pct)}</b> friction, "
-             f"{_saves(comparison.saving_electrical_pct)} electrical input",
-             f"friction to T_m FDSMC / conv. {energy('friction_J')} J",
-             f"electrical in {energy('electrical_in_total_J')} J",
+    energies = " · ".join(
+        f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {e.net_electrical_J:.3g} J"
+        f"{'</b>' if e.controller == rec.controller else ''} ({e.copper_J:.2g} Cu + {e.friction_J:.2g} fr.)"
+        for e in rec.energies)
+    best = f"recommended: <b>{LABELS[rec.controller]}</b>" if rec.controller else "no controller passes every check"
+    parts = [f"<b>Net electrical input</b> {energies}", best,
+             f"FDSMC {_saves(comparison.saving_friction_pct)} friction vs conventional",
              f"peak Γ {peak(f)} / {peak(c)} N·m vs Γ_max {g_max:.4g} N·m"]
     return ('<div data-role="key-numbers" style="font-size:0.88em;line-height:1.35;padding:2px 2px 4px 2px">'
             + " · ".join(parts) + "</div>")
@@ -141,15 +155,33 @@ class AnnualSavings:
 
 
 def design_markdown(dd: Any) -> str:
-    """Verdict of "Design for this drive" (:class:`sim.fdsmc.design.DriveDesign`): clean, or what prevents it."""
+    """Verdict of "Design for this drive" (:class:`sim.fdsmc.design.DriveDesign`) with the verified figures.
+
+    Clean (every check holds with the sensors at the requested T_m), not as asked (only at a longer
+    T_m) or not clean (the constraints say why); then the peak current, overshoot, in-position time
+    and standstill ripple of the verification run against their limits.
+    """
     c = dd.params.controller
-    head = ("**Design: clean** — simulated peaks within the drive's limits, on target at T_m, no chatter."
-            if dd.clean else "**Design: not clean** — see the constraints below.")
+    head = {"clean": "**Design: CLEAN** — with the sensors: limits, in-position, overshoot and ripple all hold.",
+            "not as asked": "**Design: NOT AS ASKED** — clean only at a longer T_m than requested.",
+            "not clean": "**Design: NOT CLEAN** — see the constraints below."}[dd.verdict]
     lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "
-                   f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms"]
+                   f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms, "
+                   f"T_so = {c.T_so * 1e3:.4g} ms, T_sα = {c.T_salpha * 1e3:.4g} ms"]
+    if dd.comparison is not None and dd.comparison.fdsmc is not None:
+        lines.append(_verified_figures(dd))
     lines += [f"- {'✗' if x.violated else '·'} {md_text(x.text)}" for x in dd.limiting]
     lines += [f"- note: {md_text(n)}" for n in dd.notes]
-    return "\n\n".join(lines[:2]) + "\n\n" + "\n".join(lines[2:])
+    return "\n\n".join(lines[:3]) + "\n\n" + "\n".join(lines[3:])
+
+
+def _verified_figures(dd: Any) -> str:
+    """One line of the verification run's figures against the pass criteria."""
+    m, crit = dd.comparison.fdsmc.metrics, pass_criteria(dd.params)
+    inpos = "never" if m.in_position_s is None else f"{m.in_position_s:.3g} s"
+    return (f"Verified: peak |i_dq| {m.i_peak_A:.3g} A (limit {crit.i_limit:.3g} A) · overshoot "
+            f"{m.overshoot_rad:.2g} rad (≤ {crit.overshoot:.2g}) · in position {inpos} (±{crit.in_position:.2g} rad) · "
+            f"standstill ripple {m.hold_i_q_rms_A:.2g} A rms (≤ {crit.hold_i_rms:.2g})")
 
 
 def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
@@ -185,5 +217,5 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
 
 
 __all__ = ["AnnualSavings", "design_markdown", "annual_savings", "checked_choice", "derived_markdown",
-           "key_numbers_html", "md_text",
+           "html_text", "key_numbers_html", "md_text",
            "savings_markdown", "warnings_html"]

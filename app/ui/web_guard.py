@@ -12,22 +12,41 @@ puts :meth:`Guard.check` in front of viser's own ``process_request``:
   refused too.
 * **Token** (only when bound to a non-loopback address): the start-up URL carries
   ``?token=…``; the first page load sets an HttpOnly, SameSite=Strict cookie, and every later
-  request (assets, websocket) must carry the token in the cookie or the query.
+  request (assets, websocket) must carry the token in the cookie or the query (one ``token``
+  parameter only). The Host is checked in token mode too: a name the tool is served as, the
+  machine's own host names, or an IP address literal (a DNS-rebinding page has a foreign name).
+  Any malformed request (token text, Host, Origin) is answered 403, never an error.
+* **Widget values** (every GUI update a client sends): checked against the widget's own value type
+  before viser casts it — a number widget takes a finite number, a text widget text, a checkbox a
+  bool, a vector a list of the same length — so a hand-made client cannot raise in the server's
+  message handler or slip NaN into a field; a refused update is dropped and recorded in
+  :data:`REFUSED_UPDATES`.
+* **Uploads** (checked while streaming): refused by their declared size before any part is kept
+  (:func:`upload_limit`: 50 MB for a drive log, 512 KiB for preset and waveform files), a part that
+  would overrun the declared size ends the transfer, and one client's unfinished uploads together
+  may hold ≤ :data:`CLIENT_INFLIGHT_BYTES`, the server's ≤ :data:`SERVER_INFLIGHT_BYTES`.
 """
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import hmac
 import http
+import ipaddress
+import math
 import secrets
+import socket
 import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
+import viser._gui_api as viser_gui
 import websockets.asyncio.server as ws_server
+
+from app.io.numbers import shorten
 
 LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 COOKIE = "pmsm_token"
@@ -43,6 +62,23 @@ def _host_of(text: str) -> str:
     """Host name of a ``Host`` header or an origin URL, lower case, without port or brackets."""
     netloc = urlsplit(text if "//" in text else f"//{text}").hostname
     return (netloc or "").lower()
+
+
+def _is_ip_literal(host: str) -> bool:
+    """Tell whether ``host`` is an IPv4/IPv6 address written out (no DNS name: no DNS rebinding)."""
+    try:
+        ipaddress.ip_address(host)
+    except ValueError:
+        return False
+    return True
+
+
+def machine_names() -> set[str]:
+    """Return the host name and fully qualified name of this machine, lower case (its names on a LAN)."""
+    names = {socket.gethostname().lower()}
+    with contextlib.suppress(OSError):
+        names.add(socket.getfqdn().lower())
+    return {n for n in names if n}
 
 
 @dataclass
@@ -69,6 +105,8 @@ class Guard:
         hosts = set(LOOPBACK_HOSTS)
         if host not in ("0.0.0.0", "::", ""):
             hosts.add(host.strip("[]").lower())
+        elif token is not None:  # every interface: the machine's own names too
+            hosts |= machine_names()
         origins = {o.rstrip("/").lower() for o in allow_origins}
         hosts |= {_host_of(o) for o in origins}
         return cls(hosts, origins, token)
@@ -76,23 +114,36 @@ class Guard:
     def _token_ok(self, request: Any) -> bool:
         if self.token is None:
             return True
-        query = parse_qs(urlsplit(request.path).query).get("token", [""])[0]
+        queries = parse_qs(urlsplit(request.path).query, keep_blank_values=True).get("token", [])
+        if len(queries) > 1:
+            return False  # ?token=OK&token=x: ambiguous, refused whichever comes first
         cookies = request.headers.get("Cookie", "")
         jar = dict(c.strip().split("=", 1) for c in cookies.split(";") if "=" in c)
-        given = query or jar.get(COOKIE, "")
-        return hmac.compare_digest(given.encode(), self.token.encode())
+        given = queries[0] if queries else jar.get(COOKIE, "")
+        return hmac.compare_digest(given.encode("utf-8", "surrogateescape"), self.token.encode())
+
+    def _host_ok(self, host: str) -> bool:
+        return host in self.hosts or (self.token is not None and _is_ip_literal(host))
 
     def reason(self, request: Any) -> str | None:
-        """Why ``request`` is refused, or None if it may proceed."""
+        """Why ``request`` is refused, or None if it may proceed (a malformed request is refused)."""
+        try:
+            return self._reason(request)
+        except Exception as exc:  # noqa: BLE001 - duplicate headers, bad URL …: a refusal, never a 500
+            return f"malformed request ({type(exc).__name__}): refused"
+
+    def _reason(self, request: Any) -> str | None:
         host_header = request.headers.get("Host", "").lower()
         host = _host_of(host_header)
-        if self.token is None and host not in self.hosts:
-            return f"Host {host!r} is not one this tool is served as ({', '.join(sorted(self.hosts))})"
+        if not self._host_ok(host):
+            shown = host if len(host) <= 80 else host[:80] + "…"
+            return f"Host {shown!r} is not one this tool is served as ({', '.join(sorted(self.hosts))})"
         if request.headers.get("Upgrade", "").lower() == "websocket":
             origin = request.headers.get("Origin", "").rstrip("/").lower()
             same = bool(origin) and urlsplit(origin).netloc == host_header
             if not origin or not (same or origin in self.origins):
-                return f"websocket Origin {origin or '(none)'!r} is not allowed (allowed: this page's own host)"
+                shown = origin[:80] + "…" if len(origin) > 80 else origin or "(none)"
+                return f"websocket Origin {shown!r} is not allowed (allowed: this page's own host)"
         if not self._token_ok(request):
             return "missing or wrong access token: open the URL printed at start-up (…?token=…)"
         return None
@@ -119,9 +170,139 @@ class Guard:
         return process_request
 
 
+#: The most recent GUI updates refused by :func:`update_problem` (one line each; for logs and tests).
+REFUSED_UPDATES: collections.deque[str] = collections.deque(maxlen=100)
+
+
+def _value_problem(current: Any, value: Any) -> str | None:
+    """Why ``value`` cannot replace a widget value like ``current``, or None."""
+    if current is None:
+        return None
+    if isinstance(current, bool):
+        return None if isinstance(value, bool) else "allowed true or false"
+    if isinstance(current, int | float):
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+        return None if ok else "allowed a finite number"
+    if isinstance(current, str):
+        return None if isinstance(value, str) else "allowed text"
+    if isinstance(current, tuple):
+        if not isinstance(value, list | tuple) or len(value) != len(current):
+            return f"allowed a list of {len(current)} values"
+        problems = [_value_problem(c, v) for c, v in zip(current, value, strict=True)]
+        return next((p for p in problems if p is not None), None)
+    return None
+
+
+def update_problem(state: Any, updates: Any) -> str | None:
+    """Why a client's GUI update of a widget (its state ``state``) is refused, or None."""
+    if not isinstance(updates, dict):
+        return "the update is not a mapping"
+    for name, value in updates.items():
+        if not isinstance(name, str) or name.startswith("_") or not hasattr(state, name):
+            return f"property {str(name)[:40]!r} is not one of the widget's"
+        why = _value_problem(getattr(state, name), value)
+        if why is not None:
+            return f"{name} = {repr(value)[:80]} has the wrong type: {why}"
+    return None
+
+
+def _checked_gui_updates(original: Callable[..., Any]) -> Callable[..., Any]:
+    async def handle(self: Any, client_id: Any, message: Any) -> None:
+        widget = self._gui_input_handle_from_uuid.get(message.uuid, None)
+        if widget is not None and not widget._impl.removed:
+            why = update_problem(widget._impl, message.updates)
+            if why is not None:
+                label = str(getattr(widget._impl, "label", ""))[:60]
+                REFUSED_UPDATES.append(f"client {client_id}: widget {label!r}: {why}")
+                return
+        await original(self, client_id, message)
+
+    handle.__wrapped__ = original  # type: ignore[attr-defined]
+    return handle
+
+
+#: Largest drive-log upload [B] (as :data:`app.io.drive_log.MAX_BYTES`), and any other upload [B].
+LOG_UPLOAD_BYTES, FILE_UPLOAD_BYTES = 50 * 2**20, 512 * 2**10
+#: Most bytes one client's unfinished uploads may declare together, and all clients' [B].
+CLIENT_INFLIGHT_BYTES, SERVER_INFLIGHT_BYTES = 60 * 2**20, 200 * 2**20
+
+
+def upload_limit(mime_type: str) -> int:
+    """Largest upload [B] an upload button taking ``mime_type`` accepts (drive logs: CSV only)."""
+    kinds = str(mime_type).lower()
+    return LOG_UPLOAD_BYTES if "csv" in kinds and "yaml" not in kinds else FILE_UPLOAD_BYTES
+
+
+def upload_problem(gui: Any, client_id: Any, message: Any) -> str | None:
+    """Why an upload announced by ``message`` is refused before any of it is kept, or None."""
+    widget = gui._gui_input_handle_from_uuid.get(message.source_component_uuid, None)
+    if widget is None:
+        return None  # viser ignores it
+    size, parts = message.size_bytes, message.part_count
+    limit = upload_limit(getattr(widget._impl.props, "mime_type", ""))
+    if not isinstance(size, int) or not isinstance(parts, int) or size < 0 or parts < 0 or parts > size + 1:
+        return f"{shorten(message.filename, 60)!r}: malformed upload (size {size!r}, {parts!r} parts)"
+    if size > limit:
+        return (f"{shorten(message.filename, 60)!r} is {size / 2**20:.1f} MB: allowed ≤ {limit / 2**20:.3g} MB "
+                "for this button")
+    states = gui._current_file_upload_states.values()
+    mine = sum(int(st["total_bytes"]) for st in states if st["client_id"] == client_id)
+    everyone = sum(int(st["total_bytes"]) for st in states)
+    if mine + size > CLIENT_INFLIGHT_BYTES or everyone + size > SERVER_INFLIGHT_BYTES:
+        return (f"{shorten(message.filename, 60)!r}: too many unfinished uploads at once: wait for the "
+                "others to finish")
+    return None
+
+
+def _checked_upload_start(original: Callable[..., Any]) -> Callable[..., Any]:
+    def handle(self: Any, client_id: Any, message: Any) -> None:
+        why = upload_problem(self, client_id, message)
+        if why is None:
+            original(self, client_id, message)
+            return
+        REFUSED_UPDATES.append(f"client {client_id}: upload refused: {why}")
+        client = self._resolve_client(client_id)
+        if client is not None:
+            client.add_notification("Upload refused — nothing read", why, color="red", auto_close_seconds=15.0)
+
+    handle.__wrapped__ = original  # type: ignore[attr-defined]
+    return handle
+
+
+def _checked_upload_part(original: Callable[..., Any]) -> Callable[..., Any]:
+    def handle(self: Any, client_id: Any, message: Any) -> None:
+        state = self._current_file_upload_states.get(message.transfer_uuid)
+        if state is not None and (state["client_id"] != client_id or not isinstance(message.content, bytes)
+                                  or state["transferred_bytes"] + len(message.content) > state["total_bytes"]):
+            self._current_file_upload_states.pop(message.transfer_uuid, None)  # the parts kept are freed
+            REFUSED_UPDATES.append(f"client {client_id}: upload {shorten(state['filename'], 60)!r} ended: "
+                                   "its parts overrun the declared size")
+            return
+        original(self, client_id, message)
+
+    handle.__wrapped__ = original  # type: ignore[attr-defined]
+    return handle
+
+
+_WRAPPERS = {"_handle_gui_updates": _checked_gui_updates, "_handle_file_transfer_start": _checked_upload_start,
+             "_handle_file_transfer_part": _checked_upload_part}
+
+
+def check_widget_updates() -> None:
+    """Put the widget-value and upload checks in front of viser's handlers (once, for every GUI created after)."""
+    for name, wrap in _WRAPPERS.items():
+        current = getattr(viser_gui.GuiApi, name)
+        if not hasattr(current, "__wrapped__"):
+            setattr(viser_gui.GuiApi, name, wrap(current))
+
+
 @contextlib.contextmanager
 def guarded(guard: Guard) -> Iterator[None]:
-    """While active, every ``websockets`` server started gets ``guard`` in front of its requests."""
+    """While active, every ``websockets`` server started gets ``guard`` in front of its requests.
+
+    Widget updates are type-checked from then on (:func:`check_widget_updates`).
+    """
+    check_widget_updates()
     with _patch_lock:
         original = ws_server.serve
 
@@ -136,4 +317,5 @@ def guarded(guard: Guard) -> Iterator[None]:
             ws_server.serve = original  # type: ignore[assignment]
 
 
-__all__ = ["COOKIE", "LOOPBACK_HOSTS", "Guard", "guarded", "new_token"]
+__all__ = ["COOKIE", "LOOPBACK_HOSTS", "REFUSED_UPDATES", "Guard", "check_widget_updates", "guarded", "new_token",
+           "update_problem", "upload_limit", "upload_problem"]

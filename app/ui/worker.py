@@ -43,6 +43,7 @@ class Worker:
         self._busy = False
         self._closed = False
         self._cancel = threading.Event()
+        self._hooks: list[Callable[[], None]] = []
         self._on_busy = on_busy
         self._on_error = on_error
 
@@ -62,12 +63,40 @@ class Worker:
         return self._pool.submit(self._run, fn)
 
     def cancel(self) -> bool:
-        """Ask the running job to stop at its next checkpoint; False if nothing runs."""
+        """Ask the running job to stop at its next checkpoint (and run its stop hooks); False if nothing runs."""
         with self._lock:
             if not self._busy:
                 return False
             self._cancel.set()
-            return True
+        self._run_hooks()
+        return True
+
+    def on_cancel(self, hook: Callable[[], None]) -> Callable[[], None]:
+        """Register ``hook`` to run when the job is cancelled or the worker closed; returns its remover.
+
+        E.g. to end a process pool the job waits on, instead of waiting for its next checkpoint.
+        """
+        with self._lock:
+            self._hooks.append(hook)
+            cancelled = self._cancel.is_set()
+        if cancelled:
+            hook()
+
+        def remove() -> None:
+            with self._lock:
+                if hook in self._hooks:
+                    self._hooks.remove(hook)
+
+        return remove
+
+    def _run_hooks(self) -> None:
+        with self._lock:
+            hooks = list(self._hooks)
+        for hook in hooks:
+            try:
+                hook()
+            except Exception as exc:  # a failing hook must not stop the others
+                self._on_error(exc)
 
     def checkpoint(self) -> None:
         """Raise :class:`Cancelled` after :meth:`cancel`; jobs call this between pieces of work."""
@@ -91,7 +120,12 @@ class Worker:
             self._on_error(exc)
 
     def close(self) -> None:
-        """Refuse new jobs and let the thread end after the current one."""
+        """Refuse new jobs and stop the current one at its next checkpoint (the page disconnected).
+
+        A study's process pool is shut down by the job itself as it ends, so no work outlives the page.
+        """
         with self._lock:
             self._closed = True
+            self._cancel.set()
+        self._run_hooks()
         self._pool.shutdown(wait=False, cancel_futures=True)

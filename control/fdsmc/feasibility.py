@@ -12,6 +12,7 @@ from control.common.checks import ParameterError
 from control.fdsmc.model import available_voltage, model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import peak_speed, shortest_manoeuvre_time
+from control.fdsmc.profile_energy import min_energy_alpha
 
 #: Relative precision of the steady-state limit checks [-]: the model's torque and voltage estimates
 #: are not more exact than this, so a peak within it of a limit is not reported as exceeding it.
@@ -84,7 +85,9 @@ class AlphaMax:
 def alpha_max(params: DriveParams, overshoot: float = 1.0) -> AlphaMax:
     """α_max under the preset's rule and the torque it needs on the total inertia.
 
-    ``paper``: α_max = H·P_r/V_0 (section 5 of [1]; H from eq. (4)). ``torque_limit``: the
+    ``paper``: α_max = H·P_r/V_0 (section 5 of [1]; H from eq. (4)). ``min_energy``: the α within
+    the torque limit that minimises the profile's copper + friction loss
+    (:func:`control.fdsmc.profile_energy.min_energy_alpha`). ``torque_limit``: the
     largest α_max whose peak torque η·α_max·(J_r + J_L) + F_v·ω_p + |Γ_Le| stays within the drive's
     torque limit Γ_lim (:func:`torque_limit`), eq. (4b) with the inner loops' overshoot η, the
     friction at the peak speed ω_p of eq. (60) (itself a function of α_max) and the external load.
@@ -107,10 +110,13 @@ def alpha_max(params: DriveParams, overshoot: float = 1.0) -> AlphaMax:
     m, load = params.motor, params.load
     Gamma_Le = abs(load.Gamma_Le)
     eta = overshoot if math.isfinite(overshoot) else 1.0
-    if params.controller.alpha_max_rule == "paper":
+    rule = params.controller.alpha_max_rule
+    if rule == "paper":
         a = model_coefficients(m).H * m.P_r / m.V_0
     else:
         a = _torque_limited_alpha(params, eta)
+        if rule == "min_energy":  # below the torque limit where copper + friction are least
+            a = min_energy_alpha(params, a)
     needed = eta * a * params.J_total + Gamma_Le
     return AlphaMax(a, params.controller.alpha_max_rule, needed, not exceeds(needed, torque_limit(params)), eta)
 

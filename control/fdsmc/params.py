@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from control.common.checks import ParameterError, check_fields, spec_field
 
-ALPHA_MAX_RULES = ("paper", "torque_limit")
+ALPHA_MAX_RULES = ("paper", "torque_limit", "min_energy")
 
 
 #: Shortest settling time of the inner loops and the observer [s]. With T_so ≥ 1 µs the observer
@@ -62,9 +62,9 @@ class Motor:
     omega_b: float = spec_field("rad/s", 0.0, 1e5, label="n_b rated speed", display="rpm")
     Gamma_max: float = spec_field("N·m", 1e-6, 1e6, low_open=False, label="Γ_max peak torque")
     psi_pm: float = spec_field("Wb", 1e-6, 100.0, low_open=False, label="Ψ_PM")
-    L_d: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_d", display="mH")
-    L_q: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_q", display="mH")
-    R_s: float = spec_field("Ω", 0.0, 1e4, label="R_s")
+    L_d: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_d", display="mH", aliases=("mH LL",))
+    L_q: float = spec_field("H", 1e-9, 10.0, low_open=False, label="L_q", display="mH", aliases=("mH LL",))
+    R_s: float = spec_field("Ω", 0.0, 1e4, label="R_s", aliases=("Ω LL",))
     p: int = spec_field("-", 1, 100, integer=True, label="p pole pairs")
     J_r: float = spec_field("kg·m²", 1e-9, 1e4, low_open=False, label="J_r rotor inertia", aliases=("kg·cm²",))
 
@@ -137,8 +137,9 @@ class Controller:
         Sliding-mode time constant of the sloped boundary segment, eq. (41) [s]; ``"T_a"``
         applies eq. (59), T_c = T_a.
     alpha_max_rule : str
-        ``"paper"`` (α_max = H·P_r/V_0, section 5) or ``"torque_limit"``
-        (α_max = (Γ_max − |Γ_Le|)/(J_r + J_L)).
+        ``"paper"`` (α_max = H·P_r/V_0, section 5), ``"torque_limit"`` (the largest α within the
+        drive's torque) or ``"min_energy"`` (the α ≤ the torque limit's that minimises the profile's
+        friction + copper loss, :mod:`control.fdsmc.profile_energy`).
     f_s : float or "continuous"
         Controller sample rate [Hz], or ``"continuous"`` to evaluate the controller continuously.
     delay_samples : int
@@ -163,7 +164,7 @@ class Controller:
     delay_samples: int = spec_field("samples", 0, 1, default=0, integer=True, label="Computation delay")
     V_dc: float = spec_field("V", 0.0, 1e5, default=0.0, low_open=False, label="V_dc inverter DC link (0 = ideal)")
     i_max: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False, aliases=("Arms",),
-                              label="i_max inverter current amplitude (0 = none)")
+                              label="i_max inverter current (0 = none)")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""

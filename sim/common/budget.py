@@ -8,8 +8,12 @@ A request (one comparison of several controllers, a Table-1 sweep, a BLDC compar
   proportional to it.
 
 Both are computed from the parameters alone (no derivation, no allocation) and compared with
-:data:`MAX_STEPS` and :data:`MAX_TRACE_BYTES`. A request over budget raises
-:class:`BudgetError` naming the fields that drive the cost and, for each, the largest (or
+:data:`MAX_STEPS` and :data:`MAX_TRACE_BYTES`. A request whose cost model also predicts CPU seconds
+and peak memory (the position drive, :func:`sim.fdsmc.grid.predict`: controller samples, RK4
+sub-steps and full-resolution chatter-window samples, calibrated by ``scripts/bench_budget.py``
+to within 2× of measured runs) is held to the promised figures themselves: ≤ :data:`MAX_CPU_S`
+CPU seconds and ≤ :data:`MAX_TRACE_BYTES` of memory above the idle process. A request over budget
+raises :class:`BudgetError` naming the fields that drive the cost and, for each, the largest (or
 smallest) value that fits with the other values kept.
 """
 
@@ -22,10 +26,39 @@ from dataclasses import dataclass
 from control.common.checks import ParameterError
 
 #: Most RK4 integration steps of one request, sub-steps and all controllers included [-].
-#: About 2–3 s of CPU for either kernel on one core (``python -m app bench`` prints the rates).
+#: The bound for engines without a calibrated CPU model (BLDC); the position drive is held to
+#: :data:`MAX_CPU_S` by its model as well.
 MAX_STEPS = 40_000_000
 #: Most bytes of trace memory of one request (kernel output arrays and the traces built from them).
 MAX_TRACE_BYTES = 256 * 2**20
+
+
+#: Most CPU seconds a request may be predicted to take (the promise of the page and the CLI).
+MAX_CPU_S = 3.0
+#: Cost model of the position drive, fitted by ``scripts/bench_budget.py`` (one core, compiled
+#: kernels, the three controllers of ``compare``): CPU seconds per RK4 step beyond the first of a
+#: sample, per controller sample (its first RK4 step, controller, observer, trace), per
+#: full-resolution chatter-window sample (recorded and analysed), and per run (derivation, metrics).
+CPU_PER_STEP_S = 2.0e-8
+CPU_PER_SAMPLE_S = 1.1e-7
+CPU_PER_WINDOW_SAMPLE_S = 2.0e-7
+CPU_PER_RUN_S = 0.025
+#: Bytes per controller sample (no full-rate array is kept: 0), of analysis temporaries per
+#: chatter-window sample, and fixed bytes per run (parameter arrays, sensor-noise tables) [B].
+MEM_PER_SAMPLE = 0
+MEM_PER_WINDOW_SAMPLE = 21
+MEM_PER_RUN = 2 * 2**20
+
+
+def cpu_seconds(steps: int, samples: int, window: int, runs: int) -> float:
+    """Predicted CPU time [s] of a request (RK4 steps, controller samples, chatter-window samples, runs)."""
+    return (CPU_PER_STEP_S * max(0, steps - samples) + CPU_PER_SAMPLE_S * samples
+            + CPU_PER_WINDOW_SAMPLE_S * window + CPU_PER_RUN_S * runs)
+
+
+def memory_bytes(trace_bytes: int, window: int, runs: int, samples: int = 0) -> int:
+    """Predicted peak memory [B] above the idle process: traces, full-rate and window arrays, per-run arrays."""
+    return int(trace_bytes + MEM_PER_SAMPLE * samples + MEM_PER_WINDOW_SAMPLE * window + MEM_PER_RUN * runs)
 
 
 class BudgetError(ParameterError):
@@ -40,19 +73,29 @@ class Cost:
     ----------
     steps : int         RK4 integration steps, all controllers and sub-steps [-].
     trace_bytes : int   Bytes of trace memory [B].
+    cpu_s : float or None         Predicted CPU time [s], when the engine has a calibrated model.
+    memory_bytes : int or None    Predicted peak memory above the idle process [B], likewise.
     """
 
     steps: int
     trace_bytes: int
+    cpu_s: float | None = None
+    memory_bytes: int | None = None
 
     def __add__(self, other: Cost) -> Cost:
-        """Add two costs field by field."""
-        return Cost(self.steps + other.steps, self.trace_bytes + other.trace_bytes)
+        """Add two costs field by field (a prediction only when both have one)."""
+        both = self.cpu_s is not None and other.cpu_s is not None
+        return Cost(self.steps + other.steps, self.trace_bytes + other.trace_bytes,
+                    (self.cpu_s or 0.0) + (other.cpu_s or 0.0) if both else None,
+                    (self.memory_bytes or 0) + (other.memory_bytes or 0) if both else None)
 
     @property
     def fits(self) -> bool:
-        """True when both figures are within the budget."""
-        return self.steps <= MAX_STEPS and self.trace_bytes <= MAX_TRACE_BYTES
+        """True when every figure is within the budget (the predicted CPU and memory too, if known)."""
+        base = self.steps <= MAX_STEPS and self.trace_bytes <= MAX_TRACE_BYTES
+        if self.cpu_s is None or self.memory_bytes is None:
+            return base
+        return base and self.cpu_s <= MAX_CPU_S and self.memory_bytes <= MAX_TRACE_BYTES
 
 
 @dataclass(frozen=True)
@@ -112,6 +155,9 @@ def best_value(driver: Driver) -> float | None:
 
 
 def _describe(cost: Cost) -> str:
+    if cost.cpu_s is not None and cost.memory_bytes is not None:
+        return (f"≈ {cost.cpu_s:.2g} s CPU, {cost.memory_bytes / 2**20:.3g} MiB, {cost.steps:.3g} integration steps: "
+                f"allowed ≤ {MAX_CPU_S:g} s, {MAX_TRACE_BYTES // 2**20} MiB, {MAX_STEPS:.3g} steps")
     return (f"{cost.steps:.3g} integration steps and {cost.trace_bytes / 2**20:.4g} MiB of traces: "
             f"allowed ≤ {MAX_STEPS:.3g} steps and ≤ {MAX_TRACE_BYTES // 2**20} MiB per request")
 
@@ -135,13 +181,13 @@ def check(cost: Cost, what: str, drivers: Sequence[Driver]) -> Cost:
         best = best_value(d)
         word = "largest" if d.limit < d.value else "smallest"
         if best is None:
-            hints.append(f"no value of {d.name} alone fits")
+            hints.append(f"no {d.name} alone fits")
         else:
             shown = f"{int(best)}" if d.integer else f"{best:.4g}"
             hints.append(f"{d.name} = {d.value:g} {d.unit}".rstrip() + f" → {word} accepted {shown} {d.unit}".rstrip())
-    names = ", ".join(d.name for d in drivers)
-    raise BudgetError(f"this run is too large ({what}): it needs {_describe(cost)}. The cost grows with "
-                      f"{names}; with the other values kept: " + "; ".join(hints))
+    raise BudgetError(f"this run is too large ({what}): {_describe(cost)}. With the other values kept: "
+                      + "; ".join(hints))
 
 
-__all__ = ["MAX_STEPS", "MAX_TRACE_BYTES", "BudgetError", "Cost", "Driver", "best_value", "check"]
+__all__ = ["MAX_CPU_S", "MAX_STEPS", "MAX_TRACE_BYTES", "BudgetError", "Cost", "Driver", "best_value", "check",
+           "cpu_seconds", "memory_bytes"]

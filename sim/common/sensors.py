@@ -43,6 +43,11 @@ def adc_step(sensors: Sensors) -> float:
     return 2.0 * sensors.i_adc_range / 2.0**sensors.i_adc_bits if sensors.i_adc_bits > 0 else 0.0
 
 
+def reading_noise(sensors: Sensors) -> float:
+    """RMS error of a current reading [A]: the noise and the ADC's rounding, √(σ² + q²/12)."""
+    return math.hypot(sensors.i_noise, adc_step(sensors) / math.sqrt(12.0))
+
+
 @jitable
 def encoder_angle(theta: float, step: float) -> float:
     """Angle the encoder reports for θ [rad]: whole counts, step·floor(θ/step); θ itself for step = 0."""
@@ -68,4 +73,4 @@ def adc_current(i: float, noise: float, sigma: float, step: float, full_scale: f
 
 
 __all__ = ["NOISE_CHANNELS", "NOISE_SAMPLES", "adc_current", "adc_step", "encoder_angle", "encoder_step",
-           "noise_table"]
+           "noise_table", "reading_noise"]

@@ -86,9 +86,11 @@ class _InjectingDrive(ReferenceDrive):
         self.inj = injection
         self.t_move = injection.dwell * len(injection.levels)
 
-    def voltages(self, x: np.ndarray, xh: np.ndarray) -> tuple[float, float]:
+    def voltages(self, y: tuple[float, float, float], xh: np.ndarray,
+                 i0: tuple[float, float] | None = None) -> tuple[float, float]:
+        """u_d, u_q [V] from the readings y = (θ_r, i_d, i_q): the injection, then the FDSMC (no limits)."""
         d, c, ctrl = self.d, self.c, self.p.controller
-        i_d, i_q = x[0], x[1]
+        i_d, i_q = y[1], y[2]
         th_h, w_h, L0, L1 = xh
         if self.t < self.t_move:
             k = min(len(self.inj.levels) - 1, int(self.t / self.inj.dwell + 1e-9))
@@ -116,7 +118,7 @@ def clean_log(true: DriveParams, d_nominal: Derived, t_end: float, injection: In
     rec = np.zeros((7, n))
     for k in range(n):
         rec[:5, k] = (drive.t, *drive.x[:4])
-        rec[5:, k] = drive.voltages(drive.x, drive.xh)
+        rec[5:, k] = drive.voltages(drive.measure(drive.x), drive.xh)
         drive.step_sample(n_sub)
     return dict(zip(("t", "i_d", "i_q", "theta_r", "omega_r", "u_d", "u_q"), rec, strict=True))
 

@@ -59,8 +59,10 @@ SENSOR_SLOWDOWN = (1.0, 1.5, 2.25, 3.4, 5.0, 7.6, 11.4)
 PREDICTION_MARGIN = 0.8
 #: T_m stretch per step and the most steps when the verified speed/voltage peak exceeds its limit.
 T_M_STRETCH, MAX_STRETCHES = 1.03, 6
+#: T_c raise per step and the most steps when the verified run overshoots θ_dem.
+T_C_STEP, MAX_T_C_STEPS = 1.25, 10
 #: Checks that slower observer and acceleration loops can mend (the sensors' noise amplified).
-SENSOR_CHECKS = frozenset({"hold_ripple", "in_position", "current_time", "chatter", "saturation"})
+SENSOR_CHECKS = frozenset({"hold_ripple", "in_position", "current", "chatter", "saturation"})
 
 __all__ = ["Constraint", "DriveDesign", "TARGET_BAND", "design_drive", "run_checks", "shortest_fitting_T_m"]
 
@@ -164,8 +166,7 @@ def predicted_noise(p: DriveParams, d: Derived) -> NoiseGain | None:
     if d.loop.f_s is None:
         return None
     se = p.sensors
-    i_rms = math.hypot(se.i_noise, sensors.adc_step(se) / math.sqrt(12.0))
-    return noise_gain(d.loop, "slope", p.controller.K, sensors.encoder_step(se), i_rms)
+    return noise_gain(d.loop, "slope", p.controller.K, sensors.encoder_step(se), sensors.reading_noise(se))
 
 
 def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
@@ -177,7 +178,7 @@ def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
     return 2**bits if 2**bits <= ENCODER_CPR_MAX else None
 
 
-def design_drive(params: DriveParams) -> DriveDesign:
+def design_drive(params: DriveParams, alpha_rule: str = "torque_limit") -> DriveDesign:
     """Design α_max, T_m, K, T_c (and T_so, T_sα for the sensors) for ``params``'s drive; verify by simulation.
 
     Parameters
@@ -186,12 +187,16 @@ def design_drive(params: DriveParams) -> DriveDesign:
         Nameplate, load, inverter limits, sensors, pass criteria, sample rate and delay,
         T_si/T_sα/T_so and the manoeuvre (θ_dem, requested T_m). K, T_c and the α_max rule are
         replaced by the design; T_so and T_sα are lengthened where the sensors need it.
+    alpha_rule : str
+        The α_max rule of the design: ``"torque_limit"`` (the fastest profile the torque allows:
+        least friction, eqs. (47)–(60) in [1]) or ``"min_energy"`` (the profile's least friction +
+        copper, :mod:`control.fdsmc.profile_energy`).
 
     Returns
     -------
     DriveDesign
     """
-    base = _with(params, "controller", alpha_max_rule="torque_limit", T_c="T_a")
+    base = _with(params, "controller", alpha_max_rule=alpha_rule, T_c="T_a")
     first: DriveDesign | None = None
     for factor in _slowdowns(base):
         dd = _design_at(_slowed(base, factor), params)
@@ -212,7 +217,9 @@ def _slowdowns(p: DriveParams) -> list[float]:
         return [1.0]
     crit = pass_criteria(p).hold_i_rms
     for i, factor in enumerate(SENSOR_SLOWDOWN):
-        q = _slowed(p, factor)
+        q = _planned(_slowed(p, factor))
+        if q is None:
+            continue
         d = derive(q)
         if d.sample_rate is not None and not d.sample_rate.stable:
             continue
@@ -222,20 +229,27 @@ def _slowdowns(p: DriveParams) -> list[float]:
     return [SENSOR_SLOWDOWN[-1]]
 
 
+def _planned(p: DriveParams) -> DriveParams | None:
+    """``p`` at the T_m the design uses (the requested one if it fits, else the shortest that does); None if none."""
+    eta = _overshoot(p)
+    if not math.isfinite(eta):
+        return p
+    T_m = shortest_fitting_T_m(p, eta)
+    return None if T_m is None else _with(p, "manoeuvre", T_m=T_m)
+
+
 def _sensor_limited(dd: DriveDesign) -> bool:
     return not dd.params.sensors.ideal and any(c.violated and c.name in SENSOR_CHECKS for c in dd.limiting)
 
 
 def _design_at(p: DriveParams, asked: DriveParams) -> DriveDesign:
     """Choose T_m, check the sample rate, set K and T_c for ``p``'s loops, and verify."""
-    eta = _overshoot(p)
     limiting: list[Constraint] = []
-    if math.isfinite(eta):
-        T_m = shortest_fitting_T_m(p, eta)
-        if T_m is None:
-            return _refused(p, [Constraint("T_m", asked.manoeuvre.T_m, 1e4, "s", True,
-                                           "No manoeuvre time up to 1e4 s fits the speed/voltage limits.")])
-        p = _with(p, "manoeuvre", T_m=T_m)
+    planned = _planned(p)
+    if planned is None:
+        return _refused(p, [Constraint("T_m", asked.manoeuvre.T_m, 1e4, "s", True,
+                                       "No manoeuvre time up to 1e4 s fits the speed/voltage limits.")])
+    p = planned
     d = derive(p)
     rate = d.sample_rate
     if rate is not None and not rate.stable:
@@ -249,7 +263,7 @@ def _design_at(p: DriveParams, asked: DriveParams) -> DriveDesign:
 
 
 def _designed_source(source: str) -> str:
-    tag = "design: torque-limit α_max, recommended K, verified by simulation with the sensors"
+    tag = "design: α_max by its rule, recommended K, verified by simulation with the sensors"
     return source if tag in source else f"{source}; {tag}"
 
 
@@ -269,7 +283,13 @@ def _simulate(p: DriveParams) -> tuple[DriveParams, Derived, Comparison]:
 
 
 def _verify(p: DriveParams, asked: DriveParams) -> DriveDesign:
-    """Simulate with the sensors; stretch T_m while only speed/voltage fail; collect the checks."""
+    """Simulate with the sensors and mend what a longer T_m or T_c mends; collect the checks.
+
+    Only speed/voltage failing: T_m stretched (T_M_STRETCH, at most MAX_STRETCHES times). Overshoot
+    or the in-position window failing: the sloped segment's T_c scanned upwards from T_a (T_C_STEP,
+    at most MAX_T_C_STEPS) — a slower, better damped final approach that the lagging inner loops
+    follow — and the first T_c that passes taken (else the one with the fewest violations).
+    """
     for _ in range(MAX_STRETCHES + 1):
         p, d, cmp = _simulate(p)
         if cmp.fdsmc is None:  # infeasible after all: derive's warnings say why
@@ -280,7 +300,38 @@ def _verify(p: DriveParams, asked: DriveParams) -> DriveDesign:
             break
         q = _with(p, "manoeuvre", T_m=_round_up(p.manoeuvre.T_m * T_M_STRETCH))
         p = _gain_and_T_c(q, derive(q))
+    if failed & {"overshoot", "in_position"}:
+        step = T_C_STEP if "overshoot" in failed else 1.0 / T_C_STEP
+        p, d, cmp = _scan_T_c(p, (p, d, cmp), len(failed), step)
     return _result(p, d, cmp, asked)
+
+
+def _scan_T_c(p: DriveParams, best: tuple[DriveParams, Derived, Comparison], n_best: int,
+              step: float) -> tuple[DriveParams, Derived, Comparison]:
+    """Scan T_c = T_a·step^k (k = 0 …, K recommended for each) for the first that passes every check.
+
+    ``step`` > 1 (an overshoot: a slower, better damped approach) or < 1 (too slow to get in position
+    within the simulated tail: a faster one). Returns the first clean case, else the one with the
+    fewest violations.
+    """
+    T_a = derive(p).profile.T_a
+    for k in range(MAX_T_C_STEPS + 1):
+        q, d, cmp = _simulate(_with_T_c(p, T_a * step**k))
+        if cmp.fdsmc is None:
+            continue
+        n = len(run_checks(q, cmp.fdsmc))
+        if n < n_best:
+            best, n_best = (q, d, cmp), n
+        if n == 0:
+            break
+    return best
+
+
+def _with_T_c(p: DriveParams, T_c: float) -> DriveParams:
+    """``p`` with the sloped segment's T_c [s] and the K recommended for it."""
+    q = _with(p, "controller", T_c=T_c)
+    g = derive(q).gain
+    return _with(q, "controller", K=g.K_recommended) if g is not None and g.K_recommended > 0.0 else q
 
 
 def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> DriveDesign:
@@ -302,9 +353,11 @@ def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> 
 def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
     lim = torque_limit(p)
     peak = run.metrics.torque_peak_Nm or 0.0
+    a = alpha_max(p, _overshoot(p)).alpha_max
+    why = ("is set by the torque limit" if p.controller.alpha_max_rule == "torque_limit" else
+           "minimises the profile's friction + copper loss (rule min_energy) within the torque limit")
     return Constraint("torque", peak, lim, "N·m", False,
-                      f"α_max = {alpha_max(p, _overshoot(p)).alpha_max:.5g} rad/s² is set by the torque limit "
-                      f"{lim:.4g} N·m (Γ_max or i_max); simulated peak {peak:.4g} N·m.")
+                      f"α_max = {a:.5g} rad/s² {why} {lim:.4g} N·m (Γ_max or i_max); simulated peak {peak:.4g} N·m.")
 
 
 def _sensor_notes(p: DriveParams, asked: DriveParams, ng: NoiseGain | None, crit: float) -> tuple[str, ...]:

@@ -28,6 +28,7 @@ from control.fdsmc.feasibility import current_limit
 from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams
+from control.fdsmc.tracking import tracking_gains
 from sim.common import budget, sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
@@ -171,7 +172,10 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
     pr, o = d.profile, d.observer
     prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
-    prm[[kn.P_G1, kn.P_G2]] = (d.conventional.g1, d.conventional.g2)
+    gains = tracking_gains(d.loop, d.conventional) if controller == "optimum" else d.conventional
+    prm[[kn.P_G1, kn.P_G2]] = (gains.g1, gains.g2)
+    if controller == "optimum":  # α(t) ≈ α_dem(t − T_sα/3) (eq. (13)), one more sample with a delay
+        prm[kn.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
     prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), current_limit(params))  # 0 = no limit
     prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)

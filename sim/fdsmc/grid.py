@@ -87,16 +87,38 @@ def time_grid(params: DriveParams, n_sub: int, h_continuous: float, max_points: 
     return TimeGrid(ctrl.is_continuous, h, n_steps, sub, decim, n_steps // decim + 1)
 
 
-def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUOUS_STEP_S,
-             max_points: int = MAX_POINTS) -> budget.Cost:
-    """Cost of one controller's run (integration steps, trace bytes), from the parameters alone.
+def window_samples(params: DriveParams, g: TimeGrid) -> tuple[int, int]:
+    """Return (samples analysed, longest window) of one run's two full-resolution chatter windows [-].
 
-    Trace bytes: the kernel's output (N_CH channels × kept points) and the two full-resolution
-    chatter windows (≤ CHATTER_MAX_WINDOW_S each, θ_r and α_dem), 8 bytes per value.
+    The cruise window lies within [0.2·T_m, T_m] and the hold window within the tail after
+    T_m + 0.5·TAIL_FRACTION·T_m, each ≤ CHATTER_MAX_WINDOW_S (:func:`sim.fdsmc.metrics.chatter_windows`).
+    """
+    T_step, T_m = g.h * g.n_sub, params.manoeuvre.T_m
+    cruise = min(CHATTER_MAX_WINDOW_S, 0.8 * T_m)
+    hold = min(CHATTER_MAX_WINDOW_S, 0.5 * TAIL_FRACTION * T_m)
+    n_cruise, n_hold = (min(g.n_steps, int(w / T_step) + 2) for w in (cruise, hold))
+    return n_cruise + n_hold, max(n_cruise, n_hold)
+
+
+def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUOUS_STEP_S,
+             max_points: int = MAX_POINTS, n_runs: int = 1) -> budget.Cost:
+    """Cost of ``n_runs`` runs of one controller, from the parameters alone.
+
+    Integration steps and trace bytes (the kernel's output, N_CH channels × kept points, and the
+    chatter-window buffer, WIN_ROWS rows per window × the longer window, 8 bytes per value), and the predicted CPU
+    seconds and peak memory of :func:`sim.common.budget.cpu_seconds` / ``memory_bytes``.
     """
     g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
-    window = min(g.n_steps, int(CHATTER_MAX_WINDOW_S / (g.h * g.n_sub)) + 2)
-    return budget.Cost(g.n_steps * g.n_sub, 8 * (kn.N_CH * g.n_out + 4 * window))
+    analysed, longest = window_samples(params, g)
+    steps, samples, window = n_runs * g.n_steps * g.n_sub, n_runs * g.n_steps, n_runs * analysed
+    trace = n_runs * 8 * (kn.N_CH * g.n_out + 2 * kn.WIN_ROWS * longest)
+    return budget.Cost(steps, trace, budget.cpu_seconds(steps, samples, window, n_runs),
+                       budget.memory_bytes(trace, window, n_runs, samples))
+
+
+def predict(params: DriveParams, n_runs: int = 1, **options: float) -> budget.Cost:
+    """Predicted cost (steps, trace bytes, CPU seconds, peak memory) of ``n_runs`` runs of ``params``."""
+    return run_cost(params, n_runs=n_runs, **options)
 
 
 def with_field(params: DriveParams, field: str, value: float) -> DriveParams:
@@ -127,8 +149,7 @@ def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budg
     :func:`table1_sweep` (which checks the whole sweep).
     """
     def request(p: DriveParams) -> budget.Cost:
-        one = run_cost(p, **options)
-        return budget.Cost(n_runs * one.steps, n_runs * one.trace_bytes)
+        return run_cost(p, n_runs=n_runs, **options)
 
     cost = request(params)
     if cost.fits:
@@ -136,7 +157,7 @@ def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budg
     g = time_grid(params, int(options.get("n_sub", 1)), float(options.get("h_continuous", CONTINUOUS_STEP_S)),
               int(options.get("max_points", MAX_POINTS)))
     what = (f"{n_runs} run(s) × {g.n_steps:.3g} RK4 steps of {g.h:.3g} s" if g.continuous else
-            f"{n_runs} run(s) × {g.n_steps:.3g} samples × {g.n_sub} RK4 sub-steps")
+            f"{n_runs} run(s) × {g.n_steps:.3g} samples × {g.n_sub} sub-steps")
     return budget.check(cost, what, _cost_drivers(params, request))
 
 

@@ -40,7 +40,9 @@ from sim.common import sensors
 # the current predictor's ZOH factors over one sample (control.fdsmc.inverter.decay_factors); the
 # in-position window [rad] of the pass criteria.
 (P_ENC, P_INOISE, P_ISTEP, P_IFS, P_PHID, P_GMID, P_PHIQ, P_GMIQ, P_INPOS) = range(46, 55)
-N_PRM = 55
+# How far ahead the tracking law reads the reference's acceleration [s] (the inner loops' lag).
+P_LEAD = 55
+N_PRM = 56
 
 # ---- state indices -----------------------------------------------------------------------
 (X_ID, X_IQ, X_TH, X_W, X_EF, X_ECU, X_EEL, X_EMOT, X_ELOAD, X_THH, X_WH, X_L0, X_L1) = range(13)
@@ -88,17 +90,22 @@ def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) 
 
 @_helper
 def reference_at(t: float, ref: np.ndarray, T_m: float) -> tuple[float, float, float]:
-    """Return θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] at t [s], linear between the rows of ``ref``.
+    """Return θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] at t [s] between the rows of ``ref``.
 
-    The rows are equally spaced nodes over [0, T_m]; after T_m the final node's θ at rest.
+    The rows are equally spaced nodes over [0, T_m]; after T_m the final node's θ at rest. ω_ref and
+    α_ref are linear between nodes and θ_ref is the integral of that ω_ref from the node before
+    (quadratic): a θ_ref linear between nodes would lag the move's own ω by up to α·h²/8 — a few
+    mrad on a 200-node move, which the tracking law turned into an overshoot of the end point.
     """
     n = ref.shape[1]
     if t >= T_m:
         return ref[0, n - 1], 0.0, 0.0
-    x = max(t, 0.0) / T_m * (n - 1)
+    h = T_m / (n - 1)
+    x = max(t, 0.0) / h
     j = min(int(x), n - 2)
     f = x - j
-    return ((1.0 - f) * ref[0, j] + f * ref[0, j + 1], (1.0 - f) * ref[1, j] + f * ref[1, j + 1],
+    w0, w1 = ref[1, j], ref[1, j + 1]
+    return (ref[0, j] + h * f * (w0 + 0.5 * f * (w1 - w0)), (1.0 - f) * w0 + f * w1,
             (1.0 - f) * ref[2, j] + f * ref[2, j + 1])
 
 
@@ -110,8 +117,9 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
     Eqs. (44)–(46), (62), or the reference tracking law :func:`control.fdsmc.conventional.tracking_demand`
     (``P_CTRL`` = 2), all of :mod:`control`.
     """
-    if prm[P_CTRL] == 2.0:
-        th_r, w_r, a_r = reference_at(t, ref, prm[P_TM])
+    if prm[P_CTRL] == 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
+        th_r, w_r, _ = reference_at(t, ref, prm[P_TM])
+        a_r = reference_at(t + prm[P_LEAD], ref, prm[P_TM])[2]
         return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
     if prm[P_CTRL] == 1.0:
         return conventional.conventional_demand(prm[P_THDEM], theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0

@@ -10,9 +10,8 @@ from __future__ import annotations
 import math
 
 from control.fdsmc.derivations import Derived
-from control.fdsmc.feasibility import current_limit, exceeds, speed_limit, torque_limit, voltage_limit
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
-from sim.fdsmc.checks import TARGET_BAND, run_checks
+from sim.fdsmc.checks import TARGET_BAND, exceeded, run_checks, saturation_matters
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
 
 
@@ -77,21 +76,14 @@ def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
     list of str
         One message per limit exceeded.
     """
-    m, p, name = run.metrics, derived.params, LABELS[run.controller]
-    t_lim, i_lim, u_lim, w_lim = torque_limit(p), current_limit(p), voltage_limit(p), speed_limit(p)
-    t_name = "Γ_max" if t_lim == p.motor.Gamma_max else "K_t·i_max"
-    checks = [("peak torque", m.torque_peak_Nm, "N·m", f"{t_name} = {t_lim:.4g} N·m", t_lim),
-              ("peak |u_dq|", m.u_peak_V, "V", f"{u_lim:.4g} V available", u_lim),
-              ("peak speed", m.omega_peak_rad_s, "rad/s", f"the speed limit {w_lim:g} rad/s", w_lim)]
-    if i_lim > 0.0:
-        checks.append(("peak |i_dq|", m.i_peak_A, "A", f"the current limit {i_lim:.4g} A", i_lim))
-    return [f"Not feasible on the real drive ({name}): {what} {v:.4g} {unit} > {text}."
-            for what, v, unit, text, lim in checks if v is not None and exceeds(v, lim)]
+    label = {"torque": "peak torque", "voltage": "peak |u_dq|", "speed": "peak speed", "current": "peak |i_dq|"}
+    return [f"Not feasible on the real drive ({LABELS[run.controller]}): {label[lim.name]} {v:.4g} {lim.unit} > "
+            f"{lim.label}." for lim, v in exceeded(derived.params, run.metrics)]
 
 
 def criteria_warnings(run: RunResult, derived: Derived) -> list[str]:
-    """List the user's pass criteria the run fails: in-position window, overshoot, standstill ripple, i_max."""
-    names = {"in_position", "overshoot", "hold_ripple", "current_time"}
+    """List the user's pass criteria the run fails: in-position window, overshoot, standstill ripple."""
+    names = {"in_position", "overshoot", "hold_ripple"}
     return [f"Criterion ({LABELS[run.controller]}): {c.text}" for c in run_checks(derived.params, run)
             if c.name in names]
 
@@ -128,14 +120,14 @@ def run_warnings(comparison: Comparison) -> list[str]:
         if miss:
             out.append(miss)
         if run.controller == "fdsmc":
-            out += _saturation(run) + limit_warnings(run, comparison.derived)
+            out += _saturation(run, comparison.derived) + limit_warnings(run, comparison.derived)
             out += criteria_warnings(run, comparison.derived)
     return out + _saving_verdicts(comparison)
 
 
-def _saturation(run: RunResult) -> list[str]:
+def _saturation(run: RunResult, derived: Derived) -> list[str]:
     sat = run.metrics.saturated_s
-    if sat > 0.0:
+    if saturation_matters(derived.params, run.metrics):
         return [f"Saturation ({LABELS[run.controller]}): voltage/current limited for {sat:.4g} s."]
     return []
 
@@ -148,7 +140,7 @@ def comparator_notes(comparison: Comparison) -> list[str]:
     run = comparison.conventional
     if run is None or not run.metrics.stable:
         return []
-    issues = _saturation(run) + limit_warnings(run, comparison.derived)
+    issues = _saturation(run, comparison.derived) + limit_warnings(run, comparison.derived)
     if not issues:
         return []
     return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."]

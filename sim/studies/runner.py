@@ -47,6 +47,9 @@ class RetryingFuture:
             try:
                 return self.future.result(timeout)
             except BrokenProcessPool as exc:
+                if self._pool.ended:
+                    raise ExecutorError(f"chunk {self.index} stopped: the local pool was ended (the run was "
+                                        "cancelled); allowed: a pool left running") from None
                 if self.attempts >= RETRIES:
                     raise ExecutorError(
                         f"chunk {self.index} lost its worker process {self.attempts + 1} times ({exc}): allowed "
@@ -64,6 +67,7 @@ class RetryingPool:
     def __init__(self, workers: int) -> None:
         self.workers = int(workers)
         self.generation = 0
+        self.ended = False
         self._lock = threading.Lock()
         self._pool = ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"))
         self._futures: list[RetryingFuture] = []
@@ -81,14 +85,21 @@ class RetryingPool:
     def renew(self, broken_generation: int) -> None:
         """Replace the pool broken in ``broken_generation`` and resubmit every chunk not finished."""
         with self._lock:
-            if broken_generation != self.generation:
-                return  # another chunk already replaced it
+            if broken_generation != self.generation or self.ended:
+                return  # another chunk already replaced it, or the pool was ended on purpose
             self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"))
             self.generation += 1
             for f in self._futures:
                 if f.generation < self.generation and not _finished(f.future):
                     f.resubmit()
+
+    def terminate(self) -> None:
+        """End the workers now (a cancelled run): their chunks are not waited for, nor run again."""
+        with self._lock:
+            self.ended = True
+            for proc in list((self._pool._processes or {}).values()):
+                proc.terminate()
 
     def processes(self) -> list[int]:
         """Process ids of the current workers (for tests and diagnostics)."""

@@ -1,18 +1,22 @@
 """The page in a real Chromium against hostile input: a foreign web page cannot open the tool's
-websocket, and markup in user text (file names, preset names) is shown as text.
+websocket, and markup in user text (file names, column headers, notes, preset names and sources) is
+shown as text: no script runs.
 """
 
 from __future__ import annotations
 
 import http.server
+import re
 import threading
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
 import viser
 
 from app.io.presets import PRESET_DIR, loads_preset
-from tests.browser.conftest import click_tab
+from app.ui.log import EXAMPLE_LOG
+from tests.browser.conftest import click_tab, open_page
 
 OPEN_WS_JS = """async ([url, protocol]) => await new Promise((resolve) => {
   const ws = new WebSocket(url, [protocol]);
@@ -80,3 +84,58 @@ def test_markup_in_file_and_preset_names_is_shown_as_text(page):
     assert page.locator("img[src='http://127.0.0.1:9/i.png']").count() == 0
     assert page.get_by_role("heading", name="GAINS VERIFIED").count() == 0
     assert status.locator("b", has_text="bold").count() == 0
+
+
+# Markup whose script, if it ever ran, sets window.__pwn (top window or parent of an iframe).
+SCRIPT_NAME = "x<img src=x onerror=window.__pwn=1>.csv"
+IFRAME = '<iframe srcdoc="&lt;script&gt;parent.__pwn=2&lt;/script&gt;"></iframe>'
+SVG = "<svg onload=window.__pwn=3>"
+ARMED = "window.__pwn = 0; window.alert = () => { window.__pwn = 9; };"
+
+
+def _hostile_log() -> bytes:
+    """The example log plus a tool column whose header (unit) carries an iframe with a script."""
+    lines = EXAMPLE_LOG.read_text(encoding="utf-8").splitlines()
+    head = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    header = IFRAME.replace('"', '""')
+    lines[head] += f',"alpha [{header}]"'
+    lines[head + 1:] = [f"{line},0" for line in lines[head + 1:]]
+    return ("\n".join(lines) + "\n").encode()
+
+
+def _assert_inert(page: Any) -> None:
+    """No payload ran and none became an element: the markup is shown as text only."""
+    assert page.evaluate("window.__pwn") == 0
+    assert page.locator("iframe[srcdoc]").count() == 0
+    assert page.locator("img[src='x']").count() == 0
+    assert page.locator("svg[onload]").count() == 0
+
+
+def test_markup_in_log_header_file_name_and_preset_runs_no_script(browser, ui_server):
+    context, page = open_page(browser, ui_server, init_script=ARMED)
+    try:
+        page.get_by_text("Drive log (measured)").click()
+        page.get_by_role("button", name="Load example log").click()
+        page.get_by_text(re.compile(r"drive_log_dq\.csv: 6800 samples")).wait_for()
+        page.locator("input[type=file][accept*='.csv']").set_input_files(
+            files=[{"name": SCRIPT_NAME, "mimeType": "text/csv", "buffer": _hostile_log()}])
+        page.get_by_text(re.compile(r"x<img src=x onerror=window.__pwn=1>\.csv: 6800 samples")).wait_for()
+        body = page.inner_text("body")
+        assert "ignored column(s) alpha [<iframe srcdoc=" in body  # the header, shown as text
+        click_tab(page, "Drive log")
+        page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && "
+                               "e.layout.meta && e.layout.meta.id === 'log-overlay' && "
+                               "e.layout.title.text.includes('&lt;img'))")
+        _assert_inert(page)
+
+        text = (PRESET_DIR / "example_log_drive.yaml").read_text(encoding="utf-8")
+        text = re.sub(r"(?m)^name: .*$", f"name: '{SVG} {MARKUP}'", text)
+        text = re.sub(r"(?m)^source: .*$", f"source: '{IFRAME}'", text)
+        with page.expect_file_chooser() as chooser:
+            page.get_by_role("button", name="Import preset (YAML/JSON)").click()
+        chooser.value.set_files(files=[{"name": f"p{SVG}.yaml", "mimeType": "text/yaml",
+                                        "buffer": text.encode()}])
+        page.get_by_text(re.compile(r"Preset: p<svg onload=window\.__pwn=3>\.yaml")).wait_for()
+        _assert_inert(page)
+    finally:
+        context.close()

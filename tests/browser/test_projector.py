@@ -97,7 +97,7 @@ def test_1280x720_shows_phase_plane_time_plot_numbers_and_scrub_without_scrollin
     assert boxes["phase"]["width"] >= 300 and boxes["phase"]["height"] >= 250  # legible on a projector
     assert boxes["omega"]["x"] > boxes["phase"]["x"] + boxes["phase"]["width"]  # side by side
     text = page.inner_text('[data-role="key-numbers"]')
-    assert "FDSMC saves" in text and "Γ_max" in text
+    assert "Net electrical input" in text and "Optimum" in text and "Γ_max" in text
     page.wait_for_timeout(300)  # let the last layout message settle before the picture
     ARTIFACTS.mkdir(exist_ok=True)
     out = ARTIFACTS / "projector_1280x720.png"  # copied by hand to docs/ for the README

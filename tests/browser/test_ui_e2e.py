@@ -107,7 +107,8 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
     name, archive = _download(page, "C controller module (.h + .c, zip)")
     assert name == "imported_case_fdsmc_controller.zip"
     with zipfile.ZipFile(io.BytesIO(archive)) as zf:
-        assert sorted(zf.namelist()) == ["fdsmc_controller.c", "fdsmc_controller.h"]
+        assert sorted(zf.namelist()) == ["fdsmc_controller.c", "fdsmc_controller.h", "fdsmc_test.c",
+                                         "fdsmc_vectors.h"]
         header = zf.read("fdsmc_controller.h").decode()
     assert "Drive: imported_case" in header and "Source: browser test" in header
     match = re.search(r"#define FDSMC_OMEGA_P\s+\(\(fdsmc_real\)([^)]+)\)", header)

@@ -1,0 +1,150 @@
+"""Cortex-M4F build of the generated C module: cross-compile, symbol check, code size, instruction count.
+
+Uses Debian's ``gcc-arm-none-eabi`` (installed by ``scripts/ensure_cc.sh``). The float32 build is
+compiled with :data:`ARM_FLAGS`; :func:`double_symbols` lists every soft-float double helper
+(``__aeabi_d*``, ``__*df*``) the object needs — none when the build is float-only.
+:func:`count_instructions` links the module with a tiny bench program (Linux ``exit`` syscall, no C
+library) that replays the golden vectors, runs it under ``qemu-arm`` (``qemu-user``) with one
+instruction per translation block and ``-d exec``, and counts the instructions executed between
+two calls of a marker function: every instruction of one ``fdsmc_step`` call (prologue, inlined
+helpers, libgcc calls, epilogue). Without qemu it counts statically: the instructions of the step's
+code in the disassembly (each instruction once, whatever the path).
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+#: Cortex-M4F, single-precision FPU, hard-float ABI; -fno-math-errno lets sqrtf be one VSQRT and
+#: -ffp-contract=fast fuses multiply-adds (VFMA: one rounding instead of two; -std=c99 turns it off).
+ARM_FLAGS = ("-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard", "-O2", "-fno-math-errno",
+             "-ffp-contract=fast",
+             "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wdouble-promotion", "-DFDSMC_USE_FLOAT")
+#: Soft-float double helpers of the ARM EABI and libgcc.
+DOUBLE_SYMBOL = re.compile(r"__aeabi_(d|l2d|ul2d|i2d|ui2d|f2d)\w*|__\w*df\w*")
+
+START_C = """\
+int main(void);
+void _start(void) __attribute__((naked, noreturn));
+void _start(void) { __asm__ volatile("bl main\\n\\tmovs r7, #1\\n\\tsvc #0\\n"); }
+"""
+
+BENCH_C = """\
+#include "fdsmc_controller.h"
+#include "fdsmc_vectors.h"
+void fdsmc_bench_mark(void) __attribute__((noinline));
+void fdsmc_bench_mark(void) { __asm__ volatile(""); }
+volatile fdsmc_real fdsmc_bench_sink;
+int main(void)
+{
+    static fdsmc_state s;
+    fdsmc_output out;
+    int k;
+    fdsmc_init(&s, &FDSMC_DESIGN, 0);
+    if (fdsmc_set_move(&s, FDSMC_VEC_THETA_DEM, (fdsmc_real)FDSMC_VEC_T_M) != FDSMC_OK) {
+        return 2;
+    }
+    for (k = 0; k < FDSMC_VEC_N; ++k) {
+        fdsmc_bench_mark();
+        fdsmc_step(&s, fdsmc_vec_theta[k], fdsmc_vec_in[k][0], fdsmc_vec_in[k][1], &out);
+        fdsmc_bench_sink = out.u_q;
+    }
+    fdsmc_bench_mark();
+    return s.status.fault != 0u;
+}
+"""
+
+
+@dataclass(frozen=True)
+class InstructionCount:
+    """Instructions per ``fdsmc_step`` call on Cortex-M4F.
+
+    Attributes
+    ----------
+    method : str   ``"qemu-arm"`` (executed, over the golden vectors) or ``"static"`` (disassembly).
+    mean : float   Mean per call [-] (static: the code's instruction count).
+    max : int      Largest per call [-].
+    calls : int    Calls counted [-].
+    """
+
+    method: str
+    mean: float
+    max: int
+    calls: int
+
+
+def arm_compiler() -> str | None:
+    """Path of ``arm-none-eabi-gcc``, or None."""
+    return shutil.which("arm-none-eabi-gcc")
+
+
+def _run(args: list[str], cwd: Path) -> str:
+    return subprocess.run(args, cwd=cwd, check=True, capture_output=True, text=True).stdout
+
+
+def cross_compile(folder: Path, extra: tuple[str, ...] = ()) -> Path:
+    """Compile ``folder/fdsmc_controller.c`` for Cortex-M4F (float32); returns the object file."""
+    obj = folder / "fdsmc_controller_m4f.o"
+    _run(["arm-none-eabi-gcc", *ARM_FLAGS, *extra, "-c", "fdsmc_controller.c", "-o", obj.name], folder)
+    return obj
+
+
+def symbols(obj: Path, kind: str = "U") -> list[str]:
+    """Names of the symbols of type ``kind`` (``U`` undefined, ``T`` text …) in an ARM object."""
+    out = _run(["arm-none-eabi-nm", str(obj)], obj.parent)
+    return [line.split()[-1] for line in out.splitlines() if line.split()[-2:-1] == [kind]]
+
+
+def double_symbols(obj: Path) -> list[str]:
+    """Soft-float double helpers an ARM object calls (empty for a float-only build)."""
+    return [s for s in symbols(obj) if DOUBLE_SYMBOL.fullmatch(s)]
+
+
+def code_size(obj: Path) -> dict[str, int]:
+    """``text`` (code and constants), ``data`` and ``bss`` of an ARM object [bytes]."""
+    line = _run(["arm-none-eabi-size", str(obj)], obj.parent).splitlines()[1].split()
+    return {"text": int(line[0]), "data": int(line[1]), "bss": int(line[2])}
+
+
+def _executed(folder: Path, elf: Path) -> InstructionCount:
+    log = folder / "qemu_exec.log"
+    _run(["qemu-arm", "-cpu", "max", "-singlestep", "-d", "exec,nochain", "-D", str(log), str(elf)], folder)
+    counts: list[int] = []
+    n = -1
+    with log.open(encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            name = line.rsplit(None, 1)[-1]
+            if name == "fdsmc_bench_mark":
+                if n > 0:
+                    counts.append(n)
+                n = 0
+            elif n >= 0 and name != "main":
+                n += 1
+    log.unlink()
+    return InstructionCount("qemu-arm", sum(counts) / len(counts), max(counts), len(counts))
+
+
+def _static(folder: Path, elf: Path) -> InstructionCount:
+    dis = _run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", str(elf)], folder)
+    n, inside = 0, False
+    for line in dis.splitlines():
+        head = re.match(r"^[0-9a-f]+ <(\w+)>:", line)
+        if head:
+            inside = head.group(1) in ("fdsmc_step", "step")
+        elif inside and re.match(r"^\s+[0-9a-f]+:\s+\w", line):
+            n += 1
+    return InstructionCount("static", float(n), n, 1)
+
+
+def count_instructions(folder: Path, extra: tuple[str, ...] = ()) -> InstructionCount:
+    """Instructions per ``fdsmc_step`` of the module and golden vectors in ``folder`` (see the module doc)."""
+    (folder / "bench_start.c").write_text(START_C, encoding="utf-8")
+    (folder / "bench.c").write_text(BENCH_C, encoding="utf-8")
+    elf = folder / "bench_m4f.elf"
+    _run(["arm-none-eabi-gcc", *ARM_FLAGS, *extra, "-nostdlib", "-nostartfiles", "-static", "bench_start.c",
+          "bench.c", "fdsmc_controller.c", "-lgcc", "-o", elf.name], folder)
+    return _executed(folder, elf) if shutil.which("qemu-arm") else _static(folder, elf)

@@ -1,0 +1,123 @@
+"""Issue 28, nothing lost: Ctrl-C (SIGINT to the process group, as a terminal sends it) or SIGTERM
+stops each long command with exit 130 and one line, no traceback; a file being replaced keeps its
+old content and no temporary file is left. The stop latency is printed by
+``scripts/bench_interrupt.py`` (not asserted here beyond the wait limit).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from app.io import atomic
+from app.io.atomic import discard_partial, write_atomic
+
+ROOT = Path(__file__).resolve().parents[1]
+OLD = b"old content that must survive\n"
+FAST = ["--set", "controller.f_s_kHz=2500", "--set", "manoeuvre.T_m=1.0"]  # ≈ 1 s of compute, within budget
+#: (name, command line with {out} for the file, seconds after the command starts working)
+LONG_COMMANDS = [
+    ("simulate --csv", ["simulate", "yaskawa_sgm7j_02a", *FAST, "--csv", "{out}"], 0.3),
+    ("simulate --csv, at once", ["simulate", "yaskawa_sgm7j_02a", *FAST, "--csv", "{out}"], 0.0),
+    ("export csv", ["export", "yaskawa_sgm7j_02a", *FAST, "--format", "csv", "-o", "{out}"], 0.3),
+    ("export html", ["export", "paper_12kw_pmsm", "--format", "html", "-o", "{out}"], 0.1),
+    ("design -o", ["design", "yaskawa_sgm7j_04a", "-o", "{out}"], 0.1),
+    ("table1", ["table1", "paper_12kw_pmsm", "--set", "controller.f_s_kHz=500"], 0.3),
+    ("bldc", ["bldc", "bldc_smc_paper"], 0.1),
+]
+
+
+def _working(pid: int) -> bool:
+    """True once the command runs in its worker thread (a second thread of the process)."""
+    try:
+        return len(os.listdir(f"/proc/{pid}/task")) >= 2
+    except OSError:
+        return False
+
+
+def interrupt(argv: list[str], after_s: float, sig: int = signal.SIGINT) -> tuple[subprocess.CompletedProcess, float]:
+    """Run ``python -m app ARGV``; ``after_s`` after its command started working, send ``sig`` to its
+    process group as a terminal does. Returns (result, time from the signal to the exit [s]).
+    """
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "app", *argv], cwd=ROOT, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    for _ in range(3000):  # imports, preset, argument parsing: then the worker thread starts
+        if _working(proc.pid) or proc.poll() is not None:
+            break
+        time.sleep(0.01)  # poll the process again (a positive condition)
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        proc.wait(timeout=after_s)
+    t0 = time.perf_counter()
+    if proc.poll() is None:
+        os.killpg(proc.pid, sig)
+    out, err = proc.communicate(timeout=30)
+    return subprocess.CompletedProcess(argv, proc.returncode, out, err), time.perf_counter() - t0
+
+
+def _no_part_files(folder: Path) -> list[str]:
+    return [p.name for p in folder.iterdir() if p.name.endswith(".part")]
+
+
+@pytest.mark.parametrize(("name", "argv", "after_s"), LONG_COMMANDS, ids=[c[0] for c in LONG_COMMANDS])
+def test_sigint_stops_with_130_one_line_and_no_partial_file(tmp_path, name, argv, after_s):
+    out = tmp_path / "result.out"
+    out.write_bytes(OLD)
+    result, _ = interrupt([a.format(out=out) for a in argv], after_s)
+    assert result.returncode == 130, (name, result.returncode, result.stderr[-500:])
+    assert "Traceback" not in result.stderr and result.stderr.strip().count("\n") == 0, result.stderr
+    assert result.stderr.startswith("interrupted")
+    assert out.read_bytes() == OLD  # never truncated, never half-written
+    assert _no_part_files(tmp_path) == []
+
+
+def test_sigterm_stops_simulate_like_sigint(tmp_path):
+    out = tmp_path / "run.csv"
+    out.write_bytes(OLD)
+    result, _ = interrupt(["simulate", "yaskawa_sgm7j_02a", *FAST, "--csv", str(out)], 0.3, signal.SIGTERM)
+    assert result.returncode == 130 and "Traceback" not in result.stderr
+    assert out.read_bytes() == OLD and _no_part_files(tmp_path) == []
+
+
+def test_write_atomic_interrupted_at_the_rename_keeps_the_old_file(tmp_path, monkeypatch):
+    target = tmp_path / "x.csv"
+    target.write_bytes(OLD)
+
+    def boom(*_: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(atomic.os, "replace", boom)
+    with pytest.raises(KeyboardInterrupt):
+        write_atomic(target, b"new" * 1000)
+    assert target.read_bytes() == OLD and _no_part_files(tmp_path) == []
+
+
+def test_write_atomic_replaces_keeps_mode_and_writes_through_a_link(tmp_path):
+    target = tmp_path / "x.yaml"
+    target.write_bytes(OLD)
+    target.chmod(0o640)
+    link = tmp_path / "link.yaml"
+    link.symlink_to(target)
+    write_atomic(link, b"new\n")
+    assert link.is_symlink() and target.read_bytes() == b"new\n" and target.stat().st_mode & 0o777 == 0o640
+    assert _no_part_files(tmp_path) == [] and discard_partial() == []
+
+
+def test_write_atomic_full_disk_leaves_nothing(tmp_path, monkeypatch):
+    target = tmp_path / "x.csv"
+    target.write_bytes(OLD)
+
+    def full(fd: int) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(atomic.os, "fsync", full)
+    with pytest.raises(OSError, match="No space"):
+        write_atomic(target, b"new")
+    assert target.read_bytes() == OLD and _no_part_files(tmp_path) == []
