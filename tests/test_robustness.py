@@ -31,9 +31,8 @@ def test_plant_equal_to_model_changes_nothing():
 
 
 def test_plant_override_changes_the_drive_not_the_controller():
-    """A heavier true load than the controller assumes: the same design, the torque held at the
-    drive's hard current limit for longer (its peak no lower), more copper energy; the energy
-    balance closes with the plant's inertia.
+    """A heavier true load than the controller assumes: the same design, more torque and energy;
+    the energy balance closes with the plant's inertia.
     """
     params, plant = load_model_and_plant(PRESET, ["plant.J_L=0.004"])
     assert pytest.approx(2.172e-3) == params.load.J_L and plant.load.J_L == 0.004
