@@ -15,7 +15,7 @@ from app.io.presets import load_preset
 from control.fdsmc.feasibility import current_limit
 from control.fdsmc.params import Sensors
 from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.design import design_drive
+from sim.fdsmc.objective import design_for
 from sim.fdsmc.engine import simulate
 
 PRESETS = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yaskawa_sgm7a_50a",
@@ -23,8 +23,10 @@ PRESETS = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yas
 
 
 def _row(name: str) -> list[str]:
-    dd = design_drive(load_preset(name))
+    od = design_for(load_preset(name))  # the default objective: net electrical input
+    dd = od.design
     p, c = dd.params, dd.params.controller
+    e = {x.controller: x.net_electrical_J for x in od.recommendation.energies}
     m = dd.comparison.fdsmc.metrics
     crit = pass_criteria(p)
     same_window = dataclasses.replace(p.limits, in_position=crit.in_position)  # not the ideal encoder's default
@@ -34,7 +36,9 @@ def _row(name: str) -> list[str]:
         return "never" if x is None else f"{x:.3f}"
 
     tc = "T_a" if c.T_c == "T_a" else f"{float(c.T_c) * 1e3:.3g} ms"
-    return [f"`{name}`", f"{p.sensors.encoder_cpr}", dd.verdict, f"{c.T_so * 1e3:.3g} / {c.T_salpha * 1e3:.3g}",
+    energy = " / ".join(f"{e[k]:.3g}" for k in ("fdsmc", "optimum", "stock", "conventional"))
+    return [f"`{name}`", f"{p.sensors.encoder_cpr}", dd.verdict, c.alpha_max_rule, energy,
+            f"{c.T_so * 1e3:.3g} / {c.T_salpha * 1e3:.3g}",
             f"{c.K:.4g}", tc, f"{m.i_peak_A:.4g} / {current_limit(p):.4g}",
             f"{m.hold_i_q_rms_A:.3g} ({dd.noise.i_q_rms:.3g}) / {crit.hold_i_rms:.3g}",
             f"{ideal.hold_i_q_rms_A:.2g}", f"{m.overshoot_rad:.2g} / {ideal.overshoot_rad:.2g} / {crit.overshoot:.2g}",
@@ -43,7 +47,8 @@ def _row(name: str) -> list[str]:
 
 def main() -> None:
     """Print the markdown table."""
-    head = ["preset", "encoder [counts/rev]", "verdict", "T_so / T_sα [ms]", "K [s/rad]", "T_c",
+    head = ["preset", "encoder [counts/rev]", "verdict", "α rule",
+            "net electrical FDSMC / optimum / stock / conv. [J]", "T_so / T_sα [ms]", "K [s/rad]", "T_c",
             "peak |i_dq| / limit [A]", "ripple sim (predicted) / limit [A rms]", "ripple, ideal sensors",
             "overshoot sensors / ideal / limit [rad]", "in position sensors / ideal [s]"]
     print("| " + " | ".join(head) + " |")

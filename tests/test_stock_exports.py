@@ -67,7 +67,8 @@ def test_cli_refuses_with_exit_2_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "p.odrive.json"
     assert main(["export", "paper_12kw_pmsm", "--format", "odrive", "-o", str(out)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: export --format odrive refused") and "chatter" in err and err[-1] == "\n"
+    # one line (≤ 300 characters: the first failed checks, the paper's torque first)
+    assert err.startswith("error: export --format odrive refused") and "torque" in err and err[-1] == "\n"
     assert not out.exists()
     assert main(["export", "paper_12kw_pmsm", "--format", "c", "-o", str(tmp_path / "c")]) == 2  # C too
     assert not (tmp_path / "c").exists()

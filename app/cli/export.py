@@ -48,13 +48,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def case(params: DriveParams, fmt: str = "yaml") -> Comparison:
     """Return the simulated case (the derivations alone when the manoeuvre is infeasible).
 
-    The stock-drive formats also simulate the stock route and the tracked optimum (their energies
-    go into the file's header).
+    The stock-drive formats and the HTML report also simulate the stock route and the tracked optimum
+    (their energies go into the file's header, the report's headline).
     """
     d = derive(params)
     if not d.profile.feasible:
         return Comparison(d, None, None, None, None)
-    return compare(params, COMPARATORS if fmt in DRIVE_FORMATS else CONTROLLERS, derived=d)
+    return compare(params, COMPARATORS if fmt in DRIVE_FORMATS or fmt == "html" else CONTROLLERS, derived=d)
 
 
 def cycle_seconds(text: str | None) -> float | None:

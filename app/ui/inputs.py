@@ -25,7 +25,7 @@ from app.ui.number_fields import NumberInput
 from app.ui.text import checked_choice
 from control.common.checks import FieldSpec, ParameterError
 from control.fdsmc.nameplate import nameplate_consistency
-from control.fdsmc.params import DriveParams, Motor
+from control.fdsmc.params import ALPHA_MAX_RULES, DriveParams, Motor
 
 Conv = Callable[[float, int], float]  # (value, pole pairs) → value
 
@@ -156,7 +156,7 @@ FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("controller", "Inver
            ("sensors", "Sensors"), ("limits", "Pass criteria"), ("manoeuvre", "Manoeuvre"))
 TC_RULES = ("T_c = T_a, eq. (59)", "T_c given below")
 FS_MODES = ("digital, sampled at f_s", "continuous")
-ALPHA_RULES = ("torque_limit", "paper")
+ALPHA_RULES = ALPHA_MAX_RULES  # the parameter model's own list: every rule a preset may hold
 DELAYS = ("0", "1")
 #: Optional datasheet values used only to cross-check the nameplate (label → key).
 CHECKS = (("Kt datasheet [N·m/A_rms] (optional check)", "Kt"), ("T_N rated torque [N·m] (optional check)", "T_N"))
@@ -229,7 +229,8 @@ class InputsPanel:
             self.tc_ms = NumberInput(gui, T_C.text(), hint=T_C.hint(None, 0))
             self.alpha_rule = gui.add_dropdown("α_max rule", ALPHA_RULES,
                                                hint="torque_limit: largest α within Γ_max/i_max incl. friction, "
-                                                    "load and inner-loop overshoot; paper: α_max = H·P_r/V_0")
+                                                    "load and inner-loop overshoot; min_energy: the α below it that "
+                                                    "draws least copper + friction; paper: α_max = H·P_r/V_0")
             self.fs_mode = gui.add_dropdown("Controller", FS_MODES)
             self.fs_khz = NumberInput(gui, F_S.text(), hint=F_S.hint(None, 0))
             self.delay = gui.add_dropdown("Computation delay [samples]", DELAYS)

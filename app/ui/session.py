@@ -35,9 +35,12 @@ from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Cancelled, Worker
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
+from sim.fdsmc.objective import OBJECTIVES, design_for
 from sim.fdsmc.verdicts import T_c_advice, recommended_K
+
+#: The page's words for the design objectives (same order as :data:`sim.fdsmc.objective.OBJECTIVES`).
+OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")
 
 
 def comparison_or_derived(params: DriveParams, optimum: bool = False) -> Comparison:
@@ -67,7 +70,7 @@ class AppConfig:
         """Return the comparison of the start-up preset (computed on first use)."""
         with self._lock:
             if self._initial is None:
-                self._initial = comparison_or_derived(self.params)
+                self._initial = comparison_or_derived(self.params, optimum=True)  # the toggle's default
             return self._initial
 
 
@@ -140,6 +143,9 @@ class Session:
                                             hint="α_max, T_m, K and T_c for this nameplate, load and inverter, "
                                                  "verified by simulation")
         self.design_button.on_click(lambda _: self.design())
+        self.objective = gui.add_dropdown("Design objective", OBJECTIVE_LABELS,
+                                          hint="net electrical input (copper + friction): the α that draws least; "
+                                               "friction: the paper's profile at the torque limit")
         self.design_note = gui.add_markdown("")
         self.optimum = OptimumToggle(gui, self.simulate)
         self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
@@ -176,7 +182,9 @@ class Session:
 
     def _run_design(self, params: DriveParams) -> None:
         self.status.content = "Designing and verifying…"
-        dd = design_drive(params)
+        objective = OBJECTIVES[OBJECTIVE_LABELS.index(checked_choice(self.objective.value, OBJECTIVE_LABELS,
+                                                                     "Design objective"))]
+        dd = design_for(params, objective).design
         self.inputs.populate(dd.params)
         self.params, self.error, self._recentre = dd.params, None, True
         self.comparison = (None if self.optimum.wanted else dd.comparison) or comparison_or_derived(

@@ -81,7 +81,7 @@ def min_energy_alpha(params: DriveParams, alpha_hi: float) -> float:
     if lo >= alpha_hi:
         return alpha_hi
     res = minimize_scalar(lambda a: profile_energy(params, a).total, bounds=(lo, alpha_hi), method="bounded",
-                          options={"xatol": 1e-6 * alpha_hi})
+                          options={"xatol": 1e-6 * lo})
     best = float(res.x)
     return alpha_hi if profile_energy(params, alpha_hi).total <= profile_energy(params, best).total else best
 

@@ -416,8 +416,8 @@ def table1_sweep(
         no row is ever computed from a diverged run.
     """
     points = [with_field(params, "manoeuvre.T_m", float(T_m)) for T_m in T_m_values]
-    total = sum((run_cost(p, **options) for p in points), budget.Cost(0, 0))
-    if points and not budget.Cost(2 * total.steps, 2 * total.trace_bytes).fits:
+    total = sum((run_cost(p, **options) for p in points), budget.Cost(0, 0, 0.0, 0))  # keeps CPU and memory
+    if points and not (total + total).fits:  # two controllers per point
         check_budget(max(points, key=lambda p: p.manoeuvre.T_m), 2 * len(points), **options)
     rows: list[Table1Row] = []
     for i, (T_m, p) in enumerate(zip(T_m_values, points, strict=True)):
