@@ -89,6 +89,9 @@ def per_sample_cpu(params, spreads, repeat: int) -> None:
         batch.append((time.process_time() - c0) / 64 * 1e3)
     figure("CPU per sample, one run at a time", one, "ms")
     figure("CPU per sample, batch kernel (1 thread)", batch, "ms")
+    for threads in (1, 2):
+        figure(f"in one process, {threads} numba thread(s)",
+               rate(lambda t=threads: simulate_chunk(params, rows, d, threads=t), len(rows), repeat), "samples/s")
 
 
 def pool_rates(params, spreads, n: int, repeat: int) -> dict[int, float]:
