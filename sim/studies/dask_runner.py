@@ -167,8 +167,9 @@ class DaskChunk:
                 raise ExecutorError(self._ex.no_workers_message())
 
     def cancel(self) -> None:
-        """Release the task."""
-        self.future.cancel()
+        """Cancel the task unless it is done (a finished one is released with its future)."""
+        if not self.future.done():
+            self.future.cancel()
 
 
 class DaskExecutor:

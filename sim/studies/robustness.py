@@ -252,9 +252,9 @@ def robustness(
 
     Raises
     ------
-    ParameterError  Bad request (see :func:`check_request`), an infeasible T_m, or cancelled.
-    IncompleteRunError   The executor failed (:class:`~sim.studies.runner.ExecutorError`); it holds
-                    the samples finished before the failure.
+    ParameterError      Bad request (see :func:`check_request`), an infeasible T_m, or cancelled.
+    IncompleteRunError  The executor failed (:class:`~sim.studies.runner.ExecutorError`); it holds
+                        the samples finished before the failure.
     """
     check_request(params, spreads, samples)
     t0 = time.perf_counter()
