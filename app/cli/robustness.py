@@ -4,8 +4,12 @@ Spreads (comma-separated or repeated), each on a plant value (see :mod:`app.io.p
 ``plant.J_L=0:0.3`` uniform between 0 and 0.3; ``plant.R_s=±20%`` (or ``+-20%``) uniform within
 ±20 % of the nominal plant's value (the preset's plant section and ``--set plant.*``, else its
 motor and load); ``plant.psi_pm=~5%`` normal with σ = 5 % of it (truncated at ±3σ).
-Runs on a local process pool (all cores) or, with ``--scheduler tcp://HOST:PORT`` or the
-environment variable ``PMSM_DASK_SCHEDULER``, on a Dask distributed cluster.
+Runs on a local process pool (all cores; a chunk whose worker is lost is run again once) or, with
+``--scheduler tcp://HOST:PORT`` or the environment variable ``PMSM_DASK_SCHEDULER``, on a Dask
+distributed cluster (checked, tuned and warmed first: :mod:`sim.studies.dask_runner`, docs/cluster.md).
+Without a spread only one sample (the nominal run) is allowed. A run whose cluster or pool fails
+exits 2 with one line; the samples finished before are written to ``--parquet``/``--csv`` with
+``complete: false`` in the Parquet metadata.
 """
 
 from __future__ import annotations
@@ -14,8 +18,7 @@ import argparse
 import json
 import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
+from collections.abc import Callable
 from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
@@ -24,7 +27,8 @@ from app.io.plant_overrides import load_model_and_plant
 from app.io.sample_table import write_csv, write_parquet
 from app.io.study_inputs import parse_spreads
 from control.common.checks import ParameterError
-from sim.studies.robustness import METRICS, robustness
+from sim.studies.robustness import METRICS, IncompleteRunError, RobustnessResult, robustness
+from sim.studies.runner import ExecutorError, RetryingPool
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
 MAX_SAMPLES = 1_000_000
@@ -42,6 +46,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=os.environ.get(SCHEDULER_ENV),
                    help=f"Dask scheduler address tcp://HOST:PORT (or ${SCHEDULER_ENV})")
+    p.add_argument("--cluster-timeout", type=float, default=60.0, metavar="S",
+                   help="seconds the Dask cluster may have no worker before the run stops (default 60)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--csv", metavar="FILE", help="write one row per sample (drawn values and metrics)")
     p.add_argument("--parquet", metavar="FILE",
@@ -56,7 +62,8 @@ def _progress(done: int, total: int) -> None:
 
 
 def _print_table(summary: dict[str, Any]) -> None:
-    print(f"{summary['samples']} samples in {summary['seconds']:.1f} s")
+    nominal = " (one nominal run: no spread)" if summary.get("nominal_run") else ""
+    print(f"{summary['samples']} samples in {summary['seconds']:.1f} s{nominal}")
     for ctrl in ("fdsmc", "conventional"):
         e = summary[ctrl]
         print(f"\n{ctrl}: chatter probability {e['chatter_probability']:.3f}, "
@@ -68,32 +75,79 @@ def _print_table(summary: dict[str, Any]) -> None:
                                           for s in ("mean", "p05", "p50", "p95", "worst")))
 
 
-def run(args: argparse.Namespace) -> int:
-    """Run the Monte-Carlo analysis and print the summary."""
+def _check(args: argparse.Namespace) -> None:
     if not 1 <= args.samples <= MAX_SAMPLES:
         raise ParameterError(f"--samples = {args.samples} is not allowed: 1 … {MAX_SAMPLES}")
     if args.workers < 1:
         raise ParameterError(f"--workers = {args.workers} is not allowed: ≥ 1")
+    if not 1.0 <= args.cluster_timeout <= 86400.0:
+        raise ParameterError(f"--cluster-timeout = {args.cluster_timeout:g} s is not allowed: 1 … 86400 s")
     for opt, path in (("--csv", args.csv), ("--parquet", args.parquet)):
         if path:
             check_writable(path, opt)  # before hours of simulation, not after
+
+
+def _quiet_dask() -> None:
+    """Silence Dask's own client logging: a lost cluster is reported in one line, not its reconnect tracebacks."""
+    import logging
+
+    import distributed  # noqa: F401 — configures its loggers, which are then raised to CRITICAL
+
+    for name in [n for n in logging.root.manager.loggerDict if n.split(".")[0] in ("distributed", "tornado")]:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
+def _compute(args: argparse.Namespace) -> RobustnessResult:
     params, plant = load_model_and_plant(args.preset, args.overrides)  # plant: the nominal plant
     spreads = parse_spreads(args.spread)
     if args.scheduler:
-        from dask.distributed import Client
+        from sim.studies.dask_runner import connect
 
-        with Client(args.scheduler) as client:
-            workers = max(1, len(client.scheduler_info().get("workers", {})))
-            res = robustness(params, spreads, args.samples, args.seed, client, workers, _progress, plant=plant)
-    else:
-        with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
-            res = robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant)
+        _quiet_dask()
+        with connect(args.scheduler, args.cluster_timeout) as ex:
+            return robustness(params, spreads, args.samples, args.seed, ex, ex.workers, _progress, plant=plant)
+    if args.workers == 1:
+        return robustness(params, spreads, args.samples, args.seed, None, 1, _progress, plant=plant)
+    with RetryingPool(args.workers) as pool:
+        return robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant)
+
+
+def _atomic(path: str, write: Callable[[str], None]) -> None:
+    """Write through a temporary file in the same folder, then rename it over ``path``."""
+    tmp = f"{path}.tmp-{os.getpid()}"
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def _write(args: argparse.Namespace, res: RobustnessResult) -> None:
     if args.csv:
-        write_csv(args.csv, res)
+        _atomic(args.csv, lambda p: write_csv(p, res))
     if args.parquet:
-        write_parquet(args.parquet, res, {"preset": args.preset, "overrides": list(args.overrides),
-                                          "spreads": list(args.spread), "seed": args.seed,
-                                          "samples": args.samples})
+        meta = {"preset": args.preset, "overrides": list(args.overrides), "spreads": list(args.spread),
+                "seed": args.seed, "samples": args.samples, "complete": res.complete,
+                "completed_samples": len(res.runs)}
+        _atomic(args.parquet, lambda p: write_parquet(p, res, meta))
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the Monte-Carlo analysis and print the summary; 2 with one line when the executor fails."""
+    _check(args)
+    try:
+        res = _compute(args)
+    except IncompleteRunError as exc:
+        sys.stderr.write("\n")
+        _write(args, exc.partial)
+        written = " (finished samples written, marked incomplete)" if args.csv or args.parquet else ""
+        sys.stderr.write(f"error: {exc}{written}\n")
+        return 2
+    except ExecutorError as exc:
+        sys.stderr.write(f"error: {exc}\n")
+        return 2
+    _write(args, res)
     if args.json:
         print(json.dumps(to_json(res.summary), indent=2, ensure_ascii=False))
     else:

@@ -3,17 +3,16 @@
 The controller keeps the simulated inputs as its model; each sample draws the plant's J_L, R_s,
 Ψ_PM, L_d/L_q and F_v from the spreads typed here (the command line's ``--spread`` syntax, parsed
 by :func:`app.io.study_inputs.parse_spread`). The cost is checked before anything starts. Large
-runs go to a process pool (all cores) that is shut down when the run ends or is cancelled;
-Cancel is polled between chunks of ≥ 0.1 s and cancels every chunk not yet started.
+runs go to the Dask cluster named by ``PMSM_DASK_SCHEDULER`` when it is set (checked and warmed
+first: :mod:`sim.studies.dask_runner`), else to a process pool (all cores) that is shut down when
+the run ends or is cancelled; Cancel is polled between chunks of ≥ 0.1 s and cancels every chunk
+not yet started. A lost cluster or pool is reported in one line.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
-from multiprocessing import get_context
 
 import viser
 
@@ -29,15 +28,18 @@ from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.params import DriveParams
 from sim.common.budget import MAX_STEPS, BudgetError
 from sim.fdsmc.grid import check_budget
-from sim.studies.robustness import TRACE_POINTS, RobustnessResult, Spread, robustness
+from sim.studies.robustness import TRACE_POINTS, IncompleteRunError, RobustnessResult, Spread, robustness
+from sim.studies.runner import ExecutorError, RetryingPool
 
 #: Most samples of one study from the page [-].
 MAX_SAMPLES = 100_000
 #: Most RK4 steps of one study (all samples, both controllers) [-]: 25 single-request budgets,
 #: about a minute or two of CPU on this machine's cores for the paper's drive.
 STUDY_MAX_STEPS = 25 * MAX_STEPS
-#: From this many samples on the study runs in a process pool (below: in the worker thread).
+#: From this many samples on the study runs in a process pool or on the cluster (below: in the worker thread).
 POOL_MIN_SAMPLES = 64
+#: Environment variable naming the Dask scheduler the page's large studies run on (as the CLI's).
+SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
 #: Spread inputs: (label, plant fields the spread applies to, default text).
 SPREAD_FIELDS = (
     ("J_L spread", ("J_L",), "±50%"),
@@ -156,27 +158,36 @@ class RobustnessView:
         self.run_button.disabled, self.cancel_button.visible = True, True
         try:
             result = self._run(params, spreads, samples, seed)
-        except (ParameterError, BrokenProcessPool) as exc:  # a pool ended by Cancel is broken
+        except (ParameterError, ExecutorError, IncompleteRunError) as exc:  # a pool ended by Cancel fails
             if self._cancel_requested():
                 self.status.content = (f"**Cancelled** after {self._done} of {samples} samples; the remaining "
                                        "work was cancelled and the pool shut down.")
                 raise Cancelled(str(exc)) from None
-            self.status.content = f"**Failed:** {md_text(exc)}"
-            self._s.client.add_notification("Robustness study failed", str(exc), color="red", auto_close_seconds=12.0)
-            self._s.say("Ready — the robustness study failed (see its tab).")
+            self._fail(str(exc))
             return
         finally:
             self.run_button.disabled, self.cancel_button.visible = False, False
         self.show(result, torque_limit(params))
         self._s.say(f"Ready — robustness study of {samples} samples done.")
 
+    def _fail(self, message: str) -> None:
+        self.status.content = f"**Failed:** {md_text(message)}"
+        self._s.client.add_notification("Robustness study failed", message, color="red", auto_close_seconds=12.0)
+        self._s.say("Ready — the robustness study failed (see its tab).")
+
     def _run(self, params: DriveParams, spreads: list[Spread], samples: int, seed: int) -> RobustnessResult:
         if samples < POOL_MIN_SAMPLES:
             return robustness(params, spreads, samples, seed, progress=self._progress,
                               cancelled=self._cancel_requested)
+        if os.environ.get(SCHEDULER_ENV):
+            from sim.studies.dask_runner import connect
+
+            with connect(os.environ[SCHEDULER_ENV]) as ex:
+                return robustness(params, spreads, samples, seed, ex, ex.workers, self._progress,
+                                  self._cancel_requested)
         workers = os.cpu_count() or 1
-        pool = ProcessPoolExecutor(workers, mp_context=get_context("spawn"))
-        unhook = self._s.on_cancel(lambda: _end_processes(pool))  # Cancel or a closed page: at once
+        pool = RetryingPool(workers)
+        unhook = self._s.on_cancel(pool.terminate)  # Cancel or a closed page: at once, no retry
         try:
             return robustness(params, spreads, samples, seed, pool, workers, self._progress,
                               self._cancel_requested)
@@ -192,12 +203,6 @@ class RobustnessView:
         with contextlib.suppress(Exception):
             self.progress.value = 100.0
         self.status.content = f"Done: {result.summary['samples']} samples in {result.summary['seconds']:.1f} s."
-
-
-def _end_processes(pool: ProcessPoolExecutor) -> None:
-    """Terminate a pool's worker processes (the study was cancelled: their chunks are not waited for)."""
-    for proc in list((getattr(pool, "_processes", None) or {}).values()):
-        proc.terminate()
 
 
 __all__ = ["MAX_SAMPLES", "POOL_MIN_SAMPLES", "SPREAD_FIELDS", "STUDY_MAX_STEPS", "RobustnessView", "check_study",

@@ -10,7 +10,10 @@ or the chunking. Work is handed to any executor with ``submit(fn, *args) -> futu
 ``dask.distributed.Client`` on a cluster), chunk by chunk; results are collected in order.
 
 The controller's model is the nominal one, so its design ``derive(params)`` is computed once and
-handed to every task; a task simulates its samples one after the other (no thread per sample).
+handed to every task; a task runs its samples in batches of compiled calls
+(:func:`sim.studies.batch.simulate_batch`). A Monte-Carlo without a spread is refused unless it is
+one sample (the nominal run, said so in the summary). When a task fails (a cluster lost, a pool
+broken twice), :class:`IncompleteRunError` carries the samples finished before it, in order.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -30,7 +33,10 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import CONTROLLERS, RunResult, reached_target, simulate
+from sim.fdsmc.engine import CONTROLLERS, RunResult, _check_feasible, reached_target, simulate
+from sim.fdsmc.grid import check_budget
+from sim.studies.batch import simulate_batch
+from sim.studies.runner import ExecutorError
 
 #: Metrics summarised per controller; the worst case is the largest value (errors as |·|).
 METRICS = ("friction_J", "copper_J", "electrical_in_total_J", "torque_peak_Nm",
@@ -64,11 +70,23 @@ class Spread:
 
 @dataclass(frozen=True)
 class RobustnessResult:
-    """Per-sample metrics (``runs[i][controller][metric]``), the drawn values and the summary."""
+    """Per-sample metrics (``runs[i][controller][metric]``), the drawn values and the summary.
+
+    ``complete`` is False for the part of a run that failed (``runs`` then holds its first samples).
+    """
 
     values: dict[str, np.ndarray]
     runs: list[dict[str, dict[str, Any]]]
     summary: dict[str, Any]
+    complete: bool = True
+
+
+class IncompleteRunError(RuntimeError):
+    """A run stopped by a failure of its executor; ``partial`` holds the samples finished before it."""
+
+    def __init__(self, message: str, partial: RobustnessResult) -> None:
+        super().__init__(message)
+        self.partial = partial
 
 
 def draw(params: DriveParams, spreads: Sequence[Spread], n: int, seed: int) -> dict[str, np.ndarray]:
@@ -136,15 +154,16 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
 
 
 def simulate_chunk(params: DriveParams, rows: list[dict[str, float]], d: Derived | None = None,
-                   plant: DriveParams | None = None) -> list[dict[str, dict[str, Any]]]:
+                   plant: DriveParams | None = None, threads: int = 1) -> list[dict[str, dict[str, Any]]]:
     """Return the metrics of several samples (one task); module-level so that it pickles.
 
     ``d`` = derive(params), the controller's design (the same for every sample; computed if None);
-    ``plant`` the nominal plant the rows' values replace values of (None: the model).
+    ``plant`` the nominal plant the rows' values replace values of (None: the model); ``threads``
+    numba threads over the samples [-]. The same numbers as :func:`sample_metrics` per row (tests).
     """
     d = derive(params) if d is None else d
     base = params if plant is None else plant
-    return [sample_metrics(params, plant_for(base, r), d) for r in rows]
+    return simulate_batch(params, d, [plant_for(base, r) for r in rows], TRACE_POINTS, threads)
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
@@ -189,47 +208,80 @@ def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str
     return out
 
 
+def check_request(params: DriveParams, spreads: Sequence[Spread], samples: int) -> None:
+    """Raise ParameterError for a run that cannot be made or would only repeat one run.
+
+    ≥ 1 sample; more than one sample needs a spread (else every sample is the nominal plant); one
+    sample (both controllers) must fit the single-request budget.
+    """
+    if samples < 1:
+        raise ParameterError(f"samples = {samples} is not allowed: ≥ 1")
+    if not spreads and samples > 1:
+        raise ParameterError(f"samples = {samples} without a spread is not allowed: every sample would be the "
+                             "nominal plant; allowed: at least one spread (e.g. plant.R_s=±20%), or samples = 1 "
+                             "for one nominal run")
+    check_budget(params, 2, max_points=TRACE_POINTS)
+
+
+def _result(values: dict[str, np.ndarray], runs: list[dict[str, dict[str, Any]]], seconds: float,
+            nominal: bool, complete: bool = True) -> RobustnessResult:
+    summary = {**summarise(runs, seconds), "nominal_run": nominal, "complete": complete}
+    return RobustnessResult({k: v[: len(runs)] for k, v in values.items()}, runs, summary, complete)
+
+
 def robustness(
     params: DriveParams, spreads: Sequence[Spread], samples: int, seed: int = 0, executor: Any = None,
     workers: int = 1, progress: Callable[[int, int], None] | None = None,
-    cancelled: Callable[[], bool] | None = None, plant: DriveParams | None = None,
+    cancelled: Callable[[], bool] | None = None, plant: DriveParams | None = None, threads: int = 1,
 ) -> RobustnessResult:
     """Run the Monte-Carlo analysis (see the module docstring).
 
     Parameters
     ----------
     params : DriveParams          The controller's model (and the nominal plant).
-    spreads : sequence of Spread  Distributions of the plant's values.
+    spreads : sequence of Spread  Distributions of the plant's values (none: one nominal sample only).
     samples : int                 Number of sampled plants [-], ≥ 1.
     seed : int                    Seed of the generator.
-    executor                      Object with ``submit``; None: computed here, serially.
+    executor                      Object with ``submit``; None: computed here.
     workers : int                 Workers behind the executor (for the chunk size) [-].
     progress : callable or None   ``progress(done, total)`` as samples complete, in order.
     cancelled : callable or None  Polled between chunks; True stops (ParameterError raised).
     plant : DriveParams or None   The nominal plant (a preset's plant section) the spreads are
                                   drawn around and applied to; None: the controller's model.
+    threads : int                 numba threads of the samples computed in this process [-].
+
+    Raises
+    ------
+    ParameterError      Bad request (see :func:`check_request`), an infeasible T_m, or cancelled.
+    IncompleteRunError  The executor failed (:class:`~sim.studies.runner.ExecutorError`); it holds
+                        the samples finished before the failure.
     """
-    if samples < 1:
-        raise ParameterError(f"samples = {samples} is not allowed: ≥ 1")
+    check_request(params, spreads, samples)
     t0 = time.perf_counter()
     values = draw(params if plant is None else plant, spreads, samples, seed)
     rows = [{k: float(v[i]) for k, v in values.items()} for i in range(samples)]
     d = derive(params)
-    runs = simulate_chunk(params, rows[:1], d, plant)  # warm-up (compiled kernel loaded) …
+    _check_feasible(d)
+    runs = simulate_chunk(params, rows[:1], d, plant, threads)  # warm-up (compiled kernel loaded) …
     t1 = time.perf_counter()
-    runs += simulate_chunk(params, rows[1:2], d, plant)  # … and one timed sample
+    runs += simulate_chunk(params, rows[1:2], d, plant, threads)  # … and one timed sample
     done = len(runs)
     size = chunk_size(time.perf_counter() - t1, samples - done, workers)
     chunks = [rows[i: i + size] for i in range(done, samples, size)]
     if progress is not None:
         progress(done, samples)
     futures = [executor.submit(simulate_chunk, params, c, d, plant) for c in chunks] if executor is not None else None
-    for j, c in enumerate(chunks):
-        if cancelled is not None and cancelled():
-            for f in futures or []:
-                f.cancel()
-            raise ParameterError(f"robustness run cancelled after {len(runs)} of {samples} samples")
-        runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d, plant))
-        if progress is not None:
-            progress(len(runs), samples)
-    return RobustnessResult(values, runs, summarise(runs, time.perf_counter() - t0))
+    try:
+        for j, c in enumerate(chunks):
+            if cancelled is not None and cancelled():
+                raise ParameterError(f"robustness run cancelled after {len(runs)} of {samples} samples")
+            runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d, plant, threads))
+            if progress is not None:
+                progress(len(runs), samples)
+    except ExecutorError as exc:
+        raise IncompleteRunError(f"robustness run stopped after {len(runs)} of {samples} samples: {exc}",
+                            _result(values, runs, time.perf_counter() - t0, not spreads, False)) from None
+    finally:
+        for f in futures or []:
+            f.cancel()
+    return _result(values, runs, time.perf_counter() - t0, not spreads)

@@ -1,0 +1,123 @@
+"""Local executor of the studies: a process pool that retries the chunks of a lost worker once.
+
+:class:`RetryingPool` has the ``submit(fn, *args) -> future`` / ``future.result()`` interface that
+:func:`sim.studies.robustness.robustness` hands its chunks to. When a worker process dies (killed,
+out of memory) ``concurrent.futures`` marks the whole pool broken and fails every pending future;
+the pool is then replaced by a new one and every chunk not finished is submitted again, once. A
+chunk that the pool loses a second time raises :class:`ExecutorError` (one line: which chunk, what
+happened, what is allowed). Workers are started with ``spawn`` (no fork of a threaded parent) and
+each runs its chunks on one numba thread: the processes are the parallelism.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from multiprocessing import get_context
+from typing import Any
+
+#: How often a chunk may be submitted again after its worker was lost [-].
+RETRIES = 1
+
+
+class ExecutorError(RuntimeError):
+    """The executor failed (workers lost, cluster gone): the message is one line naming what happened."""
+
+
+class RetryingFuture:
+    """Result of one chunk on a :class:`RetryingPool`; ``result()`` resubmits it once after a lost worker."""
+
+    def __init__(self, pool: RetryingPool, index: int, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
+        self._pool, self.index, self._fn, self._args = pool, index, fn, args
+        self.attempts = 0
+        self.future: Future[Any] = pool.raw_submit(fn, *args)
+        self.generation = pool.generation
+
+    def resubmit(self) -> None:
+        """Submit again on the pool's current generation (one more attempt)."""
+        self.attempts += 1
+        self.future = self._pool.raw_submit(self._fn, *self._args)
+        self.generation = self._pool.generation
+
+    def result(self, timeout: float | None = None) -> Any:
+        """Return the chunk's result, replacing a broken pool once; ExecutorError after that."""
+        while True:
+            try:
+                return self.future.result(timeout)
+            except BrokenProcessPool as exc:
+                if self._pool.ended:
+                    raise ExecutorError(f"chunk {self.index} stopped: the local pool was ended (the run was "
+                                        "cancelled); allowed: a pool left running") from None
+                if self.attempts >= RETRIES:
+                    raise ExecutorError(
+                        f"chunk {self.index} lost its worker process {self.attempts + 1} times ({exc}): allowed "
+                        f"{RETRIES} retry; see the system log for a process killed (e.g. out of memory)") from None
+                self._pool.renew(self.generation)
+
+    def cancel(self) -> bool:
+        """Cancel the chunk if it has not started."""
+        return self.future.cancel()
+
+
+class RetryingPool:
+    """A spawn-context process pool of ``workers`` processes that survives one lost worker per chunk."""
+
+    def __init__(self, workers: int) -> None:
+        self.workers = int(workers)
+        self.generation = 0
+        self.ended = False
+        self._lock = threading.Lock()
+        self._pool = ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"))
+        self._futures: list[RetryingFuture] = []
+
+    def raw_submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
+        """Submit to the current process pool (no retry)."""
+        return self._pool.submit(fn, *args)
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> RetryingFuture:
+        """Submit one chunk; its index is the order of submission."""
+        f = RetryingFuture(self, len(self._futures), fn, args)
+        self._futures.append(f)
+        return f
+
+    def renew(self, broken_generation: int) -> None:
+        """Replace the pool broken in ``broken_generation`` and resubmit every chunk not finished."""
+        with self._lock:
+            if broken_generation != self.generation or self.ended:
+                return  # another chunk already replaced it, or the pool was ended on purpose
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"))
+            self.generation += 1
+            for f in self._futures:
+                if f.generation < self.generation and not _finished(f.future):
+                    f.resubmit()
+
+    def terminate(self) -> None:
+        """End the workers now (a cancelled run): their chunks are not waited for, nor run again."""
+        with self._lock:
+            self.ended = True
+            for proc in list((self._pool._processes or {}).values()):
+                proc.terminate()
+
+    def processes(self) -> list[int]:
+        """Process ids of the current workers (for tests and diagnostics)."""
+        return [p.pid for p in (self._pool._processes or {}).values()]
+
+    def shutdown(self, wait: bool = True, cancel_futures: bool = False) -> None:
+        """Shut the current pool down."""
+        self._pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+    def __enter__(self) -> RetryingPool:
+        """Return self."""
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        """Shut down, cancelling what has not started."""
+        self.shutdown(wait=True, cancel_futures=True)
+
+
+def _finished(f: Future[Any]) -> bool:
+    """Return True when ``f`` holds a result (not an exception such as BrokenProcessPool)."""
+    return f.done() and not f.cancelled() and f.exception() is None
