@@ -24,8 +24,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from scipy.optimize import minimize_scalar
-
 from control.fdsmc.model import torque_constant
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import C_57, peak_speed
@@ -80,6 +78,8 @@ def min_energy_alpha(params: DriveParams, alpha_hi: float) -> float:
     lo = ALPHA_LO_MARGIN * feasible_alpha(params)
     if lo >= alpha_hi:
         return alpha_hi
+    from scipy.optimize import minimize_scalar  # 0.1 s of import: only where the rule is min_energy
+
     res = minimize_scalar(lambda a: profile_energy(params, a).total, bounds=(lo, alpha_hi), method="bounded",
                           options={"xatol": 1e-6 * lo})
     best = float(res.x)
