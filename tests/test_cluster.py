@@ -231,7 +231,7 @@ connect = dask_runner.connect
 dask_runner.connect = lambda address, *a: used.append(address) or connect(address, *a)
 view = RobustnessView.__new__(RobustnessView)
 view._done, view.progress, view.status = 0, SimpleNamespace(value=0.0), SimpleNamespace(content="")
-view._s = SimpleNamespace(worker=SimpleNamespace(checkpoint=lambda: None))
+view._s = SimpleNamespace(checkpoint=lambda: None)  # the case port the view receives
 params = load_preset("siemens_1ft7044_ak7")
 spreads = parse_spreads(["plant.J_L=0.001:0.004,plant.R_s=±20%"])
 res = view._run(params, spreads, 80, 5)
