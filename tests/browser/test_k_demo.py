@@ -9,6 +9,7 @@ import math
 import pytest
 
 from tests.browser.conftest import field, set_number
+from tests.browser.test_design import choose
 
 K_FIELD = "K boundary-layer gain [s/rad]"
 SLIDER_LABEL = "K [s/rad] (log)"
@@ -78,3 +79,11 @@ def test_dragging_K_across_K_limit_keeps_the_slider_in_place(page, ui_server):
     page.locator('[data-role="k-readout"]', has_text="K = 5000 s/rad").wait_for()
     assert page.evaluate("() => window.__boxes.size") == 1  # the slider never moved
     page.get_by_text("Ready — ").wait_for()  # the drag's settling redraw is done before the page closes
+
+
+def test_k_slider_mirrors_a_preset_chosen_from_the_list(page):
+    choose(page, "Preset", "odrive_d5065_belt")
+    K = 0.024679024621241528  # presets/odrive_d5065_belt.yaml
+    page.wait_for_function("(k) => Math.abs(parseFloat(document.querySelector"
+                           "('[data-role=\"k-readout\"]').innerText.split('K = ')[1]) - k) < 1e-4", arg=K)
+    _wait_position(page, K)
