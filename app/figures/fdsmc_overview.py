@@ -18,6 +18,7 @@ import numpy as np
 
 from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
 from app.figures.fdsmc_comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
+from app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
 
@@ -110,7 +111,9 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
     """Build the phase plane (left) and the compact time plot (right) as one plain-dict figure.
 
     ``layout.meta.id`` stays ``"phase_plane"`` (the page and its tests find the figure by it);
-    ``layout.meta.overview`` is True.
+    ``layout.meta.overview`` is True. The FDSMC run's chatter verdict
+    (:func:`app.figures.fdsmc_verdict.chatter_verdict`) is the annotation named ``"verdict"``,
+    top right of the phase plane.
 
     Parameters
     ----------
@@ -132,7 +135,10 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
     if not runs(comparison):
         return spec
     traces, ranges, t_end = _row_traces(comparison)
-    phase_notes = layout.get("annotations", [])
+    phase_notes = list(layout.get("annotations", []))
+    verdict = chatter_verdict(comparison)
+    if verdict is not None:
+        phase_notes.append(verdict_annotation(verdict, PHASE_X[1]))
     layout.update(_time_layout(comparison, t_end, ranges))
     layout["annotations"] = phase_notes + layout["annotations"]
     return {"data": spec["data"] + traces + _reference_traces(comparison, t_end, ranges), "layout": layout}

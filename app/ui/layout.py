@@ -114,13 +114,14 @@ def page_css(probe_uuid: str, show_3d: bool = False) -> str:
         f"width: calc(var(--fit-right) - {gutters:g}px) !important}}")
 
 
-def install_css_js(css: str) -> str:
-    """Return a script putting ``css`` into the page's own ``<style>`` element in the document head.
+def install_css_js(css: str, style_id: str = "app-page-style") -> str:
+    """Return a script putting ``css`` into the page's own ``<style>`` element ``style_id`` in the document head.
 
     There it holds whatever viser mounts or unmounts (a folded panel's content is unmounted).
     """
-    return ("(() => { let s = document.getElementById('app-page-style'); if (!s) {"
-            " s = document.createElement('style'); s.id = 'app-page-style'; document.head.appendChild(s); }"
+    sid = json.dumps(style_id)
+    return (f"(() => {{ let s = document.getElementById({sid}); if (!s) {{"
+            f" s = document.createElement('style'); s.id = {sid}; document.head.appendChild(s); }}"
             f" s.textContent = {json.dumps(css)}; }})();")
 
 

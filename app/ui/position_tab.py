@@ -146,6 +146,8 @@ class PositionTab:
                                        else names[0])
         self.preset.on_update(self._preset_chosen)
         self._preset_shown = self.preset.value
+        # the sliders sit above everything a run changes (warnings, status, Cancel): a drag never moves them
+        self.tuning = LiveTuning(gui, self._apply_knob, self.tuner.request)
         self.files = FilesPanel(self._client, self.export_state, self._imported, case.params)
         self.log_panel = LogPanel(self)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
@@ -163,7 +165,6 @@ class PositionTab:
         self.cancel_button.on_click(lambda _: self.cancel_run())
         self.status = gui.add_markdown("Ready.")
         self.verdicts = VerdictPanel(gui, self._use_recommended_k, self._use_T_c_min)
-        self.tuning = LiveTuning(gui, self._apply_knob, self.tuner.request)
         with gui.add_form(None) as form:
             self.inputs = InputsPanel(gui, case.params)
         form.on_submit(lambda _: self.simulate())
@@ -299,6 +300,8 @@ class PositionTab:
         if self._recentre:
             self._recentre = False
             self.tuning.centre(case.params, d.profile.T_c)
+        if status:  # not during a drag: the slider stands where the user's pointer holds it
+            self.tuning.show_K(case.params.controller.K, d.gain.K_limit, recommended_K(d))
         nameplate = self.inputs.nameplate_warnings(case.params.motor)
         self.verdicts.show(case.comparison, case.params.controller.K, case.error, nameplate)
         if status:

@@ -1,5 +1,8 @@
 """Live tuning: sliders for K, T_c, T_m and J_L that re-simulate while they are dragged.
 
+K has its own logarithmic slider mirroring the K field (:mod:`app.ui.k_slider`); T_c, T_m and
+J_L are linear, centred on their value after a preset, file or design.
+
 A slider never simulates by itself: it writes its value into the inputs panel (the same field,
 shown and kept exactly as if typed) and asks the session to simulate the panel's values. While
 a run is in progress further moves only mark the panel as changed; when the run ends, one new
@@ -18,6 +21,9 @@ from typing import Any
 import viser
 
 from app.io import units
+from app.ui.k_slider import KSlider, hide_box_css
+from app.ui.layout import install_css_js
+from app.ui.viser_adapter import run_script
 from app.ui.worker import Worker
 from control.fdsmc.params import DriveParams
 
@@ -41,7 +47,6 @@ class Knob:
 
 
 KNOBS = (
-    Knob("K [s/rad]", "controller.K", float, float),
     Knob("T_c [ms]", "controller.T_c", units.ms_to_s, units.s_to_ms),
     Knob("T_m [s]", "manoeuvre.T_m", float, float),
     Knob("J_L [kg·cm²]", "load.J_L", units.kgcm2_to_kgm2, lambda J: J * 1e4),
@@ -49,8 +54,8 @@ KNOBS = (
 
 
 def _si_values(params: DriveParams, T_c: float) -> dict[str, float]:
-    """Return the current SI values of the knobs (T_c [s] is the one in force)."""
-    return {"controller.K": params.controller.K, "controller.T_c": T_c,
+    """Return the current SI values of the linear knobs (T_c [s] is the one in force)."""
+    return {"controller.T_c": T_c,
             "manoeuvre.T_m": params.manoeuvre.T_m, "load.J_L": params.load.J_L}
 
 
@@ -78,13 +83,19 @@ class LiveTuning:
         self._apply, self._request_run = apply, request_run
         self._sliders: dict[str, Any] = {}
         with gui.add_folder("Live tuning (drag: re-simulates)", expand_by_default=True):
+            self.k = KSlider(gui, self._k_moved)
             for knob in KNOBS:
                 slider = gui.add_slider(knob.label, min=0.0, max=1.0, step=0.01, initial_value=0.5)
                 slider.on_update(lambda event, k=knob: self._moved(event, k))
                 self._sliders[knob.key] = slider
+        run_script(gui, install_css_js(hide_box_css(self.k.uuid), "app-k-slider-style"))
+
+    def show_K(self, K: float, K_limit: float, K_rec: float | None) -> None:
+        """Move the K slider to ``K`` [s/rad] (the K field's value) with K_limit and K_rec marked."""
+        self.k.show(K, K_limit, K_rec)
 
     def centre(self, params: DriveParams, T_c: float) -> None:
-        """Centre each slider's range on the current value (after a preset, file or design)."""
+        """Centre each linear slider's range on the current value (after a preset, file or design)."""
         for knob in KNOBS:
             shown = knob.from_si(_si_values(params, T_c)[knob.key])
             if not shown > 0.0:
@@ -94,6 +105,10 @@ class LiveTuning:
             slider.min, slider.max, slider.step = lo, hi, step
             slider.precision = slider_precision(step)
             slider.value = shown
+
+    def _k_moved(self, K: float) -> None:
+        self._apply("controller.K", K)
+        self._request_run()
 
     def _moved(self, event: viser.GuiEvent, knob: Knob) -> None:
         if event.client is None:  # our own centring

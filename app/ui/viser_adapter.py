@@ -13,6 +13,8 @@ The page needs four things viser's public API does not offer:
 * **a script run in the page** (:func:`run_script`, viser's own ``RunJavascriptMessage``);
 * **plotly.js sent by the page** (:func:`plotly_js_sent`, :func:`mark_plotly_js_sent`: viser's
   ``GuiApi._setup_plotly_js`` flag, so ``add_plotly`` does not send its full bundle);
+* **slider marks changed after creation** (:func:`set_slider_marks`: viser's ``_marks`` property,
+  public only as ``add_slider(marks=…)``);
 * **a widget's DOM id** (:func:`widget_id`: the uuid the page's CSS and scripts address);
 * **checks in front of viser's message handlers** (:func:`wrap_gui_handler`, used by
   :mod:`app.ui.web_guard`: widget values type-checked, uploads bounded) and what they read: a
@@ -92,6 +94,16 @@ def widget_id(handle: Any) -> str:
     return str(handle._impl.uuid)
 
 
+def set_slider_marks(handle: viser.GuiSliderHandle, marks: tuple[tuple[float, str], ...]) -> None:
+    """Show ``marks`` ((value, label) pairs) on a slider's track instead of its min/max labels.
+
+    Nothing is sent when the slider already shows exactly these marks.
+    """
+    new = tuple(_messages.GuiSliderMark(value=float(v), label=label) for v, label in marks)
+    if handle._impl.props._marks != new:
+        handle._marks = new  # type: ignore[attr-defined]  # viser's props setter queues the update
+
+
 #: viser's ``GuiApi`` message handlers that :mod:`app.ui.web_guard` puts its checks in front of.
 GUI_UPDATES = "_handle_gui_updates"
 UPLOAD_START, UPLOAD_PART = "_handle_file_transfer_start", "_handle_file_transfer_part"
@@ -126,4 +138,4 @@ def resolve_client(gui: Any, client_id: Any) -> Any | None:
 
 __all__ = ["GUI_UPDATES", "UPLOAD_PART", "UPLOAD_START", "WRITTEN_FOR", "add_figure", "figure_json_of",
            "input_widget", "mark_plotly_js_sent", "plotly_js_sent", "resolve_client", "run_script",
-           "set_figure_json", "upload_states", "widget_id", "widget_state", "wrap_gui_handler"]
+           "set_figure_json", "set_slider_marks", "upload_states", "widget_id", "widget_state", "wrap_gui_handler"]

@@ -90,11 +90,11 @@ def test_dragging_the_K_slider_resimulates_with_the_latest_value(page):
     before_band, before_y = page.evaluate(BAND_JS), page.evaluate(FDSMC_Y_JS)
     k_field = field(page, "K boundary-layer gain [s/rad]")
     k0 = float(k_field.input_value())
-    thumb = _slider(page, "K [s/rad]")
+    thumb = _slider(page, "K [s/rad] (log)")
     thumb.focus()
     for _ in range(4):
         thumb.press("ArrowLeft")  # smaller K: wider boundary layer
-    k_shown = float(thumb.get_attribute("aria-valuenow"))
+    k_shown = float(f"{10 ** float(thumb.get_attribute('aria-valuenow')):.3g}")  # log₁₀ K, written to 3 digits
     assert k_shown < k0
     # the field holds the slider's value, and the phase plane is redrawn for exactly that K
     page.wait_for_function(f"(k) => Math.abs(parseFloat(({BAND_JS})().split('±')[2]) * k - 1) < 6e-3",

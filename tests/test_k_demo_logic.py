@@ -1,0 +1,78 @@
+"""The K demo without a browser: the verdict text, the log K slider's range, marks and readout."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import pytest
+
+from app.figures.fdsmc_verdict import VERDICT_FONT_PX, chatter_verdict, verdict_annotation
+from app.ui.k_slider import K_RANGE, K_marks, K_of_position, hide_box_css, log_K_range, readout_html
+
+
+def _comparison(K: float, K_limit: float, chatter: bool = False, freq: float | None = None,
+                stable: bool = True, ran: bool = True) -> SimpleNamespace:
+    metrics = SimpleNamespace(chatter=chatter, chatter_frequency_Hz=freq, stable=stable)
+    derived = SimpleNamespace(params=SimpleNamespace(controller=SimpleNamespace(K=K)),
+                              gain=SimpleNamespace(K_limit=K_limit))
+    return SimpleNamespace(fdsmc=SimpleNamespace(metrics=metrics) if ran else None, derived=derived)
+
+
+def test_verdict_says_chatter_with_its_frequency_and_K_against_the_limit():
+    v = chatter_verdict(_comparison(1000.0, 0.6048, chatter=True, freq=270.4))
+    assert v is not None and v.chatter
+    assert v.text == "CHATTER 270 Hz (K ≥ K_limit = 0.605)"
+
+
+def test_verdict_below_the_limit_is_sliding_without_chatter():
+    v = chatter_verdict(_comparison(0.3024, 0.6048))
+    assert v is not None and not v.chatter
+    assert v.text == "sliding, no chatter (K < K_limit = 0.605)"
+
+
+def test_verdict_comes_from_the_run_not_from_the_prediction():
+    # above the predicted limit but the run is clean: the run decides, the detail says where K is
+    assert chatter_verdict(_comparison(0.7, 0.6048)).text == "sliding, no chatter (K ≥ K_limit = 0.605)"
+    assert chatter_verdict(_comparison(0.3, 0.6048, chatter=True)).text == "CHATTER (K < K_limit = 0.605)"
+    assert chatter_verdict(_comparison(5.0, 0.0)).detail == "K = 5"  # no limit known
+    unstable = chatter_verdict(_comparison(5.0, 0.6, chatter=True, stable=False))
+    assert unstable.headline == "UNSTABLE" and unstable.chatter
+    assert chatter_verdict(_comparison(1.0, 0.6, ran=False)) is None  # infeasible: nothing run
+
+
+def test_verdict_annotation_is_large_named_and_escaped():
+    a = verdict_annotation(chatter_verdict(_comparison(0.3, 0.6)), 0.55)
+    assert a["name"] == "verdict" and a["font"]["size"] == VERDICT_FONT_PX >= 16
+    assert "&lt; K_limit" in a["text"] and "< K" not in a["text"]  # a raw "<" opens a tag in Plotly
+    assert a["font"]["color"] != verdict_annotation(chatter_verdict(_comparison(1e3, 0.6, True)), 0.55)["font"]["color"]
+
+
+def test_log_range_holds_the_default_span_and_every_gain_in_whole_decades():
+    lo, hi = log_K_range(1000.0, 0.605, 0.302)
+    assert (lo, hi) == (math.log10(K_RANGE[0]), math.log10(K_RANGE[1]))
+    assert log_K_range(2e5, 1e-4, None) == (-4.0, 6.0)
+    assert log_K_range(1.0, math.inf, None) == (-2.0, math.log10(K_RANGE[1]))  # no finite limit: ignored
+
+
+def test_marks_label_both_ends_the_recommended_K_and_the_limit():
+    marks = K_marks(-2.0, 3.7, 0.605, 0.302)
+    assert marks[0] == (-2.0, "0.01") and marks[1][1] == "5011.87"
+    assert (pytest.approx(math.log10(0.302)), "rec") == marks[2] and marks[3][1] == "lim"
+    assert [m[1] for m in K_marks(-2.0, 4.0, 0.0, None)] == ["0.01", "10000"]
+
+
+def test_slider_positions_become_K_with_three_significant_digits():
+    assert K_of_position(3.0) == 1000.0
+    assert K_of_position(math.log10(0.30242085)) == 0.302
+    assert K_of_position(-0.52) == 0.302
+    # the rounding stays within half a slider step: the mirrored slider does not jump back
+    for p in (-1.995, -0.215, 0.005, 2.345):
+        assert abs(math.log10(K_of_position(p)) - p) < 0.005
+
+
+def test_readout_says_K_in_red_at_or_above_the_limit():
+    above, below = readout_html(5000.0, 0.605, 0.302), readout_html(0.302, 0.605, 0.302)
+    assert "K = 5000 s/rad" in above and "#c92a2a" in above and "#c92a2a" not in below
+    assert "lim 0.605" in below and "rec 0.302" in below
+    assert 'id="abc"' in hide_box_css("abc")
