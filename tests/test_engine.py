@@ -330,7 +330,7 @@ def test_table1_printed_row_read_right_to_left_within_0p2_points(paper_params):
     # 0.2 percentage points, and disagrees with it as printed (the saving rises toward 28.57 %).
     import dataclasses
 
-    from sim.fdsmc.engine import PAPER_TABLE1, table1_sweep
+    from sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
 
     p = dataclasses.replace(paper_params, controller=dataclasses.replace(paper_params.controller, f_s="continuous"))
     T_m = sorted(PAPER_TABLE1)

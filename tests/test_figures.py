@@ -20,7 +20,8 @@ from app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure
 from app.figures.fdsmc_replay import KEY_RATE, MAX_FRAMES, SPEEDS
 from app.figures.plain import figure_json
 from app.ui.replay import phase_plane_json
-from sim.fdsmc.engine import PAPER_TABLE1, Comparison, Table1Row, compare
+from sim.fdsmc.engine import Comparison, compare
+from sim.fdsmc.table1 import PAPER_TABLE1, Table1Row
 
 
 @pytest.fixture(scope="module")

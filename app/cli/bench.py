@@ -26,9 +26,10 @@ from app.io.numbers import integer_option
 from app.io.presets import load, load_preset
 from control.fdsmc.derivations import clear_caches, derive
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import TABLE1_T_M, compare, run_steps, table1_sweep
+from sim.fdsmc.engine import compare, run_steps
 from sim.fdsmc.grid import CONTINUOUS_STEP_S
 from sim.fdsmc.reference import run_reference
+from sim.fdsmc.table1 import TABLE1_T_M, table1_sweep
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

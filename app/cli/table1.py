@@ -19,7 +19,7 @@ from app.cli.main import add_preset_arguments
 from app.io.json_data import to_json
 from app.io.numbers import format_metric, parse_T_m_list
 from app.io.presets import load
-from sim.fdsmc.engine import PAPER_TABLE1, TABLE1_T_M, Table1Row, table1_sweep
+from sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M, Table1Row, table1_sweep
 
 DEFAULT_TM = ",".join(map(str, TABLE1_T_M))
 

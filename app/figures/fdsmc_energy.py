@@ -12,8 +12,9 @@ import plotly.graph_objects as go
 
 from app.figures.decimate import f32, time_axis
 from app.figures.fdsmc_comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
-from sim.fdsmc.engine import LABELS, Comparison, RunResult, Table1Row
+from sim.fdsmc.engine import LABELS, Comparison, RunResult
 from sim.fdsmc.optimum_gap import saving_vs_optimum
+from sim.fdsmc.table1 import Table1Row
 
 #: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
 ENERGIES = (
@@ -130,7 +131,7 @@ def make_table1_figure(rows: Sequence[Table1Row], paper: Mapping[float, float] |
 
     Parameters
     ----------
-    rows : sequence of sim.fdsmc.engine.Table1Row
+    rows : sequence of sim.fdsmc.table1.Table1Row
         ``T_m`` [s], ``saving_pct``, ``saving_eq52_pct``, ``bound_pct``, ``paper_pct`` [%] (None allowed).
     paper : mapping T_m [s] → saving [%], optional
         The paper's Table 1 values; drawn in full when given.

@@ -32,8 +32,9 @@ from app.ui.verdict_panel import VerdictPanel
 from app.ui.worker import Cancelled, Worker
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, PAPER_TABLE1, Comparison, compare, table1_sweep
+from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Comparison, compare
 from sim.fdsmc.objective import OBJECTIVES, design_for
+from sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
 from sim.fdsmc.verdicts import T_c_advice, recommended_K
 
 #: The page's words for the design objectives (same order as :data:`sim.fdsmc.objective.OBJECTIVES`).

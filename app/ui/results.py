@@ -25,7 +25,7 @@ from app.ui.savings import annual_savings, savings_markdown
 from app.ui.scene import RotorScene
 from app.ui.text import key_numbers_html
 from app.ui.viser_adapter import add_figure, set_figure_json
-from sim.fdsmc.engine import TABLE1_T_M
+from sim.fdsmc.table1 import TABLE1_T_M
 
 #: Plot height / width per figure [-].
 ASPECT_PHASE, ASPECT_TIME, ASPECT_SMALL = 0.72, 1.45, 0.55

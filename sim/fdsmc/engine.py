@@ -1,4 +1,4 @@
-"""Closed-loop simulation engine: one run, an FDSMC-vs-conventional comparison, the Table-1 sweep.
+"""Closed-loop simulation engine: one run and the comparison of the controllers (Table 1: :mod:`sim.fdsmc.table1`).
 
 The model (plant, FDC inner loops, observer, outer loop, energies) is integrated by the
 compiled kernel :func:`sim.fdsmc.kernel.run_kernel`; this module packs the parameters, chooses the
@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -31,7 +31,7 @@ from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import infeasible_T_m
 from control.fdsmc.tracking import tracking_gains
-from sim.common import budget, sensors
+from sim.common import sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.criteria import pass_criteria
@@ -41,9 +41,7 @@ from sim.fdsmc.grid import (
     check_budget,
     continuous_step,
     load_steps,
-    run_cost,
     time_grid,
-    with_field,
 )
 from sim.fdsmc.metrics import (
     RunMetrics,
@@ -67,10 +65,6 @@ KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 2.0, "stock": 2.0}
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
 _RUNS = ThreadPoolExecutor(max_workers=max(2, os.cpu_count() or 2), thread_name_prefix="sim-run")
-#: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
-PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}
-#: The manoeuvre times [s] of Table 1 in [1]: the default sweep.
-TABLE1_T_M: tuple[float, ...] = tuple(PAPER_TABLE1)
 
 
 #: Time series of one run on a common grid (SI units; energies cumulative from t = 0), one field per
@@ -111,19 +105,6 @@ class Comparison:
     saving_electrical_pct: float | None
     optimum: RunResult | None = None
     stock: RunResult | None = None
-
-
-@dataclass(frozen=True)
-class Table1Row:
-    """One column of Table 1 in [1]: friction [J] over [0, T_m] and savings [%]."""
-
-    T_m: float
-    friction_fdsmc_J: float
-    friction_conventional_J: float
-    saving_pct: float
-    saving_eq52_pct: float
-    bound_pct: float
-    paper_pct: float | None
 
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
@@ -375,56 +356,3 @@ def compare(
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
                       _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"))
-
-
-def table1_sweep(
-    params: DriveParams,
-    T_m_values: Sequence[float],
-    progress: Callable[[int, int], None] | None = None,
-    **options: float,
-) -> list[Table1Row]:
-    """Friction energies and savings over manoeuvre times, as Table 1 of [1].
-
-    Parameters
-    ----------
-    params : DriveParams
-        The case; its T_m is replaced by each value.
-    T_m_values : sequence of float
-        Manoeuvre times [s].
-    progress : callable or None
-        Called as ``progress(done, total)`` after each point.
-
-    Returns
-    -------
-    list of Table1Row
-
-    Raises
-    ------
-    ParameterError
-        For an infeasible T_m, or when a run is unstable (naming T_m and the reason), so that
-        no row is ever computed from a diverged run.
-    """
-    points = [with_field(params, "manoeuvre.T_m", float(T_m)) for T_m in T_m_values]
-    total = sum((run_cost(p, **options) for p in points), budget.Cost(0, 0, 0.0, 0))  # keeps CPU and memory
-    if points and not (total + total).fits:  # two controllers per point
-        check_budget(max(points, key=lambda p: p.manoeuvre.T_m), 2 * len(points), **options)
-    rows: list[Table1Row] = []
-    for i, (T_m, p) in enumerate(zip(T_m_values, points, strict=True)):
-        cmp = compare(p, **options)
-        assert cmp.fdsmc is not None and cmp.conventional is not None
-        for run in (cmp.fdsmc, cmp.conventional):
-            if not run.metrics.stable:
-                raise ParameterError(
-                    f"manoeuvre.T_m = {T_m:g} s: {run.controller} run unstable — {run.metrics.reason}")
-            if not reached_target(run):
-                raise ParameterError(f"manoeuvre.T_m = {T_m:g} s: the {run.controller} run never reached the "
-                                     "2 % band around θ_dem, so its energy is not comparable")
-        wf, wc = cmp.fdsmc.metrics.friction_J, cmp.conventional.metrics.friction_J
-        assert wf is not None and wc is not None  # a run that reached its target has its energies
-        e = cmp.derived.energy
-        rows.append(Table1Row(float(T_m), wf, wc, 100.0 * (1.0 - wf / wc),
-                              float(e.saving_pct) if e.saving_pct is not None else math.nan,
-                              e.bound_pct, PAPER_TABLE1.get(round(float(T_m), 3))))
-        if progress is not None:
-            progress(i + 1, len(T_m_values))
-    return rows
