@@ -131,7 +131,8 @@ def _stop_interrupted() -> NoReturn:
     discard_partial()
     try:
         sys.stdout.flush()
-        sys.stderr.write("interrupted: stopped; no partial file was left\n")
+        # \r: over a progress line a command may have left open (table1's "simulated 2/5"), as a terminal shows it
+        sys.stderr.write("\rinterrupted: stopped; no partial file was left\n")
         sys.stderr.flush()
     finally:
         os._exit(INTERRUPTED)
