@@ -340,34 +340,34 @@ def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> 
     limiting = [] if T_m == T_asked else [Constraint(
         "T_m", T_asked, T_m, "s", False, f"Requested T_m = {T_asked:g} s is not feasible with these limits; "
                                          f"the shortest that passes is {T_m:.4g} s (used): not as asked.")]
-    limiting += [_torque_binding(p, cmp.fdsmc)] + run_checks(p, cmp.fdsmc)
+    limiting += [_torque_binding(p, d, cmp.fdsmc)] + run_checks(p, cmp.fdsmc)
     ng = predicted_noise(p, d)
     crit = pass_criteria(p).hold_i_rms
+    need = encoder_needed(ng, crit)
     as_asked = T_m == T_asked
     clean = as_asked and not any(c.violated for c in limiting)
-    notes = _notes(d) + _sensor_notes(p, asked, ng, crit)
-    return DriveDesign(p, d, cmp, clean, tuple(limiting), notes, tuple(comparator_notes(cmp)), as_asked, ng,
-                       encoder_needed(ng, crit))
+    notes = _notes(d) + _sensor_notes(p, asked, ng, crit, need)
+    return DriveDesign(p, d, cmp, clean, tuple(limiting), notes, tuple(comparator_notes(cmp)), as_asked, ng, need)
 
 
-def _torque_binding(p: DriveParams, run: RunResult) -> Constraint:
+def _torque_binding(p: DriveParams, d: Derived, run: RunResult) -> Constraint:
     lim = torque_limit(p)
     peak = run.metrics.torque_peak_Nm or 0.0
-    a = alpha_max(p, _overshoot(p)).alpha_max
+    a = d.alpha.alpha_max  # derive's α_max: the rule with the inner loops' overshoot η
     why = ("is set by the torque limit" if p.controller.alpha_max_rule == "torque_limit" else
            "minimises the profile's friction + copper loss (rule min_energy) within the torque limit")
     return Constraint("torque", peak, lim, "N·m", False,
                       f"α_max = {a:.5g} rad/s² {why} {lim:.4g} N·m (Γ_max or i_max); simulated peak {peak:.4g} N·m.")
 
 
-def _sensor_notes(p: DriveParams, asked: DriveParams, ng: NoiseGain | None, crit: float) -> tuple[str, ...]:
+def _sensor_notes(p: DriveParams, asked: DriveParams, ng: NoiseGain | None, crit: float,
+                  need: int | None) -> tuple[str, ...]:
     out = []
     c, a = p.controller, asked.controller
     if c.T_so != a.T_so:
         out.append(f"T_so {a.T_so * 1e3:.4g} → {c.T_so * 1e3:.4g} ms and T_sα {a.T_salpha * 1e3:.4g} → "
                    f"{c.T_salpha * 1e3:.4g} ms: slower observer and acceleration loop for the sensors' noise.")
     if ng is not None and math.isfinite(ng.i_q_rms):
-        need = encoder_needed(ng, crit)
         out.append(f"Predicted standstill ripple {ng.i_q_rms:.3g} A rms of i_q, {ng.u_q_rms:.3g} V rms of u_q "
                    f"(criterion {crit:.3g} A)" + (f"; the encoder needs ≥ {need} counts/rev." if need else "."))
     return tuple(out)
