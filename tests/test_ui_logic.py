@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import dataclasses
 import threading
 import time
@@ -158,13 +160,14 @@ def test_assign_sends_only_changed_properties():
 
 @pytest.mark.parametrize("value", [0.0431, 4.86e-5, 2.6, 21.72, 1000.0])
 def test_a_live_tuning_key_step_moves_the_value_whatever_its_size(value):
-    """The page rounds a slider value to the slider's precision: one step up or down from the
-    centre must move it by about one step (a K of 0.043 s/rad was rounded back to 0.04).
+    """The page rounds a slider position to the slider's precision: one key step up or down must
+    move the value by one step of the logarithmic track (≈ 2.3 %) whatever its size (a K of
+    0.043 s/rad was rounded back to 0.04 on a linear track).
     """
-    from app.ui.tuning import slider_precision, slider_range
+    from app.ui.log_slider import LOG_PRECISION, LOG_STEP, value_of_position
 
-    lo, hi, step = slider_range(value)
-    digits = slider_precision(step)
+    position = round(math.log10(value), LOG_PRECISION)
     for sign in (1, -1):
-        moved = round(value + sign * step, digits)
-        assert abs(moved - (value + sign * step)) < 0.1 * step
+        moved = value_of_position(round(position + sign * LOG_STEP, LOG_PRECISION))
+        ratio = moved / value_of_position(position)
+        assert ratio == pytest.approx(10.0 ** (sign * LOG_STEP), rel=5e-3)

@@ -110,15 +110,16 @@ def _phase_marks(comparison: Comparison, key: str, run: RunResult, x_mid: float)
     """
     tr, th = run.trace, comparison.derived.params.manoeuvre.theta_dem
     out = []
-    k = layer_entry_index(comparison, run) if key != "optimum" else None  # the optimum does not slide
-    if k is not None and key == "fdsmc":
+    # only the FDSMC has a boundary layer: the conventional law and the tracked optimum do not slide
+    k = layer_entry_index(comparison, run) if key == "fdsmc" else None
+    if k is not None:
         i = k + minmax_index(tr.omega_r[k:], BINS_PHASE)
         out.append({"type": "scatter", "x": f32(tr.theta_r[i] - th), "y": f32(tr.omega_r[i]), "mode": "lines",
                     "name": "FDSMC sliding phase (in the layer)", "hoverinfo": "skip", "opacity": 0.3,
                     "line": {"color": COLOURS[key], "width": 9}})
     if k is not None:
         out.append({"type": "scatter", "x": [float(tr.theta_r[k] - th)], "y": [float(tr.omega_r[k])],
-                    "mode": "markers+text", "text": ["reaching → sliding"] if key == "fdsmc" else [""],
+                    "mode": "markers+text", "text": ["reaching → sliding"],
                     # the label leans into the plot (it was clipped at the plot's edge)
                     "textposition": "top right" if tr.theta_r[k] - th < x_mid else "top left",
                     "name": f"{LABELS[key]} enters boundary layer",

@@ -18,6 +18,7 @@ import numpy as np
 
 from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
 from app.figures.fdsmc_comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
+from app.figures.fdsmc_pins import Pin, ghost_traces
 from app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
@@ -107,7 +108,7 @@ def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> di
     return {**axes, "annotations": notes, "shapes": shapes}
 
 
-def overview_spec(comparison: Any) -> dict[str, Any]:
+def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]:
     """Build the phase plane (left) and the compact time plot (right) as one plain-dict figure.
 
     ``layout.meta.id`` stays ``"phase_plane"`` (the page and its tests find the figure by it);
@@ -118,6 +119,8 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
     Parameters
     ----------
     comparison : sim.fdsmc.engine.Comparison
+    pins : tuple of Pin
+        Pinned runs, drawn first as grey ghosts (:func:`app.figures.fdsmc_pins.ghost_traces`).
 
     Returns
     -------
@@ -133,7 +136,7 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
                         "entrywidth": 0.36, "entrywidthmode": "fraction"}
     layout["margin"] = {"l": 56, "r": 12, "t": 96, "b": 84, "autoexpand": False}
     if not runs(comparison):
-        return spec
+        return {**spec, "data": ghost_traces(pins, time_row=False) + spec["data"]}
     traces, ranges, t_end = _row_traces(comparison)
     phase_notes = list(layout.get("annotations", []))
     verdict = chatter_verdict(comparison)
@@ -141,7 +144,8 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
         phase_notes.append(verdict_annotation(verdict, PHASE_X[1]))
     layout.update(_time_layout(comparison, t_end, ranges))
     layout["annotations"] = phase_notes + layout["annotations"]
-    return {"data": spec["data"] + traces + _reference_traces(comparison, t_end, ranges), "layout": layout}
+    data = ghost_traces(pins) + spec["data"] + traces + _reference_traces(comparison, t_end, ranges)
+    return {"data": data, "layout": layout}
 
 
 __all__ = ["CURSORS", "motor_torque", "overview_spec"]

@@ -37,6 +37,9 @@ class Case:
         The last input refusal, None after a successful run.
     runs : int
         Runs (simulations and designs) done in this tab.
+    plant_J_L : float or None
+        The plant's load inertia [kg·m²] of the run shown when it differs from the controller's
+        model ``params.load.J_L`` (the live-tuning J_L slider); None: the plant is the model.
     """
 
     params: DriveParams
@@ -44,6 +47,7 @@ class Case:
     comparison: Comparison
     error: str | None = None
     runs: int = 0
+    plant_J_L: float | None = None
 
 
 class CaseState:
@@ -57,10 +61,10 @@ class CaseState:
         """Return the current snapshot (frozen: readers cannot change it)."""
         return self._case
 
-    def ran(self, params: DriveParams, comparison: Comparison) -> Case:
-        """Record a finished run of ``params``: its comparison shown, no error, one more run."""
+    def ran(self, params: DriveParams, comparison: Comparison, plant_J_L: float | None = None) -> Case:
+        """Record a finished run of ``params`` (plant J_L ``plant_J_L`` [kg·m²] if not the model's)."""
         self._case = dataclasses.replace(self._case, params=params, comparison=comparison, error=None,
-                                         runs=self._case.runs + 1)
+                                         runs=self._case.runs + 1, plant_J_L=plant_J_L)
         return self._case
 
     def opened(self, params: DriveParams, origin: str) -> Case:

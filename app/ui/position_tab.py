@@ -9,6 +9,7 @@ actions) and nothing else. Simulations run on the browser tab's worker, never on
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import sys
 import traceback
 from collections.abc import Callable
@@ -17,6 +18,7 @@ from typing import Any
 
 import viser
 
+from app.figures.fdsmc_pins import MAX_PINS, Pin, pin_of, pinned
 from app.io.presets import list_presets_of, load, require_mode
 from app.ui.case import Case, CaseState
 from app.ui.choices import checked_choice
@@ -26,8 +28,8 @@ from app.ui.log import LogPanel
 from app.ui.props import assign
 from app.ui.results import ResultsPanel
 from app.ui.studies import OptimumToggle
-from app.ui.text import derived_markdown, design_markdown, md_text
-from app.ui.tuning import LiveTuning, TuneRunner
+from app.ui.text import derived_markdown, design_markdown, md_text, pins_html
+from app.ui.tuning import PLANT_J_L, LiveTuning, TuneRunner
 from app.ui.verdict_panel import VerdictPanel
 from app.ui.worker import Cancelled, Worker
 from control.fdsmc.derivations import derive
@@ -41,15 +43,22 @@ from sim.fdsmc.verdicts import T_c_advice, recommended_K
 OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")
 
 
-def comparison_or_derived(params: DriveParams, optimum: bool = False) -> Comparison:
-    """Simulate both controllers (and the tracked optimum if ``optimum``).
+def with_plant_J_L(params: DriveParams, J_L: float) -> DriveParams:
+    """``params`` with the load inertia ``J_L`` [kg·m²]: the plant of a model-mismatch run."""
+    return dataclasses.replace(params, load=dataclasses.replace(params.load, J_L=J_L))
 
-    For an infeasible case, return the derivations alone (no runs).
+
+def comparison_or_derived(params: DriveParams, optimum: bool = False, plant_J_L: float | None = None) -> Comparison:
+    """Simulate both controllers (and the tracked optimum if ``optimum``) on a plant with ``plant_J_L`` [kg·m²].
+
+    The controllers' model stays ``params`` (``plant_J_L`` None: the plant is the model). For an
+    infeasible case, return the derivations alone (no runs).
     """
     d = derive(params)  # a ParameterError here is an input error for the caller
     if not d.profile.feasible:
         return Comparison(d, None, None, None, None)
-    return compare(params, COMPARATORS if optimum else CONTROLLERS, derived=d)
+    plant = None if plant_J_L is None else with_plant_J_L(params, plant_J_L)
+    return compare(params, COMPARATORS if optimum else CONTROLLERS, derived=d, plant=plant)
 
 
 class PositionTab:
@@ -68,6 +77,8 @@ class PositionTab:
     def __init__(self, client: viser.ClientHandle, state: CaseState, worker: Worker) -> None:
         self._client, self._state, self._worker = client, state, worker
         self._recentre = True
+        self._plant_J_L: float | None = None  # the J_L slider's plant [kg·m²]; None: the model's
+        self._pins: tuple[Pin, ...] = ()
         self.results: ResultsPanel | None = None  # the right-hand panel, given by the page once built
         self.tuner = TuneRunner(worker, self._run_latest, self._tuned)
         self._controls(client.gui)
@@ -117,14 +128,19 @@ class PositionTab:
         self._state.opened(params, origin)
 
     def run(self, params: DriveParams, autoplay: bool = True, overview_only: bool = False) -> None:
-        """On the worker: simulate ``params`` and show the results (``overview_only``: a live-tuning run)."""
+        """On the worker: simulate ``params`` and show the results (``overview_only``: a live-tuning run).
+
+        A live-tuning run keeps the J_L slider's plant; any other run simulates the nominal plant.
+        """
         if not overview_only:
             self.status.content = "Simulating…"
+            self._plant_J_L = None
         assign(self.design_note, content="")
         self._worker.checkpoint()
-        comparison = comparison_or_derived(params, self.optimum.wanted)  # ParameterError → job_failed
+        plant_J_L = self._plant_J_L
+        comparison = comparison_or_derived(params, self.optimum.wanted, plant_J_L)  # ParameterError → job_failed
         self._worker.checkpoint()
-        self._state.ran(params, comparison)
+        self._state.ran(params, comparison, plant_J_L)
         if comparison.fdsmc is not None:
             self._results().show(comparison, autoplay=autoplay, overview_only=overview_only)
         else:
@@ -149,6 +165,9 @@ class PositionTab:
         self._preset_shown = self.preset.value
         # the sliders sit above everything a run changes (warnings, status, Cancel): a drag never moves them
         self.tuning = LiveTuning(gui, self._apply_knob, self.tuner.request)
+        self.pin_buttons = gui.add_button_group("Compare runs", ("Pin this run", "Clear pins"))
+        self.pin_buttons.on_click(lambda _: self._pin_clicked(self.pin_buttons.value))
+        self.pins_line = gui.add_html("")
         self.files = FilesPanel(self._client, self.export_state, self._imported, case.params)
         self.log_panel = LogPanel(self)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
@@ -207,6 +226,7 @@ class PositionTab:
                                                                      "Design objective"))]
         dd = design_for(params, objective).design
         self.inputs.populate(dd.params)
+        self._plant_J_L = None
         self._recentre = True
         comparison = (None if self.optimum.wanted else dd.comparison) or comparison_or_derived(
             dd.params, self.optimum.wanted)
@@ -234,7 +254,9 @@ class PositionTab:
 
     def _apply_knob(self, key: str, value_si: float) -> None:
         """Write a live-tuning slider's value into the inputs panel, as if typed."""
-        if key == "controller.T_c":
+        if key == PLANT_J_L:
+            self._plant_J_L = value_si
+        elif key == "controller.T_c":
             self.inputs.set_T_c(value_si)
         else:
             self.inputs.set_value(key, value_si)
@@ -251,6 +273,7 @@ class PositionTab:
             progress(0, len(T_m_values))
             rows = table1_sweep(params, T_m_values, progress=progress)
             self._results().show_table1(rows, PAPER_TABLE1)
+            self.status.content = f"Ready — Table 1: {len(rows)} manoeuvre time(s) simulated."
 
         self.submit(job)
 
@@ -278,6 +301,26 @@ class PositionTab:
         self.open_case(params, origin)
         self.simulate()
 
+    # ---- pins -----------------------------------------------------------------------------------
+    @property
+    def pins(self) -> tuple[Pin, ...]:
+        """The pinned runs drawn as ghosts (oldest first)."""
+        return self._pins
+
+    def show_pins(self, pins: tuple[Pin, ...]) -> None:
+        """Keep ``pins`` and draw them as ghosts in the overview (on the worker)."""
+        self._pins = pins[-MAX_PINS:]
+        assign(self.pins_line, content=pins_html(self._pins))
+        self.submit(lambda: self._results().replay.show_pins(self._pins))
+
+    def _pin_clicked(self, label: str) -> None:
+        if label == "Clear pins":
+            self.show_pins(())
+            return
+        pin = pin_of(self.case.comparison, self.case.plant_J_L)
+        if pin is not None:
+            self.show_pins(pinned(self._pins, pin))
+
     def _use_recommended_k(self) -> None:
         k_rec = recommended_K(self.case.comparison.derived)
         if k_rec is not None:
@@ -298,11 +341,9 @@ class PositionTab:
         assign(self.derived, content=derived_markdown(d))
         self.optimum.show(case.comparison)
         self.inputs.show_T_c_in_force(d.profile.T_c)
-        if self._recentre:
+        if status:  # not during a drag: the sliders stand where the user's pointer holds them
+            self.tuning.show(d, case.plant_J_L, recentre=self._recentre)
             self._recentre = False
-            self.tuning.centre(case.params, d.profile.T_c)
-        if status:  # not during a drag: the slider stands where the user's pointer holds it
-            self.tuning.show_K(case.params.controller.K, d.gain.K_limit, recommended_K(d))
         nameplate = self.inputs.nameplate_warnings(case.params.motor)
         self.verdicts.show(case.comparison, case.params.controller.K, case.error, nameplate)
         if status:
@@ -354,4 +395,4 @@ class PositionTab:
         return comparison
 
 
-__all__ = ["OBJECTIVE_LABELS", "PositionTab", "comparison_or_derived"]
+__all__ = ["OBJECTIVE_LABELS", "PositionTab", "comparison_or_derived", "with_plant_J_L"]

@@ -23,6 +23,7 @@ import viser
 
 from app.figures.fdsmc_comparison import runs, time_plots_spec
 from app.figures.fdsmc_overview import overview_spec
+from app.figures.fdsmc_pins import Pin
 from app.figures.fdsmc_replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
 from app.figures.plain import figure_json
 from app.ui.props import assign
@@ -32,14 +33,14 @@ from app.ui.viser_adapter import run_script, set_figure_json
 FRAME_HZ = 25.0
 
 
-def overview_json(comparison: Any, replay: bool = True) -> tuple[str, ScrubTargets]:
-    """JSON of the overview figure (phase plane + compact time plot) and the traces a scrub moves.
+def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = ()) -> tuple[str, ScrubTargets]:
+    """JSON of the overview figure (phase plane + compact time plot, ``pins`` as ghosts) and the traces a scrub moves.
 
     With ``replay`` the figure carries its in-browser replay (play buttons and key frames); without
     them (and without Plotly's mode bar) the browser redraws it faster: what a slider drag needs;
     both come back when the drag stops.
     """
-    spec = overview_spec(comparison)
+    spec = overview_spec(comparison, pins)
     targets = ScrubTargets.of(spec["data"])
     if not replay:
         return figure_json(_drag_figure(spec)), targets
@@ -62,9 +63,9 @@ def _drag_figure(spec: dict[str, Any]) -> dict[str, Any]:
     return {**spec, "data": data, "config": {"staticPlot": True}}
 
 
-def phase_plane_json(comparison: Any, replay: bool = True) -> str:
+def phase_plane_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = ()) -> str:
     """JSON of the overview figure, with its in-browser replay if ``replay`` (see :func:`overview_json`)."""
-    return overview_json(comparison, replay)[0]
+    return overview_json(comparison, replay, pins)[0]
 
 
 #: Script run in the page for a scrub: stop the overview's replay, then restyle its moved traces.
@@ -102,6 +103,7 @@ class Replay:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._gui = gui
+        self.pins: tuple[Pin, ...] = ()  # pinned runs, drawn as ghosts in every overview sent
         self._comparison, self._targets = shown if shown is not None else (None, ScrubTargets((), (), ()))
         self._t_end = self._t_now = end_time(self._comparison) if self._comparison is not None else 1.0
         self.slider = gui.add_slider("Replay t [s]", min=0.0, max=self._t_end, step=self._t_end / 1000.0,
@@ -134,7 +136,7 @@ class Replay:
         plots, until :meth:`complete`.
         """
         self.pause()
-        figure, targets = overview_json(comparison, replay=not light)
+        figure, targets = overview_json(comparison, replay=not light, pins=self.pins)
         set_figure_json(self._phase, figure)
         self._flush()  # the phase plane goes out before the larger figure is even built
         if not light:
@@ -152,8 +154,18 @@ class Replay:
 
     def complete(self, comparison: Any) -> None:
         """Send what a light :meth:`load` left out: the overview's replay and the time plots."""
-        set_figure_json(self._phase, phase_plane_json(comparison))
+        set_figure_json(self._phase, phase_plane_json(comparison, pins=self.pins))
         self.show_time_plots(comparison)
+
+    def show_pins(self, pins: tuple[Pin, ...]) -> None:
+        """Draw the overview of the comparison shown again with ``pins`` as its ghosts."""
+        with self._lock:
+            self.pins, comparison = pins, self._comparison
+        if comparison is not None:
+            figure, targets = overview_json(comparison, pins=pins)
+            set_figure_json(self._phase, figure)
+            with self._lock:
+                self._targets = targets
 
     def show_time_plots(self, comparison: Any) -> None:
         """Send the time-plots figure of ``comparison`` (if this panel has one)."""

@@ -12,6 +12,7 @@ import html
 import re
 from typing import Any
 
+from app.figures.fdsmc_pins import pins_note
 from app.io.derived_view import derived_rows
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
@@ -87,6 +88,14 @@ def _saves(pct: float | None) -> str:
     if pct is None:
         return "saving –"
     return f"saves {pct:.1f} %" if pct >= 0 else f"costs {-pct:.1f} % more"
+
+
+def pins_html(pins: Any) -> str:
+    """Return the pinned runs for under the pin buttons: one small grey line each (labels escaped), or nothing."""
+    if not pins:
+        return ""
+    lines = "".join(f"<div>{html_text(line)}</div>" for line in pins_note(tuple(pins)).splitlines())
+    return f'<div data-role="pins" style="font-size:0.8em;color:#495057">{lines}</div>'
 
 
 def key_numbers_html(comparison: Any) -> str:

@@ -1,13 +1,18 @@
-"""Live tuning: sliders for K, T_c, T_m and J_L that re-simulate while they are dragged.
+"""Live tuning: logarithmic sliders for K, T_c, T_m and the plant's J_L that re-simulate while dragged.
 
-K has its own logarithmic slider mirroring the K field (:mod:`app.ui.k_slider`); T_c, T_m and
-J_L are linear, centred on their value after a preset, file or design.
+Each slider is an :class:`app.ui.log_slider.LogSlider` (K's is :class:`app.ui.k_slider.KSlider`)
+with the values a lecturer steers by marked on its track: K_limit and K_recommended on K; T_a of
+eq. (59) ("eq.59") and T_c,min ("ζ=1") on T_c; T_m,min ("min") on T_m; the nominal J_L ("nom")
+on J_L. After every committed run (Simulate, a preset, a file, a design, "Use …") each slider
+mirrors its field (:meth:`LiveTuning.show`); during a drag nothing moves under the pointer.
 
-A slider never simulates by itself: it writes its value into the inputs panel (the same field,
-shown and kept exactly as if typed) and asks the session to simulate the panel's values. While
-a run is in progress further moves only mark the panel as changed; when the run ends, one new
-run of the latest values starts. Stale values are never queued, and what runs is what the
-inputs panel shows.
+A slider never simulates by itself: K, T_c and T_m write their value into the inputs panel (the
+same field, shown and kept exactly as if typed) and ask the session to simulate the panel's
+values. The J_L slider changes the **plant's** load inertia only: the controller keeps the typed
+J_L as its model and does not know (the robustness demo); a Simulate of the typed inputs runs
+the nominal plant again. While a run is in progress further moves only mark the panel as
+changed; when the run ends, one new run of the latest values starts. Stale values are never
+queued, and what runs is what the inputs panel shows.
 """
 
 from __future__ import annotations
@@ -15,105 +20,80 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
 
 import viser
 
 from app.io import units
-from app.ui.k_slider import KSlider, hide_box_css
+from app.ui.k_slider import KSlider
 from app.ui.layout import install_css_js
+from app.ui.log_slider import LogSlider, default_readout, hide_box_css
 from app.ui.viser_adapter import run_script
 from app.ui.worker import Worker
-from control.fdsmc.params import DriveParams
+from control.fdsmc.derivations import Derived
+from sim.fdsmc.verdicts import recommended_K
 
-#: Slider range around the value it is centred on: [value / SPAN, value · SPAN].
-SPAN = 5.0
-#: Positions per slider.
-STEPS = 200
 #: Quiet time after the last slider move before the rest of the results (replay, time plots,
 #: energy figures) is drawn [s]: a drag's moves arrive tens of ms apart.
 TUNE_SETTLE_S = 0.4
+#: The key of the plant's load inertia (not an input field: the controller's model keeps J_L).
+PLANT_J_L = "plant.J_L"
+#: Least span of the T_c, T_m and J_L sliders around their reference value [-]: ×/÷ this.
+SPAN = 10.0
 
 
-@dataclass(frozen=True)
-class Knob:
-    """One slider: page label, the inputs-panel key, and shown value ↔ SI [shown unit → SI unit]."""
-
-    label: str
-    key: str
-    to_si: Callable[[float], float]
-    from_si: Callable[[float], float]
+def _around(value: float) -> tuple[float, float]:
+    return (value / SPAN, value * SPAN) if value > 0.0 and math.isfinite(value) else (1.0, 10.0)
 
 
-KNOBS = (
-    Knob("T_c [ms]", "controller.T_c", units.ms_to_s, units.s_to_ms),
-    Knob("T_m [s]", "manoeuvre.T_m", float, float),
-    Knob("J_L [kg·cm²]", "load.J_L", units.kgcm2_to_kgm2, lambda J: J * 1e4),
-)
-
-
-def _si_values(params: DriveParams, T_c: float) -> dict[str, float]:
-    """Return the current SI values of the linear knobs (T_c [s] is the one in force)."""
-    return {"controller.T_c": T_c,
-            "manoeuvre.T_m": params.manoeuvre.T_m, "load.J_L": params.load.J_L}
-
-
-def slider_range(value: float) -> tuple[float, float, float]:
-    """(min, max, step) of a slider centred on ``value`` (> 0) in the shown unit."""
-    lo, hi = value / SPAN, value * SPAN
-    return lo, hi, (hi - lo) / STEPS
-
-
-def slider_precision(step: float) -> int:
-    """Decimals a slider with ``step`` keeps: two finer than the step.
-
-    The page rounds every slider value to its ``precision``, which viser fixes when the slider is
-    made; a slider re-centred on a small value (K = 0.043 s/rad, step ≈ 0.001) with the
-    precision of its first range (2) rounded each key step back to 0.04.
-    """
-    return max(0, 2 - math.floor(math.log10(step)))
+def _ms(t: float) -> float:
+    return units.s_to_ms(t) if math.isfinite(t) else math.nan
 
 
 class LiveTuning:
-    """The "Live tuning" folder; ``apply(key, si)`` writes a value into the inputs panel."""
+    """The "Live tuning" folder; ``apply(key, si)`` writes a value into the inputs panel (or the plant)."""
 
     def __init__(self, gui: viser.GuiApi, apply: Callable[[str, float], None],
                  request_run: Callable[[], None]) -> None:
         self._apply, self._request_run = apply, request_run
-        self._sliders: dict[str, Any] = {}
         with gui.add_folder("Live tuning (drag: re-simulates)", expand_by_default=True):
             self.k = KSlider(gui, self._k_moved)
-            for knob in KNOBS:
-                slider = gui.add_slider(knob.label, min=0.0, max=1.0, step=0.01, initial_value=0.5)
-                slider.on_update(lambda event, k=knob: self._moved(event, k))
-                self._sliders[knob.key] = slider
-        run_script(gui, install_css_js(hide_box_css(self.k.uuid), "app-k-slider-style"))
+            self.T_c = LogSlider(gui, "T_c [ms] (log)", (1.0, 100.0), default_readout("T_c", "ms"),
+                                 self._mover("controller.T_c", units.ms_to_s),
+                                 hint="eq.59: T_c = T_a of eq. (59); ζ=1: T_c,min, critically damped with "
+                                      "the recommended K")
+            self.T_m = LogSlider(gui, "T_m [s] (log)", (0.1, 10.0), default_readout("T_m", "s"),
+                                 self._mover("manoeuvre.T_m", float),
+                                 hint="min: T_m,min, the shortest feasible manoeuvre time")
+            self.J_L = LogSlider(gui, "J_L plant [kg·cm²] (log)", (1.0, 100.0),
+                                 default_readout("J_L plant", "kg·cm²"),
+                                 self._mover(PLANT_J_L, units.kgcm2_to_kgm2),
+                                 hint="The plant's load inertia; the controller keeps the typed J_L (nom) as "
+                                      "its model. Simulate runs the nominal plant again")
+        css = "\n".join(hide_box_css(s.uuid) for s in (self.k, self.T_c, self.T_m, self.J_L))
+        run_script(gui, install_css_js(css, "app-k-slider-style"))
 
-    def show_K(self, K: float, K_limit: float, K_rec: float | None) -> None:
-        """Move the K slider to ``K`` [s/rad] (the K field's value) with K_limit and K_rec marked."""
-        self.k.show(K, K_limit, K_rec)
+    def show(self, d: Derived, plant_J_L: float | None = None, recentre: bool = False) -> None:
+        """Mirror the fields of ``d.params`` (and the plant's J_L [kg·m²]) with their marks.
 
-    def centre(self, params: DriveParams, T_c: float) -> None:
-        """Centre each linear slider's range on the current value (after a preset, file or design)."""
-        for knob in KNOBS:
-            shown = knob.from_si(_si_values(params, T_c)[knob.key])
-            if not shown > 0.0:
-                continue
-            lo, hi, step = slider_range(shown)
-            slider = self._sliders[knob.key]
-            slider.min, slider.max, slider.step = lo, hi, step
-            slider.precision = slider_precision(step)
-            slider.value = shown
+        ``recentre`` (a new drive: preset, file, design): the J_L track is laid out around its J_L.
+        """
+        p, g = d.params, d.gain
+        self.k.show_gains(p.controller.K, g.K_limit, recommended_K(d))
+        T_a = _ms(d.profile.T_a)
+        self.T_c.show(_ms(d.profile.T_c), (("eq.59", T_a), ("ζ=1", _ms(g.T_c_min))), _around(T_a))
+        self.T_m.show(p.manoeuvre.T_m, (("min", d.profile.T_m_min),), _around(p.manoeuvre.T_m) if recentre else None)
+        nominal = p.load.J_L * 1e4
+        J = nominal if plant_J_L is None else plant_J_L * 1e4
+        self.J_L.show(J, (("nom", nominal),), _around(nominal) if recentre else None)
+
+    def _mover(self, key: str, to_si: Callable[[float], float]) -> Callable[[float], None]:
+        def moved(value: float) -> None:
+            self._apply(key, to_si(value))
+            self._request_run()
+        return moved
 
     def _k_moved(self, K: float) -> None:
         self._apply("controller.K", K)
-        self._request_run()
-
-    def _moved(self, event: viser.GuiEvent, knob: Knob) -> None:
-        if event.client is None:  # our own centring
-            return
-        self._apply(knob.key, knob.to_si(float(self._sliders[knob.key].value)))
         self._request_run()
 
 
