@@ -142,8 +142,10 @@ def test_energy_figures_show_totals_and_saving(comparison):
 def test_table1_figure_plots_paper_values():
     rows = [Table1Row(1.0, 1600.0, 2150.0, 25.6, 25.1, 28.57, 27.9)]
     fig = make_table1_figure(rows, PAPER_TABLE1)
-    paper = next(t for t in fig.data if t.name == "paper, Table 1")
+    paper = next(t for t in fig.data if t.name == "paper, Table 1 as printed")
     assert list(paper.x) == sorted(PAPER_TABLE1)
+    back = next(t for t in fig.data if t.name.startswith("paper, columns reversed"))
+    assert list(back.y) == list(paper.y)[::-1]  # the erratum: the printed row read right to left
     assert make_table1_figure([]).layout.meta["id"] == "table1"
 
 

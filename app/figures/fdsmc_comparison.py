@@ -131,7 +131,9 @@ def _phase_marks(comparison: Comparison, key: str, run: RunResult, x_mid: float)
         idx = [min(int(np.searchsorted(tr.t, t)), len(tr.t) - 1) for t in steps]
         out.append({"type": "scatter", "x": tr.theta_r[idx] - th, "y": tr.omega_r[idx], "mode": "markers",
                     "name": f"{LABELS[key]} load step", "showlegend": key == "fdsmc",
-                    "marker": {"symbol": "x-thin", "size": 14, "color": "#c92a2a", "line": {"width": 3}},
+                    # an "-thin" symbol is drawn by its line alone: the line carries the red
+                    "marker": {"symbol": "x-thin", "size": 14, "color": "#c92a2a",
+                               "line": {"width": 3, "color": "#c92a2a"}},
                     "hovertemplate": "load step at t = %{customdata:.4g} s<extra></extra>",
                     "customdata": np.asarray(steps)})
     return out

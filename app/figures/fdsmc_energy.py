@@ -14,7 +14,7 @@ from app.figures.decimate import f32, time_axis
 from app.figures.fdsmc_comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
 from sim.fdsmc.engine import LABELS, Comparison, RunResult
 from sim.fdsmc.optimum_gap import saving_vs_optimum
-from sim.fdsmc.table1 import Table1Row
+from sim.fdsmc.table1 import Table1Row, printed_reversed
 
 #: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
 ENERGIES = (
@@ -152,8 +152,11 @@ def make_table1_figure(rows: Sequence[Table1Row], paper: Mapping[float, float] |
                         line={"color": colour, "dash": "dash" if attr == "bound_pct" else "solid"})
     if paper:
         xs = sorted(paper)
-        fig.add_scatter(x=xs, y=[paper[x] for x in xs], mode="markers", name="paper, Table 1",
+        fig.add_scatter(x=xs, y=[paper[x] for x in xs], mode="markers", name="paper, Table 1 as printed",
                         marker={"symbol": "x", "size": 11, "color": "#c92a2a"})
+        back = printed_reversed(dict(paper))
+        fig.add_scatter(x=xs, y=[back[x] for x in xs], mode="markers", name="paper, columns reversed (erratum)",
+                        marker={"symbol": "circle-open", "size": 13, "color": "#c92a2a", "line": {"width": 2}})
     return _styled(fig, "table1", "Friction saving vs manoeuvre time (Table 1)", -0.2,
                    xaxis_title="T_m [s]", yaxis_title="saving [%]")
 

@@ -19,6 +19,7 @@ import numpy as np
 from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
 from app.figures.fdsmc_comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
 from app.figures.fdsmc_pins import Pin, ghost_traces
+from app.figures.fdsmc_trail import piece_traces, pieces
 from app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
@@ -44,26 +45,30 @@ def _padded(lo: float, hi: float, pad: float = 0.08) -> list[float]:
 
 
 def _row_traces(comparison: Any) -> tuple[list[dict[str, Any]], list[list[float]], float]:
-    """ω_r and Γ traces of both controllers, the y ranges of the two rows and t_end [s]."""
+    """ω_r, Γ and Γ_L traces of both controllers, the y ranges (ω_r, Γ, Γ_L's own axis) and t_end [s].
+
+    Γ_L has its own axis (``y4``, right, over the Γ row): a load step of a few N·m stays visible
+    next to a chattering Γ on a ±Γ_max scale.
+    """
     d = comparison.derived
     motor, g_max, w_p = d.params.motor, torque_limit(d.params), d.profile.omega_p
     data: list[dict[str, Any]] = []
-    ys: list[list[float]] = [[-w_p, w_p, 0.0], [-g_max, g_max]]
+    ys: list[list[float]] = [[-w_p, w_p, 0.0], [-g_max, g_max], [0.0]]
     t_end = 0.0
     for key, run in runs(comparison):
         tr = run.trace
         t_end = max(t_end, float(tr.t[-1]))
         gamma = motor_torque(motor, tr.i_d, tr.i_q)
         style = {"type": "scatter", "mode": "lines", "showlegend": False}
-        for row, full, name, unit, line in (
-                (0, tr.omega_r, "ω_r", "rad/s", {"width": 1.6}),
-                (1, gamma, "Γ", "N·m", {"width": 1.6}),
-                (1, tr.Gamma_L, "Γ_L", "N·m", {"width": 1.2, "dash": "dot"})):
+        for row, axis, full, name, unit, line in (
+                (0, 0, tr.omega_r, "ω_r", "rad/s", {"width": 1.6}),
+                (1, 1, gamma, "Γ", "N·m", {"width": 1.6}),
+                (1, 2, tr.Gamma_L, "Γ_L", "N·m", {"width": 2.0, "dash": "dot"})):
             t, y = envelope(tr.t, full, BINS_OVERVIEW_ROWS)  # a chattering Γ stays a band
             data.append({**style, **t, "y": f32(y), "name": f"{name} {LABELS[key]}", "xaxis": f"x{row + 2}",
-                         "yaxis": f"y{row + 2}", "line": {"color": COLOURS[key], **line},
+                         "yaxis": f"y{axis + 2}", "line": {"color": COLOURS[key], **line},
                          "hovertemplate": f"t = %{{x:.4f}} s: %{{y:.4g}} {unit}<extra>{LABELS[key]}</extra>"})
-            ys[row] += [float(np.min(y)), float(np.max(y))]
+            ys[axis] += [float(np.min(y)), float(np.max(y))]
     return data, [_padded(min(y), max(y)) for y in ys], t_end
 
 
@@ -94,18 +99,39 @@ def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> di
         axes[f"yaxis{n}"] = {"domain": list(y_dom), "anchor": f"x{n}", "range": ranges[row],
                              "title": {"text": title, "standoff": 4}}
     axes["xaxis3"]["title"] = {"text": "t [s]", "standoff": 4}
-    notes = [{"text": f"motor Γ, load Γ_L dotted, ±Γ_max = {g_max:.4g} N·m dashed", "x": TIME_X[0],
+    axes["yaxis4"] = {"overlaying": "y3", "side": "right", "anchor": "x3", "range": ranges[2], "showgrid": False,
+                      "zeroline": False, "ticklabelposition": "inside", "tickfont": {"color": LOAD_STEP_COLOUR},
+                      "title": {"text": "Γ_L [N·m]", "font": {"color": LOAD_STEP_COLOUR}, "standoff": 2}}
+    notes = [{"text": f"motor Γ; load Γ_L dotted, own scale right; ±Γ_max = {g_max:.4g} N·m dashed", "x": TIME_X[0],
               "y": ROW_Y[1][1], "xref": "paper", "yref": "paper", "xanchor": "left", "yanchor": "bottom",
               "showarrow": False, "font": {"size": 10, "color": "#555"}}]
     shapes = []
-    for t in load_step_times(comparison):
+    for k, t in enumerate(load_step_times(comparison)):
         for row in (2, 3):
             shapes.append({"type": "line", "xref": f"x{row}", "yref": f"y{row} domain", "x0": t, "x1": t,
                            "y0": 0.0, "y1": 1.0, "line": {"color": LOAD_STEP_COLOUR, "width": 2, "dash": "dot"}})
-        notes.append({"text": f"load step {t:.3g} s", "x": t, "y": 1.0, "xref": "x2", "yref": "y2 domain",
+        # staggered: the labels of steps close in time do not overlap
+        notes.append({"text": f"load step {t:.3g} s", "x": t, "y": 1.0 - 0.14 * (k % 3), "xref": "x2",
+                      "yref": "y2 domain",
                       "xanchor": "left", "yanchor": "top", "showarrow": False,
                       "font": {"size": 10, "color": LOAD_STEP_COLOUR}})
     return {**axes, "annotations": notes, "shapes": shapes}
+
+
+def _with_trail(comparison: Any, data: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Return the phase plane's traces with the replay's trail (:mod:`app.figures.fdsmc_trail`) drawing the runs.
+
+    The trail pieces go under everything else but the boundary and its layer (the first two
+    traces); the whole trajectories stay (hover, names) but transparent; the FDSMC's translucent
+    sliding band gives way to the trail's phase colours. The optimum keeps its plain trajectory.
+    """
+    def kept(tr: dict[str, Any]) -> dict[str, Any]:
+        name = str(tr.get("name", ""))
+        if name.endswith(" trajectory") and not name.startswith(LABELS["optimum"]):
+            return {**tr, "opacity": 0.0, "showlegend": False}
+        return tr
+    rest = [kept(tr) for tr in data[2:] if "sliding phase" not in str(tr.get("name", ""))]
+    return data[:2] + piece_traces([p for p in pieces(comparison) if p.key != "optimum"]) + rest
 
 
 def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]:
@@ -137,6 +163,7 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
     layout["margin"] = {"l": 56, "r": 12, "t": 96, "b": 84, "autoexpand": False}
     if not runs(comparison):
         return {**spec, "data": ghost_traces(pins, time_row=False) + spec["data"]}
+    spec["data"] = _with_trail(comparison, spec["data"])
     traces, ranges, t_end = _row_traces(comparison)
     phase_notes = list(layout.get("annotations", []))
     verdict = chatter_verdict(comparison)

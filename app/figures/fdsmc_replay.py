@@ -17,6 +17,11 @@ trajectory through a key frame every 1/:data:`KEY_RATE` wall seconds (at most
 :data:`MAX_FRAMES` per speed). A slow replay (0.01×) is therefore as smooth as a fast one, with a
 figure that stays small (≈150 B per key frame, before compression).
 
+The buttons do not call Plotly themselves (``execute: false``): the page's handler
+(:data:`app.ui.replay.BUTTONS_JS`) passes their ``args`` to ``Plotly.animate`` and ignores the
+rejection Plotly gives an animation that a pause, a scrub or another speed interrupts (through
+Plotly's own button call, every such interruption logged "API call to Plotly.animate rejected").
+
 Scrubbing to a time is a ``Plotly.restyle`` of the same traces (:func:`scrub_update`, a few hundred
 bytes) that the page's "Replay t" slider sends per move. A Plotly slider inside the figure would
 need no server, but it is drawn again with every redraw of the figure: with 50 positions it made
@@ -25,6 +30,7 @@ each redraw ≈ 40 % slower (≈ 114 ms instead of ≈ 64 ms in headless Chromiu
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -42,22 +48,51 @@ KEY_RATE, MAX_FRAMES = 10.0, 150
 
 @dataclass(frozen=True)
 class ScrubTargets:
-    """Traces a replay moves: the ``"<name> now"`` markers and the time cursors (``x = [t, t]``).
+    """Traces a replay moves: the ``"<name> now"`` markers, the time cursors (``x = [t, t]``), the trail.
 
-    ``cursor_y`` keeps each cursor's vertical extent [row units].
+    ``cursor_y`` keeps each cursor's vertical extent [row units]; ``trail`` holds, per trail piece
+    (:mod:`app.figures.fdsmc_trail`), its trace index, end time [s] and its points as the JSON
+    object ``{"x": […], "y": […]}`` a frame shows once the replay has passed it.
     """
 
     now: tuple[int, ...]
     cursors: tuple[int, ...]
     cursor_y: tuple[tuple[float, ...], ...]
+    trail: tuple[tuple[int, float, str], ...] = ()
 
     @classmethod
     def of(cls, data: list[dict[str, Any]]) -> ScrubTargets:
-        """Find the moved traces among a figure's traces ``data`` by their names."""
+        """Find the moved traces among a figure's traces ``data`` by their names (the trail by ``meta.trail``)."""
         names = [t.get("name", "") for t in data]
         cursors = tuple(i for i, n in enumerate(names) if n.startswith("time cursor"))
+        trail = tuple((i, float(t["meta"]["trail"]), _points_json(t["x"], t["y"])) for i, t in enumerate(data)
+                      if isinstance(t.get("meta"), dict) and "trail" in t["meta"])
         return cls(tuple(i for i, n in enumerate(names) if n.endswith(" now")), cursors,
-                   tuple(tuple(float(v) for v in data[i]["y"]) for i in cursors))
+                   tuple(tuple(float(v) for v in data[i]["y"]) for i in cursors), trail)
+
+
+def _points_json(x: Any, y: Any) -> str:
+    """``{"x": […], "y": […]}`` of a trail piece, 4 significant digits."""
+    def fmt(a: Any) -> str:
+        return ",".join(f"{v:.4g}" for v in np.asarray(a, dtype=float).tolist())
+    return f'{{"x":[{fmt(x)}],"y":[{fmt(y)}]}}'
+
+
+#: A trail piece not reached yet.
+EMPTY = '{"x":[],"y":[]}'
+
+
+def _trail_frames(trail: tuple[tuple[int, float, str], ...], t_grid: np.ndarray) -> list[tuple[list[int], list[str]]]:
+    """Per key frame, the trail pieces it changes: all emptied at the first, then each once passed."""
+    out: list[tuple[list[int], list[str]]] = []
+    before = -math.inf
+    for k, t in enumerate(t_grid.tolist()):
+        shown = [(i, points) for i, t_end, points in trail if before < t_end <= t]
+        if k == 0:
+            shown = [(i, points if t_end <= t else EMPTY) for i, t_end, points in trail]
+        out.append(([i for i, _ in shown], [points for _, points in shown]))
+        before = t
+    return out
 
 
 def end_time(comparison: Comparison) -> float:
@@ -72,22 +107,23 @@ def _marker_positions(comparison: Comparison, t_grid: np.ndarray) -> list[tuple[
             for _, run in runs(comparison)]
 
 
-def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = ()) -> str:
+def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = (),
+                 trail: tuple[tuple[int, float, str], ...] = ()) -> str:
     """Write the JSON list of frames at the times ``t_grid`` [s].
 
-    Per time t: the x/y of each "now" marker (and a time label) and ``x = [t, t]`` of each
-    time-cursor trace (indices ``cursors``).
+    Per time t: the x/y of each "now" marker (and a time label), ``x = [t, t]`` of each
+    time-cursor trace (indices ``cursors``) and the trail pieces the frame shows (:func:`_trail_frames`).
 
     Written as text directly: a few thousand small frames are ~10× faster this way than as dicts.
     """
     cols = [([f"{v:.5g}" for v in x.tolist()], [f"{v:.5g}" for v in y.tolist()])
             for x, y in _marker_positions(comparison, t_grid)]
-    traces = ",".join(map(str, [*now, *cursors]))
     frames = []
-    for k, t in enumerate(t_grid.tolist()):
+    for k, (t, (pieces, points)) in enumerate(zip(t_grid.tolist(), _trail_frames(trail, t_grid), strict=True)):
         parts = [f'{{"x":[{x[k]}],"y":[{y[k]}]' + (f',"text":["t = {t:.3f} s"]}}' if j == 0 else "}")
                  for j, (x, y) in enumerate(cols)]
-        parts += [f'{{"x":[{t:.6g},{t:.6g}]}}'] * len(cursors)
+        parts += [f'{{"x":[{t:.6g},{t:.6g}]}}'] * len(cursors) + points
+        traces = ",".join(map(str, [*now, *cursors, *pieces]))
         frames.append(f'{{"data":[{",".join(parts)}],"traces":[{traces}]}}')
     return "[" + ",".join(frames) + "]"
 
@@ -122,13 +158,13 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
     for k, (label, speed) in enumerate(SPEEDS.items()):
         n = _n_frames(t_end, speed)
         raw[f"__frames_{k}__"] = _frames_json(comparison, list(targets.now), np.linspace(0.0, t_end, n),
-                                              targets.cursors)
+                                              targets.cursors, targets.trail)
         ms = 1e3 * t_end / speed / (n - 1)
         # per key frame: a jump to the start, then glides of one frame's duration each
         glide = [{"duration": 0}] + [{"duration": ms, "easing": "linear"} for _ in range(n - 1)]
-        buttons.append({"label": f"▶ {label}", "method": "animate", "args": [f"__frames_{k}__", {
+        buttons.append({"label": f"▶ {label}", "method": "animate", "execute": False, "args": [f"__frames_{k}__", {
             "mode": "immediate", "frame": {"duration": ms, "redraw": False}, "transition": glide}]})
-    buttons.append({"label": "Pause", "method": "animate", "args": [[None], PAUSE]})
+    buttons.append({"label": "Pause", "method": "animate", "execute": False, "args": [[None], PAUSE]})
     return {
         "updatemenus": [{"type": "buttons", "direction": "left", "showactive": False, "x": 1.0, "y": -0.1,
                          "xanchor": "right", "yanchor": "top", "pad": {"t": 0, "b": 2},
@@ -144,8 +180,8 @@ def scrub_update(comparison: Comparison, targets: ScrubTargets, t: float) -> tup
     """``Plotly.restyle`` arguments that put the replayed traces at time ``t`` [s].
 
     The markers go to (θ_r(t) − θ_dem, ω_r(t)) of each run (linear between samples, as the key
-    frames), the cursors to ``x = [t, t]`` with their vertical extent kept; the first marker's
-    text gives the time.
+    frames), the cursors to ``x = [t, t]`` with their vertical extent kept, the trail shows the
+    pieces ending by ``t``; the first marker's text gives the time.
 
     Returns
     -------
@@ -155,9 +191,11 @@ def scrub_update(comparison: Comparison, targets: ScrubTargets, t: float) -> tup
     t = float(t)
     marks = [(float(x[0]), float(y[0])) for x, y in _marker_positions(comparison, np.array([t]))]
     texts = [[f"t = {t:.3f} s"]] + [[""]] * (len(marks) - 1 + len(targets.cursors))
-    return ({"x": [[x] for x, _ in marks] + [[t, t]] * len(targets.cursors),
-             "y": [[y] for _, y in marks] + [list(y) for y in targets.cursor_y], "text": texts},
-            [*targets.now, *targets.cursors])
+    trail = [json.loads(points if t_end <= t else EMPTY) for _, t_end, points in targets.trail]
+    return ({"x": [[x] for x, _ in marks] + [[t, t]] * len(targets.cursors) + [p["x"] for p in trail],
+             "y": [[y] for _, y in marks] + [list(y) for y in targets.cursor_y] + [p["y"] for p in trail],
+             "text": texts + [[]] * len(trail)},
+            [*targets.now, *targets.cursors, *(i for i, _, _ in targets.trail)])
 
 
 __all__ = ["KEY_RATE", "MAX_FRAMES", "PAUSE", "SPEEDS", "ScrubTargets", "end_time", "replay_layout", "scrub_update"]

@@ -19,13 +19,14 @@ from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_
 from app.figures.plain import figure_json
 from app.io.numbers import parse_T_m_list
 from app.ui.layout import PanelLayout
+from app.ui.paper_text import errata_html, table1_html
 from app.ui.props import assign
 from app.ui.replay import Replay, overview_json, time_plots_json
 from app.ui.savings import annual_savings, savings_markdown
 from app.ui.scene import RotorScene
 from app.ui.text import key_numbers_html
 from app.ui.viser_adapter import add_figure, set_figure_json
-from sim.fdsmc.table1 import TABLE1_T_M
+from sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M
 
 #: Plot height / width per figure [-].
 ASPECT_PHASE, ASPECT_TIME, ASPECT_SMALL = 0.72, 1.45, 0.55
@@ -54,6 +55,10 @@ class ResultsPanel:
         with phase_tab:
             self.replay = Replay(gui, self.phase, self.time_plots, scene, (comparison, targets),
                                  flush=client.flush, on_3d=on_3d)
+            with gui.add_folder("Paper errata for this figure", expand_by_default=False):
+                gui.add_html(errata_html("overview"))
+        with time_tab:
+            gui.add_html(errata_html("time_plots"))
         simulated = bool(runs(comparison))
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
             self.energy = add_figure(gui, figure_json(energy_spec(comparison)) if simulated else None, ASPECT_SMALL)
@@ -64,7 +69,9 @@ class ResultsPanel:
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
             self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
             self.progress = gui.add_progress_bar(0.0, animated=False)
-            self.table1 = add_figure(gui, make_table1_figure([]).to_json(), ASPECT_SMALL)
+            self.table1_numbers = gui.add_html(table1_html([], PAPER_TABLE1))
+            self.table1 = add_figure(gui, make_table1_figure([], PAPER_TABLE1).to_json(), ASPECT_SMALL)
+            gui.add_html(errata_html("table1"))
         self.sweep_button.on_click(lambda _: self._sweep_clicked(client))
 
     def _build_savings(self, gui: viser.GuiApi) -> None:
@@ -133,4 +140,5 @@ class ResultsPanel:
 
     def show_table1(self, rows: list[Any], paper: dict[float, float]) -> None:
         """Draw the sweep result."""
+        self.table1_numbers.content = table1_html(rows, paper)
         set_figure_json(self.table1, make_table1_figure(rows, paper).to_json())

@@ -24,6 +24,15 @@ PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 
 TABLE1_T_M: tuple[float, ...] = tuple(PAPER_TABLE1)
 
 
+def printed_reversed(paper: dict[float, float]) -> dict[float, float]:
+    """Return the printed Table-1 row read right to left: the value under the last T_m belongs to the first.
+
+    [1] prints the row in reverse column order (read so, it agrees with the simulation).
+    """
+    keys = sorted(paper)
+    return dict(zip(keys, [paper[k] for k in reversed(keys)], strict=True))
+
+
 @dataclass(frozen=True)
 class Table1Row:
     """One column of Table 1 in [1]: friction [J] over [0, T_m] and savings [%]."""
