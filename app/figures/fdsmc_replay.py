@@ -30,7 +30,6 @@ each redraw ≈ 40 % slower (≈ 114 ms instead of ≈ 64 ms in headless Chromiu
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -180,8 +179,8 @@ def scrub_update(comparison: Comparison, targets: ScrubTargets, t: float) -> tup
     """``Plotly.restyle`` arguments that put the replayed traces at time ``t`` [s].
 
     The markers go to (θ_r(t) − θ_dem, ω_r(t)) of each run (linear between samples, as the key
-    frames), the cursors to ``x = [t, t]`` with their vertical extent kept, the trail shows the
-    pieces ending by ``t``; the first marker's text gives the time.
+    frames), the cursors to ``x = [t, t]`` with their vertical extent kept; the first marker's
+    text gives the time. (The trail follows in the page: :data:`app.ui.replay.BUTTONS_JS`.)
 
     Returns
     -------
@@ -191,11 +190,9 @@ def scrub_update(comparison: Comparison, targets: ScrubTargets, t: float) -> tup
     t = float(t)
     marks = [(float(x[0]), float(y[0])) for x, y in _marker_positions(comparison, np.array([t]))]
     texts = [[f"t = {t:.3f} s"]] + [[""]] * (len(marks) - 1 + len(targets.cursors))
-    trail = [json.loads(points if t_end <= t else EMPTY) for _, t_end, points in targets.trail]
-    return ({"x": [[x] for x, _ in marks] + [[t, t]] * len(targets.cursors) + [p["x"] for p in trail],
-             "y": [[y] for _, y in marks] + [list(y) for y in targets.cursor_y] + [p["y"] for p in trail],
-             "text": texts + [[]] * len(trail)},
-            [*targets.now, *targets.cursors, *(i for i, _, _ in targets.trail)])
+    return ({"x": [[x] for x, _ in marks] + [[t, t]] * len(targets.cursors),
+             "y": [[y] for _, y in marks] + [list(y) for y in targets.cursor_y], "text": texts},
+            [*targets.now, *targets.cursors])
 
 
 __all__ = ["KEY_RATE", "MAX_FRAMES", "PAUSE", "SPEEDS", "ScrubTargets", "end_time", "replay_layout", "scrub_update"]

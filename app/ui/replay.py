@@ -85,18 +85,30 @@ SCRUB_JS = """(() => {{ const P = window.Plotly; if (!P) return;
     if (!(el.layout && el.layout.meta && el.layout.meta.id === 'phase_plane' && el.data)) continue;
     P.animate(el, [null], {pause}).catch(() => {{}});
     P.restyle(el, {update}, {indices});
+    if (window.__appTrail) window.__appTrail(el, {t});
   }} }})();"""
 
 
-#: Installed once per page: the overview's replay buttons (``execute: false``) call ``Plotly.animate``
-#: from here, where the rejection of an interrupted animation (pause, scrub, another speed) is caught.
+#: Installed once per page. The overview's replay buttons (``execute: false``) call ``Plotly.animate``
+#: from here, where the rejection of an interrupted animation (pause, scrub, another speed) is
+#: caught. ``window.__appTrail(el, t)`` shows the trail pieces ending by ``t`` [s]: their points
+#: are kept from the figure as it arrived (a replay empties them), so a scrub sends only ``t``.
 BUTTONS_JS = """(() => { if (window.__appReplayButtons) return; window.__appReplayButtons = true;
+  const stash = (el) => { if (el.__trailFor !== el.data) { el.__trailFor = el.data;
+      el.__trail = (el._fullData || []).filter(d => d.meta && typeof d.meta.trail === 'number')
+                   .map(d => [d.index, d.meta.trail, d.x, d.y]); }
+    return el.__trail; };
+  window.__appTrail = (el, t) => { const s = stash(el); if (!s.length) return;
+    window.Plotly.restyle(el, {x: s.map(r => r[1] <= t ? r[2] : []), y: s.map(r => r[1] <= t ? r[3] : [])},
+                          s.map(r => r[0])).catch(() => {}); };
   setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
+    if (!(el.layout && el.layout.meta && el.layout.meta.overview && el._fullData)) continue;
+    stash(el);
     if (el.__appReplayButtons || !el.on) continue;
     el.__appReplayButtons = true;
     el.on('plotly_buttonclicked', (e) => { const b = e && e.button;
-      if (b && b.method === 'animate' && b.execute === false && window.Plotly)
-        window.Plotly.animate(el, ...b.args).catch(() => {}); });
+      if (b && b.method === 'animate' && b.execute === false && window.Plotly) {
+        stash(el); window.Plotly.animate(el, ...b.args).catch(() => {}); } });
   } }, 250); })();"""
 
 
@@ -104,7 +116,7 @@ def scrub_js(comparison: Any, targets: ScrubTargets, t: float) -> str:
     """Return the page script that puts the overview's markers and cursors at time ``t`` [s]."""
     update, indices = scrub_update(comparison, targets, t)
     return SCRUB_JS.format(pause=json.dumps(PAUSE), update=json.dumps(update, separators=(",", ":")),
-                           indices=json.dumps(indices))
+                           indices=json.dumps(indices), t=json.dumps(float(t)))
 
 
 def time_plots_json(comparison: Any) -> str:

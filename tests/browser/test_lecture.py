@@ -1,0 +1,130 @@
+"""A lecture on one 1280×720 page: the live-tuning sliders mirror the fields, the replay draws its trail
+progressively (no console errors over play, pause and scrub), pins leave ghosts, the paper's
+Table 1 is a numeric table, and the main story fits the projector without scrolling.
+
+The tests share one page (module scope) and run in file order; each leaves the page in a state
+the next one can start from.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from app.figures.fdsmc_replay import SPEEDS
+from tests.browser.conftest import click_tab, field, open_page, set_number
+
+#: Trail pieces drawn in the overview: [number of points shown, pieces shown, latest end time shown].
+TRAIL_JS = """() => {
+  const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
+  const trail = el._fullData.filter(d => d.meta && typeof d.meta.trail === 'number');
+  const shown = trail.filter(d => d.x && d.x.length > 0);
+  return [shown.reduce((n, d) => n + d.x.length, 0), shown.length, trail.length,
+          Math.max(-1, ...shown.map(d => d.meta.trail))];
+}"""
+NAMES_JS = """() => [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane')
+  ._fullData.map(d => d.name)"""
+
+
+@pytest.fixture(scope="module")
+def lecture(browser: Any, ui_server: Any) -> Iterator[Any]:
+    """One 1280×720 page shared by this module's tests, with every console error and page error recorded."""
+    context, page = open_page(browser, ui_server, viewport={"width": 1280, "height": 720})
+    page.errors = []  # type: ignore[attr-defined]
+    page.on("console", lambda m: m.type in ("error", "warning") and page.errors.append(m.text))
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    try:
+        yield page
+    finally:
+        context.close()
+
+
+def _thumb(page: Any, label: str) -> Any:
+    return page.locator(f'xpath=//label[normalize-space(.)="{label}"]/ancestor::*[.//*[@role="slider"]][1]'
+                        '//*[@role="slider"]').first
+
+
+def _wait_thumb(page: Any, label: str, value: float) -> None:
+    page.wait_for_function("([t, p]) => Math.abs(parseFloat(t.getAttribute('aria-valuenow')) - p) < 0.006",
+                           arg=[_thumb(page, label).element_handle(), math.log10(value)])
+
+
+def test_the_sliders_mirror_the_fields_after_typing_and_simulate(lecture, ui_server):
+    page = lecture
+    set_number(page, "T_m manoeuvre time [s]", 1.4)
+    set_number(page, "K boundary-layer gain [s/rad]", 2)
+    page.get_by_role("button", name="Simulate").click()
+    _wait_thumb(page, "T_m [s] (log)", 1.4)
+    _wait_thumb(page, "K [s/rad] (log)", 2.0)
+    page.locator('[data-role="t-m-readout"]', has_text="T_m = 1.4 s").wait_for()
+    marks = page.locator(".mantine-Slider-markLabel").all_inner_texts()
+    assert {"lim", "rec", "eq.59", "min", "nom"} <= set(marks)
+    # T_c (rule T_c = T_a of eq. (59)): the slider stands at the T_c in force, on its "eq.59" mark
+    T_c_ms = float(field(page, "T_c sliding time const. [ms]").input_value())
+    _wait_thumb(page, "T_c [ms] (log)", T_c_ms)
+    # the plant's J_L stands at the model's (nominal) J_L after a Simulate
+    J_L = ui_server.config.initial().derived.params.load.J_L
+    _wait_thumb(page, "J_L plant [kg·cm²] (log)", J_L * 1e4)
+    page.get_by_text("Ready — ").wait_for()
+
+
+def test_the_replay_draws_the_trail_progressively_without_console_errors(lecture):
+    page = lecture
+    points, _, pieces, _ = page.evaluate(TRAIL_JS)
+    assert pieces > 20 and points > 0  # the whole trail drawn before any replay
+    names = page.evaluate(NAMES_JS)
+    assert "FDSMC enters boundary layer" in names and "Conventional enters boundary layer" not in names
+    assert {"FDSMC reaching the boundary", "FDSMC linear, ω_r = −θ_re/T_c"} <= set(names)
+    page.locator(".updatemenu-button", has_text=f"▶ {list(SPEEDS)[2]}").click()  # 0.1×: ≈ 14 s
+    page.wait_for_function(f"() => {{ const r = ({TRAIL_JS})(); return r[1] > 0 && r[1] < r[2] / 3; }}")
+    early = page.evaluate(TRAIL_JS)
+    page.wait_for_function(f"(n) => ({TRAIL_JS})()[0] > n", arg=early[0])
+    later = page.evaluate(TRAIL_JS)
+    assert later[0] > early[0] and later[3] > early[3]  # more points, reaching later in time
+    page.locator(".updatemenu-button", has_text="Pause").click()
+    page.locator(".updatemenu-button", has_text=f"▶ {list(SPEEDS)[0]}").click()
+    box = page.locator('xpath=//label[normalize-space(.)="Replay t [s]"]/ancestor::*[.//input][1]'
+                       '//input[not(@type="hidden")]').first
+    box.fill("0.3")
+    box.press("Tab")  # a scrub during a replay: pauses it
+    page.wait_for_function(f"() => {{ const r = ({TRAIL_JS})(); return r[1] > 0 && r[3] <= 0.3; }}")
+    page.wait_for_timeout(300)  # an interrupted animation's rejection would be logged by now
+    assert not [e for e in page.errors if "rejected" in e or "Uncaught" in e], page.errors
+
+
+def test_a_pinned_run_stays_as_a_ghost_until_cleared(lecture):
+    page = lecture
+    page.get_by_role("button", name="Pin this run").click()
+    page.wait_for_function(f"() => ({NAMES_JS})().includes('pin 1 trajectory')")
+    page.locator('[data-role="pins"]', has_text="pin 1").wait_for()
+    set_number(page, "K boundary-layer gain [s/rad]", 1000)
+    page.get_by_role("button", name="Simulate").click()
+    page.wait_for_function("() => { const el = [...document.querySelectorAll('.js-plotly-plot')]"
+                           ".find(e => e.layout.meta.id === 'phase_plane');"
+                           " return (el.layout.annotations || []).some(a => a.name === 'verdict'"
+                           " && a.text.includes('CHATTER')); }")
+    names = page.evaluate(NAMES_JS)
+    assert {"pin 1 trajectory", "pin 1 ω_r"} <= set(names)  # the ghost outlives the new run
+    page.get_by_role("button", name="Clear pins").click()
+    page.wait_for_function(f"() => !({NAMES_JS})().some(n => n.startsWith('pin '))")
+
+
+def test_table1_tab_shows_the_printed_row_reversed_row_and_simulation(lecture):
+    page = lecture
+    click_tab(page, "Table 1 sweep")
+    table = page.locator('[data-role="table1"]')
+    rows = table.locator("tr").all_inner_texts()
+    assert rows[1].startswith("printed in [1]") and "27.9" in rows[1]
+    assert rows[2].startswith("printed, columns reversed")
+    assert rows[1].split()[-1] == rows[2].split()[3] == "25.1"  # last printed under T_m = 1 s
+    page.locator('[data-role="errata-table1"]', has_text="reverse column order").wait_for()
+    field(page, "T_m list [s]").fill("1, 1.4")
+    page.wait_for_timeout(120)  # viser throttles GUI messages to one per 50 ms
+    page.get_by_role("button", name="Run Table-1 sweep").click()
+    page.get_by_text("Ready — Table 1: 2 manoeuvre time(s) simulated.").wait_for()  # not "Working…"
+    simulated = table.locator("tr").nth(3).inner_text().split()
+    assert simulated[:3] == ["simulated,", "this", "drive"] and float(simulated[3]) > 20.0
+    click_tab(page, "Overview")
