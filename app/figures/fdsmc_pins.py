@@ -9,6 +9,7 @@ case and go into the saved demo state as plain numbers.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,7 +51,7 @@ def pin_label(params: Any, plant_J_L: float | None = None) -> str:
     c, J_L = params.controller, params.load.J_L
     T_c = "T_a" if c.T_c == "T_a" else f"{float(c.T_c) * 1e3:.3g} ms"
     plant = "" if plant_J_L is None else f" (model {J_L:.3g})"
-    return (f"K = {c.K:.3g} s/rad, T_c = {T_c}, T_m = {params.manoeuvre.T_m:.3g} s, "
+    return (f"K = {c.K:.4g} s/rad, T_c = {T_c}, T_m = {params.manoeuvre.T_m:.4g} s, "
             f"J_L plant = {J_L if plant_J_L is None else plant_J_L:.3g} kg·m²{plant}, "
             f"{len(params.load.steps)} load step(s)")
 
@@ -74,6 +75,11 @@ def pinned(pins: tuple[Pin, ...], pin: Pin) -> tuple[Pin, ...]:
     return (*pins, pin)[-MAX_PINS:]
 
 
+def _plain(label: str) -> str:
+    """``label`` without the characters Plotly's hover template would read as markup or fields."""
+    return re.sub(r"[<>{}%&]", "", label)
+
+
 def ghost_traces(pins: tuple[Pin, ...], time_row: bool = True) -> list[dict[str, Any]]:
     """Grey ghost traces of ``pins``: trajectory in the phase plane, and ω_r(t) in the time plot's top row.
 
@@ -83,7 +89,7 @@ def ghost_traces(pins: tuple[Pin, ...], time_row: bool = True) -> list[dict[str,
     for n, pin in enumerate(pins, start=1):
         line = {"color": GHOST_COLOUR, "width": 2.5, "dash": GHOST_DASHES[(n - 1) % len(GHOST_DASHES)]}
         ghost = {"type": "scatter", "mode": "lines", "showlegend": False, "line": line,
-                 "hovertemplate": f"pin {n}: {pin.label}<extra></extra>"}
+                 "hovertemplate": f"pin {n}: {_plain(pin.label)}<extra></extra>"}
         out.append({**ghost, "x": f32(pin.theta_re), "y": f32(pin.omega_r), "name": f"pin {n} trajectory"})
         if time_row:
             out.append({**ghost, "x": f32(pin.t), "y": f32(pin.omega_r), "name": f"pin {n} ω_r",

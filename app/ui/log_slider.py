@@ -108,6 +108,16 @@ class LogSlider:
         return widget_id(self.slider)
 
     @property
+    def least(self) -> tuple[float, float]:
+        """The least range [shown unit] (the track always holds it)."""
+        return self._least
+
+    @least.setter
+    def least(self, least: tuple[float, float]) -> None:
+        if all(positive(v) for v in least) and least[0] < least[1]:
+            self._least = (float(least[0]), float(least[1]))
+
+    @property
     def value(self) -> float:
         """The value the slider stands at [shown unit]."""
         return value_of_position(float(self.slider.value))
@@ -120,8 +130,8 @@ class LogSlider:
         if not positive(value):
             return
         self._marks = marks
-        if least is not None and all(positive(v) for v in least):
-            self._least = least
+        if least is not None:
+            self.least = least
         lo, hi = log_range([value, *(v for _, v in marks)], self._least)
         assign(self.slider, min=lo, max=hi)
         set_slider_marks(self.slider, track_marks(lo, hi, marks))

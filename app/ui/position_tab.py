@@ -18,17 +18,17 @@ from typing import Any
 
 import viser
 
-from app.figures.fdsmc_pins import MAX_PINS, Pin, pin_of, pinned
 from app.io.presets import list_presets_of, load, require_mode
 from app.ui.case import Case, CaseState
 from app.ui.choices import checked_choice
 from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
 from app.ui.inputs import InputError, InputsPanel
+from app.ui.lecture import DemoStateFiles, LecturePins
 from app.ui.log import LogPanel
 from app.ui.props import assign
 from app.ui.results import ResultsPanel
 from app.ui.studies import OptimumToggle
-from app.ui.text import derived_markdown, design_markdown, md_text, pins_html
+from app.ui.text import derived_markdown, design_markdown, md_text
 from app.ui.tuning import PLANT_J_L, LiveTuning, TuneRunner
 from app.ui.verdict_panel import VerdictPanel
 from app.ui.worker import Cancelled, Worker
@@ -78,7 +78,6 @@ class PositionTab:
         self._client, self._state, self._worker = client, state, worker
         self._recentre = True
         self._plant_J_L: float | None = None  # the J_L slider's plant [kg·m²]; None: the model's
-        self._pins: tuple[Pin, ...] = ()
         self.results: ResultsPanel | None = None  # the right-hand panel, given by the page once built
         self.tuner = TuneRunner(worker, self._run_latest, self._tuned)
         self._controls(client.gui)
@@ -127,14 +126,17 @@ class PositionTab:
         self.inputs.populate(params)
         self._state.opened(params, origin)
 
-    def run(self, params: DriveParams, autoplay: bool = True, overview_only: bool = False) -> None:
+    def run(self, params: DriveParams, autoplay: bool = True, overview_only: bool = False,
+            keep_plant: bool = False) -> None:
         """On the worker: simulate ``params`` and show the results (``overview_only``: a live-tuning run).
 
-        A live-tuning run keeps the J_L slider's plant; any other run simulates the nominal plant.
+        A live-tuning run (or ``keep_plant``) keeps the J_L slider's plant; any other run simulates
+        the nominal plant.
         """
         if not overview_only:
             self.status.content = "Simulating…"
-            self._plant_J_L = None
+            if not keep_plant:
+                self._plant_J_L = None
         assign(self.design_note, content="")
         self._worker.checkpoint()
         plant_J_L = self._plant_J_L
@@ -165,10 +167,9 @@ class PositionTab:
         self._preset_shown = self.preset.value
         # the sliders sit above everything a run changes (warnings, status, Cancel): a drag never moves them
         self.tuning = LiveTuning(gui, self._apply_knob, self.tuner.request)
-        self.pin_buttons = gui.add_button_group("Compare runs", ("Pin this run", "Clear pins"))
-        self.pin_buttons.on_click(lambda _: self._pin_clicked(self.pin_buttons.value))
-        self.pins_line = gui.add_html("")
+        self.lecture = LecturePins(gui, self)
         self.files = FilesPanel(self._client, self.export_state, self._imported, case.params)
+        self.demo_files = DemoStateFiles(gui, self)
         self.log_panel = LogPanel(self)
         self.simulate_button = gui.add_button("Simulate", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.simulate_button.on_click(lambda _: self.simulate())
@@ -301,25 +302,19 @@ class PositionTab:
         self.open_case(params, origin)
         self.simulate()
 
-    # ---- pins -----------------------------------------------------------------------------------
     @property
-    def pins(self) -> tuple[Pin, ...]:
-        """The pinned runs drawn as ghosts (oldest first)."""
-        return self._pins
+    def busy(self) -> bool:
+        """True while a job runs on this tab's worker."""
+        return self._worker.busy
 
-    def show_pins(self, pins: tuple[Pin, ...]) -> None:
-        """Keep ``pins`` and draw them as ghosts in the overview (on the worker)."""
-        self._pins = pins[-MAX_PINS:]
-        assign(self.pins_line, content=pins_html(self._pins))
-        self.submit(lambda: self._results().replay.show_pins(self._pins))
+    def hold_ranges(self) -> None:
+        """Keep the sliders' ranges as they are at the next run (a loaded demo state set them)."""
+        self._recentre = False
 
-    def _pin_clicked(self, label: str) -> None:
-        if label == "Clear pins":
-            self.show_pins(())
-            return
-        pin = pin_of(self.case.comparison, self.case.plant_J_L)
-        if pin is not None:
-            self.show_pins(pinned(self._pins, pin))
+    def run_with_plant(self, params: DriveParams, plant_J_L: float | None) -> None:
+        """On the worker: simulate ``params`` on a plant with load inertia ``plant_J_L`` [kg·m²] (None: the model's)."""
+        self._plant_J_L = plant_J_L
+        self.run(params, keep_plant=True)
 
     def _use_recommended_k(self) -> None:
         k_rec = recommended_K(self.case.comparison.derived)

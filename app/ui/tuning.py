@@ -86,6 +86,21 @@ class LiveTuning:
         J = nominal if plant_J_L is None else plant_J_L * 1e4
         self.J_L.show(J, (("nom", nominal),), _around(nominal) if recentre else None)
 
+    @property
+    def _logs(self) -> dict[str, LogSlider]:
+        return {"K": self.k, "T_c": self.T_c, "T_m": self.T_m, "J_L": self.J_L}
+
+    @property
+    def ranges(self) -> dict[str, tuple[float, float]]:
+        """The least range of each slider [its unit], by name (``K``, ``T_c``, ``T_m``, ``J_L``)."""
+        return {name: s.least for name, s in self._logs.items()}
+
+    @ranges.setter
+    def ranges(self, ranges: dict[str, tuple[float, float]]) -> None:
+        for name, least in ranges.items():
+            if name in self._logs:
+                self._logs[name].least = least
+
     def _mover(self, key: str, to_si: Callable[[float], float]) -> Callable[[float], None]:
         def moved(value: float) -> None:
             self._apply(key, to_si(value))
