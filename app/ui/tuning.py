@@ -37,12 +37,16 @@ from sim.fdsmc.verdicts import recommended_K
 TUNE_SETTLE_S = 0.4
 #: The key of the plant's load inertia (not an input field: the controller's model keeps J_L).
 PLANT_J_L = "plant.J_L"
-#: Least span of the T_c, T_m and J_L sliders around their reference value [-]: ×/÷ this.
+#: Least span of the T_c, T_m and J_L sliders around their reference value [-]: ×/÷ this, widened
+#: to whole decades.
 SPAN = 10.0
 
 
 def _around(value: float) -> tuple[float, float]:
-    return (value / SPAN, value * SPAN) if value > 0.0 and math.isfinite(value) else (1.0, 10.0)
+    """Least range of a slider around ``value``: whole decades holding [value / SPAN, value · SPAN]."""
+    if not (value > 0.0 and math.isfinite(value)):
+        return 1.0, 10.0
+    return 10.0 ** math.floor(math.log10(value / SPAN)), 10.0 ** math.ceil(math.log10(value * SPAN))
 
 
 def _ms(t: float) -> float:

@@ -8,14 +8,17 @@ the next one can start from.
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 from app.figures.fdsmc_replay import SPEEDS
-from tests.browser.conftest import click_tab, field, open_page, set_number
+from app.ui.demo_state import loads_state
+from tests.browser.conftest import ARTIFACTS, click_tab, field, open_page, set_number
 
 #: Trail pieces drawn in the overview: [number of points shown, pieces shown, latest end time shown].
 TRAIL_JS = """() => {
@@ -128,3 +131,68 @@ def test_table1_tab_shows_the_printed_row_reversed_row_and_simulation(lecture):
     simulated = table.locator("tr").nth(3).inner_text().split()
     assert simulated[:3] == ["simulated,", "this", "drive"] and float(simulated[3]) > 20.0
     click_tab(page, "Overview")
+
+
+def test_a_saved_demo_state_loads_back_and_a_bad_file_is_refused(lecture, tmp_path):
+    page = lecture
+    page.get_by_role("button", name="Pin this run").click()
+    page.locator('[data-role="pins"]', has_text="pin 1").wait_for()
+    page.get_by_text("Demo state (lecture)").click()
+    with page.expect_download() as info:
+        page.get_by_role("button", name="Save demo state").click()
+    saved = Path(info.value.path()).read_text(encoding="utf-8")
+    state = loads_state(saved, "saved.json")
+    assert len(state.pins) == 1 and state.ranges["T_m"][0] < state.params.manoeuvre.T_m
+    T_m = field(page, "T_m manoeuvre time [s]").input_value()
+    assert float(T_m) == state.params.manoeuvre.T_m
+    page.get_by_role("button", name="Clear pins").click()
+    set_number(page, "T_m manoeuvre time [s]", 2.2)
+    page.get_by_role("button", name="Simulate").click()
+    page.wait_for_function(f"() => !({NAMES_JS})().some(n => n.startsWith('pin '))")
+    upload = page.locator("input[type=file][accept^='.json']")
+    upload.set_input_files(files=[{"name": "lecture.json", "mimeType": "application/json",
+                                   "buffer": saved.encode()}])
+    page.wait_for_function(f"() => ({NAMES_JS})().includes('pin 1 trajectory')")
+    assert field(page, "T_m manoeuvre time [s]").input_value() == T_m
+    _wait_thumb(page, "T_m [s] (log)", float(T_m))
+    page.get_by_text("Ready — ").wait_for()
+    upload.set_input_files(files=[{"name": "not_a_state.json", "mimeType": "application/json",
+                                   "buffer": b'{"demo_state": 1, "preset": "x"}'}])
+    page.get_by_text("not_a_state.json is not a demo-state file").wait_for()
+    assert field(page, "T_m manoeuvre time [s]").input_value() == T_m  # nothing changed
+
+
+#: Scrolls the control panel back to its top (earlier tests scrolled it), as a page opens.
+TOP_JS = """() => { let e = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'Preset');
+  for (; e; e = e.parentElement) if (e.scrollTop) e.scrollTop = 0; }"""
+#: Boxes (page px) of what a lecturer needs on the projector, and the page's scroll size.
+STORY_JS = """() => {
+  const row = (text) => { const l = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === text);
+    let r = l; while (r && !r.querySelector('[role="slider"]')) r = r.parentElement; return r; };
+  const box = (e) => { const r = e.getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; };
+  const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
+  const r = el.getBoundingClientRect(), L = el._fullLayout;
+  const verdict = [...el.querySelectorAll('.annotation')].find(a => a.textContent.includes('CHATTER')
+                                                                  || a.textContent.includes('chatter'));
+  const pin = [...document.querySelectorAll('button')].find(b => b.textContent.trim() === 'Pin this run');
+  return {sliders: LABELS.map(t => box(row(t))), pin: box(pin),
+          preset: box([...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'Preset')),
+          phase: [r.x + L.xaxis._offset, r.y + L.yaxis._offset, L.xaxis._length, L.yaxis._length],
+          numbers: box(document.querySelector('[data-role="key-numbers"]')), verdict: box(verdict),
+          scroll: [document.scrollingElement.scrollWidth, document.scrollingElement.scrollHeight]};
+}"""
+
+
+def test_the_main_story_fits_1280x720_without_scrolling(lecture):
+    page = lecture
+    page.get_by_text("Demo state (lecture)").click()  # folded again, as a lecture starts
+    page.evaluate(TOP_JS)
+    page.wait_for_timeout(100)  # one frame to lay out
+    labels = ["K [s/rad] (log)", "T_c [ms] (log)", "T_m [s] (log)", "J_L plant [kg·cm²] (log)"]
+    boxes = page.evaluate(STORY_JS.replace("LABELS", json.dumps(labels)))
+    page.screenshot(path=str(ARTIFACTS / "lecture_1280x720.png"))
+    assert boxes["scroll"] == [1280, 720]
+    for name in ("pin", "preset", "phase", "numbers", "verdict", *(f"slider {i}" for i in range(4))):
+        x, y, w, h = boxes["sliders"][int(name[-1])] if name.startswith("slider") else boxes[name]
+        assert w > 0 and h > 0 and x >= 0 and y >= 0 and x + w <= 1280 and y + h <= 720, (name, x, y, w, h)
+    assert boxes["phase"][2] >= 380 and boxes["phase"][3] >= 300  # the phase plane keeps its size
