@@ -21,6 +21,7 @@ from app.figures.fdsmc_comparison import COLOURS, LABELS, load_step_times, phase
 from app.figures.fdsmc_pins import Pin, ghost_traces
 from app.figures.fdsmc_trail import piece_traces, pieces
 from app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
+from app.figures.fdsmc_zoom import zoom_parts
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
 
@@ -171,6 +172,13 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
         phase_notes.append(verdict_annotation(verdict, PHASE_X[1]))
     layout.update(_time_layout(comparison, t_end, ranges))
     layout["annotations"] = phase_notes + layout["annotations"]
+    zoom = zoom_parts(comparison)
+    if zoom is not None:
+        z_traces, z_axes, z_shapes, z_notes = zoom
+        spec["data"] += z_traces
+        layout.update(z_axes)
+        layout["shapes"] = z_shapes + layout["shapes"]
+        layout["annotations"] += z_notes
     data = ghost_traces(pins) + spec["data"] + traces + _reference_traces(comparison, t_end, ranges)
     return {"data": data, "layout": layout}
 

@@ -116,7 +116,10 @@ def loads_state(text: str, origin: str = "<demo state>") -> DemoState:
                           f"(found {found})")
     if str(raw["demo_state"]) != str(VERSION):
         raise PresetError(f"{origin} › demo_state = {shorten(raw['demo_state'])!r}: allowed {VERSION}")
-    params, plant = loads_preset_and_plant(_text_full(raw["preset"], f"{origin} › preset"), f"{origin} › preset")
+    try:
+        params, plant = loads_preset_and_plant(_text_full(raw["preset"], f"{origin} › preset"), f"{origin} › preset")
+    except ValueError as exc:  # the preset loader's own message, said of this file
+        raise PresetError(f"{origin} › preset: {exc}") from None
     if not isinstance(params, DriveParams):
         raise PresetError(f"{origin} › preset is not a position-drive preset: allowed a position-drive preset")
     return DemoState(params, None if plant is None else plant.load.J_L, _text(raw["origin"], f"{origin} › origin"),

@@ -190,6 +190,8 @@ def test_the_main_story_fits_1280x720_without_scrolling(lecture):
     page.wait_for_timeout(100)  # one frame to lay out
     labels = ["K [s/rad] (log)", "T_c [ms] (log)", "T_m [s] (log)", "J_L plant [kg·cm²] (log)"]
     boxes = page.evaluate(STORY_JS.replace("LABELS", json.dumps(labels)))
+    for close in page.locator(".mantine-Notification-closeButton").all():
+        close.click()  # the uploads' notes, viser's "software WebGL" notice
     page.screenshot(path=str(ARTIFACTS / "lecture_1280x720.png"))
     assert boxes["scroll"] == [1280, 720]
     for name in ("pin", "preset", "phase", "numbers", "verdict", *(f"slider {i}" for i in range(4))):
