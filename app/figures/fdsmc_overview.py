@@ -135,6 +135,17 @@ def _with_trail(comparison: Any, data: list[dict[str, Any]]) -> list[dict[str, A
     return data[:2] + piece_traces([p for p in pieces(comparison) if p.key != "optimum"]) + rest
 
 
+def _add_zoom(comparison: Any, data: list[dict[str, Any]], layout: dict[str, Any]) -> None:
+    """Add the sliding-region inset (:mod:`app.figures.fdsmc_zoom`) to ``data`` and ``layout``, if the run cruised."""
+    zoom = zoom_parts(comparison)
+    if zoom is not None:
+        traces, axes, shapes, notes = zoom
+        data += traces
+        layout.update(axes)
+        layout["shapes"] = shapes + layout["shapes"]
+        layout["annotations"] += notes
+
+
 def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]:
     """Build the phase plane (left) and the compact time plot (right) as one plain-dict figure.
 
@@ -172,13 +183,7 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
         phase_notes.append(verdict_annotation(verdict, PHASE_X[1]))
     layout.update(_time_layout(comparison, t_end, ranges))
     layout["annotations"] = phase_notes + layout["annotations"]
-    zoom = zoom_parts(comparison)
-    if zoom is not None:
-        z_traces, z_axes, z_shapes, z_notes = zoom
-        spec["data"] += z_traces
-        layout.update(z_axes)
-        layout["shapes"] = z_shapes + layout["shapes"]
-        layout["annotations"] += z_notes
+    _add_zoom(comparison, spec["data"], layout)
     data = ghost_traces(pins) + spec["data"] + traces + _reference_traces(comparison, t_end, ranges)
     return {"data": data, "layout": layout}
 

@@ -78,20 +78,26 @@ def zoom_parts(comparison: Any) -> tuple[list[dict[str, Any]], dict[str, Any], l
         {"type": "scatter", "x": f32(x_all[i]), "y": f32(y_all[i]), "mode": "lines", "name": "zoom: FDSMC",
          "line": {"color": "#1f6fd1", "width": 1.5}, **axes},
     ]
+    return traces, *_inset_frame((x0, x1, y0, y1), th >= 0, K)
+
+
+def _inset_frame(win: tuple[float, float, float, float], upward: bool,
+                 K: float) -> tuple[dict[str, Any], list[dict[str, Any]], list[dict[str, Any]]]:
+    """Return the inset's axes over window ``win``, its white ground and marking rectangle, and its title."""
+    x0, x1, y0, y1 = win
     frame = {"showgrid": False, "zeroline": False, "mirror": True, "showline": True, "linecolor": ZOOM_COLOUR,
              "tickfont": {"size": 10}}
-    y_dom = INSET_Y if th >= 0 else (1.0 - INSET_Y[1] - 0.1, 1.0 - INSET_Y[0] - 0.1)
+    y_dom = INSET_Y if upward else (1.0 - INSET_Y[1] - 0.1, 1.0 - INSET_Y[0] - 0.1)
     layout = {"xaxis4": {**frame, "domain": list(INSET_X), "anchor": "y5", "range": [x0, x1], "nticks": 3},
               "yaxis5": {**frame, "domain": list(y_dom), "anchor": "x4", "range": [y0, y1], "nticks": 4}}
     box = {"type": "rect", "xref": "x", "yref": "y", "x0": x0, "x1": x1, "y0": y0, "y1": y1,
            "line": {"color": ZOOM_COLOUR, "width": 1.5}}
     # the inset's own white ground, under its traces, over the phase plane's grid
-    ground = {"type": "rect", "xref": "x4", "yref": "y5", "x0": x0, "x1": x1, "y0": y0, "y1": y1, "layer": "below",
-              "fillcolor": "white", "line": {"width": 0}}
+    ground = {**box, "xref": "x4", "yref": "y5", "layer": "below", "fillcolor": "white", "line": {"width": 0}}
     title = {"text": f"zoom: sliding region, layer ±1/K = ±{1 / K:.3g} rad/s", "x": INSET_X[0],
              "y": y_dom[1], "xref": "paper", "yref": "paper", "xanchor": "left", "yanchor": "bottom",
              "showarrow": False, "font": {"size": 11, "color": ZOOM_COLOUR}, "bgcolor": "rgba(255,255,255,0.8)"}
-    return traces, layout, [ground, box], [title]
+    return layout, [ground, box], [title]
 
 
 __all__ = ["INSET_X", "INSET_Y", "zoom_parts", "zoom_window"]
