@@ -149,6 +149,8 @@ def test_a_saved_demo_state_loads_back_and_a_bad_file_is_refused(lecture, tmp_pa
     set_number(page, "T_m manoeuvre time [s]", 2.2)
     page.get_by_role("button", name="Simulate").click()
     page.wait_for_function(f"() => !({NAMES_JS})().some(n => n.startsWith('pin '))")
+    _wait_thumb(page, "T_m [s] (log)", 2.2)  # the run is shown: the worker is free for the upload
+    page.get_by_text("Ready — ").wait_for()
     upload = page.locator("input[type=file][accept^='.json']")
     upload.set_input_files(files=[{"name": "lecture.json", "mimeType": "application/json",
                                    "buffer": saved.encode()}])
@@ -190,8 +192,7 @@ def test_the_main_story_fits_1280x720_without_scrolling(lecture):
     page.wait_for_timeout(100)  # one frame to lay out
     labels = ["K [s/rad] (log)", "T_c [ms] (log)", "T_m [s] (log)", "J_L plant [kg·cm²] (log)"]
     boxes = page.evaluate(STORY_JS.replace("LABELS", json.dumps(labels)))
-    for close in page.locator(".mantine-Notification-closeButton").all():
-        close.click()  # the uploads' notes, viser's "software WebGL" notice
+    page.add_style_tag(content=".mantine-Notifications-root { display: none !important; }")  # uploads' notes
     page.screenshot(path=str(ARTIFACTS / "lecture_1280x720.png"))
     assert boxes["scroll"] == [1280, 720]
     for name in ("pin", "preset", "phase", "numbers", "verdict", *(f"slider {i}" for i in range(4))):
