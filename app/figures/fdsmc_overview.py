@@ -125,15 +125,25 @@ def _with_trail(comparison: Any, data: list[dict[str, Any]]) -> list[dict[str, A
 
     The trail pieces go under everything else but the boundary and its layer (the first two
     traces); the whole trajectories stay (hover, names) but transparent; the FDSMC's translucent
-    sliding band gives way to the trail's phase colours. The optimum keeps its plain trajectory.
+    sliding band gives way to the trail's phase colours.
     """
     def kept(tr: dict[str, Any]) -> dict[str, Any]:
-        name = str(tr.get("name", ""))
-        if name.endswith(" trajectory") and not name.startswith(LABELS["optimum"]):
+        if str(tr.get("name", "")).endswith(" trajectory"):
             return {**tr, "opacity": 0.0, "showlegend": False}
         return tr
     rest = [kept(tr) for tr in data[2:] if "sliding phase" not in str(tr.get("name", ""))]
-    return data[:2] + piece_traces([p for p in pieces(comparison) if p.key != "optimum"]) + rest
+    return data[:2] + piece_traces(pieces(comparison)) + rest
+
+
+def keeper(xaxis: str, yaxis: str) -> dict[str, Any]:
+    """Return an invisible one-point trace on subplot (``xaxis``, ``yaxis``) that every replay frame carries.
+
+    Plotly's replay transitions clear a subplot none of whose traces is in the frame: the Γ_L
+    axis and the zoom inset would go blank while a replay runs (:mod:`app.figures.fdsmc_replay`).
+    """
+    return {"type": "scatter", "mode": "markers", "x": [0.0], "y": [0.0], "xaxis": xaxis, "yaxis": yaxis,
+            "name": f"keeper {xaxis}{yaxis}", "showlegend": False, "hoverinfo": "skip",
+            "marker": {"opacity": 0.0, "size": 1}, "meta": {"keep": True}}
 
 
 def _add_zoom(comparison: Any, data: list[dict[str, Any]], layout: dict[str, Any]) -> None:
@@ -185,7 +195,8 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
     layout.update(_time_layout(comparison, t_end, ranges))
     layout["annotations"] = phase_notes + layout["annotations"]
     _add_zoom(comparison, spec["data"], layout)
-    data = ghost_traces(pins) + spec["data"] + traces + _reference_traces(comparison, t_end, ranges)
+    data = (ghost_traces(pins) + spec["data"] + traces + _reference_traces(comparison, t_end, ranges)
+            + [keeper(xa, ya) for xa, ya in (("x3", "y4"), ("x4", "y5")) if f"yaxis{ya[1:]}" in layout])
     return {"data": data, "layout": layout}
 
 

@@ -50,24 +50,29 @@ class ScrubTargets:
     """Traces a replay moves: the ``"<name> now"`` markers, the time cursors (``x = [t, t]``), the trail.
 
     ``cursor_y`` keeps each cursor's vertical extent [row units]; ``trail`` holds, per trail piece
-    (:mod:`app.figures.fdsmc_trail`), its trace index, end time [s] and its points as the JSON
-    object ``{"x": […], "y": […]}`` a frame shows once the replay has passed it.
+    (:mod:`app.figures.fdsmc_trail`), its trace index, end time [s], its points as the JSON object
+    ``{"x": […], "y": […]}`` a frame shows once the replay has passed it, and the same with its
+    first point only: the piece not reached yet. (A line of one point is not drawn; an empty
+    trace would be, because Plotly's transitions keep the path of a trace that lost all its points.)
     """
 
     now: tuple[int, ...]
     cursors: tuple[int, ...]
     cursor_y: tuple[tuple[float, ...], ...]
-    trail: tuple[tuple[int, float, str], ...] = ()
+    trail: tuple[tuple[int, float, str, str], ...] = ()
+    keep: tuple[tuple[int, str], ...] = ()
 
     @classmethod
     def of(cls, data: list[dict[str, Any]]) -> ScrubTargets:
         """Find the moved traces among a figure's traces ``data`` by their names (the trail by ``meta.trail``)."""
         names = [t.get("name", "") for t in data]
         cursors = tuple(i for i, n in enumerate(names) if n.startswith("time cursor"))
-        trail = tuple((i, float(t["meta"]["trail"]), _points_json(t["x"], t["y"])) for i, t in enumerate(data)
-                      if isinstance(t.get("meta"), dict) and "trail" in t["meta"])
+        trail = tuple((i, float(t["meta"]["trail"]), _points_json(t["x"], t["y"]), _points_json(t["x"][:1], t["y"][:1]))
+                      for i, t in enumerate(data) if isinstance(t.get("meta"), dict) and "trail" in t["meta"])
+        keep = tuple((i, _points_json(t["x"], t["y"])) for i, t in enumerate(data)
+                     if isinstance(t.get("meta"), dict) and t["meta"].get("keep"))
         return cls(tuple(i for i, n in enumerate(names) if n.endswith(" now")), cursors,
-                   tuple(tuple(float(v) for v in data[i]["y"]) for i in cursors), trail)
+                   tuple(tuple(float(v) for v in data[i]["y"]) for i in cursors), trail, keep)
 
 
 def _points_json(x: Any, y: Any) -> str:
@@ -77,18 +82,15 @@ def _points_json(x: Any, y: Any) -> str:
     return f'{{"x":[{fmt(x)}],"y":[{fmt(y)}]}}'
 
 
-#: A trail piece not reached yet.
-EMPTY = '{"x":[],"y":[]}'
-
-
-def _trail_frames(trail: tuple[tuple[int, float, str], ...], t_grid: np.ndarray) -> list[tuple[list[int], list[str]]]:
-    """Per key frame, the trail pieces it changes: all emptied at the first, then each once passed."""
+def _trail_frames(trail: tuple[tuple[int, float, str, str], ...],
+                  t_grid: np.ndarray) -> list[tuple[list[int], list[str]]]:
+    """Per key frame, the trail pieces it changes: all hidden at the first, then each once passed."""
     out: list[tuple[list[int], list[str]]] = []
     before = -math.inf
     for k, t in enumerate(t_grid.tolist()):
-        shown = [(i, points) for i, t_end, points in trail if before < t_end <= t]
+        shown = [(i, points) for i, t_end, points, _ in trail if before < t_end <= t]
         if k == 0:
-            shown = [(i, points if t_end <= t else EMPTY) for i, t_end, points in trail]
+            shown = [(i, points if t_end <= t else hidden) for i, t_end, points, hidden in trail]
         out.append(([i for i, _ in shown], [points for _, points in shown]))
         before = t
     return out
@@ -106,23 +108,26 @@ def _marker_positions(comparison: Comparison, t_grid: np.ndarray) -> list[tuple[
             for _, run in runs(comparison)]
 
 
-def _frames_json(comparison: Comparison, now: list[int], t_grid: np.ndarray, cursors: tuple[int, ...] = (),
-                 trail: tuple[tuple[int, float, str], ...] = ()) -> str:
+def _frames_json(comparison: Comparison, targets: ScrubTargets, t_grid: np.ndarray) -> str:
     """Write the JSON list of frames at the times ``t_grid`` [s].
 
     Per time t: the x/y of each "now" marker (and a time label), ``x = [t, t]`` of each
-    time-cursor trace (indices ``cursors``) and the trail pieces the frame shows (:func:`_trail_frames`).
+    time-cursor trace, the trail pieces the frame shows (:func:`_trail_frames`) and each subplot's
+    *keeper* as it is (``meta.keep``: Plotly's transitions clear a subplot none of whose traces
+    is in the frame).
 
     Written as text directly: a few thousand small frames are ~10× faster this way than as dicts.
     """
     cols = [([f"{v:.5g}" for v in x.tolist()], [f"{v:.5g}" for v in y.tolist()])
             for x, y in _marker_positions(comparison, t_grid)]
-    frames = []
-    for k, (t, (pieces, points)) in enumerate(zip(t_grid.tolist(), _trail_frames(trail, t_grid), strict=True)):
+    frames, cursors = [], targets.cursors
+    keep = [i for i, _ in targets.keep], [points for _, points in targets.keep]
+    for k, (t, (pieces, points)) in enumerate(zip(t_grid.tolist(), _trail_frames(targets.trail, t_grid),
+                                                  strict=True)):
         parts = [f'{{"x":[{x[k]}],"y":[{y[k]}]' + (f',"text":["t = {t:.3f} s"]}}' if j == 0 else "}")
                  for j, (x, y) in enumerate(cols)]
-        parts += [f'{{"x":[{t:.6g},{t:.6g}]}}'] * len(cursors) + points
-        traces = ",".join(map(str, [*now, *cursors, *pieces]))
+        parts += [f'{{"x":[{t:.6g},{t:.6g}]}}'] * len(cursors) + points + keep[1]
+        traces = ",".join(map(str, [*targets.now, *cursors, *pieces, *keep[0]]))
         frames.append(f'{{"data":[{",".join(parts)}],"traces":[{traces}]}}')
     return "[" + ",".join(frames) + "]"
 
@@ -156,8 +161,7 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
     buttons, raw = [], {}
     for k, (label, speed) in enumerate(SPEEDS.items()):
         n = _n_frames(t_end, speed)
-        raw[f"__frames_{k}__"] = _frames_json(comparison, list(targets.now), np.linspace(0.0, t_end, n),
-                                              targets.cursors, targets.trail)
+        raw[f"__frames_{k}__"] = _frames_json(comparison, targets, np.linspace(0.0, t_end, n))
         ms = 1e3 * t_end / speed / (n - 1)
         # per key frame: a jump to the start, then glides of one frame's duration each
         glide = [{"duration": 0}] + [{"duration": ms, "easing": "linear"} for _ in range(n - 1)]

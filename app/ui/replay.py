@@ -84,8 +84,8 @@ SCRUB_JS = """(() => {{ const P = window.Plotly; if (!P) return;
   for (const el of document.querySelectorAll('.js-plotly-plot')) {{
     if (!(el.layout && el.layout.meta && el.layout.meta.id === 'phase_plane' && el.data)) continue;
     P.animate(el, [null], {pause}).catch(() => {{}});
-    P.restyle(el, {update}, {indices});
-    if (window.__appTrail) window.__appTrail(el, {t});
+    const show = () => {{ P.restyle(el, {update}, {indices}); if (window.__appTrail) window.__appTrail(el, {t}); }};
+    if (window.__appAfterTransition) window.__appAfterTransition(el, show); else show();
   }} }})();"""
 
 
@@ -98,8 +98,12 @@ BUTTONS_JS = """(() => { if (window.__appReplayButtons) return; window.__appRepl
       el.__trail = (el._fullData || []).filter(d => d.meta && typeof d.meta.trail === 'number')
                    .map(d => [d.index, d.meta.trail, d.x, d.y]); }
     return el.__trail; };
+  // a redraw while a replay's transition still runs is undone when it ends: wait for its end
+  window.__appAfterTransition = (el, fn) => { const go = () => el._transitioning ? requestAnimationFrame(go) : fn();
+    go(); };
   window.__appTrail = (el, t) => { const s = stash(el); if (!s.length) return;
-    window.Plotly.restyle(el, {x: s.map(r => r[1] <= t ? r[2] : []), y: s.map(r => r[1] <= t ? r[3] : [])},
+    window.Plotly.restyle(el, {x: s.map(r => r[1] <= t ? r[2] : r[2].slice(0, 1)),
+                               y: s.map(r => r[1] <= t ? r[3] : r[3].slice(0, 1))},
                           s.map(r => r[0])).catch(() => {}); };
   setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
     if (!(el.layout && el.layout.meta && el.layout.meta.overview && el._fullData)) continue;

@@ -20,13 +20,16 @@ from app.figures.fdsmc_replay import SPEEDS
 from app.ui.demo_state import loads_state
 from tests.browser.conftest import ARTIFACTS, click_tab, field, open_page, set_number
 
-#: Trail pieces drawn in the overview: [number of points shown, pieces shown, latest end time shown].
+#: Trail pieces as drawn (the SVG, not the data: Plotly can keep a path its data lost):
+#: [line segments drawn, pieces drawn, pieces, latest end time drawn].
 TRAIL_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
-  const trail = el._fullData.filter(d => d.meta && typeof d.meta.trail === 'number');
-  const shown = trail.filter(d => d.x && d.x.length > 0);
-  return [shown.reduce((n, d) => n + d.x.length, 0), shown.length, trail.length,
-          Math.max(-1, ...shown.map(d => d.meta.trail))];
+  const groups = [...el.querySelectorAll('g.trace.scatter')].filter(g => { const m = g.__data__[0].trace.meta;
+    return m && typeof m.trail === 'number'; });
+  const drawn = groups.map(g => { const p = g.querySelector('path.js-line');
+    return [((p && p.getAttribute('d')) || '').split('L').length - 1, g.__data__[0].trace.meta.trail]; })
+    .filter(([n, _]) => n > 0);
+  return [drawn.reduce((n, d) => n + d[0], 0), drawn.length, groups.length, Math.max(-1, ...drawn.map(d => d[1]))];
 }"""
 NAMES_JS = """() => [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane')
   ._fullData.map(d => d.name)"""
@@ -87,6 +90,7 @@ def test_the_replay_draws_the_trail_progressively_without_console_errors(lecture
     page.wait_for_function(f"(n) => ({TRAIL_JS})()[0] > n", arg=early[0])
     later = page.evaluate(TRAIL_JS)
     assert later[0] > early[0] and later[3] > early[3]  # more points, reaching later in time
+    page.screenshot(path=str(ARTIFACTS / "lecture_replay.png"))
     page.locator(".updatemenu-button", has_text="Pause").click()
     page.locator(".updatemenu-button", has_text=f"▶ {list(SPEEDS)[0]}").click()
     box = page.locator('xpath=//label[normalize-space(.)="Replay t [s]"]/ancestor::*[.//input][1]'
