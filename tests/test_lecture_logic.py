@@ -61,6 +61,9 @@ def test_each_replay_frame_shows_the_pieces_it_passed_once_after_emptying_them_a
     assert trail <= set(first) and all(len(first[i]["x"]) == 1 for i in trail)  # a point: no line drawn
     shown = [i for f in frames[1:] for i in f["traces"] if i in trail]
     assert sorted(shown) == sorted(trail)  # every piece appears exactly once
+    # the Γ_L axis and the zoom inset keep a trace in every frame (else Plotly blanks them while replaying)
+    keep = {i for i, _ in targets.keep}
+    assert len(keep) == 2 and all(keep <= set(f["traces"]) for f in frames)
     names = [t["name"] for t in spec["data"]]
     assert "FDSMC enters boundary layer" in names and "Conventional enters boundary layer" not in names
 
