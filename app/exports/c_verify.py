@@ -72,10 +72,13 @@ def readings(params: DriveParams, k: int, theta: float, i_d: float, i_q: float,
             sensors.adc_current(i_q, noise[1, j], se.i_noise, i_step, se.i_adc_range))
 
 
-def write_module(folder: Path, params: DriveParams, verdict: Verdict | None = None) -> None:
-    """Generate ``fdsmc_controller.h``/``.c`` for ``params`` into ``folder`` (unverified unless ``verdict``)."""
+def write_module(folder: Path, params: DriveParams, verdict: Verdict | None = None, law: str = "fdsmc") -> None:
+    """Generate ``fdsmc_controller.h``/``.c`` for ``params`` into ``folder`` (unverified unless ``verdict``).
+
+    ``law``: the module's outer law, ``"fdsmc"`` or ``"optimum"`` (the tracked optimum's module).
+    """
     kw = {} if verdict is None else {"verdict": verdict}
-    for name, text in controller_files(params, derive(params), SCHEMA, **kw).items():
+    for name, text in controller_files(params, derive(params), SCHEMA, law=law, **kw).items():
         (folder / name).write_text(text, encoding="utf-8")
 
 
@@ -114,10 +117,13 @@ class CModule:
         observer = ([("n0", i32), ("f0", real), ("z", real * 3)] if single
                     else [("theta_dem_rad", ctypes.c_double), ("x", ctypes.c_double * 4)])
 
+        # The tracked optimum's module appends its move clock (the FDSMC's struct is the prefix).
+        clock = ([("ref_k", u32)] if single else [("ref_t", ctypes.c_double), ("ref_start_rad", ctypes.c_double)])
+
         class State(ctypes.Structure):
             _fields_ = [("p", ctypes.c_void_p), ("theta_dem", i32), *observer, ("u_hold", real * 2),
                         ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
-                        ("status", Status)]
+                        ("status", Status), *clock, ("ref_on", i32)]
 
         class Output(ctypes.Structure):
             _fields_ = [("u_d", real), ("u_q", real), ("theta_re", real), ("omega_hat", real),
@@ -143,7 +149,9 @@ def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller:
     """Plant states [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, …] at every sample, C module in the loop.
 
     ``params`` as :func:`count_params` returns them; the move is set at run time (``fdsmc_set_move``
-    to θ_dem in counts, in T_m); the module reads the sensors of :func:`readings`.
+    to θ_dem in counts, in T_m); the module reads the sensors of :func:`readings`. ``controller``:
+    ``"conventional"`` runs ``fdsmc_step_conventional``, else ``fdsmc_step`` (the module's outer law:
+    the FDSMC, or the tracked optimum in its module).
     """
     m = CModule(lib, single)
     state, out = m.new_state(0), m.Output()
@@ -151,7 +159,7 @@ def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller:
     rc = lib.fdsmc_set_move(ctypes.byref(state), count, params.manoeuvre.T_m)
     if rc != 0:
         raise RuntimeError(f"fdsmc_set_move refused the designed move: status {rc}")
-    step = lib.fdsmc_step if controller == "fdsmc" else lib.fdsmc_step_conventional
+    step = lib.fdsmc_step_conventional if controller == "conventional" else lib.fdsmc_step
     plant, noise = PlantInTheLoop(params), sensors.noise_table(params.sensors)
     rows = np.zeros((plant.n_samples, len(plant.x)))
     for k in range(plant.n_samples):
@@ -173,11 +181,14 @@ def agreement(params: DriveParams, rows: np.ndarray, controller: str = "fdsmc") 
 
 
 def measure(params: DriveParams, single: bool, controller: str = "fdsmc") -> dict[str, float]:
-    """Generate, compile, run and compare one build for ``params`` (demand rounded to a count)."""
+    """Generate, compile, run and compare one build for ``params`` (demand rounded to a count).
+
+    ``controller`` ``"optimum"`` generates the tracked optimum's module.
+    """
     params, _ = count_params(params)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        write_module(folder, params)
+        write_module(folder, params, law="optimum" if controller == "optimum" else "fdsmc")
         return agreement(params, closed_loop(build(folder, single), single, params, controller), controller)
 
 
