@@ -269,9 +269,9 @@ def _gate_texts(v: Verdict, hash_value: str, label: str = "FDSMC") -> dict[str, 
 
 #: The outer law's line in the header: FDSMC, or the tracked optimum.
 LAW_TEXT = {False: "FDSMC, eqs. (41)-(46) of [1] (fdsmc_step).",
-            True: "tracked minimum-energy optimum with the FDSMC's terminal slide (fdsmc_step; "
-                  "control/fdsmc/terminal_slide.py): the reference table of the designed move only, "
-                  "FDSMC_REF_DELTA counts in FDSMC_T_M (fdsmc_set_move refuses others: FDSMC_ERR_TABLE)."}
+            True: "tracked minimum-energy optimum with the FDSMC's terminal slide (fdsmc_step;\n"
+                  " *   control/fdsmc/terminal_slide.py): the reference table of the designed move only,\n"
+                  " *   FDSMC_REF_DELTA counts in FDSMC_T_M (fdsmc_set_move refuses others: FDSMC_ERR_TABLE)."}
 
 
 def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED,
