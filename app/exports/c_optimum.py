@@ -102,7 +102,7 @@ def optimum_constants(params: DriveParams, d: Derived, table: ReferenceTable) ->
     """(name, value, unit, reference, integer) of the optimum's ``#define`` constants, in SI units."""
     prm = pack_parameters(params, d, "optimum")
     g = time_grid(params, 1, 0.0, 1)
-    T_s, lead = g.h * g.n_sub, float(prm[kn.P_LEAD])
+    lead = float(prm[kn.P_LEAD])
     cpr = encoder_counts_per_rev(params)
     return [
         ("G1_TRACK", float(prm[kn.P_G1]), "1/s^2", "tracking gain a^2 (control/fdsmc/tracking.py)", False),
@@ -112,8 +112,7 @@ def optimum_constants(params: DriveParams, d: Derived, table: ReferenceTable) ->
         ("REF_NODES", table.nodes, "-", f"nodes of the reference table ({table.float_bytes} bytes float32)", True),
         ("REF_H", table.h, "s", "node spacing T_m/(REF_NODES - 1)", False),
         ("REF_DELTA", table.delta_counts, "counts", "the designed move theta_dem - theta_start", True),
-        ("REF_NODES_PER_SAMPLE", T_s / table.h, "-", "T_s/REF_H (float build's clock)", False),
-        ("REF_LEAD_NODES", lead / table.h, "-", "REF_LEAD/REF_H (float build)", False),
+        ("REF_INV_H", 1.0 / table.h, "1/s", "1/REF_H (float build)", False),
         ("REF_H_COUNTS", table.h * cpr / (2.0 * math.pi), "counts*s/rad", "REF_H in counts per rad/s", False),
         ("CLOCK_SUBSTEPS", g.n_sub, "-", "additions of CLOCK_H per sample (the simulator's clock)", True),
         ("CLOCK_H", g.h, "s", "the simulator's RK4 step T_s/CLOCK_SUBSTEPS", False),
@@ -181,103 +180,80 @@ OUTER_LAW = """\
 /* ---- tracked optimum (control/fdsmc/terminal_slide.py): the designed move's reference table ---- */
 #ifdef FDSMC_USE_FLOAT
 typedef struct { fdsmc_count n; fdsmc_real f, omega, alpha; } ref_node; /* theta_ref - theta_dem = n + f counts */
+#define REF_STEP FDSMC_REF_H_COUNTS /* node spacing in counts per rad/s */
 #else
 typedef struct { double theta, omega, alpha; } ref_node;                  /* theta_ref - theta_start [rad] */
+#define REF_STEP FDSMC_REF_H
 #endif
 static const ref_node ref_table[FDSMC_REF_NODES] = {
 $table
 };
 
-#ifdef FDSMC_USE_FLOAT
-/* The reference at x = t/REF_H nodes: theta_ref - theta_dem = *n + *frac counts, omega_ref, alpha_ref. */
-static void reference_at(fdsmc_real x, fdsmc_count *n, fdsmc_real *frac, fdsmc_real *w, fdsmc_real *a)
+/* Node j and fraction f [-] of the reference at t [s] since the move was set, as reference_at of
+ * sim/fdsmc/kernel.py; -1 from T_m on (the last node at rest). */
+static int32_t ref_node_at(fdsmc_real t, fdsmc_real *f)
 {
-    const int32_t last = FDSMC_REF_NODES - 1;
-    fdsmc_real f, w0, w1;
+    fdsmc_real x;
     int32_t j;
-    if (x >= (fdsmc_real)last) {
-        *n = ref_table[last].n;
-        *frac = ref_table[last].f;
-        *w = R_(0);
-        *a = R_(0);
-        return;
+    if (t >= FDSMC_T_M) {
+        return -1;
     }
+    x = FDSMC_DIV(t, FDSMC_REF_H, FDSMC_REF_INV_H);
     j = (int32_t)x;
-    j = j < last - 1 ? j : last - 1;
-    f = x - (fdsmc_real)j;
-    w0 = ref_table[j].omega;
-    w1 = ref_table[j + 1].omega;
-    *n = ref_table[j].n;
-    *frac = ref_table[j].f + FDSMC_REF_H_COUNTS * f * (w0 + R_(0.5) * f * (w1 - w0));
-    *w = (R_(1) - f) * w0 + f * w1;
-    *a = (R_(1) - f) * ref_table[j].alpha + f * ref_table[j + 1].alpha;
+    j = j < FDSMC_REF_NODES - 2 ? j : FDSMC_REF_NODES - 2;
+    *f = x - (fdsmc_real)j;
+    return j;
 }
 
-/* alpha_dem of the tracked optimum and S (0 while tracking), as sim/fdsmc/kernel.py outer_law. */
+/* alpha_dem [rad/s^2] and S of the tracked optimum (outer_law of sim/fdsmc/kernel.py, law 3): alpha_ref
+ * (read FDSMC_REF_LEAD ahead) + g1*(theta_ref - theta_hat) + g2*(omega_ref - omega_hat), S = 0, until the
+ * reference reaches the sloped segment of eq. (41); from there eq. (46) at the slide's T_c. */
 static fdsmc_real tracked_optimum(fdsmc_state *s, fdsmc_real theta_re, fdsmc_real omega_hat, fdsmc_real *S)
 {
-    const fdsmc_real x = (fdsmc_real)s->ref_k * FDSMC_REF_NODES_PER_SAMPLE;
-    fdsmc_count n, n_lead;
-    fdsmc_real frac, w, a, unused, sw;
+    fdsmc_real t, f = R_(0), f_lead = R_(0), w = R_(0), a = R_(0), dth = R_(0), th, sw, e_th;
+    int32_t j, j_lead;
     if (s->ref_on == 0) {
-        return sliding_mode(s, theta_re, omega_hat, S); /* no move: the reference at rest on theta_dem */
+        return sliding_mode(s, theta_re, omega_hat, S); /* no move set: the reference at rest on theta_dem */
     }
-    reference_at(x, &n, &frac, &w, &unused);
-    reference_at(x + FDSMC_REF_LEAD_NODES, &n_lead, &unused, &unused, &a);
+#ifdef FDSMC_USE_FLOAT
+    t = (fdsmc_real)s->ref_k * FDSMC_T_S;
     s->ref_k += s->ref_k < 0x7fffffffu ? 1u : 0u;
-    sw = w + FDSMC_DIV(((fdsmc_real)n + frac) * s->p->rad_per_count, s->t_c, s->inv_t_c);
+#else
+    {
+        int i;
+        t = s->ref_t;
+        for (i = 0; i < FDSMC_CLOCK_SUBSTEPS; ++i) {
+            s->ref_t += FDSMC_CLOCK_H; /* the simulator's clock, addition for addition */
+        }
+    }
+#endif
+    j = ref_node_at(t, &f);
+    j_lead = ref_node_at(t + FDSMC_REF_LEAD, &f_lead);
+    if (j_lead >= 0) {
+        a = (R_(1) - f_lead) * ref_table[j_lead].alpha + f_lead * ref_table[j_lead + 1].alpha;
+    }
+    if (j >= 0) {
+        const fdsmc_real w0 = ref_table[j].omega, w1 = ref_table[j + 1].omega;
+        dth = REF_STEP * f * (w0 + R_(0.5) * f * (w1 - w0)); /* integral of the linear omega_ref */
+        w = (R_(1) - f) * w0 + f * w1;
+    } else {
+        j = FDSMC_REF_NODES - 1;
+    }
+#ifdef FDSMC_USE_FLOAT
+    th = ref_table[j].f + dth; /* fraction of theta_ref - theta_dem [counts] */
+    sw = w + FDSMC_DIV(((fdsmc_real)ref_table[j].n + th) * s->p->rad_per_count, s->t_c, s->inv_t_c);
+    e_th = ((fdsmc_real)count_diff(ref_table[j].n, s->n0) + (th - s->f0)) * s->p->rad_per_count;
+#else
+    th = s->ref_start_rad + (ref_table[j].theta + dth);
+    sw = w + (th - s->theta_dem_rad) / s->t_c;
+    e_th = th - s->x[0];
+#endif
     if (FDSMC_REF_DELTA >= 0 ? sw >= R_(0) : sw <= R_(0)) {
         return sliding_mode(s, theta_re, omega_hat, S); /* on the sloped segment: eq. (46) */
     }
     *S = R_(0);
-    return a + FDSMC_G1_TRACK * (((fdsmc_real)count_diff(n, s->n0) + (frac - s->f0)) * s->p->rad_per_count)
-           + FDSMC_G2_TRACK * (w - omega_hat);
+    return a + FDSMC_G1_TRACK * e_th + FDSMC_G2_TRACK * (w - omega_hat);
 }
-#else
-/* The reference at t [s] of the move: theta_ref - theta_start [rad], omega_ref, alpha_ref (reference_at). */
-static void reference_at(double t, double *th, double *w, double *a)
-{
-    const int32_t last = FDSMC_REF_NODES - 1;
-    double x, f, w0, w1;
-    int32_t j;
-    if (t >= FDSMC_T_M) {
-        *th = ref_table[last].theta;
-        *w = 0.0;
-        *a = 0.0;
-        return;
-    }
-    x = t / FDSMC_REF_H;
-    j = (int32_t)x;
-    j = j < last - 1 ? j : last - 1;
-    f = x - (double)j;
-    w0 = ref_table[j].omega;
-    w1 = ref_table[j + 1].omega;
-    *th = ref_table[j].theta + FDSMC_REF_H * f * (w0 + 0.5 * f * (w1 - w0));
-    *w = (1.0 - f) * w0 + f * w1;
-    *a = (1.0 - f) * ref_table[j].alpha + f * ref_table[j + 1].alpha;
-}
-
-static fdsmc_real tracked_optimum(fdsmc_state *s, fdsmc_real theta_re, fdsmc_real omega_hat, fdsmc_real *S)
-{
-    double th, w, a, unused, th_r, sw;
-    int i;
-    if (s->ref_on == 0) {
-        return sliding_mode(s, theta_re, omega_hat, S);
-    }
-    reference_at(s->ref_t, &th, &w, &unused);
-    reference_at(s->ref_t + FDSMC_REF_LEAD, &unused, &unused, &a);
-    for (i = 0; i < FDSMC_CLOCK_SUBSTEPS; ++i) {
-        s->ref_t += FDSMC_CLOCK_H;
-    }
-    th_r = s->ref_start_rad + th;
-    sw = w + (th_r - s->theta_dem_rad) / s->t_c;
-    if (FDSMC_REF_DELTA >= 0 ? sw >= 0.0 : sw <= 0.0) {
-        return sliding_mode(s, theta_re, omega_hat, S);
-    }
-    *S = 0.0;
-    return a + FDSMC_G1_TRACK * (th_r - s->x[0]) + FDSMC_G2_TRACK * (w - omega_hat);
-}
-#endif
 
 """
 
