@@ -11,8 +11,10 @@ designed one is refused with a status.
 from __future__ import annotations
 
 import ctypes
+import io
 import os
 import subprocess
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -33,7 +35,7 @@ from app.exports.c_verify import (
     write_module,
 )
 from app.exports.drive_files import ExportOptions
-from app.exports.model import export_files
+from app.exports.model import export_download, export_files
 from app.exports.provenance import ExportRefusedError
 from app.io.presets import load_preset
 from control.common.checks import ParameterError
@@ -157,6 +159,19 @@ def test_cli_writes_the_optimum_module_and_refuses_it_for_other_formats(tmp_path
     err = capsys.readouterr().err.strip()
     assert "controller = 'optimum'" in err and "format c" in err and "\n" not in err
     assert not (tmp_path / "x.yaml").exists()
+
+
+def test_the_page_offers_the_optimum_module_as_its_own_zip():
+    """The page's Export button of the optimum's module downloads the same files as the CLI, named apart."""
+    from app.ui.files import LAW_EXPORTS
+
+    assert list(LAW_EXPORTS.values()) == [("c", "optimum")]
+    cmp = compare(load_preset("yaskawa_sgm7j_04a"))  # the optimum is simulated on demand
+    name, archive = export_download("c", cmp, OPTIMUM)
+    assert name == "yaskawa_sgm7j_04a_optimum_controller.zip"
+    with zipfile.ZipFile(io.BytesIO(archive)) as zf:
+        assert b"#define FDSMC_OUTER_LAW_OPTIMUM 1" in zf.read(HEADER_NAME)
+        assert zf.read(HEADER_NAME) == export_files("c", cmp, OPTIMUM)[HEADER_NAME]
 
 
 def test_float_build_for_cortex_m4f(tmp_path):

@@ -250,7 +250,8 @@ def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPT
 def export_download(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPTIONS) -> tuple[str, bytes]:
     """Return one downloadable file: the single export file, or a zip of the C module's header and source.
 
-    The zip is named ``<name>_fdsmc_controller.zip``.
+    The zip is named ``<name>_fdsmc_controller.zip`` (the tracked optimum's module:
+    ``<name>_optimum_controller.zip``).
     """
     files = export_files(fmt, cmp, options)
     if len(files) == 1:
@@ -260,4 +261,5 @@ def export_download(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_
         for name, content in files.items():
             info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))  # reproducible bytes
             zf.writestr(info, content, zipfile.ZIP_DEFLATED)
-    return f"{safe_stem(cmp.derived.params.name)}_fdsmc_controller.zip", buf.getvalue()
+    law = "optimum" if options.controller == "optimum" else "fdsmc"
+    return f"{safe_stem(cmp.derived.params.name)}_{law}_controller.zip", buf.getvalue()
