@@ -20,20 +20,10 @@ from pathlib import Path
 import pytest
 
 from app.cli.main import main
+from app.exports import c_verify as cv
 from app.exports.c_arm import arm_compiler, code_size, count_instructions, cross_compile, double_symbols
 from app.exports.c_module import HEADER_NAME
 from app.exports.c_optimum import NODE_BYTES_FLOAT, reference_table
-from app.exports.c_verify import (
-    CFLAGS,
-    CModule,
-    accept_flag,
-    agreement,
-    build,
-    closed_loop,
-    compiler,
-    count_params,
-    write_module,
-)
 from app.exports.drive_files import ExportOptions
 from app.exports.model import export_download, export_files
 from app.exports.provenance import ExportRefusedError
@@ -50,7 +40,7 @@ OPTIMUM = ExportOptions(force=True, controller="optimum")
 
 
 def _compiler() -> str:
-    cc = compiler()
+    cc = cv.compiler()
     if cc is None:
         if CI:
             pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
@@ -60,9 +50,9 @@ def _compiler() -> str:
 
 def _closed_loop(folder: Path, preset: str, single: bool) -> dict[str, float]:
     _compiler()
-    params, _ = count_params(load_preset(preset))
-    write_module(folder, params, law="optimum")
-    return agreement(params, closed_loop(build(folder, single), single, params, "optimum"), "optimum")
+    params, _ = cv.count_params(load_preset(preset))
+    cv.write_module(folder, params, law="optimum")
+    return cv.agreement(params, cv.closed_loop(cv.build(folder, single), single, params, "optimum"), "optimum")
 
 
 @pytest.mark.parametrize("preset", ["yaskawa_sgm7j_04a", "odrive_d5065_belt"])
@@ -70,7 +60,7 @@ def test_double_build_is_bit_identical_to_the_simulated_optimum(tmp_path, preset
     """The presets' own encoders (2^24 and 8192 counts), current noise and ADC, delay and limits: zero difference."""
     err = _closed_loop(tmp_path, preset, False)
     assert max(err.values()) == 0.0, err
-    S = simulate(count_params(load_preset(preset))[0], "optimum").trace.S
+    S = simulate(cv.count_params(load_preset(preset))[0], "optimum").trace.S
     assert (S == 0.0).mean() > 0.5 and (S != 0.0).any()  # the run tracked the table, then slid in
 
 
@@ -96,7 +86,7 @@ def test_golden_vectors_of_the_optimum_pass_the_host_test_program(tmp_path, pres
     _export(tmp_path, preset)
     assert "#define FDSMC_OUTER_LAW_OPTIMUM 1" in (tmp_path / HEADER_NAME).read_text(encoding="utf-8")
     for defines, tol in (((), 0.0), (("-DFDSMC_USE_FLOAT",), 1e-4)):
-        subprocess.run([cc, *CFLAGS, *defines, accept_flag(tmp_path), "-O2", "fdsmc_test.c", "fdsmc_controller.c",
+        subprocess.run([cc, *cv.CFLAGS, *defines, cv.accept_flag(tmp_path), "-O2", "fdsmc_test.c", "fdsmc_controller.c",
                         "-lm", "-o", "fdsmc_test"], cwd=tmp_path, check=True, capture_output=True, text=True)
         run = subprocess.run(["./fdsmc_test"], cwd=tmp_path, capture_output=True, text=True)
         assert run.returncode == 0, (defines, run.stdout)
@@ -105,9 +95,9 @@ def test_golden_vectors_of_the_optimum_pass_the_host_test_program(tmp_path, pres
 
 def test_set_move_accepts_only_the_designed_move_and_keeps_the_move(tmp_path):
     _compiler()
-    params, delta = count_params(load_preset("yaskawa_sgm7j_04a"))
-    write_module(tmp_path, params, law="optimum")
-    m = CModule(build(tmp_path, True), True)
+    params, delta = cv.count_params(load_preset("yaskawa_sgm7j_04a"))
+    cv.write_module(tmp_path, params, law="optimum")
+    m = cv.CModule(cv.build(tmp_path, True), True)
     T_m = params.manoeuvre.T_m
     s = m.new_state(1000)
     T_c = slide_time_constant(derive(params).alpha.alpha_max, params.controller.K)
@@ -123,7 +113,7 @@ def test_set_move_accepts_only_the_designed_move_and_keeps_the_move(tmp_path):
 
 
 def test_the_table_is_the_simulators_and_its_size_is_limited():
-    params, _ = count_params(load_preset("yaskawa_sgm7j_04a"))
+    params, _ = cv.count_params(load_preset("yaskawa_sgm7j_04a"))
     d = derive(params)
     table, mv = reference_table(params, d), tracked_move(d)
     assert (table.theta == mv.theta).all() and (table.omega == mv.omega).all() and (table.alpha == mv.alpha).all()
