@@ -135,3 +135,14 @@ def test_log_slider_ranges_are_whole_decades_with_named_marks():
     assert log_range([250.0], (0.1, 10.0)) == (-1.0, 3.0)
     marks = track_marks(-1.0, 1.0, (("min", 0.48), ("none", math.nan)))
     assert [m[1] for m in marks] == ["0.1", "10", "min"] and marks[2][0] == pytest.approx(math.log10(0.48))
+
+
+def test_the_J_L_slider_changes_the_plant_and_not_the_controllers_model(comparison):
+    from app.ui.position_tab import comparison_or_derived
+
+    params = comparison.derived.params
+    heavier = comparison_or_derived(params, plant_J_L=3.0 * params.load.J_L)
+    assert heavier.derived.params == params  # the controllers keep the typed J_L as their model
+    # a heavier plant than modelled: the same law gives a slower, different motion
+    assert not np.allclose(heavier.fdsmc.trace.omega_r[:200], comparison.fdsmc.trace.omega_r[:200])
+    assert heavier.fdsmc.metrics.torque_peak_Nm > 0.0

@@ -383,6 +383,10 @@ class PositionTab:
         except ValueError as exc:
             raise ExportRefusedError(f"The inputs shown are not valid, so nothing was exported: {exc}") from None
         comparison = self.case.comparison
+        if self.case.plant_J_L is not None:
+            raise ExportRefusedError(f"The run shown has the J_L slider's plant (J_L = {self.case.plant_J_L:.4g} "
+                                     f"kg·m², model {comparison.derived.params.load.J_L:.4g} kg·m²), which no export "
+                                     "describes — press Simulate to run the typed inputs, then export.")
         changed = uncommitted(shown, comparison.derived.params)
         if changed:
             raise ExportRefusedError("Inputs edited but not simulated — press Simulate (or wait for the run in "

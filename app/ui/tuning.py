@@ -86,8 +86,8 @@ class LiveTuning:
         T_a = _ms(d.profile.T_a)
         self.T_c.show(_ms(d.profile.T_c), (("eq.59", T_a), ("ζ=1", _ms(g.T_c_min))), _around(T_a))
         self.T_m.show(p.manoeuvre.T_m, (("min", d.profile.T_m_min),), _around(p.manoeuvre.T_m) if recentre else None)
-        nominal = p.load.J_L * 1e4
-        J = nominal if plant_J_L is None else plant_J_L * 1e4
+        nominal = units.kgm2_to_kgcm2(p.load.J_L)
+        J = nominal if plant_J_L is None else units.kgm2_to_kgcm2(plant_J_L)
         self.J_L.show(J, (("nom", nominal),), _around(nominal) if recentre else None)
 
     @property
