@@ -23,7 +23,7 @@ from sim.fdsmc.checks import run_checks
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import compare, simulate
 from sim.fdsmc.recommend import recommend
-from sim.fdsmc.verdicts import run_warnings
+from sim.fdsmc.verdicts import flux_warnings, run_warnings
 from sim.studies.robustness import Spread, plant_for, robustness, sample_metrics, simulate_chunk
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yaskawa_sgm7a_50a", "odrive_d5065_belt")
@@ -103,8 +103,12 @@ def _psi(p, factor):
     return dataclasses.replace(p, motor=dataclasses.replace(p.motor, psi_pm=p.motor.psi_pm * factor))
 
 
+def _paper_fdc(p):
+    return dataclasses.replace(p, controller=dataclasses.replace(p.controller, T_dv=0.0))
+
+
 def test_fdc_flux_tolerance_predicts_runaway_and_stall():
-    p = load_preset("siemens_1ft7044_ak7")
+    p = _paper_fdc(load_preset("siemens_1ft7044_ak7"))  # the paper's FDC, without the mismatch estimate
     d = derive(p)
     x = flux_tolerance(d.coefficients, d.alpha.alpha_max, d.profile.omega_p, p.controller.T_salpha)
     assert 0.03 < x < 0.06
@@ -133,3 +137,18 @@ def test_robustness_of_the_tracked_optimum_reports_p95_energy_and_chatter():
     rows = [{k: float(v[i]) for k, v in res.values.items()} for i in range(2)]
     one = [sample_metrics(p, plant_for(p, r), d, ("fdsmc", "optimum")) for r in rows]
     assert simulate_chunk(p, rows, d, controllers=("fdsmc", "optimum")) == one
+
+
+def test_the_voltage_mismatch_estimate_keeps_the_design_clean_off_nameplate_flux():
+    # the shipped design (T_dv = 1 ms) passes every check with the motor's flux 10 % off either way, where the
+    # paper's FDC (T_dv = 0) ran away or stalled; nominal energy within 1.5 %
+    p = load_preset("siemens_1ft7044_ak7")
+    assert p.controller.T_dv == pytest.approx(1e-3)
+    d, d0 = derive(p), derive(_paper_fdc(p))
+    for factor in (0.9, 1.1):
+        for ctrl in ("fdsmc", "optimum"):
+            assert run_checks(p, simulate(p, ctrl, d, plant=_psi(p, factor))) == []
+        assert run_checks(p, simulate(_paper_fdc(p), "fdsmc", d0, plant=_psi(p, factor)))
+    assert simulate(p, "fdsmc", d).metrics.electrical_in_total_J == pytest.approx(
+        simulate(_paper_fdc(p), "fdsmc", d0).metrics.electrical_in_total_J, rel=0.015)
+    assert flux_warnings(d) == [] and flux_warnings(d0)
