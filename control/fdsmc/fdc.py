@@ -146,7 +146,10 @@ def voltage_mismatch(dv_hat: float, i_q: float, i_q_model: float, gain: float, b
     i_q with the model's prediction over the last sample (:func:`control.fdsmc.inverter.predict_currents`,
     the voltages that were applied), converts the difference to volts with the prediction's gain
     γ_q·G [A/V] and low-pass filters it, d̂ ← d̂ + β·((i_q − i_q,model)/(γ_q·G) − d̂); the FDC subtracts
-    d̂ from its u_q. With the exact model the difference is only the sensors' noise.
+    d̂ from its u_q. With the exact model the difference is only the sensors' noise (and the speed's change
+    within a sample, which the prediction holds constant), so the linearised loop of
+    :mod:`control.fdsmc.loop_analysis` (K limit) and the noise gain of :mod:`control.fdsmc.noise` leave it
+    out; the design's verification by simulation includes it.
 
     Parameters
     ----------
