@@ -30,7 +30,7 @@ from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import infeasible_T_m
-from control.fdsmc.tracking import slide_time_constant, tracking_gains
+from control.fdsmc.tracking import slide_gain, slide_time_constant, tracking_gains
 from sim.common import sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
@@ -133,10 +133,12 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
     pr, o = d.profile, d.observer
     prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
-    gains = tracking_gains(d.loop, d.conventional) if controller == "optimum" else d.conventional
+    gains = d.conventional
+    if controller == "optimum":  # its own K (below the chatter limit), tracking gains and terminal slide's T_c
+        K = slide_gain(d.gain, ctrl.K)
+        gains = tracking_gains(d.loop, d.conventional, K)
+        prm[[kn.P_TC, kn.P_KB]] = (slide_time_constant(d.alpha.alpha_max, K), K)
     prm[[kn.P_G1, kn.P_G2]] = (gains.g1, gains.g2)
-    if controller == "optimum":  # its terminal slide's own T_c
-        prm[kn.P_TC] = slide_time_constant(d.alpha.alpha_max, ctrl.K)
     if controller == "optimum":  # α(t) ≈ α_dem(t − T_sα/3) (eq. (13)), one more sample with a delay
         prm[kn.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
