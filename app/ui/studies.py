@@ -21,14 +21,15 @@ from app.ui.case import CasePort
 from app.ui.props import assign
 from app.ui.studies_multiaxis import MultiAxisView
 from app.ui.studies_robustness import RobustnessView
+from app.ui.text import md_text
 from sim.fdsmc.optimum_gap import OPTIMUM_BASIS
 
 
 def optimum_markdown(comparison: Any) -> str:
     """One line: the optimum's energy [J] and the share of each controller's it would save [%]."""
     opt = getattr(comparison, "optimum", None)
-    if opt is None:
-        return ""
+    if opt is None:  # left out (its solvers failed): say why
+        return " ".join(md_text(n) for n in getattr(comparison, "notes", ()) if n.startswith("Optimum omitted"))
     w = getattr(opt.metrics, OPTIMUM_BASIS)
     gaps = optimum_gaps(comparison)
     parts = [f"{LABELS[k]}'s by **{v:.1f} %**" for k, v in gaps.items() if v is not None]

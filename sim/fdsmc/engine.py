@@ -28,6 +28,7 @@ from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import current_limit
 from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
+from control.fdsmc.optimum import OptimumSolverError
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import infeasible_T_m
 from control.fdsmc.tracking import tracking_gains
@@ -95,7 +96,8 @@ class Comparison:
 
     ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
     ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
-    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for.
+    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for;
+    ``notes`` say why an asked-for comparator is missing (e.g. the optimum's solvers failed).
     """
 
     derived: Derived
@@ -105,6 +107,7 @@ class Comparison:
     saving_electrical_pct: float | None
     optimum: RunResult | None = None
     stock: RunResult | None = None
+    notes: tuple[str, ...] = ()
 
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
@@ -352,7 +355,13 @@ def compare(
     # checked once above for all runs (the budget of len(controllers) runs covers each one's)
     futures = {c: _RUNS.submit(_simulate_checked, params, c, d, plant=plant, **options) for c in controllers[1:]}
     runs = {c: _simulate_checked(params, c, d, plant=plant, **options) for c in controllers[:1]}
-    runs |= {c: f.result() for c, f in futures.items()}
+    notes: list[str] = []
+    for name, fut in futures.items():
+        try:
+            runs[name] = fut.result()
+        except OptimumSolverError as exc:  # the optimum is a yardstick: left out with a note, never a traceback
+            notes.append(f"Optimum omitted: {exc}")
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
-                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"))
+                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"),
+                      tuple(notes))
