@@ -1,0 +1,75 @@
+"""Bounded load test (loopback): three pages start robustness studies on a server that runs one at a
+time; the later two are told their place in the queue; two disconnect, the third then runs; when all
+have gone, no study process is left. ``scripts/load_test.py`` is the full-size version with figures.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import multiprocessing
+import time
+
+from app.io.presets import DEFAULT_PRESET, load_preset
+from app.ui.page import create_server
+from app.ui.studies_queue import StudySlots
+from tests.page_client import PageClient
+from tests.test_ui_hostile import _run, free_port
+
+#: Generous bound on a closed page's processes being gone [s] (the promise is 2 s).
+GONE_S = 5.0
+RUN = "Run robustness study"
+
+
+async def _until(condition, limit_s: float) -> bool:
+    end = time.monotonic() + limit_s
+    while time.monotonic() < end:
+        if condition():
+            return True
+        await asyncio.sleep(0.05)
+    return condition()
+
+
+def test_three_pages_queue_their_studies_and_leave_no_process_behind():
+    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(), scene_3d=False)
+    config.slots = StudySlots(max_studies=1, max_processes=1)
+    hostport, before = f"127.0.0.1:{server.get_port()}", set(multiprocessing.active_children())
+    seen: dict[str, object] = {}
+
+    def children() -> set:
+        return set(multiprocessing.active_children()) - before
+
+    async def go() -> None:
+        pages = [PageClient(hostport) for _ in range(3)]
+        for page in pages:
+            await page.open()
+            await page.set_value("Samples", 20_000)  # minutes of work: still running when closed
+        for page in pages:
+            await page.set_value(RUN, True)
+            await asyncio.sleep(0.3)  # in this order
+        seen["pool"] = await _until(lambda: bool(children()), 60.0)
+        seen["queued"] = await _until(lambda: pages[1].says("next in line") and pages[2].says("1 study ahead"), 10.0)
+        first_pool = children()
+        await pages[0].close()  # the running study's page
+        await pages[1].close()  # a queued one
+        seen["third runs"] = await _until(lambda: bool(children() - first_pool) and config.slots.running == 1, 60.0)
+        seen["third's place"] = pages[2].says("next in line")
+        await pages[2].close()
+
+    try:
+        _run(go)
+        gone = _wait_gone(children)
+        assert seen == {"pool": True, "queued": True, "third runs": True, "third's place": True}
+        assert gone, children()
+        assert config.slots.running == 0 and config.slots.queued == 0
+        assert not config.sessions
+    finally:
+        server.stop()
+
+
+def _wait_gone(children) -> bool:
+    end = time.monotonic() + GONE_S
+    while time.monotonic() < end:
+        if not children():
+            return True
+        time.sleep(0.05)  # poll again (a positive condition)
+    return not children()
