@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import viser
 
-from app.threads import limit_blas_threads
+from app.threads import limit_blas_threads, release_memory
 from app.ui.bldc_tab import add_bldc_tab
 from app.ui.case import Case, CaseState
 from app.ui.files import FilesPanel
@@ -60,6 +60,8 @@ class AppConfig:
 
 #: The Table-1 sweep's label as a study.
 SWEEP = "Table-1 sweep"
+#: Delay from a page's disconnect to returning freed memory to the system [s] (its job stops by then).
+RELEASE_AFTER_S = 2.0
 
 
 class Session:
@@ -231,6 +233,8 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
         session = config.sessions.pop(client.client_id, None)
         if session is not None:
             session.close()
+            # once its job has stopped (next checkpoint), the page's memory goes back to the system
+            threading.Timer(RELEASE_AFTER_S, release_memory).start()
 
     return server, config
 
