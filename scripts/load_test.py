@@ -1,15 +1,16 @@
 """Load test of the page server (loopback only, bounded): studies from many pages, then the pages leave.
 
-Run: ``.venv/bin/python scripts/load_test.py [--pages 10] [--disconnect 5] [--samples 20000]``.
+Run: ``.venv/bin/python scripts/load_test.py [--pages 10] [--disconnect 5] [--samples 20000]
+[--study robustness|multiaxis]`` (``multiaxis``: 16-axis moves, run in the server's threads).
 
-Starts ``python -m app serve`` on a free loopback port, warms it with one page, measures the idle
-server, then: ``--pages`` pages (hand-written websocket clients, :mod:`tests.page_client`) each start
-a robustness study of ``--samples`` samples; an extra page opens while they run and its first figure
-is timed; ``--disconnect`` pages leave, then all the rest. Prints the study processes and queue,
-the server's RSS (idle / peak / after close, with its children), the time until study processes
-and CPU are back to idle after the last disconnect, and the extra page's first-figure time.
-Targets: processes and CPU idle within 5 s, RSS after close within 20 % of idle, first figure ≤ 1 s.
-Linux only (reads /proc). Everything ends within ``--limit`` seconds.
+Starts ``python -m app serve`` on a free loopback port, warms it with one page and measures the
+idle server. Then ``--pages`` pages (hand-written websocket clients, :mod:`tests.page_client`) each
+start a robustness study of ``--samples`` samples (or a multi-axis move); an extra page opens while
+they run and its first figure is timed; ``--disconnect`` pages leave, then all the rest. Prints the
+study processes and the queue, the server's RSS with its children (idle / peak / after close), the
+time until study processes and CPU are back to idle after the last disconnect, and the extra
+page's first-figure time. Targets: processes and CPU idle within 5 s, RSS after close within 20 %
+of idle, first figure ≤ 1 s. Linux only (reads /proc). Every wait is bounded by ``--limit`` seconds.
 """
 
 from __future__ import annotations
@@ -29,7 +30,10 @@ sys.path.insert(0, str(ROOT))
 
 from tests.page_client import PageClient  # noqa: E402
 
-RUN = "Run robustness study"
+RUN = {"robustness": "Run robustness study", "multiaxis": "Run multi-axis move"}
+#: The multi-axis study: 16 axes of the shipped real-motor presets.
+AXES = "".join(f"- {{preset: {p}, name: A{k}}}\n" for k, p in enumerate(
+    ["yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "siemens_1ft7044_ak7", "odrive_d5065_belt"] * 4))
 TICK_S = os.sysconf("SC_CLK_TCK")
 
 
@@ -152,9 +156,13 @@ async def run(args: argparse.Namespace, pid: int, hostport: str) -> None:
     pages = [PageClient(hostport) for _ in range(args.pages)]
     for page in pages:
         await page.open()
-        await page.set_value("Samples", args.samples)
-        await page.set_value(RUN, True)
-    await _until(lambda: bool(study_processes(pid)), 60.0)
+        if args.study == "robustness":
+            await page.set_value("Samples", args.samples)
+        else:
+            await page.set_value("Axes (YAML list)", AXES)
+        await page.set_value(RUN[args.study], True)
+    if args.study == "robustness":
+        await _until(lambda: bool(study_processes(pid)), 60.0)
     await asyncio.sleep(3.0)
     queued = sum(page.says("queued") for page in pages)
     print(f"{args.pages} pages started studies: {len(study_processes(pid))} study processes, {queued} pages "
@@ -193,6 +201,7 @@ def main() -> None:
     ap.add_argument("--pages", type=int, default=10)
     ap.add_argument("--disconnect", type=int, default=5)
     ap.add_argument("--samples", type=int, default=20_000)
+    ap.add_argument("--study", choices=tuple(RUN), default="robustness")
     ap.add_argument("--limit", type=float, default=60.0, help="longest wait of each step [s]")
     args = ap.parse_args()
     port = _free_port()
