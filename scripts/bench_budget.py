@@ -58,17 +58,8 @@ BLDC_CASES = [
 #: Below these measured figures a case is too small to judge the model (fixed costs, timer noise).
 SMALL_CPU_S, SMALL_MEM = 0.1, 16 * 2**20
 
-CHILD = r"""
-import json, os, resource, sys, time
-from app.io.presets import load_preset
-from sim.common import budget
-from sim.fdsmc.engine import compare
-from sim.fdsmc.grid import predict
-preset, overrides = sys.argv[1], json.loads(sys.argv[2])
-ctrls = ("fdsmc", "conventional", "optimum")
-compare(load_preset("paper_12kw_pmsm", ["manoeuvre.T_m=0.6"]), ctrls)  # JIT, cvxpy, caches
-params = load_preset(preset, overrides)
-pred = predict(params, len(ctrls))
+#: Measures ``run()`` after the engine's set-up (which defines ``params``, ``pred`` and ``run``).
+MEASURE = r"""
 def rss(key):
     for line in open("/proc/self/status"):
         if line.startswith(key):
@@ -78,7 +69,7 @@ with open("/proc/self/clear_refs", "w") as f:
     f.write("5")
 r0 = resource.getrusage(resource.RUSAGE_SELF)
 try:
-    compare(params, ctrls)
+    run()
     refused = ""
 except budget.BudgetError as exc:
     refused = str(exc)[:60]
@@ -88,6 +79,20 @@ print(json.dumps({"cpu": cpu, "mem": rss("VmHWM:") - base, "pred_cpu": pred.cpu_
                   "refused": refused}))
 """
 
+CHILD = r"""
+import json, resource, sys
+from app.io.presets import load_preset
+from sim.common import budget
+from sim.fdsmc.engine import compare
+from sim.fdsmc.grid import predict
+preset, overrides = sys.argv[1], json.loads(sys.argv[2])
+ctrls = ("fdsmc", "conventional", "optimum")
+compare(load_preset("paper_12kw_pmsm", ["manoeuvre.T_m=0.6"]), ctrls)  # JIT, cvxpy, caches
+params = load_preset(preset, overrides)
+pred = predict(params, len(ctrls))
+def run():
+    compare(params, ctrls)
+""" + MEASURE
 
 BLDC_CHILD = r"""
 import dataclasses, json, resource, sys
@@ -108,30 +113,15 @@ def case(f_s, t_end, active, emf):
 compare_bldc(case(2000.0, None, "1000rpm", emf))  # JIT and caches
 simulate_bldc(case(2000.0, None, "1000rpm", emf), n_sub=2)
 params, ctrls = case(f_s, t_end, active, emf), tuple(drives.split(","))
-pred, refused = run_cost(params, len(ctrls), n_sub), ""
-try:
+pred = run_cost(params, len(ctrls), n_sub)
+def run():
     check_budget(params, len(ctrls), n_sub)
-except budget.BudgetError as exc:
-    refused = str(exc)[:60]
-def rss(key):
-    for line in open("/proc/self/status"):
-        if line.startswith(key):
-            return int(line.split()[1]) * 1024
-base = rss("VmRSS:")
-with open("/proc/self/clear_refs", "w") as f:
-    f.write("5")
-r0 = resource.getrusage(resource.RUSAGE_SELF)
-if not refused:
     if n_sub == 1:
         compare_bldc(params, ctrls)
     else:
         for c in ctrls:
             simulate_bldc(params, c, n_sub=n_sub)
-r1 = resource.getrusage(resource.RUSAGE_SELF)
-cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
-print(json.dumps({"cpu": cpu, "mem": rss("VmHWM:") - base, "pred_cpu": pred.cpu_s, "pred_mem": pred.memory_bytes,
-                  "refused": refused}))
-"""
+""" + MEASURE
 
 
 def measure(preset: str, overrides: list[str]) -> dict:

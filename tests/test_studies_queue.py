@@ -6,22 +6,20 @@ from __future__ import annotations
 
 import os
 import threading
-import time
 
 import pytest
 
 from app.ui.studies_queue import STUDY_NICE, StudySlots, run_lowered
 from app.ui.worker import Cancelled, Worker
 from sim.studies.runner import RetryingPool
+from tests.test_faults_disconnect import _wait as _wait_for
+
+#: Generous bound on each queue change being seen [s].
+SEEN_S = 10.0
 
 
-def _wait(condition, limit_s: float = 10.0) -> bool:
-    end = time.monotonic() + limit_s
-    while time.monotonic() < end:
-        if condition():
-            return True
-        time.sleep(0.01)  # poll again (a positive condition)
-    return condition()
+def _wait(condition) -> bool:
+    return _wait_for(condition, SEEN_S)
 
 
 def _niceness() -> int:
