@@ -67,7 +67,7 @@ def test_cancel_and_close_leave_the_queue_without_running_the_study():
     assert _wait(lambda: c.told == [1])
     assert b.worker.cancel()  # Cancel pressed while queued
     b.future.result(timeout=5.0)
-    assert isinstance(b.errors[0], Cancelled) and not b.worker.busy
+    assert isinstance(b.errors[0], Cancelled) and not b.worker.busy and b.told == [0, -1]
     assert _wait(lambda: c.told == [1, 0])  # c moved up
     c.worker.close()  # the page of c disconnected
     c.future.result(timeout=5.0)

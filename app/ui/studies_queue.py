@@ -119,7 +119,8 @@ class StudySlots:
         """Wait for a slot, hold it while the block runs, then hand it to the next in the queue.
 
         ``on_queued(ahead)`` is called whenever the number of studies queued ahead changes while
-        this one waits; :class:`~app.ui.worker.Cancelled` is raised if ``cancelled()`` turns true first.
+        this one waits; :class:`~app.ui.worker.Cancelled` is raised if ``cancelled()`` turns true
+        first, after ``on_queued(-1)`` (it left the queue) if it had been told a place.
         """
         ticket = next(self._tickets)
         with self._cond:
@@ -148,13 +149,17 @@ class StudySlots:
                     self._cond.wait(QUEUE_POLL_S)
                     ahead = self._ahead(ticket)
             if cancelled():
+                if told is not None:
+                    on_queued(-1)
                 raise Cancelled("cancelled while queued")
             if ahead is not None and ahead != told:
                 on_queued(ahead)
                 told = ahead
 
     def queued_text(self, label: str, ahead: int) -> str:
-        """Markdown line for the study ``label`` waiting behind ``ahead`` others."""
+        """Markdown line for the study ``label`` waiting behind ``ahead`` others (-1: it left the queue)."""
+        if ahead < 0:
+            return f"{label} cancelled while queued: nothing ran."
         where = "next in line" if ahead == 0 else f"{ahead} {'study' if ahead == 1 else 'studies'} ahead"
         return (f"{label} queued: {where} — the server runs at most {self.max_studies} studies at once; it "
                 "starts when one ends (Cancel leaves the queue).")

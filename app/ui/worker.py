@@ -14,7 +14,7 @@ budget's bytes) pickled back, for a gain of at most those seconds.
 A job submitted as a study (``submit(fn, study=label)``, or any submission inside
 ``with worker.as_study(label):``) first waits for a server-wide slot and then runs at lower
 priority (:class:`app.ui.studies_queue.StudySlots`); while it waits, ``on_queued(label, ahead)``
-tells the page how many studies are ahead of it.
+tells the page how many studies are ahead of it (-1 once a Cancel took it out of the queue).
 """
 
 from __future__ import annotations
