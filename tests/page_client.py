@@ -37,6 +37,7 @@ class PageClient:
         self.hostport = hostport
         self.uuids: dict[str, str] = {}  # label → uuid (the first widget of that label)
         self.content: dict[str, str] = {}  # markdown/html uuid → text shown
+        self.shown: list[str] = []  # every markdown/html text shown, in order
         self.opened = self.first_figure_s = 0.0
         self._ws: Any = None
         self._reader: asyncio.Task | None = None
@@ -65,6 +66,7 @@ class PageClient:
         for key in ("_markdown", "content"):  # markdown, html
             if key in props or key in updates:
                 self.content[m["uuid"]] = props.get(key, updates.get(key))
+                self.shown.append(str(self.content[m["uuid"]]))
         fig = props.get("_plotly_json_str") or updates.get("_plotly_json_str")
         if fig and not self.first_figure_s and json.loads(fig).get("data"):
             self.first_figure_s = time.monotonic() - self.opened
@@ -85,8 +87,12 @@ class PageClient:
                                                     "updates": {"value": value}}))
 
     def says(self, text: str) -> bool:
-        """True when some markdown of the page contains ``text``."""
+        """True when some markdown of the page contains ``text`` now."""
         return any(text in c for c in self.content.values() if isinstance(c, str))
+
+    def said(self, text: str) -> bool:
+        """True when some markdown of the page has contained ``text`` (now or before)."""
+        return any(text in c for c in self.shown)
 
     async def close(self) -> None:
         """Close the websocket (the page is gone)."""

@@ -138,6 +138,10 @@ class StudySlots:
     def _wait(self, ticket: int, on_queued: Callable[[int], None], cancelled: Callable[[], bool]) -> None:
         told: int | None = None
         while True:
+            if cancelled():  # before taking a slot: a cancelled study never runs
+                if told is not None:
+                    on_queued(-1)
+                raise Cancelled("cancelled while queued")
             with self._cond:
                 ahead = self._ahead(ticket)
                 if ahead is None:
@@ -148,10 +152,6 @@ class StudySlots:
                 if ahead == told:
                     self._cond.wait(QUEUE_POLL_S)
                     ahead = self._ahead(ticket)
-            if cancelled():
-                if told is not None:
-                    on_queued(-1)
-                raise Cancelled("cancelled while queued")
             if ahead is not None and ahead != told:
                 on_queued(ahead)
                 told = ahead
