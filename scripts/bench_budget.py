@@ -1,4 +1,4 @@
-"""Print the cost model's predicted CPU time and peak memory next to measured ones (issue 28).
+"""Print the cost model's predicted CPU time and peak memory next to measured ones.
 
 Each case runs ``compare`` of the three controllers in a fresh subprocess (warmed up on a small
 case first), measuring CPU seconds (user + system, all threads) and the peak resident memory above

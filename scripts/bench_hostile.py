@@ -1,4 +1,4 @@
-"""Print how long each parser attack of issue 28 takes to be refused (CPU seconds, best of 3).
+"""Print how long each hostile parser attack takes to be refused (CPU seconds, best of 3).
 
 Run: ``.venv/bin/python scripts/bench_hostile.py [--pure]``. The promise: every attack ≤ 0.5 s (a text
 can cost no more than its size allows). The attacks are those of ``tests/hostile_inputs.py``
