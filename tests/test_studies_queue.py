@@ -90,3 +90,14 @@ def test_a_study_pool_s_processes_run_at_lower_priority():
     with RetryingPool(1, nice=STUDY_NICE) as pool:
         worker_nice = pool.submit(os.nice, 0).result(timeout=60.0)
     assert worker_nice == min(os.nice(0) + STUDY_NICE, 19)
+
+
+def test_the_shared_run_threads_keep_normal_priority_after_a_study_used_them():
+    from sim.fdsmc import engine
+
+    engine.start_run_threads()
+    before = _niceness()
+    seen: list[int] = []
+    run_lowered(lambda: [f.result() for f in [engine._RUNS.submit(lambda: seen.append(_niceness()))
+                                              for _ in range(2 * engine.RUN_THREADS)]], "study-test")
+    assert seen and set(seen) == {before}  # the study's own thread was lowered, not the shared ones

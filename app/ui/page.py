@@ -34,7 +34,7 @@ from app.ui.viser_adapter import run_script, widget_id
 from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Worker
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison
+from sim.fdsmc.engine import Comparison, start_run_threads
 
 
 @dataclass
@@ -216,6 +216,7 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
         The running server and its settings (``config.sessions`` maps client id → Session).
     """
     limit_blas_threads()
+    start_run_threads()  # at normal priority, before any study's lowered thread could start one
     guard = guard or Guard.for_host(host)
     with guarded(guard):
         server = viser.ViserServer(host=host, port=port, verbose=False)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -65,7 +66,19 @@ KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "stock": 2.0, "optimum": 3.0}
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
-_RUNS = ThreadPoolExecutor(max_workers=max(2, os.cpu_count() or 2), thread_name_prefix="sim-run")
+RUN_THREADS = max(2, os.cpu_count() or 2)
+_RUNS = ThreadPoolExecutor(max_workers=RUN_THREADS, thread_name_prefix="sim-run")
+
+
+def start_run_threads() -> None:
+    """Start every thread of the shared run pool now, from the caller's thread.
+
+    A new thread inherits its creator's scheduling priority, so a server calls this at start-up:
+    no shared thread is then created later by a lower-priority caller (a study) and kept.
+    """
+    gate = threading.Barrier(RUN_THREADS)  # each task waits until all threads run one
+    for f in [_RUNS.submit(gate.wait, 10.0) for _ in range(RUN_THREADS)]:
+        f.result()
 
 
 #: Time series of one run on a common grid (SI units; energies cumulative from t = 0), one field per
