@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -28,6 +29,7 @@ from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import current_limit
 from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
+from control.fdsmc.optimum import OptimumSolverError
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import infeasible_T_m
 from control.fdsmc.tracking import slide_gain, slide_time_constant, tracking_gains
@@ -64,7 +66,19 @@ KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "stock": 2.0, "optimum": 3.0}
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
-_RUNS = ThreadPoolExecutor(max_workers=max(2, os.cpu_count() or 2), thread_name_prefix="sim-run")
+RUN_THREADS = max(2, os.cpu_count() or 2)
+_RUNS = ThreadPoolExecutor(max_workers=RUN_THREADS, thread_name_prefix="sim-run")
+
+
+def start_run_threads() -> None:
+    """Start every thread of the shared run pool now, from the caller's thread.
+
+    A new thread inherits its creator's scheduling priority, so a server calls this at start-up:
+    no shared thread is then created later by a lower-priority caller (a study) and kept.
+    """
+    gate = threading.Barrier(RUN_THREADS)  # each task waits until all threads run one
+    for f in [_RUNS.submit(gate.wait, 10.0) for _ in range(RUN_THREADS)]:
+        f.result()
 
 
 #: Time series of one run on a common grid (SI units; energies cumulative from t = 0), one field per
@@ -95,7 +109,8 @@ class Comparison:
 
     ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
     ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
-    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for.
+    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for;
+    ``notes`` say why an asked-for comparator is missing (e.g. the optimum's solvers failed).
     """
 
     derived: Derived
@@ -105,6 +120,7 @@ class Comparison:
     saving_electrical_pct: float | None
     optimum: RunResult | None = None
     stock: RunResult | None = None
+    notes: tuple[str, ...] = ()
 
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
@@ -358,7 +374,13 @@ def compare(
     # checked once above for all runs (the budget of len(controllers) runs covers each one's)
     futures = {c: _RUNS.submit(_simulate_checked, params, c, d, plant=plant, **options) for c in controllers[1:]}
     runs = {c: _simulate_checked(params, c, d, plant=plant, **options) for c in controllers[:1]}
-    runs |= {c: f.result() for c, f in futures.items()}
+    notes: list[str] = []
+    for name, fut in futures.items():
+        try:
+            runs[name] = fut.result()
+        except OptimumSolverError as exc:  # the optimum is a yardstick: left out with a note, never a traceback
+            notes.append(f"Optimum omitted: {exc}")
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
-                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"))
+                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"),
+                      tuple(notes))
