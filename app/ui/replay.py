@@ -13,7 +13,6 @@ runs only while playing.
 from __future__ import annotations
 
 import json
-import math
 import threading
 import time
 from collections.abc import Callable
@@ -27,16 +26,11 @@ from app.figures.fdsmc_overview import overview_spec
 from app.figures.fdsmc_pins import Pin
 from app.figures.fdsmc_replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
 from app.figures.plain import figure_json
-from app.ui.layout import install_css_js
 from app.ui.props import assign
 from app.ui.scene import RotorScene
-from app.ui.viser_adapter import run_script, set_figure_json, widget_id
+from app.ui.viser_adapter import run_script, set_figure_json
 
 FRAME_HZ = 25.0
-#: Most reports per second of a running in-browser replay's time (the *Replay t* slider follows).
-FOLLOW_HZ = 5.0
-#: Time after a user's scrub during which replay-time reports are not followed [s] (in flight).
-FOLLOW_QUIET_S = 0.6
 
 
 def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = ()) -> tuple[str, ScrubTargets]:
@@ -122,29 +116,6 @@ BUTTONS_JS = """(() => { if (window.__appReplayButtons) return; window.__appRepl
   } }, 250); })();"""
 
 
-def follow_js(probe_uuid: str) -> str:
-    """Return the page script that reports a running replay's time to the hidden field ``probe_uuid``.
-
-    At most :data:`FOLLOW_HZ` times a second it writes the key frame's time (the first marker's
-    label, ``"t = 0.123 s"``) into the field as if typed; the server moves the *Replay t* slider.
-    """
-    return """(() => { const uuid = UUID, period = 1000 / HZ;
-  const setValue = Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set;
-  let last = 0;
-  const report = (e) => { const now = performance.now(); const d = e && e.frame && e.frame.data;
-    const text = d && d[0] && d[0].text && d[0].text[0]; if (!text || now - last < period) return;
-    last = now;
-    const label = document.querySelector(`label[for="${uuid}"]`);
-    const input = label && label.closest('.mantine-Flex-root').querySelector('input');
-    if (!input) return;
-    setValue.call(input, text.replace(/[^0-9.]/g, ''));
-    input.dispatchEvent(new Event('input', {bubbles: true})); };
-  setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
-    if (el.__appFollow === uuid || !el.on || !(el.layout && el.layout.meta && el.layout.meta.overview)) continue;
-    el.__appFollow = uuid; el.on('plotly_animatingframe', report); } }, 250); })();""".replace(
-        "UUID", json.dumps(probe_uuid)).replace("HZ", f"{FOLLOW_HZ:g}")
-
-
 def scrub_js(comparison: Any, targets: ScrubTargets, t: float) -> str:
     """Return the page script that puts the overview's markers and cursors at time ``t`` [s]."""
     update, indices = scrub_update(comparison, targets, t)
@@ -188,14 +159,6 @@ class Replay:
         self.buttons.on_click(self._on_button)
         self.slider.on_update(self._on_slider)
         run_script(gui, BUTTONS_JS)
-        # a hidden field the page writes a running replay's time into: the slider follows it
-        self._scrubbed = -math.inf
-        self._follow = gui.add_text("replay t [s] (page)", "")
-        self._follow.on_update(lambda _: self._followed(self._follow.value))
-        uuid = widget_id(self._follow)
-        run_script(gui, install_css_js(f'div:has(> .mantine-Flex-root label[for="{uuid}"]) '
-                                       "{display: none !important}", "app-replay-follow-style"))
-        run_script(gui, follow_js(uuid))
         self.show_3d.on_update(lambda _: self._toggle_3d())
 
     def _toggle_3d(self) -> None:
@@ -300,20 +263,9 @@ class Replay:
         else:
             self.play(restart=label.endswith("Replay"))
 
-    def _followed(self, text: str) -> None:
-        """Move the *Replay t* slider to the time [s] a running in-browser replay reported (nothing else)."""
-        try:
-            t = float(text)
-        except ValueError:
-            return
-        # a report sent before the user's last scrub arrives after it: not followed
-        if math.isfinite(t) and 0.0 <= t <= self._t_end and time.monotonic() - self._scrubbed > FOLLOW_QUIET_S:
-            assign(self.slider, value=round(t, 6))
-
     def _on_slider(self, event: viser.GuiEvent) -> None:
         if event.client is None:  # our own update during play
             return
-        self._scrubbed = time.monotonic()
         self.pause()
         self.seek(float(self.slider.value))
 
