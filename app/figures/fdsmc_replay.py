@@ -63,11 +63,15 @@ class ScrubTargets:
     keep: tuple[tuple[int, str], ...] = ()
 
     @classmethod
-    def of(cls, data: list[dict[str, Any]]) -> ScrubTargets:
-        """Find the moved traces among a figure's traces ``data`` by their names (the trail by ``meta.trail``)."""
+    def of(cls, data: list[dict[str, Any]], points: bool = True) -> ScrubTargets:
+        """Find the moved traces among a figure's traces ``data`` by their names (the trail by ``meta.trail``).
+
+        Without ``points`` the trail's JSON is left empty (a figure without replay frames: a drag).
+        """
         names = [t.get("name", "") for t in data]
         cursors = tuple(i for i, n in enumerate(names) if n.startswith("time cursor"))
-        trail = tuple((i, float(t["meta"]["trail"]), _points_json(t["x"], t["y"]), _points_json(t["x"][:1], t["y"][:1]))
+        trail = tuple((i, float(t["meta"]["trail"]), _points_json(t["x"], t["y"]) if points else "",
+                       _points_json(t["x"][:1], t["y"][:1]) if points else "")
                       for i, t in enumerate(data) if isinstance(t.get("meta"), dict) and "trail" in t["meta"])
         keep = tuple((i, _points_json(t["x"], t["y"])) for i, t in enumerate(data)
                      if isinstance(t.get("meta"), dict) and t["meta"].get("keep"))

@@ -41,7 +41,7 @@ def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = 
     both come back when the drag stops.
     """
     spec = overview_spec(comparison, pins)
-    targets = ScrubTargets.of(spec["data"])
+    targets = ScrubTargets.of(spec["data"], points=replay)
     if not replay:
         return figure_json(_drag_figure(spec)), targets
     layout, raw = replay_layout(comparison, spec["data"])
