@@ -15,7 +15,8 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from app.figures.bldc_speed_smc import finish_layout, stride
+from app.figures.bldc_speed_smc import finish_layout, xy
+from app.figures.decimate import BINS_OVERVIEW_ROWS, f32, time_axis
 from app.figures.style import BLDC_COLOURS, BLDC_DASHES, REFERENCE_COLOUR, fmt
 from app.io.units import rad_s_to_rpm
 from sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
@@ -42,14 +43,15 @@ def _window(t: np.ndarray, t0: float, t1: float) -> slice:
 
 def _torque_cell(fig: go.Figure, run: BldcRunResult, row: int, col: int, part: slice | None) -> None:
     tr, c = run.trace, run.controller
-    k = 1 if part is not None else stride(tr.t.size)
-    part = part or slice(None, None, k)
     line = {"color": BLDC_COLOURS[c], "dash": BLDC_DASHES[c], "width": 1.8}
     first = row == 1 and col == 1
-    fig.add_scatter(x=tr.t[part], y=tr.T_EL[part], name=LABELS[c], line=line, showlegend=col == 1,
-                    legendgroup=c, row=row, col=col)
-    fig.add_scatter(x=tr.t[part], y=tr.T_ref[part], name="T* (reference)", line=_REF, showlegend=first,
-                    legendgroup="ref", row=row, col=col)
+    if part is None:  # the whole run: one point per pixel; the zoomed window: every sample
+        t_el, t_ref = xy(tr.t, tr.T_EL, BINS_OVERVIEW_ROWS), xy(tr.t, tr.T_ref, BINS_OVERVIEW_ROWS)
+    else:
+        axis = time_axis(tr.t[part])
+        t_el, t_ref = {**axis, "y": f32(tr.T_EL[part])}, {**axis, "y": f32(tr.T_ref[part])}
+    fig.add_scatter(**t_el, name=LABELS[c], line=line, showlegend=col == 1, legendgroup=c, row=row, col=col)
+    fig.add_scatter(**t_ref, name="T* (reference)", line=_REF, showlegend=first, legendgroup="ref", row=row, col=col)
 
 
 def make_torque_grid_figure(comp: BldcComparison) -> go.Figure:
@@ -86,14 +88,13 @@ def make_antiwindup_figure(with_aw: BldcRunResult, without_aw: BldcRunResult, ep
                         horizontal_spacing=0.05, row_heights=[0.55, 0.45], subplot_titles=titles)
     for col, (run, key) in enumerate(((with_aw, "smc_integral"), (without_aw, "smc_plain")), start=1):
         tr = run.trace
-        k = stride(tr.t.size)
         line = {"color": BLDC_COLOURS[key], "dash": BLDC_DASHES[key], "width": 1.8}
         name = titles[col - 1]
-        fig.add_scatter(x=tr.t[::k], y=rad_s_to_rpm(tr.omega_ref[::k]), name="ω*", line=_REF, showlegend=col == 1,
+        fig.add_scatter(**xy(tr.t, rad_s_to_rpm(tr.omega_ref)), name="ω*", line=_REF, showlegend=col == 1,
                         legendgroup="ref", row=1, col=col)
-        fig.add_scatter(x=tr.t[::k], y=rad_s_to_rpm(tr.omega[::k]), name=name, line=line, legendgroup=name,
+        fig.add_scatter(**xy(tr.t, rad_s_to_rpm(tr.omega)), name=name, line=line, legendgroup=name,
                         row=1, col=col)
-        fig.add_scatter(x=tr.t[::k], y=tr.T_EL[::k], name=f"T_EL, {name}", line=line, legendgroup=name,
+        fig.add_scatter(**xy(tr.t, tr.T_EL), name=f"T_EL, {name}", line=line, legendgroup=name,
                         showlegend=False, row=2, col=col)
         ov = run.metrics.overshoot_rad_s
         fig.add_annotation(text=f"overshoot {fmt(None if ov is None else rad_s_to_rpm(ov), 'rpm', 3)}",

@@ -8,12 +8,13 @@ it. Speeds are shown in rpm, angles in electrical degrees (display edge only).
 
 from __future__ import annotations
 
-import math
+from typing import Any
 
 import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from app.figures.decimate import BINS_TIME_PLOTS, envelope, f32
 from app.figures.plain import slim_template
 from app.figures.style import (
     BLDC_COLOURS,
@@ -30,7 +31,6 @@ from control.bldc.dqx import dqx_coefficients, ideal_coefficients
 from sim.bldc import emf as bldc_emf
 from sim.bldc.engine import LABELS, BldcComparison
 
-MAX_POINTS = 3000
 _MARGIN = {"l": 64, "r": 15, "t": 48, "b": 40}
 _IDEAL = {"dash": "dash", "color": REFERENCE_COLOUR}
 _REAL = {"color": WARNING_COLOUR}
@@ -45,9 +45,10 @@ def finish_layout(fig: go.Figure, fid: str, title: str, height: int = 320) -> go
     return fig
 
 
-def stride(n: int) -> int:
-    """Sample stride keeping at most :data:`MAX_POINTS` points of ``n``."""
-    return max(1, int(math.ceil(n / MAX_POINTS)))
+def xy(t: np.ndarray, y: np.ndarray, n_bins: int = BINS_TIME_PLOTS) -> dict[str, Any]:
+    """Trace keys of ``y(t)``: its min/max envelope on about one point per pixel, float32 (chatter stays a band)."""
+    axis, values = envelope(t, y, n_bins)
+    return {**axis, "y": f32(values)}
 
 
 def _line(controller: str, width: float = 1.8) -> dict[str, object]:
@@ -86,15 +87,14 @@ def make_speed_figure(comp: BldcComparison) -> go.Figure:
     """Speed of every drive and ω*, load torque below (Figs. 9–10, 12–13 of [2])."""
     fig = make_subplots(rows=2, cols=1, shared_xaxes=True, row_heights=[0.72, 0.28], vertical_spacing=0.06)
     tr0 = comp.runs[0].trace
-    k = stride(tr0.t.size)
-    fig.add_scatter(x=tr0.t[::k], y=rad_s_to_rpm(tr0.omega_ref[::k]), name="ω*",
+    fig.add_scatter(**xy(tr0.t, rad_s_to_rpm(tr0.omega_ref)), name="ω*",
                     line={"dash": "dot", "color": REFERENCE_COLOUR},
                     row=1, col=1)
     for r in comp.runs:
         tr = r.trace
-        fig.add_scatter(x=tr.t[::k], y=rad_s_to_rpm(tr.omega[::k]), name=LABELS[r.controller],
+        fig.add_scatter(**xy(tr.t, rad_s_to_rpm(tr.omega)), name=LABELS[r.controller],
                         line=_line(r.controller), row=1, col=1)
-    fig.add_scatter(x=tr0.t[::k], y=tr0.T_L[::k], name="T_L", line={"color": REFERENCE_COLOUR, "shape": "hv"},
+    fig.add_scatter(**xy(tr0.t, tr0.T_L), name="T_L", line={"color": REFERENCE_COLOUR, "shape": "hv"},
                     row=2, col=1)
     fig.update_yaxes(title="n [rpm]", row=1, col=1)
     fig.update_yaxes(title="T_L [N·m]", row=2, col=1)
@@ -107,8 +107,7 @@ def make_sigma_figure(comp: BldcComparison) -> go.Figure:
     fig = go.Figure()
     for r in comp.runs:
         tr = r.trace
-        k = stride(tr.t.size)
-        fig.add_scatter(x=tr.t[::k], y=tr.sigma[::k], name=r.controller, line=_line(r.controller))
+        fig.add_scatter(**xy(tr.t, tr.sigma), name=r.controller, line=_line(r.controller))
     fig.update_xaxes(title="t [s]")
     fig.update_yaxes(title="σ_ω [rad/s]")
     return finish_layout(fig, "bldc_sigma", "Sliding variable σ_ω, eq. (16)")
@@ -125,9 +124,8 @@ def make_currents_figure(comp: BldcComparison,
                         subplot_titles=[LABELS[c] for c in names])
     for row, c in enumerate(names, start=1):
         tr = comp.run(c).trace
-        k = stride(tr.t.size)
         for j, phase in enumerate("abc"):
-            fig.add_scatter(x=tr.t[::k], y=tr.i_abc[j, ::k], name=f"i_{phase}", legendgroup=phase,
+            fig.add_scatter(**xy(tr.t, tr.i_abc[j]), name=f"i_{phase}", legendgroup=phase,
                             showlegend=row == 1, row=row, col=1,
                             line={"color": PHASE_COLOURS[j], "dash": PHASE_DASHES[j], "width": 1.5})
         fig.update_yaxes(title="i [A]", row=row, col=1)

@@ -15,9 +15,12 @@ from dataclasses import dataclass, field
 
 import viser
 
+from app.figures.style import SLIDER_CSS
 from app.threads import limit_blas_threads
+from app.ui.bldc_results import follow_tabs_js
 from app.ui.bldc_tab import add_bldc_tab
 from app.ui.case import Case, CaseState
+from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
 from app.ui.inputs import InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
@@ -88,12 +91,21 @@ class Session:
             self.tab.results = self.results
             self.results.panel.dock_right()
             self.studies = StudiesSection(self.tab)
-            add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
+            self.bldc = add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
+            with self.results.panel.add_tab("Share", viser.Icon.SHARE):
+                self.export = FigureExport(gui, self._figure_handles)
             self.fit = WindowFit(self._apply_layout)
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
         run_script(gui, window_report_js(widget_id(self._window_probe)))
+        run_script(gui, follow_tabs_js())
+        run_script(gui, install_css_js(SLIDER_CSS, "app-legibility-style"))
+
+    def _figure_handles(self) -> list[viser.GuiPlotlyHandle]:
+        r, b = self.results, self.bldc.results
+        return [r.phase, r.time_plots, r.energy, r.bars, r.table1, b.speed, b.torque, b.antiwindup, b.sigma,
+                b.currents, b.emf, b.dqx, b.reach]
 
     def _apply_layout(self, layout: PanelLayout) -> None:
         self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
