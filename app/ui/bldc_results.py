@@ -93,7 +93,9 @@ def follow_tabs_js() -> str:
     if (want === null) return;
     setTimeout(() => {
       const target = document.querySelector(`[role="tab"][title="${want}"]`);
-      if (target && target.getAttribute("aria-selected") !== "true") target.click();
+      if (target && target.getAttribute("aria-selected") !== "true") {  // viser's dock tabs: Enter activates
+        target.dispatchEvent(new KeyboardEvent("keydown", {key: "Enter", code: "Enter", bubbles: true}));
+      }
     }, 0);
   }, true);
 })();"""

@@ -51,7 +51,7 @@ def test_no_console_errors_over_a_demo_on_both_tabs(browser, ui_server):
         page.get_by_role("button", name="Simulate", exact=True).click()
         page.wait_for_timeout(1500)
         page.get_by_text("Controller", exact=True).first.click()
-        set_number(page, "K [-]", 0.3)
+        set_number(page, "K boundary-layer gain [s/rad]", 0.3)
         page.get_by_role("button", name="Simulate", exact=True).click()
         page.wait_for_timeout(1500)
         for tab in ("Time plots", "Energy", "Overview"):
