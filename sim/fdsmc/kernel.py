@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from control.fdsmc import conventional, fdc, inverter, model, sliding_mode
+from control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
 from sim.common import sensors
 
 # ---- prm indices -------------------------------------------------------------------------
@@ -117,10 +117,13 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
     Eqs. (44)–(46), (62), or the reference tracking law :func:`control.fdsmc.conventional.tracking_demand`
     (``P_CTRL`` = 2), all of :mod:`control`.
     """
-    if prm[P_CTRL] == 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
+    if prm[P_CTRL] >= 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
         th_r, w_r, _ = reference_at(t, ref, prm[P_TM])
         a_r = reference_at(t + prm[P_LEAD], ref, prm[P_TM])[2]
-        return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
+        if prm[P_CTRL] == 2.0:
+            return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
+        return terminal_slide.slide_in_demand(th_r, w_r, a_r, ref[0, 0], theta_hat, omega_hat, prm[P_G1], prm[P_G2],
+                                              prm[P_THDEM], prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
     if prm[P_CTRL] == 1.0:
         return conventional.conventional_demand(prm[P_THDEM], theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
     return sliding_mode.smc_demand(theta_hat - prm[P_THDEM], omega_hat, prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
