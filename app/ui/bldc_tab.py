@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -294,6 +295,17 @@ class BldcTab:
             return
         self.client.send_file_download(f"{params.name}.yaml", annotate_units(dumps_preset(params)).encode("utf-8"),
                                        save_immediately=True)
+
+
+def warm_bldc() -> None:
+    """Prepare the BLDC tab before the first page: the preset's design figures now, its kernels in the background.
+
+    The design figures are in every page's first messages; the kernels' first load (≈ 1–5 s of
+    numba cache reading) would otherwise fall on the first "Simulate BLDC".
+    """
+    params = load(PRESET, mode="bldc")
+    design_view(params)
+    threading.Thread(target=lambda: compare_bldc(params), name="bldc-warm-up", daemon=True).start()
 
 
 def add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,

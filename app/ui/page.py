@@ -18,7 +18,7 @@ import viser
 from app.figures.style import SLIDER_CSS
 from app.threads import limit_blas_threads
 from app.ui.bldc_results import follow_tabs_js
-from app.ui.bldc_tab import add_bldc_tab
+from app.ui.bldc_tab import add_bldc_tab, warm_bldc
 from app.ui.case import Case, CaseState
 from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
@@ -213,6 +213,8 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     if not environment_map:  # the HDRI stalls software WebGL for seconds
         server.scene.configure_environment_map(hdri=None)
     config = AppConfig(params, origin, scene_3d, guard=guard)
+    config.initial()  # the first page must not wait for the kernels' first load and the start-up run
+    warm_bldc()
 
     @server.on_client_connect
     def _(client: viser.ClientHandle) -> None:
