@@ -364,6 +364,8 @@ def cold_round(browser, with_3d: bool) -> tuple[float, float, float, float]:
 
 def cold_rounds(browser, runs: int, with_3d: bool) -> None:
     """What a user gets: ``runs`` rounds of :func:`cold_round`, each printed with the load average, then medians."""
+    warm = cold_round(browser, with_3d)  # fills numba's on-disk cache (keyed on the source path), as set-up does
+    print(f"  untimed first round (numba's on-disk cache filled for this checkout): page open {warm[0]:.2f} s")
     rows = []
     for k in range(runs):
         row = cold_round(browser, with_3d)
