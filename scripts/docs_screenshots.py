@@ -2,7 +2,9 @@
 
 Writes ``docs/k_demo_chatter_1280x720.png`` (paper preset, K = 1000: chattering),
 ``docs/k_demo_clean_1280x720.png`` (after "Use recommended K") and ``docs/bldc_tab_1280x720.png``
-(BLDC tab, paper drive with and without anti-windup side by side). The server runs in-process
+(BLDC tab, paper drive with and without anti-windup side by side), and the BLDC torque small
+multiples and anti-windup figures scrolled into view (``docs/bldc_torque_1280x720.png``,
+``docs/bldc_antiwindup_1280x720.png``). The server runs in-process
 with the 3D view off. Usage: ``.venv/bin/python scripts/docs_screenshots.py``
 """
 
@@ -26,6 +28,9 @@ SIZE = {"width": 1280, "height": 720}
 FIGURE_DRAWN = ("(id) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"
                 " && e.layout.meta.id === id && e.data.length && e.getBoundingClientRect().width > 0)")
 
+SCROLL_TO = ("(id) => [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout && e.layout.meta"
+             " && e.layout.meta.id === id).scrollIntoView({block: 'start'})")
+
 
 def _settle(page) -> None:
     page.wait_for_timeout(2500)  # the run, its figures and an autoplayed replay's first frames
@@ -39,12 +44,14 @@ def main() -> int:
             page = browser.new_page(viewport=SIZE)
             page.set_default_timeout(120_000)
             page.goto(f"http://127.0.0.1:{server.get_port()}")
+            page.add_style_tag(content=".mantine-Notifications-root {display: none !important}")  # software-WebGL notice
             page.wait_for_function(FIGURE_DRAWN, arg="phase_plane")
             _settle(page)
             page.screenshot(path=str(DOCS / "k_demo_chatter_1280x720.png"))
             page.get_by_role("button", name=re.compile(r"^Use recommended K")).first.click()
             _settle(page)
             page.screenshot(path=str(DOCS / "k_demo_clean_1280x720.png"))
+            page.get_by_role("tab", name="BLDC speed SMC", exact=True).scroll_into_view_if_needed()
             click_tab(page, "BLDC speed SMC")
             page.get_by_text("Paper drive with / without anti-windup, side by side", exact=True).click()
             page.wait_for_timeout(200)
@@ -52,6 +59,10 @@ def main() -> int:
             page.wait_for_function(FIGURE_DRAWN, arg="bldc_antiwindup")
             page.wait_for_timeout(1500)
             page.screenshot(path=str(DOCS / "bldc_tab_1280x720.png"))
+            for fid in ("bldc_torque", "bldc_antiwindup"):  # the small multiples and the side-by-side runs
+                page.evaluate(SCROLL_TO, fid)
+                page.wait_for_timeout(800)
+                page.screenshot(path=str(DOCS / f"{fid}_1280x720.png"))
             browser.close()
     finally:
         server.stop()

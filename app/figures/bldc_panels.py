@@ -24,6 +24,8 @@ from sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
 _REF = {"color": REFERENCE_COLOUR, "dash": "dot", "width": 1.5}
 #: Height of one small-multiple row [px].
 ROW_PX = 130
+#: Top margin [px]: the figure's title above the panels' own titles.
+TOP_PX = 84
 
 
 def loaded_window(comp: BldcComparison) -> tuple[float, float]:
@@ -70,8 +72,9 @@ def make_torque_grid_figure(comp: BldcComparison) -> go.Figure:
     n = len(comp.runs)
     fig.update_xaxes(title="t [s]", row=n, col=1)
     fig.update_xaxes(title=f"t [s], loaded window {fmt(t0)}–{fmt(t1)} s", row=n, col=2)
-    return finish_layout(fig, "bldc_torque", "Torque T_EL per drive (eq. (3)); right: loaded-window ripple",
-                         height=90 + ROW_PX * n)
+    fig = finish_layout(fig, "bldc_torque", "Torque T_EL per drive (eq. (3)); right: loaded-window ripple",
+                        height=90 + ROW_PX * n)
+    return fig.update_layout(margin={"t": TOP_PX})
 
 
 def make_antiwindup_figure(with_aw: BldcRunResult, without_aw: BldcRunResult, eps_lambda: float) -> go.Figure:
@@ -103,8 +106,9 @@ def make_antiwindup_figure(with_aw: BldcRunResult, without_aw: BldcRunResult, ep
     fig.update_yaxes(title="n [rpm]", row=1, col=1)
     fig.update_yaxes(title="T_EL [N·m]", row=2, col=1)
     fig.update_xaxes(title="t [s]", row=2)
-    return finish_layout(fig, "bldc_antiwindup", "Paper drive: anti-windup on λ(ε), eq. (16), side by side",
-                         height=440)
+    fig = finish_layout(fig, "bldc_antiwindup", "Paper drive: anti-windup on λ(ε), eq. (16), side by side",
+                        height=440)
+    return fig.update_layout(margin={"t": TOP_PX})
 
 
 __all__ = ["ROW_PX", "loaded_window", "make_antiwindup_figure", "make_torque_grid_figure"]

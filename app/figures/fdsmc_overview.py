@@ -131,8 +131,8 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
     layout["meta"] = {**layout["meta"], "overview": True}
     layout["title"] = {**layout["title"], "font": {"size": TITLE_PX}, "y": 0.995, "yref": "container", "yanchor": "top"}
     layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": FONT_PX},
-                        "entrywidth": 0.36, "entrywidthmode": "fraction"}
-    layout["margin"] = {"l": 56, "r": 12, "t": 96, "b": 84, "autoexpand": False}
+                        "entrywidth": 0.5, "entrywidthmode": "fraction"}
+    layout["margin"] = {"l": 56, "r": 12, "t": 116, "b": 84, "autoexpand": False}  # a 3-row legend at 14 px
     if not runs(comparison):
         return spec
     traces, ranges, t_end = _row_traces(comparison)
