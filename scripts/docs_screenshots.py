@@ -44,7 +44,7 @@ def main() -> int:
             page = browser.new_page(viewport=SIZE)
             page.set_default_timeout(120_000)
             page.goto(f"http://127.0.0.1:{server.get_port()}")
-            page.add_style_tag(content=".mantine-Notifications-root {display: none !important}")  # software-WebGL notice
+            page.add_style_tag(content=".mantine-Notifications-root {display: none !important}")  # WebGL notice
             page.wait_for_function(FIGURE_DRAWN, arg="phase_plane")
             _settle(page)
             page.screenshot(path=str(DOCS / "k_demo_chatter_1280x720.png"))
