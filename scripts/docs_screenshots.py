@@ -50,6 +50,9 @@ def main() -> int:
             page.screenshot(path=str(DOCS / "k_demo_chatter_1280x720.png"))
             page.get_by_role("button", name=re.compile(r"^Use recommended K")).first.click()
             _settle(page)
+            page.get_by_role("tab", name="Position drive (FDSMC)", exact=True).scroll_into_view_if_needed()
+            page.mouse.move(200, 30)  # no tooltip under the pointer
+            page.wait_for_timeout(500)
             page.screenshot(path=str(DOCS / "k_demo_clean_1280x720.png"))
             page.get_by_role("tab", name="BLDC speed SMC", exact=True).scroll_into_view_if_needed()
             click_tab(page, "BLDC speed SMC")
