@@ -44,10 +44,28 @@ def test_overview_saved_as_svg_and_png_without_replay_buttons(browser, ui_server
         context.close()
 
 
+#: Colour [r, g, b] and font size [px] of every slider limit label of the page.
+MARK_LABELS_JS = """() => [...document.querySelectorAll('.mantine-Slider-markLabel')].map(e => {
+  const s = getComputedStyle(e);
+  return [s.color.match(/[0-9.]+/g).slice(0, 3).map(Number), parseFloat(s.fontSize)]; })"""
+
+
+def _contrast_on_white(rgb: list[float]) -> float:
+    """WCAG 2 contrast ratio of an sRGB colour (0–255) on white."""
+    lin = [c / 255 / 12.92 if c / 255 <= 0.04045 else ((c / 255 + 0.055) / 1.055) ** 2.4 for c in rgb]
+    luminance = 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2]
+    return 1.05 / (luminance + 0.05)
+
+
 def test_no_console_errors_over_a_demo_on_both_tabs(browser, ui_server):
-    """Simulate, a K change, the results tabs, the BLDC tab with its side-by-side run, back: no console error."""
+    """Simulate, a K change, the results tabs, the BLDC tab with its side-by-side run, back: no console error.
+
+    On the way: the sliders' limit labels are legible (contrast ≥ 4.5:1 on white, ≥ 13 px).
+    """
     context, page = open_page(browser, ui_server, init_script=ERRORS_JS)
     try:
+        labels = page.evaluate(MARK_LABELS_JS)
+        assert labels and all(_contrast_on_white(rgb) >= 4.5 and px >= 13 for rgb, px in labels), labels
         page.get_by_role("button", name="Simulate", exact=True).click()
         page.wait_for_timeout(1500)
         page.get_by_text("Controller", exact=True).first.click()
