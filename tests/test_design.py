@@ -48,7 +48,9 @@ def test_real_presets_are_clean_as_shipped(name):
     assert pytest.approx(dd.params.controller.K, rel=1e-12) == shipped.controller.K
     d = dd.derived
     x = flux_tolerance(d.coefficients, d.alpha.alpha_max, d.profile.omega_p, dd.params.controller.T_salpha)
-    flux = [f"Flux tolerance: the FDC of eq. (14) tolerates a Ψ_PM error of only ±{100 * x:.2g} %"] if x < 0.1 else []
+    paper_fdc = dd.params.controller.T_dv == 0.0  # without the q-axis voltage-mismatch estimate
+    flux = ([f"Flux tolerance: the FDC of eq. (14) tolerates a Ψ_PM error of only ±{100 * x:.2g} %"]
+            if x < 0.1 and paper_fdc else [])
     assert [w[: len(flux[0])] if flux else w for w in run_warnings(dd.comparison)] == flux
     assert dd.derived.warnings == ()
 

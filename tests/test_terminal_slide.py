@@ -23,7 +23,7 @@ from sim.fdsmc.checks import run_checks
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import compare, simulate
 from sim.fdsmc.recommend import recommend
-from sim.fdsmc.verdicts import run_warnings
+from sim.fdsmc.verdicts import flux_warnings, run_warnings
 from sim.studies.robustness import Spread, plant_for, robustness, sample_metrics, simulate_chunk
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yaskawa_sgm7a_50a", "odrive_d5065_belt")
@@ -78,7 +78,7 @@ def test_tracked_optimum_is_clean_recommended_and_within_10pct_of_the_optimum(na
     e = {x.controller: x.net_electrical_J for x in rec.energies}
     assert rec.controller == "optimum"
     assert e["optimum"] <= 1.10 * optimal_move(p).energy_J and e["optimum"] < e["conventional"]
-    assert slide_stability(d.loop) < 0.0  # the slide's sampled loop at its T_c and the case's K
+    assert slide_stability(d.loop, p.controller.K) < 0.0  # the slide's sampled loop at its T_c and the case's K
 
 
 def test_tracking_to_the_very_end_overshoots_the_window(monkeypatch):
@@ -93,7 +93,7 @@ def test_tracking_to_the_very_end_overshoots_the_window(monkeypatch):
 def test_tracking_gains_are_held_to_the_fdsmc_layer():
     for name in REAL:
         d = derive(load_preset(name))
-        g = tracking_gains(d.loop, d.conventional)
+        g = tracking_gains(d.loop, d.conventional, d.params.controller.K)
         layer = d.alpha.alpha_max * d.params.controller.K  # the FDSMC's boundary-layer gain α_max·K
         assert g.a <= layer / 3.0 + 1e-9
         assert slide_time_constant(d.alpha.alpha_max, d.params.controller.K) * layer == pytest.approx(3.5)
@@ -103,8 +103,12 @@ def _psi(p, factor):
     return dataclasses.replace(p, motor=dataclasses.replace(p.motor, psi_pm=p.motor.psi_pm * factor))
 
 
+def _paper_fdc(p):
+    return dataclasses.replace(p, controller=dataclasses.replace(p.controller, T_dv=0.0))
+
+
 def test_fdc_flux_tolerance_predicts_runaway_and_stall():
-    p = load_preset("siemens_1ft7044_ak7")
+    p = _paper_fdc(load_preset("siemens_1ft7044_ak7"))  # the paper's FDC, without the mismatch estimate
     d = derive(p)
     x = flux_tolerance(d.coefficients, d.alpha.alpha_max, d.profile.omega_p, p.controller.T_salpha)
     assert 0.03 < x < 0.06
@@ -133,3 +137,18 @@ def test_robustness_of_the_tracked_optimum_reports_p95_energy_and_chatter():
     rows = [{k: float(v[i]) for k, v in res.values.items()} for i in range(2)]
     one = [sample_metrics(p, plant_for(p, r), d, ("fdsmc", "optimum")) for r in rows]
     assert simulate_chunk(p, rows, d, controllers=("fdsmc", "optimum")) == one
+
+
+def test_the_voltage_mismatch_estimate_keeps_the_design_clean_off_nameplate_flux():
+    # the shipped design (T_dv = 1 ms) passes every check with the motor's flux 10 % off either way, where the
+    # paper's FDC (T_dv = 0) ran away or stalled; nominal energy within 1.5 %
+    p = load_preset("siemens_1ft7044_ak7")
+    assert p.controller.T_dv == pytest.approx(1e-3)
+    d, d0 = derive(p), derive(_paper_fdc(p))
+    for factor in (0.9, 1.1):
+        for ctrl in ("fdsmc", "optimum"):
+            assert run_checks(p, simulate(p, ctrl, d, plant=_psi(p, factor))) == []
+        assert run_checks(p, simulate(_paper_fdc(p), "fdsmc", d0, plant=_psi(p, factor)))
+    assert simulate(p, "fdsmc", d).metrics.electrical_in_total_J == pytest.approx(
+        simulate(_paper_fdc(p), "fdsmc", d0).metrics.electrical_in_total_J, rel=0.015)
+    assert flux_warnings(d) == [] and flux_warnings(d0)

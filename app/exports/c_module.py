@@ -33,6 +33,7 @@ from app.io.units import spec_of
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
+from control.fdsmc.tracking import slide_gain
 
 from .c_optimum import STATE_FIELDS, ReferenceTable, law_parts, optimum_constants, reference_table
 from .c_source import FDSMC_MOVE, LIMIT_CODE, SOURCE
@@ -143,7 +144,7 @@ INPUT_KEYS: dict[str, str] = {
     "J_R": "motor.J_r", "T_SI": "controller.T_si", "T_SALPHA": "controller.T_salpha", "T_SO": "controller.T_so",
     "K_BL": "controller.K", "THETA_DEM": "manoeuvre.theta_dem", "T_M": "manoeuvre.T_m",
     "DELAY_SAMPLES": "controller.delay_samples", "V_DC": "controller.V_dc", "I_MAX": "controller.i_max",
-    "GAMMA_MAX": "motor.Gamma_max",
+    "GAMMA_MAX": "motor.Gamma_max", "T_DV": "controller.T_dv",
 }
 
 
@@ -210,6 +211,9 @@ def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     return k + [_input("V_DC", params, "DC link (0 = ideal inverter)"),
                 CConstant("U_MAX", u_max, "V", "|u_dq| limit V_dc/sqrt(3) (0 = none)"),
                 _input("I_MAX", params, "inverter current amplitude (0 = none)"),
+                _input("T_DV", params, "q-axis voltage-mismatch estimate's time constant (0 = none, the paper)"),
+                CConstant("VOLTAGE_MISMATCH", 1 if ctrl.T_dv > 0.0 else 0, "-",
+                          "1: u_q corrected by the q-axis voltage-mismatch estimate", integer=True),
                 _input("GAMMA_MAX", params, "motor torque limit (information)"),
                 CConstant("COUNTS_PER_REV", encoder_counts_per_rev(params), "1/rev",
                           "encoder counts per mechanical revolution", integer=True)]
@@ -299,7 +303,8 @@ def controller_source(params: DriveParams, d: Derived, table: ReferenceTable | N
     so = scaled_observer(d)
     law = (law_parts(table, c_literal) if table is not None else
            {"set_move": FDSMC_MOVE, "outer_law": "", "outer_call": "sliding_mode(s, th_re, w, &S)", "law_init": ""})
-    return SOURCE.substitute(name=c_string(params.name), design=design_initializer(params, d, so, c_literal),
+    K = slide_gain(d.gain, params.controller.K) if table is not None else params.controller.K
+    return SOURCE.substitute(name=c_string(params.name), design=design_initializer(params, d, so, c_literal, K),
                              limit_code=LIMIT_CODE, **law)
 
 

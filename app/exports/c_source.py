@@ -169,6 +169,9 @@ void fdsmc_init(fdsmc_state *s, const fdsmc_params *p, fdsmc_count theta_r0)
     observer_reset(s, theta_r0);
     s->u_hold[0] = R_(0);
     s->u_hold[1] = R_(0);
+    for (int i = 0; i < 6; i++) {
+        s->dv_mem[i] = R_(0);
+    }
     s->omega_p = FDSMC_OMEGA_P;
     s->t_c = FDSMC_T_C;
     s->inv_t_c = R_(1) / FDSMC_T_C;
@@ -258,6 +261,9 @@ static void step(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real
     estimates(s, &th_re, &w, &mL0, &mL1);
     alpha_dem = conventional ? -p->g1 * th_re - p->g2 * w : $outer_call;
     fdc_voltages(p, alpha_dem, i_d, i_q, w, mL0, mL1, &u_d, &u_q);
+#if FDSMC_VOLTAGE_MISMATCH
+    u_q -= voltage_mismatch(s, i_q);
+#endif
 #if FDSMC_DELAY_SAMPLES == 1
     predict_currents(p, s->u_hold, i_d, i_q, w, &i_d0, &i_q0); /* where the new voltages start acting */
 #else
@@ -283,6 +289,13 @@ static void step(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real
 #else
     out->u_d = u_d;
     out->u_q = u_q;
+#endif
+#if FDSMC_VOLTAGE_MISMATCH
+    s->dv_mem[0] = i_d; /* this call's readings and speed, and the voltages applied until the next */
+    s->dv_mem[1] = i_q;
+    s->dv_mem[2] = w;
+    s->dv_mem[3] = out->u_d;
+    s->dv_mem[4] = out->u_q;
 #endif
     out->theta_re = th_re;
     out->omega_hat = w;
@@ -354,13 +367,27 @@ static int32_t limit_voltage(const fdsmc_params *p, fdsmc_real *u_d, fdsmc_real 
     return sat;
 }
 
-#if FDSMC_DELAY_SAMPLES == 1
-/* Currents [A] at the end of the sample now running, with the held voltages u_hold (computation delay). */
+#if FDSMC_DELAY_SAMPLES == 1 || FDSMC_VOLTAGE_MISMATCH
+/* Currents [A] one sample after (i_d, i_q) with the voltages u held (eqs. (1)-(2) of [1]). */
 static void predict_currents(const fdsmc_params *p, const fdsmc_real *u, fdsmc_real i_d, fdsmc_real i_q,
                              fdsmc_real w, fdsmc_real *i_d1, fdsmc_real *i_q1)
 {
     *i_d1 = p->phi_d * i_d + p->gam_d * (p->b * w * i_q + p->f * u[0]);
     *i_q1 = p->phi_q * i_q + p->gam_q * (p->g * u[1] - (p->c * i_d + p->e) * w);
+}
+#endif
+
+#if FDSMC_VOLTAGE_MISMATCH
+/* q-axis voltage-mismatch estimate of control/fdsmc/fdc.py (not in [1]), updated with this call's i_q [A]:
+ * dv += beta*((i_q - i_q predicted from the last call's readings and applied voltages)/(gam_q*G) - dv) [V]. */
+static fdsmc_real voltage_mismatch(fdsmc_state *s, fdsmc_real i_q)
+{
+    const fdsmc_params *p = s->p;
+    fdsmc_real i_d1, i_q1;
+    predict_currents(p, &s->dv_mem[3], s->dv_mem[0], s->dv_mem[1], s->dv_mem[2], &i_d1, &i_q1);
+    (void)i_d1;
+    s->dv_mem[5] = s->dv_mem[5] + p->beta_dv * (FDSMC_DIV(i_q - i_q1, p->gain_dv, p->inv_gain_dv) - s->dv_mem[5]);
+    return s->dv_mem[5];
 }
 #endif"""
 

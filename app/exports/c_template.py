@@ -123,6 +123,7 @@ typedef struct {
     fdsmc_real a, b, c, d, e, f, g, inv_f, inv_g, h, k, m, three_inv_t_si, three_inv_t_salpha;
     fdsmc_real g1, g2, f_s, f_s2, f_s3, t_s2, j_r;
     fdsmc_real u_max, u_max2, i_max, i_max2, phi_d, inv_gam_d, gam_d, phi_q, inv_gam_q, gam_q;
+    fdsmc_real beta_dv, gain_dv, inv_gain_dv;
     fdsmc_real i_fault2, u_fault2, e_o_max_counts;
     fdsmc_real rad_per_count, counts_per_rad;
     fdsmc_real phi[4][4], gamma[4], l[4];
@@ -154,6 +155,8 @@ typedef struct {
     double x[4];            /* theta_hat [rad], omega_hat [rad/s], Gamma_L_hat [N*m], its rate [N*m/s] */
 #endif
     fdsmc_real u_hold[2];   /* voltages computed at the previous call [V] */
+    fdsmc_real dv_mem[6];   /* last call's i_d, i_q [A], omega_hat [rad/s], applied u_d, u_q [V]; the q-axis
+                               voltage-mismatch estimate [V] (FDSMC_VOLTAGE_MISMATCH) */
     fdsmc_real omega_p;     /* the move's peak speed, eq. (60) [rad/s] */
     fdsmc_real t_c;         /* its sliding-mode time constant, eq. (59) or fixed [s] */
     fdsmc_real inv_t_c;     /* 1/t_c [1/s] */

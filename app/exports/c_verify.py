@@ -123,7 +123,7 @@ class CModule:
 
         class State(ctypes.Structure):
             _fields_ = [("p", ctypes.c_void_p), ("theta_dem", i32), *observer, ("u_hold", real * 2),
-                        ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
+                        ("dv_mem", real * 6), ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
                         ("status", Status), *clock, ("ref_on", i32)]
 
         class Output(ctypes.Structure):

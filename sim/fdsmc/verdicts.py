@@ -131,19 +131,21 @@ def run_warnings(comparison: Comparison) -> list[str]:
 
 
 def flux_warnings(derived: Derived) -> list[str]:
-    """Warn when the FDC tolerates less than FLUX_TOLERANCE_WARN of flux error at ω_p.
+    """Warn when the paper's FDC tolerates less than FLUX_TOLERANCE_WARN of flux error at ω_p.
 
     :mod:`control.fdsmc.flux_tolerance`: beyond it the FDSMC runs away (weaker magnets) or stalls
-    (stronger ones).
+    (stronger ones). A digital controller with the q-axis voltage-mismatch estimate (controller.T_dv > 0)
+    has no such steady offset: no warning.
     """
-    T_sa = derived.params.controller.T_salpha
-    x = flux_tolerance(derived.coefficients, derived.alpha.alpha_max, derived.profile.omega_p, T_sa)
+    c = derived.params.controller
+    if c.T_dv > 0.0 and not c.is_continuous:
+        return []
+    x = flux_tolerance(derived.coefficients, derived.alpha.alpha_max, derived.profile.omega_p, c.T_salpha)
     if x >= FLUX_TOLERANCE_WARN:
         return []
     return [f"Flux tolerance: the FDC of eq. (14) tolerates a Ψ_PM error of only ±{100 * x:.2g} % at ω_p "
             f"(magnets ≈ {x * 1000:.0f} K warmer): a weaker flux runs the FDSMC away, a stronger one stalls it. "
-            f"Shorten T_sα (now {T_sa * 1e3:.3g} ms) or lengthen T_m; the tracked optimum, not bounded by α_max, "
-            "tolerates more."]
+            "Set controller.T_dv (the q-axis voltage-mismatch estimate, e.g. 1 ms) on a digital controller."]
 
 
 def _saturation(run: RunResult, derived: Derived) -> list[str]:
@@ -156,15 +158,17 @@ def _saturation(run: RunResult, derived: Derived) -> list[str]:
 def comparator_notes(comparison: Comparison) -> list[str]:
     """Note where the conventional comparator (eq. (61) gains) itself exceeds the drive's limits.
 
-    Its energy is then not a fair baseline for the saving.
+    Its energy is then not a fair baseline for the saving. The comparison's own notes (a comparator
+    left out, e.g. the optimum when its solvers failed) follow.
     """
+    notes = list(comparison.notes)  # e.g. an optimum left out because its solvers failed
     run = comparison.conventional
     if run is None or not run.metrics.stable:
-        return []
+        return notes
     issues = _saturation(run, comparison.derived) + limit_warnings(run, comparison.derived)
     if not issues:
-        return []
-    return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."]
+        return notes
+    return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."] + notes
 
 
 def _saving_verdicts(comparison: Comparison) -> list[str]:

@@ -36,7 +36,7 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
     ``noise`` is the sensors' table (:func:`sim.common.sensors.noise_table`), read by sample number.
     """
     p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    o, hold = (0.0, 0.0, 0.0, 0.0), (0.0, 0.0)
+    o, hold = (0.0, 0.0, 0.0, 0.0), kn.HOLD0
     t, k_all, n_out = 0.0, 0, 0
     for j in range(seg_steps.size):
         prm = prm_all[j]
