@@ -25,21 +25,18 @@ from typing import Any
 import numpy as np
 
 from app.figures.decimate import f32, minmax_index
+from app.figures.style import POSITION_COLOURS, POSITION_DASHES, TRAIL_PHASE_COLOURS, TRAIL_PHASE_DASHES
 from control.fdsmc.sliding_mode import boundary_speed
 from sim.fdsmc.engine import LABELS
 
 #: Pieces per trajectory in time (more where the FDSMC changes phase), and min/max bins of the
 #: trail's points (each key frame of each replay speed carries them once).
 N_PIECES, BINS_TRAIL = 40, 250
-#: The FDSMC's phases in order, with their legend names, colours and dashes.
+#: The FDSMC's phases in order, with their legend names, colours and dashes (:mod:`app.figures.style`).
 PHASES = ("reaching", "sliding", "linear")
-PHASE_STYLE = {
-    "reaching": ("FDSMC reaching the boundary", "#74a9e8", "dot"),
-    "sliding": ("FDSMC sliding, ω_r = ω_p", "#1f6fd1", "solid"),
-    "linear": ("FDSMC linear, ω_r = −θ_re/T_c", "#5f3dc4", "dash"),
-}
-#: Trail colours of the runs without phases.
-RUN_COLOURS = {"conventional": "#e8590c", "optimum": "#2f9e44"}
+PHASE_STYLE = dict(zip(PHASES, zip(("FDSMC reaching the boundary", "FDSMC sliding, ω_r = ω_p",
+                                    "FDSMC linear, ω_r = −θ_re/T_c"), TRAIL_PHASE_COLOURS, TRAIL_PHASE_DASHES,
+                                   strict=True), strict=True))
 
 
 @dataclass(frozen=True)
@@ -110,7 +107,7 @@ def piece_traces(parts: list[Piece]) -> list[dict[str, Any]]:
         if p.key == "fdsmc":
             legend, colour, dash = PHASE_STYLE[p.phase]
         else:
-            legend, colour, dash = LABELS[p.key], RUN_COLOURS.get(p.key, "#495057"), "solid"
+            legend, colour, dash = LABELS[p.key], POSITION_COLOURS[p.key], POSITION_DASHES[p.key]
         first = (p.key, p.phase) not in seen
         seen.add((p.key, p.phase))
         out.append({"type": "scatter", "mode": "lines", "x": f32(p.theta_re), "y": f32(p.omega_r),

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from app.figures.decimate import f32, minmax_index
+from app.figures.style import FONT_PX, POSITION_COLOURS
 
 #: Inset domain in the figure [paper]: x within the phase plane's, y from its bottom.
 INSET_X, INSET_Y = (0.13, 0.40), (0.07, 0.40)
@@ -76,7 +77,7 @@ def zoom_parts(comparison: Any) -> tuple[list[dict[str, Any]], dict[str, Any], l
         {"type": "scatter", "x": [x0, x1], "y": [w_b, w_b], "mode": "lines", "name": "zoom: boundary",
          "line": {"color": "#2b2b2b", "width": 1.5, "dash": "dash"}, **axes},
         {"type": "scatter", "x": f32(x_all[i]), "y": f32(y_all[i]), "mode": "lines", "name": "zoom: FDSMC",
-         "line": {"color": "#1f6fd1", "width": 1.5}, **axes},
+         "line": {"color": POSITION_COLOURS["fdsmc"], "width": 1.5}, **axes},
     ]
     return traces, *_inset_frame((x0, x1, y0, y1), th >= 0, K)
 
@@ -86,7 +87,7 @@ def _inset_frame(win: tuple[float, float, float, float], upward: bool,
     """Return the inset's axes over window ``win``, its white ground and marking rectangle, and its title."""
     x0, x1, y0, y1 = win
     frame = {"showgrid": False, "zeroline": False, "mirror": True, "showline": True, "linecolor": ZOOM_COLOUR,
-             "tickfont": {"size": 10}}
+             "tickfont": {"size": FONT_PX}}
     y_dom = INSET_Y if upward else (1.0 - INSET_Y[1] - 0.1, 1.0 - INSET_Y[0] - 0.1)
     layout = {"xaxis4": {**frame, "domain": list(INSET_X), "anchor": "y5", "range": [x0, x1], "nticks": 3},
               "yaxis5": {**frame, "domain": list(y_dom), "anchor": "x4", "range": [y0, y1], "nticks": 4}}
@@ -96,7 +97,7 @@ def _inset_frame(win: tuple[float, float, float, float], upward: bool,
     ground = {**box, "xref": "x4", "yref": "y5", "layer": "below", "fillcolor": "white", "line": {"width": 0}}
     title = {"text": f"zoom: sliding region, layer ±1/K = ±{1 / K:.3g} rad/s", "x": INSET_X[0],
              "y": y_dom[1], "xref": "paper", "yref": "paper", "xanchor": "left", "yanchor": "bottom",
-             "showarrow": False, "font": {"size": 11, "color": ZOOM_COLOUR}, "bgcolor": "rgba(255,255,255,0.8)"}
+             "showarrow": False, "font": {"size": FONT_PX, "color": ZOOM_COLOUR}, "bgcolor": "rgba(255,255,255,0.8)"}
     return layout, [ground, box], [title]
 
 

@@ -16,9 +16,12 @@ from dataclasses import dataclass, field
 
 import viser
 
+from app.figures.style import SLIDER_CSS
 from app.threads import limit_blas_threads, release_memory
-from app.ui.bldc_tab import add_bldc_tab
+from app.ui.bldc_results import follow_tabs_js
+from app.ui.bldc_tab import add_bldc_tab, warm_bldc
 from app.ui.case import Case, CaseState
+from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
 from app.ui.inputs import InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
@@ -99,12 +102,21 @@ class Session:
             self.tab.results = self.results
             self.results.panel.dock_right()
             self.studies = StudiesSection(self.tab, self.worker.as_study, self.slots.processes_per_study)
-            add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
+            self.bldc = add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
+            with self.results.panel.add_tab("Share", viser.Icon.SHARE):
+                self.export = FigureExport(gui, self._figure_handles)
             self.fit = WindowFit(self._apply_layout)
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
         run_script(gui, window_report_js(widget_id(self._window_probe)))
+        run_script(gui, follow_tabs_js())
+        run_script(gui, install_css_js(SLIDER_CSS, "app-legibility-style"))
+
+    def _figure_handles(self) -> list[viser.GuiPlotlyHandle]:
+        r, b = self.results, self.bldc.results
+        return [r.phase, r.time_plots, r.energy, r.bars, r.table1, b.speed, b.torque, b.antiwindup, b.sigma,
+                b.currents, b.emf, b.dqx, b.reach]
 
     def _sweep(self, T_m_values: list[float]) -> None:
         """Start the Table-1 sweep as a study (it waits for a server-wide slot)."""
@@ -224,6 +236,8 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     if not environment_map:  # the HDRI stalls software WebGL for seconds
         server.scene.configure_environment_map(hdri=None)
     config = AppConfig(params, origin, scene_3d, guard=guard)
+    config.initial()  # the first page must not wait for the kernels' first load and the start-up run
+    warm_bldc()
 
     @server.on_client_connect
     def _(client: viser.ClientHandle) -> None:
