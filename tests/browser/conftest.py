@@ -160,6 +160,7 @@ def click_tab(page: Any, name: str) -> None:
                                "{ pointer-events: none !important; }")
     tab = page.get_by_role("tab", name=name, exact=True)
     tab.wait_for()
+    tab.scroll_into_view_if_needed()  # a control-panel tab scrolls away with the panel's content
     page.wait_for_function(TAB_STEADY_JS, arg=tab.element_handle(), polling="raf")
     tab.click()
     page.wait_for_function("(t) => t.getAttribute('aria-selected') === 'true'", arg=tab.element_handle())
