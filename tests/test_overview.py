@@ -28,7 +28,7 @@ def test_overview_keeps_the_phase_plane_and_adds_the_time_rows(comparison):
     spec = overview_spec(comparison)
     names = [t["name"] for t in spec["data"]]
     assert spec["layout"]["meta"]["id"] == "phase_plane" and spec["layout"]["meta"]["overview"]
-    assert names[:2] == ["Boundary layer ±1/K = ±0.001 rad/s, eq. (45)", "Switching boundary, eq. (41)"]
+    assert names[:2] == ["Layer ±1/K = ±0.001 rad/s (45)", "Switching boundary, eq. (41)"]
     assert {"FDSMC trajectory", "FDSMC now", "Conventional now", "ω_r FDSMC", "Γ Conventional", *CURSORS} <= set(names)
     # the two plots sit side by side, the time rows one above the other
     lay = spec["layout"]

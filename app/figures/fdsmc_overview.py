@@ -129,11 +129,16 @@ def _with_trail(comparison: Any, data: list[dict[str, Any]]) -> list[dict[str, A
     sliding band gives way to the trail's phase colours.
     """
     def kept(tr: dict[str, Any]) -> dict[str, Any]:
-        if str(tr.get("name", "")).endswith(" trajectory"):
+        name = str(tr.get("name", ""))
+        if name.endswith(" trajectory"):
             return {**tr, "opacity": 0.0, "showlegend": False}
+        if name.endswith(" enters boundary layer"):  # labelled "reaching → sliding" on the plot
+            return {**tr, "showlegend": False}
         return tr
     rest = [kept(tr) for tr in data[2:] if "sliding phase" not in str(tr.get("name", ""))]
-    return data[:2] + piece_traces(pieces(comparison)) + rest
+    # the layer's legend entry short enough for a third of the legend's width (three entries a row)
+    layer = {**data[0], "name": data[0]["name"].replace("Boundary layer", "Layer").replace(", eq. (45)", " (45)")}
+    return [layer, data[1]] + piece_traces(pieces(comparison)) + rest
 
 
 def keeper(xaxis: str, yaxis: str) -> dict[str, Any]:
@@ -183,7 +188,7 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
     layout["meta"] = {**layout["meta"], "overview": True}
     layout["title"] = {**layout["title"], "font": {"size": TITLE_PX}, "y": 0.995, "yref": "container", "yanchor": "top"}
     layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": FONT_PX},
-                        "entrywidth": 0.5, "entrywidthmode": "fraction"}
+                        "entrywidth": 0.33, "entrywidthmode": "fraction"}
     layout["margin"] = {"l": 56, "r": 12, "t": 116, "b": 84, "autoexpand": False}  # a 3-row legend at 14 px
     if not runs(comparison):
         return {**spec, "data": ghost_traces(pins, time_row=False) + spec["data"]}

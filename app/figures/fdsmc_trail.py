@@ -34,8 +34,8 @@ from sim.fdsmc.engine import LABELS
 N_PIECES, BINS_TRAIL = 40, 250
 #: The FDSMC's phases in order, with their legend names, colours and dashes (:mod:`app.figures.style`).
 PHASES = ("reaching", "sliding", "linear")
-PHASE_STYLE = dict(zip(PHASES, zip(("FDSMC reaching the boundary", "FDSMC sliding, ω_r = ω_p",
-                                    "FDSMC linear, ω_r = −θ_re/T_c"), TRAIL_PHASE_COLOURS, TRAIL_PHASE_DASHES,
+PHASE_STYLE = dict(zip(PHASES, zip(("FDSMC reaching", "FDSMC sliding (ω_p)", "FDSMC linear (−θ_re/T_c)"),
+                                   TRAIL_PHASE_COLOURS, TRAIL_PHASE_DASHES,
                                    strict=True), strict=True))
 
 
@@ -99,7 +99,7 @@ def pieces(comparison: Any, n: int = N_PIECES) -> list[Piece]:
 def piece_traces(parts: list[Piece]) -> list[dict[str, Any]]:
     """One trace per piece (``meta.trail`` = its end time [s]); the first of each kind names the legend entry.
 
-    The first piece of a kind is named by its legend text (e.g. ``"FDSMC sliding, ω_r = ω_p"``),
+    The first piece of a kind is named by its legend text (e.g. ``"FDSMC sliding (ω_p)"``),
     the others ``"<run> <phase> trail"``.
     """
     out, seen = [], set()

@@ -83,7 +83,7 @@ def test_the_replay_draws_the_trail_progressively_without_console_errors(lecture
     assert pieces > 20 and points > 0  # the whole trail drawn before any replay
     names = page.evaluate(NAMES_JS)
     assert "FDSMC enters boundary layer" in names and "Conventional enters boundary layer" not in names
-    assert {"FDSMC reaching the boundary", "FDSMC linear, ω_r = −θ_re/T_c"} <= set(names)
+    assert {"FDSMC reaching", "FDSMC linear (−θ_re/T_c)"} <= set(names)
     page.locator(".updatemenu-button", has_text=f"▶ {list(SPEEDS)[2]}").click()  # 0.1×: ≈ 14 s
     page.wait_for_function(f"() => {{ const r = ({TRAIL_JS})(); return r[1] > 0 && r[1] < r[2] / 3; }}")
     early = page.evaluate(TRAIL_JS)
