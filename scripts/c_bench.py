@@ -1,7 +1,8 @@
 """Print the Cortex-M4F figures of the generated C controller: instructions per step, code size, doubles.
 
 Usage: ``.venv/bin/python scripts/c_bench.py [PRESET …] [--set section.field=value …]``
-(default: every shipped position-drive preset). For each preset the case is simulated, the C export
+(default: every shipped position-drive preset; ``--controller optimum``: the tracked optimum's
+module, whose code size includes its reference table). For each preset the case is simulated, the C export
 written (module, golden vectors), the float32 build cross-compiled with Debian's arm-none-eabi-gcc
 (``-mcpu=cortex-m4 -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2``) and the step run over the golden vectors
 under qemu-arm, counting every instruction of each ``fdsmc_step`` call (a static count of the step's
@@ -31,15 +32,16 @@ from sim.fdsmc.engine import compare  # noqa: E402
 BUDGET = 300
 
 
-def bench(preset: str, sets: list[str]) -> str:
-    """One line of figures for ``preset``."""
+def bench(preset: str, sets: list[str], controller: str = "fdsmc") -> str:
+    """One line of figures for ``preset`` (``controller``: the module's outer law, fdsmc or optimum)."""
     params = load_preset(preset, sets)
-    cmp = compare(params)
-    checks = run_checks(params, cmp.fdsmc) if cmp.fdsmc is not None else None
+    cmp = compare(params, ("fdsmc", "conventional") + (("optimum",) if controller == "optimum" else ()))
+    run = cmp.optimum if controller == "optimum" else cmp.fdsmc
+    checks = run_checks(params, run) if run is not None else None
     clean = checks is not None and not any(c.violated for c in checks)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        for name, text in c_files(cmp, checks, force=True).items():
+        for name, text in c_files(cmp, checks, force=True, controller=controller).items():
             (folder / name).write_text(text, encoding="utf-8")
         extra = () if clean else (accept_flag(folder),)
         obj = cross_compile(folder, extra)
@@ -56,12 +58,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("presets", nargs="*")
     ap.add_argument("--set", action="append", default=[], dest="sets")
+    ap.add_argument("--controller", choices=("fdsmc", "optimum"), default="fdsmc",
+                    help="outer law of the module (optimum: the tracked optimum's module)")
     args = ap.parse_args()
     if arm_compiler() is None:
         sys.exit("arm-none-eabi-gcc missing: run bash scripts/ensure_cc.sh")
     names = args.presets or [n for n in list_presets() if isinstance(load_preset(n), DriveParams)]
     for name in names:
-        print(bench(name, args.sets), flush=True)
+        print(bench(name, args.sets, args.controller), flush=True)
 
 
 if __name__ == "__main__":

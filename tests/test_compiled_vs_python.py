@@ -47,7 +47,13 @@ def _case(rng: np.random.Generator):
     p = dataclasses.replace(p, manoeuvre=dataclasses.replace(p.manoeuvre, theta_dem=theta,
                                                              T_m=round(T_min * float(rng.uniform(1.1, 2.5)), 4)))
     plant = dataclasses.replace(p, load=dataclasses.replace(p.load, J_L=p.load.J_L * float(rng.uniform(0.5, 2.0))))
-    return p, plant, CONTROLLERS[rng.integers(len(CONTROLLERS))]
+    ctrl_name = CONTROLLERS[rng.integers(len(CONTROLLERS))]
+    # the q-axis voltage-mismatch estimate on half the cases, against a motor whose flux is a few % off
+    T_dv = float(rng.choice([0.0, 2.0 * c.T_si]))
+    p = dataclasses.replace(p, controller=dataclasses.replace(p.controller, T_dv=T_dv))
+    plant = dataclasses.replace(plant, motor=dataclasses.replace(plant.motor, psi_pm=plant.motor.psi_pm
+                                                                 * float(rng.uniform(0.97, 1.03))))
+    return p, plant, ctrl_name
 
 
 def run_cases(seed: int, n: int) -> list[dict]:

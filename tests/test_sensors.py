@@ -22,9 +22,10 @@ from sim.fdsmc.design import design_drive, encoder_needed, predicted_noise
 from sim.fdsmc.engine import simulate
 
 IDEAL = ["sensors.encoder_cpr=0", "sensors.i_noise=0", "sensors.i_adc_bits=0"]
-#: The Siemens drive's loops at the torque limit (T_so = 1 ms, K recommended): a fixed case for the noise gain.
+#: The Siemens drive's loops at the torque limit (T_so = 1 ms, K recommended): a fixed case for the noise gain,
+#: with the paper's FDC (no q-axis voltage-mismatch estimate), which the closed form models.
 SIEMENS_LOOPS = ["controller.T_so_ms=1", "controller.T_salpha_ms=3", "controller.K=0.043075511186974044",
-                 "controller.T_c=T_a", "controller.alpha_max_rule=torque_limit"]
+                 "controller.T_c=T_a", "controller.alpha_max_rule=torque_limit", "controller.T_dv=0"]
 
 
 def test_encoder_reads_whole_counts_down_and_the_adc_rounds_and_clips():
@@ -84,7 +85,8 @@ def test_quantization_ripple_scales_with_the_count_and_sets_the_encoder_needed()
 def test_the_design_slows_the_observer_for_a_coarse_encoder_and_verifies_it_with_the_sensors():
     # 8192 counts on the D5065: at T_so = 1 ms the predicted ripple is above the 2 A criterion;
     # the design lengthens T_so/T_sα until it is not, and the simulation with the encoder agrees.
-    asked = load_preset("odrive_d5065_belt", ["controller.T_so_ms=1", "controller.T_salpha_ms=3"])
+    # (the closed form models the paper's FDC: without the q-axis voltage-mismatch estimate, T_dv = 0)
+    asked = load_preset("odrive_d5065_belt", ["controller.T_so_ms=1", "controller.T_salpha_ms=3", "controller.T_dv=0"])
     d = derive(asked)
     assert predicted_noise(asked, d).i_q_rms > 2.0
     dd = design_drive(asked)

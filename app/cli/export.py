@@ -1,7 +1,8 @@
-"""``python -m app export PRESET [--set …] --format FORMAT [-o PATH] [--force]``.
+"""``python -m app export PRESET [--set …] --format FORMAT [-o PATH] [--force] [--controller LAW]``.
 
 Writes the same files as the page's Export menu (:func:`app.exports.model.export_files`): for ``c``,
-PATH is a folder receiving ``fdsmc_controller.h`` and ``.c``; otherwise PATH is the file
+PATH is a folder receiving ``fdsmc_controller.h`` and ``.c`` (outer law ``--controller``: the FDSMC, or
+the tracked optimum with its designed move's reference table); otherwise PATH is the file
 (default: ``<name>.<format>`` here; the stock-drive formats ``<name>.odrive.json``,
 ``<name>.moteus.cfg``, ``<name>.vesc.xml``, ``<name>.setpoints.csv``). Every format is refused,
 naming the failed checks, when the simulated design is not clean; ``--force`` writes it with the
@@ -16,9 +17,10 @@ import sys
 from pathlib import Path
 
 from app.cli.main import add_preset_arguments
+from app.exports.c_module import LAWS
 from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
 from app.exports.drive_units import ANGLE_UNITS
-from app.exports.model import FORMATS, export_files
+from app.exports.model import FORMATS, c_law, export_files
 from app.io import atomic
 from app.io.numbers import parse_number
 from app.io.presets import load, load_with_plant
@@ -40,20 +42,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="write a design that is not clean, with the failed checks inside the file")
     p.add_argument("--angle-unit", choices=tuple(ANGLE_UNITS), default="rad",
                    help="angle unit of --format setpoints (default rad)")
+    p.add_argument("--controller", choices=LAWS, default="fdsmc",
+                   help="outer law of --format c: fdsmc (default) or optimum (the tracked minimum-energy optimum, "
+                        "its designed move only)")
     p.add_argument("--cycle-ms", metavar="MS",
                    help="cycle time of --format setpoints [ms] (default the drive's 1/f_s; 1 ms if continuous)")
 
 
-def case(params: DriveParams, fmt: str = "yaml") -> Comparison:
+def case(params: DriveParams, fmt: str = "yaml", controller: str = "fdsmc") -> Comparison:
     """Return the simulated case (the derivations alone when the manoeuvre is infeasible).
 
     The stock-drive formats and the HTML report also simulate the stock route and the tracked optimum
-    (their energies go into the file's header, the report's headline).
+    (their energies go into the file's header, the report's headline); the optimum's C module its run.
     """
     d = derive(params)
     if not d.profile.feasible:
         return Comparison(d, None, None, None, None)
-    return compare(params, COMPARATORS if fmt in DRIVE_FORMATS or fmt == "html" else CONTROLLERS, derived=d)
+    if fmt in DRIVE_FORMATS or fmt == "html":
+        return compare(params, COMPARATORS, derived=d)
+    return compare(params, CONTROLLERS + (("optimum",) if controller == "optimum" else ()), derived=d)
 
 
 def cycle_seconds(text: str | None) -> float | None:
@@ -88,8 +95,9 @@ def run(args: argparse.Namespace) -> int:
                              "simulate it with `python -m app simulate`, or move the values into motor/load")
     renamed = {k: v for k, v in (("name", args.name), ("source", args.source)) if v is not None}
     params = dataclasses.replace(params, **renamed)
-    options = ExportOptions(args.force, args.angle_unit, cycle_seconds(args.cycle_ms))
-    files = export_files(args.format, case(params, args.format), options)
+    c_law(args.format, args.controller)  # before the simulation: a wrong combination is refused at once
+    options = ExportOptions(args.force, args.angle_unit, cycle_seconds(args.cycle_ms), args.controller)
+    files = export_files(args.format, case(params, args.format, args.controller), options)
     if args.format == "c":
         folder = Path(args.output or ".")
         if folder.exists() and not folder.is_dir():

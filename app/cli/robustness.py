@@ -27,7 +27,14 @@ from app.io.plant_overrides import load_model_and_plant
 from app.io.sample_table import write_csv, write_parquet
 from app.io.study_inputs import parse_spreads
 from control.common.checks import ParameterError
-from sim.studies.robustness import METRICS, IncompleteRunError, RobustnessResult, robustness
+from sim.studies.robustness import (
+    CONTROLLERS,
+    METRICS,
+    STUDY_CONTROLLERS,
+    IncompleteRunError,
+    RobustnessResult,
+    robustness,
+)
 from sim.studies.runner import ExecutorError, RetryingPool
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
@@ -48,6 +55,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"Dask scheduler address tcp://HOST:PORT (or ${SCHEDULER_ENV})")
     p.add_argument("--cluster-timeout", type=float, default=60.0, metavar="S",
                    help="seconds the Dask cluster may have no worker before the run stops (default 60)")
+    p.add_argument("--controllers", default=",".join(CONTROLLERS), metavar="NAME[,NAME…]",
+                   help=f"controllers run on every sample, of {', '.join(STUDY_CONTROLLERS)} "
+                        f"(default {','.join(CONTROLLERS)}; optimum: the tracked minimum-energy move)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--csv", metavar="FILE", help="write one row per sample (drawn values and metrics)")
     p.add_argument("--parquet", metavar="FILE",
@@ -64,7 +74,7 @@ def _progress(done: int, total: int) -> None:
 def _print_table(summary: dict[str, Any]) -> None:
     nominal = " (one nominal run: no spread)" if summary.get("nominal_run") else ""
     print(f"{summary['samples']} samples in {summary['seconds']:.1f} s{nominal}")
-    for ctrl in ("fdsmc", "conventional"):
+    for ctrl in [c for c in STUDY_CONTROLLERS if c in summary]:
         e = summary[ctrl]
         print(f"\n{ctrl}: chatter probability {e['chatter_probability']:.3f}, "
               f"infeasible probability {e['infeasible_probability']:.3f}")
@@ -100,16 +110,20 @@ def _quiet_dask() -> None:
 def _compute(args: argparse.Namespace) -> RobustnessResult:
     params, plant = load_model_and_plant(args.preset, args.overrides)  # plant: the nominal plant
     spreads = parse_spreads(args.spread)
+    ctrl = tuple(c.strip() for c in args.controllers.split(","))
     if args.scheduler:
         from sim.studies.dask_runner import connect
 
         _quiet_dask()
         with connect(args.scheduler, args.cluster_timeout) as ex:
-            return robustness(params, spreads, args.samples, args.seed, ex, ex.workers, _progress, plant=plant)
+            return robustness(params, spreads, args.samples, args.seed, ex, ex.workers, _progress, plant=plant,
+                              controllers=ctrl)
     if args.workers == 1:
-        return robustness(params, spreads, args.samples, args.seed, None, 1, _progress, plant=plant)
+        return robustness(params, spreads, args.samples, args.seed, None, 1, _progress, plant=plant,
+                          controllers=ctrl)
     with RetryingPool(args.workers) as pool:
-        return robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant)
+        return robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant,
+                          controllers=ctrl)
 
 
 def _atomic(path: str, write: Callable[[str], None]) -> None:

@@ -34,12 +34,16 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
 
-from .c_source import LIMIT_CODE, SOURCE
+from .c_optimum import STATE_FIELDS, ReferenceTable, law_parts, optimum_constants, reference_table
+from .c_source import FDSMC_MOVE, LIMIT_CODE, SOURCE
 from .c_template import HEADER
 
 TOOL = "pmsm-commissioning (FDSMC)"
 #: File names of the generated module.
 HEADER_NAME, SOURCE_NAME = "fdsmc_controller.h", "fdsmc_controller.c"
+
+#: The outer laws the C module can run.
+LAWS = ("fdsmc", "optimum")
 
 #: Why a continuous-mode case has no C export.
 CONTINUOUS_REFUSED = ("controller.f_s = 'continuous' cannot be exported as C firmware: "
@@ -139,7 +143,7 @@ INPUT_KEYS: dict[str, str] = {
     "J_R": "motor.J_r", "T_SI": "controller.T_si", "T_SALPHA": "controller.T_salpha", "T_SO": "controller.T_so",
     "K_BL": "controller.K", "THETA_DEM": "manoeuvre.theta_dem", "T_M": "manoeuvre.T_m",
     "DELAY_SAMPLES": "controller.delay_samples", "V_DC": "controller.V_dc", "I_MAX": "controller.i_max",
-    "GAMMA_MAX": "motor.Gamma_max",
+    "GAMMA_MAX": "motor.Gamma_max", "T_DV": "controller.T_dv",
 }
 
 
@@ -206,6 +210,9 @@ def _sampling_constants(params: DriveParams, d: Derived) -> list[CConstant]:
     return k + [_input("V_DC", params, "DC link (0 = ideal inverter)"),
                 CConstant("U_MAX", u_max, "V", "|u_dq| limit V_dc/sqrt(3) (0 = none)"),
                 _input("I_MAX", params, "inverter current amplitude (0 = none)"),
+                _input("T_DV", params, "q-axis voltage-mismatch estimate's time constant (0 = none, the paper)"),
+                CConstant("VOLTAGE_MISMATCH", 1 if ctrl.T_dv > 0.0 else 0, "-",
+                          "1: u_q corrected by the q-axis voltage-mismatch estimate", integer=True),
                 _input("GAMMA_MAX", params, "motor torque limit (information)"),
                 CConstant("COUNTS_PER_REV", encoder_counts_per_rev(params), "1/rev",
                           "encoder counts per mechanical revolution", integer=True)]
@@ -248,11 +255,11 @@ def parameter_hash(params: DriveParams) -> str:
     return hashlib.sha256(text.encode("ascii")).hexdigest()[:16]
 
 
-def _gate_texts(v: Verdict, hash_value: str) -> dict[str, str]:
-    """Header placeholders of the verdict gate."""
+def _gate_texts(v: Verdict, hash_value: str, label: str = "FDSMC") -> dict[str, str]:
+    """Header placeholders of the verdict gate (``label``: the outer law whose run was checked)."""
     names = ", ".join(n for n, _ in v.failed)
     if v.clean:
-        verdict = "CLEAN -- the simulated FDSMC run of this design passed every check."
+        verdict = f"CLEAN -- the simulated {label} run of this design passed every check."
     else:
         verdict = ("UNVERIFIED" if not v.verified else "NOT CLEAN") + " -- this header stops the build (#error)" \
                   " unless FDSMC_ACCEPT_UNCLEAN is defined as FDSMC_PARAM_HASH. Failed checks:"
@@ -263,28 +270,51 @@ def _gate_texts(v: Verdict, hash_value: str) -> dict[str, str]:
             "failed": c_string(names), "error_text": c_string(error)}
 
 
+#: The outer law's line in the header: FDSMC, or the tracked optimum.
+LAW_TEXT = {False: "FDSMC, eqs. (41)-(46) of [1] (fdsmc_step).",
+            True: "tracked minimum-energy optimum with the FDSMC's terminal slide (fdsmc_step;\n"
+                  " *   control/fdsmc/terminal_slide.py): the reference table of the designed move only,\n"
+                  " *   FDSMC_REF_DELTA counts in FDSMC_T_M (fdsmc_set_move refuses others: FDSMC_ERR_TABLE)."}
+
+
 def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED,
-                      inputs: DriveParams | None = None) -> str:
+                      inputs: DriveParams | None = None, table: ReferenceTable | None = None) -> str:
     """Text of ``fdsmc_controller.h`` for the derived design ``d`` of ``params``.
 
     ``inputs``: the preset as entered, whose :func:`parameter_hash` the header carries (default ``params``;
-    the export passes the entered preset when ``params`` has θ_dem rounded to a count).
+    the export passes the entered preset when ``params`` has θ_dem rounded to a count). ``table``: the
+    tracked optimum's reference (:func:`app.exports.c_optimum.reference_table`) for its module; None: FDSMC.
     """
-    defines = "\n".join(_define(k) for k in controller_constants(params, d))
+    constants = controller_constants(params, d)
+    if table is not None:
+        constants += [CConstant(*k) for k in optimum_constants(params, d, table)]
+    defines = "\n".join(_define(k) for k in constants)
     h = parameter_hash(params if inputs is None else inputs)
+    optimum = table is not None
     return HEADER.substitute(tool=TOOL, name=c_string(params.name), source=c_string(params.source), schema=schema,
-                             constants=defines, hash_text=h, hash_value=f"0x{h}u", **_gate_texts(verdict, f"0x{h}u"))
+                             constants=defines, hash_text=h, hash_value=f"0x{h}u", law_text=LAW_TEXT[optimum],
+                             optimum=int(optimum), state_fields=STATE_FIELDS if optimum else "",
+                             **_gate_texts(verdict, f"0x{h}u", "tracked optimum" if optimum else "FDSMC"))
 
 
-def controller_source(params: DriveParams, d: Derived) -> str:
-    """Text of ``fdsmc_controller.c`` for the derived design ``d`` of ``params``."""
+def controller_source(params: DriveParams, d: Derived, table: ReferenceTable | None = None) -> str:
+    """Text of ``fdsmc_controller.c`` for the derived design ``d`` of ``params`` (``table``: the optimum's)."""
     so = scaled_observer(d)
+    law = (law_parts(table, c_literal) if table is not None else
+           {"set_move": FDSMC_MOVE, "outer_law": "", "outer_call": "sliding_mode(s, th_re, w, &S)", "law_init": ""})
     return SOURCE.substitute(name=c_string(params.name), design=design_initializer(params, d, so, c_literal),
-                             limit_code=LIMIT_CODE)
+                             limit_code=LIMIT_CODE, **law)
 
 
 def controller_files(params: DriveParams, d: Derived, schema: int, verdict: Verdict = UNVERIFIED,
-                     inputs: DriveParams | None = None) -> dict[str, str]:
-    """File name → text of the controller module (header and source); unverified unless ``verdict`` says."""
-    return {HEADER_NAME: controller_header(params, d, schema, verdict, inputs),
-            SOURCE_NAME: controller_source(params, d)}
+                     inputs: DriveParams | None = None, law: str = "fdsmc") -> dict[str, str]:
+    """File name → text of the controller module (header and source); unverified unless ``verdict`` says.
+
+    ``law``: ``"fdsmc"``, or ``"optimum"`` for the tracked optimum's module (its reference table from
+    :func:`control.fdsmc.optimum.tracked_move`, as the simulator's).
+    """
+    if law not in LAWS:
+        raise ParameterError(f"controller = {law!r} has no C module: allowed {', '.join(LAWS)}")
+    table = reference_table(params, d) if law == "optimum" else None
+    return {HEADER_NAME: controller_header(params, d, schema, verdict, inputs, table),
+            SOURCE_NAME: controller_source(params, d, table)}

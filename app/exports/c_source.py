@@ -6,7 +6,9 @@ sensor readings in, outer law (eqs. (41)–(46) of [1] or the comparator (62)), 
 (:data:`LIMIT_CODE`), the computation delay, then the observer update — the same formulas in the same
 order. The double build is that arithmetic operation for operation; the float build keeps the observer
 scaled, θ̂ − θ_dem in counts and uses reciprocals. ``$design`` is filled by
-:func:`app.exports.c_design.design_initializer`.
+:func:`app.exports.c_design.design_initializer`. The outer law is the module's: the FDSMC's
+(``$set_move`` = :data:`FDSMC_MOVE`, ``$outer_call`` = ``sliding_mode``, no ``$outer_law``/``$law_init``)
+or the tracked optimum's (:mod:`app.exports.c_optimum`).
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -167,6 +169,9 @@ void fdsmc_init(fdsmc_state *s, const fdsmc_params *p, fdsmc_count theta_r0)
     observer_reset(s, theta_r0);
     s->u_hold[0] = R_(0);
     s->u_hold[1] = R_(0);
+    for (int i = 0; i < 6; i++) {
+        s->dv_mem[i] = R_(0);
+    }
     s->omega_p = FDSMC_OMEGA_P;
     s->t_c = FDSMC_T_C;
     s->inv_t_c = R_(1) / FDSMC_T_C;
@@ -177,52 +182,9 @@ void fdsmc_init(fdsmc_state *s, const fdsmc_params *p, fdsmc_count theta_r0)
     s->status.saturated_samples = 0u;
     s->status.e_o_peak = R_(0);
     s->status.last_move = FDSMC_OK;
-}
+$law_init}
 
-/* Peak speed of eq. (60) of [1] for |dtheta| [rad] in T_m [s] (stable root); FDSMC_ERR_T_M if none. */
-static int32_t peak_speed(const fdsmc_params *p, fdsmc_real dtheta, fdsmc_real T_m, fdsmc_real *omega_p)
-{
-    const fdsmc_real at = p->alpha_max * T_m;
-    fdsmc_real disc = at * at - R_(2) * FDSMC_C_57 * p->alpha_max * dtheta;
-    if (disc < R_(0)) {
-        if (disc < -R_(FDSMC_DISC_TOL) * at * at) {
-            return FDSMC_ERR_T_M;
-        }
-        disc = R_(0); /* T_m = T_m,min up to rounding: the double root */
-    }
-    *omega_p = R_(2) * p->alpha_max * dtheta / (at + FDSMC_SQRT(disc));
-    return FDSMC_OK;
-}
-
-int32_t fdsmc_set_move(fdsmc_state *s, fdsmc_count theta_dem, fdsmc_real T_m)
-{
-    const fdsmc_params *p = s->p;
-    fdsmc_real omega_p = R_(0), t_c;
-    int32_t rc = FDSMC_OK;
-    if (s->status.fault != 0u) {
-        rc = FDSMC_ERR_FAULT;
-    } else if (!(T_m > R_(0) && T_m <= p->t_m_max)) {
-        rc = FDSMC_ERR_ARG;
-    } else {
-        rc = peak_speed(p, move_distance(s, theta_dem, 0), T_m, &omega_p);
-    }
-    t_c = p->t_c_fixed > R_(0) ? p->t_c_fixed : FDSMC_DIV(omega_p, p->alpha_max, p->inv_alpha_max); /* (59) */
-    if (rc == FDSMC_OK && omega_p > p->omega_p_max) {
-        rc = FDSMC_ERR_SPEED;
-    } else if (rc == FDSMC_OK && t_c < p->t_c_min) {
-        rc = FDSMC_ERR_T_C;
-    }
-    s->status.last_move = rc;
-    if (rc == FDSMC_OK) {
-        (void)move_distance(s, theta_dem, 1);
-        s->omega_p = omega_p;
-        s->t_c = t_c;
-        s->inv_t_c = R_(1) / t_c;
-        s->slope_end = t_c * omega_p;
-    }
-    return rc;
-}
-
+$set_move
 /* Demanded acceleration of eqs. (44)-(46) of [1], -alpha_max*sat(K*S); theta_re = theta_hat - theta_dem. */
 static fdsmc_real sliding_mode(const fdsmc_state *s, fdsmc_real theta_re, fdsmc_real omega_hat, fdsmc_real *S)
 {
@@ -237,6 +199,7 @@ static fdsmc_real sliding_mode(const fdsmc_state *s, fdsmc_real theta_re, fdsmc_
     return -s->p->alpha_max * x;
 }
 
+$outer_law
 /* u_d of eq. (9) with i_d,dem = 0 and u_q of eq. (14) of [1]; mL0 = M*Gamma_L_hat, mL1 = M*dGamma_L_hat/dt. */
 static void fdc_voltages(const fdsmc_params *p, fdsmc_real alpha_dem, fdsmc_real i_d, fdsmc_real i_q,
                          fdsmc_real w, fdsmc_real mL0, fdsmc_real mL1, fdsmc_real *u_d, fdsmc_real *u_q)
@@ -296,8 +259,11 @@ static void step(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real
         return;
     }
     estimates(s, &th_re, &w, &mL0, &mL1);
-    alpha_dem = conventional ? -p->g1 * th_re - p->g2 * w : sliding_mode(s, th_re, w, &S);
+    alpha_dem = conventional ? -p->g1 * th_re - p->g2 * w : $outer_call;
     fdc_voltages(p, alpha_dem, i_d, i_q, w, mL0, mL1, &u_d, &u_q);
+#if FDSMC_VOLTAGE_MISMATCH
+    u_q -= voltage_mismatch(s, i_q);
+#endif
 #if FDSMC_DELAY_SAMPLES == 1
     predict_currents(p, s->u_hold, i_d, i_q, w, &i_d0, &i_q0); /* where the new voltages start acting */
 #else
@@ -323,6 +289,13 @@ static void step(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real
 #else
     out->u_d = u_d;
     out->u_q = u_q;
+#endif
+#if FDSMC_VOLTAGE_MISMATCH
+    s->dv_mem[0] = i_d; /* this call's readings and speed, and the voltages applied until the next */
+    s->dv_mem[1] = i_q;
+    s->dv_mem[2] = w;
+    s->dv_mem[3] = out->u_d;
+    s->dv_mem[4] = out->u_q;
 #endif
     out->theta_re = th_re;
     out->omega_hat = w;
@@ -394,12 +367,73 @@ static int32_t limit_voltage(const fdsmc_params *p, fdsmc_real *u_d, fdsmc_real 
     return sat;
 }
 
-#if FDSMC_DELAY_SAMPLES == 1
-/* Currents [A] at the end of the sample now running, with the held voltages u_hold (computation delay). */
+#if FDSMC_DELAY_SAMPLES == 1 || FDSMC_VOLTAGE_MISMATCH
+/* Currents [A] one sample after (i_d, i_q) with the voltages u held (eqs. (1)-(2) of [1]). */
 static void predict_currents(const fdsmc_params *p, const fdsmc_real *u, fdsmc_real i_d, fdsmc_real i_q,
                              fdsmc_real w, fdsmc_real *i_d1, fdsmc_real *i_q1)
 {
     *i_d1 = p->phi_d * i_d + p->gam_d * (p->b * w * i_q + p->f * u[0]);
     *i_q1 = p->phi_q * i_q + p->gam_q * (p->g * u[1] - (p->c * i_d + p->e) * w);
 }
+#endif
+
+#if FDSMC_VOLTAGE_MISMATCH
+/* q-axis voltage-mismatch estimate of control/fdsmc/fdc.py (not in [1]), updated with this call's i_q [A]:
+ * dv += beta*((i_q - i_q predicted from the last call's readings and applied voltages)/(gam_q*G) - dv) [V]. */
+static fdsmc_real voltage_mismatch(fdsmc_state *s, fdsmc_real i_q)
+{
+    const fdsmc_params *p = s->p;
+    fdsmc_real i_d1, i_q1;
+    predict_currents(p, &s->dv_mem[3], s->dv_mem[0], s->dv_mem[1], s->dv_mem[2], &i_d1, &i_q1);
+    (void)i_d1;
+    s->dv_mem[5] = s->dv_mem[5] + p->beta_dv * (FDSMC_DIV(i_q - i_q1, p->gain_dv, p->inv_gain_dv) - s->dv_mem[5]);
+    return s->dv_mem[5];
+}
 #endif"""
+
+#: fdsmc_set_move of the FDSMC module: the profile of eqs. (59)-(60) computed on the target.
+FDSMC_MOVE = """\
+/* Peak speed of eq. (60) of [1] for |dtheta| [rad] in T_m [s] (stable root); FDSMC_ERR_T_M if none. */
+static int32_t peak_speed(const fdsmc_params *p, fdsmc_real dtheta, fdsmc_real T_m, fdsmc_real *omega_p)
+{
+    const fdsmc_real at = p->alpha_max * T_m;
+    fdsmc_real disc = at * at - R_(2) * FDSMC_C_57 * p->alpha_max * dtheta;
+    if (disc < R_(0)) {
+        if (disc < -R_(FDSMC_DISC_TOL) * at * at) {
+            return FDSMC_ERR_T_M;
+        }
+        disc = R_(0); /* T_m = T_m,min up to rounding: the double root */
+    }
+    *omega_p = R_(2) * p->alpha_max * dtheta / (at + FDSMC_SQRT(disc));
+    return FDSMC_OK;
+}
+
+int32_t fdsmc_set_move(fdsmc_state *s, fdsmc_count theta_dem, fdsmc_real T_m)
+{
+    const fdsmc_params *p = s->p;
+    fdsmc_real omega_p = R_(0), t_c;
+    int32_t rc = FDSMC_OK;
+    if (s->status.fault != 0u) {
+        rc = FDSMC_ERR_FAULT;
+    } else if (!(T_m > R_(0) && T_m <= p->t_m_max)) {
+        rc = FDSMC_ERR_ARG;
+    } else {
+        rc = peak_speed(p, move_distance(s, theta_dem, 0), T_m, &omega_p);
+    }
+    t_c = p->t_c_fixed > R_(0) ? p->t_c_fixed : FDSMC_DIV(omega_p, p->alpha_max, p->inv_alpha_max); /* (59) */
+    if (rc == FDSMC_OK && omega_p > p->omega_p_max) {
+        rc = FDSMC_ERR_SPEED;
+    } else if (rc == FDSMC_OK && t_c < p->t_c_min) {
+        rc = FDSMC_ERR_T_C;
+    }
+    s->status.last_move = rc;
+    if (rc == FDSMC_OK) {
+        (void)move_distance(s, theta_dem, 1);
+        s->omega_p = omega_p;
+        s->t_c = t_c;
+        s->inv_t_c = R_(1) / t_c;
+        s->slope_end = t_c * omega_p;
+    }
+    return rc;
+}
+"""

@@ -17,6 +17,7 @@ HEADER = Template("""\
  * $tool. Do not edit: regenerate with `python -m app export PRESET --format c`.
  *
  * Drive:  $name
+ * Outer law: $law_text
  * Source: $source
  * Parameter hash: $hash_text (FDSMC_PARAM_HASH; the YAML/JSON export of the same inputs carries
  * the same hash). Schema $schema. SI units (rad, s, A, V, N*m, kg*m^2) unless a name says otherwise.
@@ -101,6 +102,7 @@ typedef double fdsmc_real;
 typedef int32_t fdsmc_count;
 
 #define FDSMC_SCHEMA $schema
+#define FDSMC_OUTER_LAW_OPTIMUM $optimum /* 1: fdsmc_step runs the tracked optimum, 0: the FDSMC */
 $constants
 
 /* fdsmc_set_move() results and fdsmc_status.fault bits. */
@@ -110,6 +112,7 @@ $constants
 #define FDSMC_ERR_SPEED (-3) /* omega_p > FDSMC_OMEGA_P_MAX (base speed or inverter voltage) */
 #define FDSMC_ERR_T_C (-4)   /* T_c < FDSMC_T_C_MIN: sloped segment poorly damped (move too short) */
 #define FDSMC_ERR_FAULT (-5) /* a fault is latched: fdsmc_init() first */
+#define FDSMC_ERR_TABLE (-6) /* tracked-optimum module: not the designed move of its reference table */
 #define FDSMC_FAULT_CURRENT 1u    /* i_d or i_q not finite, or |i_dq| > FDSMC_I_FAULT */
 #define FDSMC_FAULT_INNOVATION 2u /* |theta_r - theta_hat| > FDSMC_E_O_MAX */
 #define FDSMC_FAULT_STATE 4u      /* a voltage or estimate not finite or beyond range */
@@ -120,6 +123,7 @@ typedef struct {
     fdsmc_real a, b, c, d, e, f, g, inv_f, inv_g, h, k, m, three_inv_t_si, three_inv_t_salpha;
     fdsmc_real g1, g2, f_s, f_s2, f_s3, t_s2, j_r;
     fdsmc_real u_max, u_max2, i_max, i_max2, phi_d, inv_gam_d, gam_d, phi_q, inv_gam_q, gam_q;
+    fdsmc_real beta_dv, gain_dv, inv_gain_dv;
     fdsmc_real i_fault2, u_fault2, e_o_max_counts;
     fdsmc_real rad_per_count, counts_per_rad;
     fdsmc_real phi[4][4], gamma[4], l[4];
@@ -151,12 +155,14 @@ typedef struct {
     double x[4];            /* theta_hat [rad], omega_hat [rad/s], Gamma_L_hat [N*m], its rate [N*m/s] */
 #endif
     fdsmc_real u_hold[2];   /* voltages computed at the previous call [V] */
+    fdsmc_real dv_mem[6];   /* last call's i_d, i_q [A], omega_hat [rad/s], applied u_d, u_q [V]; the q-axis
+                               voltage-mismatch estimate [V] (FDSMC_VOLTAGE_MISMATCH) */
     fdsmc_real omega_p;     /* the move's peak speed, eq. (60) [rad/s] */
     fdsmc_real t_c;         /* its sliding-mode time constant, eq. (59) or fixed [s] */
     fdsmc_real inv_t_c;     /* 1/t_c [1/s] */
     fdsmc_real slope_end;   /* t_c*omega_p: |theta_re| where the sloped segment starts [rad] */
     fdsmc_status status;
-} fdsmc_state;
+$state_fields} fdsmc_state;
 
 /* One sample's outputs: the voltages to apply [V] and diagnostics: theta_hat - theta_dem [rad],
  * omega_hat [rad/s], Gamma_L_hat [N*m], acceleration demand [rad/s^2], switching function S
@@ -180,7 +186,7 @@ void fdsmc_init(fdsmc_state *s, const fdsmc_params *p, fdsmc_count theta_r0);
 /* Start a minimum-energy move to theta_dem [counts] lasting T_m [s] (call at rest). */
 int32_t fdsmc_set_move(fdsmc_state *s, fdsmc_count theta_dem, fdsmc_real T_m);
 
-/* One FDSMC sample: sliding-mode outer loop + FDC inner loops + limits + observer update. */
+/* One sample of the module's outer law (see "Outer law" above) + FDC inner loops + limits + observer update. */
 void fdsmc_step(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real i_q, fdsmc_output *out);
 
 /* The conventional comparator (eq. (62) of [1], sign-corrected) with the same inner loops. */

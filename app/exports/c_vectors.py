@@ -93,8 +93,10 @@ def _rows(values: np.ndarray) -> str:
     return ",\n".join("    {" + ", ".join(f"V_({c_literal(v)})" for v in row) + "}" for row in values)
 
 
-def vector_header(params: DriveParams) -> str:
+def vector_header(params: DriveParams, controller: str = "fdsmc") -> str:
     """Text of ``fdsmc_vectors.h``: the simulator's controller inputs and outputs of the first samples.
+
+    ``controller``: the module's outer law (``"fdsmc"`` or ``"optimum"``), whose run is recorded.
 
     Raises
     ------
@@ -103,7 +105,7 @@ def vector_header(params: DriveParams) -> str:
     """
     sim_params, count = count_params(params)
     n = min(VECTOR_SAMPLES, time_grid(sim_params, 1, 0.0, 1).n_steps)
-    trace = simulate(sim_params, "fdsmc", max_points=time_grid(sim_params, 1, 0.0, 1).n_steps + 1).trace
+    trace = simulate(sim_params, controller, max_points=time_grid(sim_params, 1, 0.0, 1).n_steps + 1).trace
     if trace.t.size < n:
         raise ParameterError(f"the simulated run stops after {trace.t.size} samples: no test vectors")
     noise = sensors.noise_table(sim_params.sensors)
@@ -123,7 +125,8 @@ def vector_header(params: DriveParams) -> str:
             f"static const fdsmc_real fdsmc_vec_u[{n}][2] = {{\n{_rows(u)}\n}};\n#endif\n")
 
 
-def c_files(cmp: Comparison, checks: Sequence | None, force: bool = False) -> dict[str, str]:
+def c_files(cmp: Comparison, checks: Sequence | None, force: bool = False,
+            controller: str = "fdsmc") -> dict[str, str]:
     """File name → text of the C export of a simulated case: module, golden vectors, host test program.
 
     Parameters
@@ -131,9 +134,12 @@ def c_files(cmp: Comparison, checks: Sequence | None, force: bool = False) -> di
     cmp : Comparison
         The simulated case (``cmp.derived.params`` are the inputs).
     checks : sequence of Constraint or None
-        ``sim.fdsmc.design.run_checks(params, cmp.fdsmc)`` (None when there is no FDSMC run).
+        ``sim.fdsmc.design.run_checks(params, run)`` of the module's law's run (None when there is no run).
     force : bool
         Export a design that is not clean (the header still stops the build unless accepted).
+    controller : str
+        The module's outer law: ``"fdsmc"`` (its run ``cmp.fdsmc``) or ``"optimum"`` (``cmp.optimum``,
+        the tracked optimum's module, :mod:`app.exports.c_optimum`).
 
     Raises
     ------
@@ -144,14 +150,15 @@ def c_files(cmp: Comparison, checks: Sequence | None, force: bool = False) -> di
     if entered.controller.is_continuous:  # before the counted case, which needs a sample rate for its encoder
         raise ParameterError(CONTINUOUS_REFUSED)
     params, _ = count_params(entered)  # the firmware's demand is a whole count
-    verdict: Verdict = verdict_of(checks if cmp.fdsmc is not None else None)
+    run = cmp.optimum if controller == "optimum" else cmp.fdsmc
+    verdict: Verdict = verdict_of(checks if run is not None else None)
     if not verdict.clean and not force:
         names = ", ".join(f"{n} ({t})" for n, t in verdict.failed)
         raise ParameterError(f"the design is not clean: {names}; export with --force to write it anyway "
                              "(the header then stops the build unless FDSMC_ACCEPT_UNCLEAN is defined)")
-    files = controller_files(params, derive(params), SCHEMA, verdict, inputs=entered)
+    files = controller_files(params, derive(params), SCHEMA, verdict, inputs=entered, law=controller)
     assert HEADER_NAME in files
-    if cmp.fdsmc is not None:
-        files[VECTORS_NAME] = vector_header(entered)
+    if run is not None:
+        files[VECTORS_NAME] = vector_header(entered, controller)
         files[TEST_NAME] = TEST_PROGRAM
     return files

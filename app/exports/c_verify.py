@@ -9,7 +9,8 @@ the seeded noise and ADC of :mod:`sim.common.sensors`), sets the move with the d
 and the simulator runs on the same demand and encoder (:func:`count_params`). Agreement = max |C − simulator|
 / max |simulator| over the run, per signal (error relative to the signal's peak), at every sample.
 
-``python -m app.exports.c_verify`` prints the figures for the paper preset and the real-motor presets.
+``python -m app.exports.c_verify [--controller optimum]`` prints the figures for the paper preset and the
+real-motor presets (of the FDSMC's module, or the tracked optimum's).
 """
 
 from __future__ import annotations
@@ -72,10 +73,13 @@ def readings(params: DriveParams, k: int, theta: float, i_d: float, i_q: float,
             sensors.adc_current(i_q, noise[1, j], se.i_noise, i_step, se.i_adc_range))
 
 
-def write_module(folder: Path, params: DriveParams, verdict: Verdict | None = None) -> None:
-    """Generate ``fdsmc_controller.h``/``.c`` for ``params`` into ``folder`` (unverified unless ``verdict``)."""
+def write_module(folder: Path, params: DriveParams, verdict: Verdict | None = None, law: str = "fdsmc") -> None:
+    """Generate ``fdsmc_controller.h``/``.c`` for ``params`` into ``folder`` (unverified unless ``verdict``).
+
+    ``law``: the module's outer law, ``"fdsmc"`` or ``"optimum"`` (the tracked optimum's module).
+    """
     kw = {} if verdict is None else {"verdict": verdict}
-    for name, text in controller_files(params, derive(params), SCHEMA, **kw).items():
+    for name, text in controller_files(params, derive(params), SCHEMA, law=law, **kw).items():
         (folder / name).write_text(text, encoding="utf-8")
 
 
@@ -114,10 +118,13 @@ class CModule:
         observer = ([("n0", i32), ("f0", real), ("z", real * 3)] if single
                     else [("theta_dem_rad", ctypes.c_double), ("x", ctypes.c_double * 4)])
 
+        # The tracked optimum's module appends its move clock (the FDSMC's struct is the prefix).
+        clock = ([("ref_k", u32)] if single else [("ref_t", ctypes.c_double), ("ref_start_rad", ctypes.c_double)])
+
         class State(ctypes.Structure):
             _fields_ = [("p", ctypes.c_void_p), ("theta_dem", i32), *observer, ("u_hold", real * 2),
-                        ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
-                        ("status", Status)]
+                        ("dv_mem", real * 6), ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
+                        ("status", Status), *clock, ("ref_on", i32)]
 
         class Output(ctypes.Structure):
             _fields_ = [("u_d", real), ("u_q", real), ("theta_re", real), ("omega_hat", real),
@@ -143,7 +150,9 @@ def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller:
     """Plant states [i_d, i_q, θ_r, ω_r, E_f, E_cu, E_el, …] at every sample, C module in the loop.
 
     ``params`` as :func:`count_params` returns them; the move is set at run time (``fdsmc_set_move``
-    to θ_dem in counts, in T_m); the module reads the sensors of :func:`readings`.
+    to θ_dem in counts, in T_m); the module reads the sensors of :func:`readings`. ``controller``:
+    ``"conventional"`` runs ``fdsmc_step_conventional``, else ``fdsmc_step`` (the module's outer law:
+    the FDSMC, or the tracked optimum in its module).
     """
     m = CModule(lib, single)
     state, out = m.new_state(0), m.Output()
@@ -151,7 +160,7 @@ def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller:
     rc = lib.fdsmc_set_move(ctypes.byref(state), count, params.manoeuvre.T_m)
     if rc != 0:
         raise RuntimeError(f"fdsmc_set_move refused the designed move: status {rc}")
-    step = lib.fdsmc_step if controller == "fdsmc" else lib.fdsmc_step_conventional
+    step = lib.fdsmc_step_conventional if controller == "conventional" else lib.fdsmc_step
     plant, noise = PlantInTheLoop(params), sensors.noise_table(params.sensors)
     rows = np.zeros((plant.n_samples, len(plant.x)))
     for k in range(plant.n_samples):
@@ -173,11 +182,14 @@ def agreement(params: DriveParams, rows: np.ndarray, controller: str = "fdsmc") 
 
 
 def measure(params: DriveParams, single: bool, controller: str = "fdsmc") -> dict[str, float]:
-    """Generate, compile, run and compare one build for ``params`` (demand rounded to a count)."""
+    """Generate, compile, run and compare one build for ``params`` (demand rounded to a count).
+
+    ``controller`` ``"optimum"`` generates the tracked optimum's module.
+    """
     params, _ = count_params(params)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        write_module(folder, params)
+        write_module(folder, params, law="optimum" if controller == "optimum" else "fdsmc")
         return agreement(params, closed_loop(build(folder, single), single, params, controller), controller)
 
 
@@ -193,29 +205,39 @@ def replay(folder: Path, single: bool) -> float:
     return float(out.split("peak |u| = ")[1].split()[0])
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     """Print closed-loop agreement (both builds) and the golden-vector replay, paper and real-motor presets.
 
-    The real-motor presets run with their own sensors (encoder, current noise, ADC).
+    The real-motor presets run with their own sensors (encoder, current noise, ADC). ``--controller
+    optimum``: the tracked optimum's module (the paper drive with K = 0.3 and limits instead of K = 1000).
     """
+    import argparse
+
     from app.exports.c_vectors import c_files  # the vectors module imports this one
     from sim.fdsmc.design import run_checks
     from sim.fdsmc.engine import compare
 
-    cases = [("paper, K = 1000", "paper_12kw_pmsm", []), ("paper, K = 0.3", "paper_12kw_pmsm", ["controller.K=0.3"])]
+    ap = argparse.ArgumentParser(prog="python -m app.exports.c_verify", description=main.__doc__.splitlines()[0])
+    ap.add_argument("--controller", choices=("fdsmc", "optimum"), default="fdsmc")
+    law = ap.parse_args(argv).controller
+    limits = ["controller.K=0.3", "controller.delay_samples=1", "controller.V_dc=300", "controller.i_max=40"]
+    cases = ([("paper, K = 1000", "paper_12kw_pmsm", [])] if law == "fdsmc" else
+             [("paper, K = 0.3, limits", "paper_12kw_pmsm", limits)])
+    cases += [("paper, K = 0.3", "paper_12kw_pmsm", ["controller.K=0.3"])]
     cases += [(n, n, []) for n in list_presets()
               if n != "paper_12kw_pmsm" and isinstance(load_preset(n), DriveParams)]
     for label, preset, sets in cases:
         params = load_preset(preset, sets)
-        cmp = compare(params)
+        cmp = compare(params, ("fdsmc", "conventional", "optimum") if law == "optimum" else ("fdsmc", "conventional"))
+        run = cmp.optimum if law == "optimum" else cmp.fdsmc
         with tempfile.TemporaryDirectory() as tmp:
-            for name, text in c_files(cmp, run_checks(params, cmp.fdsmc), force=True).items():
+            for name, text in c_files(cmp, run_checks(params, run), force=True, controller=law).items():
                 (Path(tmp) / name).write_text(text, encoding="utf-8")
             same = [replay(Path(tmp), single) for single in (False, True)]
         for single in (False, True):
-            err = measure(params, single)
+            err = measure(params, single, law)
             text = "  ".join(f"{k} {v:.1e}" for k, v in err.items())
-            print(f"{label:20s} {'float32' if single else 'double':7s} closed loop: {text}; same readings: "
+            print(f"{label:22s} {'float32' if single else 'double':7s} closed loop: {text}; same readings: "
                   f"u {same[single]:.1e}", flush=True)
 
 

@@ -35,11 +35,13 @@ class ExportOptions:
     force : bool              Write a design that is not clean, with the failed checks inside.
     angle_unit : str          Angle unit of the setpoint table: rad, deg or rev.
     cycle_s : float | None    Cycle time of the setpoint table [s]; None: the drive's 1/f_s.
+    controller : str          Outer law of the C module: ``"fdsmc"`` or ``"optimum"`` (the tracked optimum).
     """
 
     force: bool = False
     angle_unit: str = "rad"
     cycle_s: float | None = None
+    controller: str = "fdsmc"
 
 
 def drive_file(fmt: str, cmp: Comparison, failed: Sequence[Constraint], stem: str,

@@ -26,6 +26,7 @@ Files are named after the case's ``name``; no date is written, so exports are re
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import re
@@ -36,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from app.exports.c_module import TOOL
+from app.exports.c_module import LAWS, TOOL
 from app.exports.c_vectors import c_files
 from app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
 from app.exports.provenance import check_text, failed_checks, gate, verdict_lines
@@ -47,7 +48,7 @@ from app.io.units import SI_UNITS
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from sim.fdsmc.checks import run_checks
-from sim.fdsmc.engine import Comparison
+from sim.fdsmc.engine import Comparison, simulate
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 FORMATS = ("yaml", "json", "c", "csv", "html") + tuple(DRIVE_FORMATS)
@@ -190,6 +191,29 @@ def _warned(fmt: str, text: str, failed: list) -> str:
     return text
 
 
+def c_law(fmt: str, controller: str) -> str:
+    """Return the C module's outer law of ``controller`` (``fdsmc`` for every other format's default).
+
+    Raises
+    ------
+    ParameterError
+        For a law without a C module, or ``optimum`` with a format other than ``c``.
+    """
+    if controller not in LAWS:
+        raise ParameterError(f"controller = {controller!r} has no C module: allowed {', '.join(LAWS)}")
+    if controller != "fdsmc" and fmt != "c":
+        raise ParameterError(f"controller = {controller!r} applies to the C module only: allowed with format c "
+                             f"(format {fmt!r} writes the FDSMC design)")
+    return controller
+
+
+def with_optimum_run(cmp: Comparison) -> Comparison:
+    """Return the case with the tracked optimum simulated (as it is, when it has one or no run at all)."""
+    if cmp.optimum is not None or cmp.fdsmc is None:
+        return cmp
+    return dataclasses.replace(cmp, optimum=simulate(cmp.derived.params, "optimum", derived=cmp.derived))
+
+
 def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPTIONS) -> dict[str, bytes]:
     """File name → content of one export format for the case ``cmp`` (see the module doc).
 
@@ -202,14 +226,18 @@ def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPT
     """
     if fmt not in FORMATS:
         raise ParameterError(f"format = {fmt!r} is not allowed: one of {', '.join(FORMATS)}")
-    failed = gate(fmt, cmp, options.force)
+    law = c_law(fmt, options.controller)
+    if law == "optimum":
+        cmp = with_optimum_run(cmp)
+    failed = gate(fmt, cmp, options.force, law)
     stem = safe_stem(cmp.derived.params.name)
     if fmt in DRIVE_FORMATS:
         name, text = drive_file(fmt, cmp, failed, stem, options)
         return {name: text.encode("utf-8")}
     if fmt == "c":  # the gate above has refused an unclean design unless forced; the header gates the build
-        checks = run_checks(cmp.derived.params, cmp.fdsmc) if cmp.fdsmc is not None else None
-        files = c_files(cmp, checks, force=True)
+        run = cmp.optimum if law == "optimum" else cmp.fdsmc
+        checks = run_checks(cmp.derived.params, run) if run is not None else None
+        files = c_files(cmp, checks, force=True, controller=law)
         return {name: _warned(fmt, text, failed).encode("utf-8") for name, text in files.items()}
     if fmt == "html":
         from app.exports.html import html_report  # plotly: imported only when a report is made
@@ -222,7 +250,8 @@ def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPT
 def export_download(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPTIONS) -> tuple[str, bytes]:
     """Return one downloadable file: the single export file, or a zip of the C module's header and source.
 
-    The zip is named ``<name>_fdsmc_controller.zip``.
+    The zip is named ``<name>_fdsmc_controller.zip`` (the tracked optimum's module:
+    ``<name>_optimum_controller.zip``).
     """
     files = export_files(fmt, cmp, options)
     if len(files) == 1:
@@ -232,4 +261,5 @@ def export_download(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_
         for name, content in files.items():
             info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))  # reproducible bytes
             zf.writestr(info, content, zipfile.ZIP_DEFLATED)
-    return f"{safe_stem(cmp.derived.params.name)}_fdsmc_controller.zip", buf.getvalue()
+    law = "optimum" if options.controller == "optimum" else "fdsmc"
+    return f"{safe_stem(cmp.derived.params.name)}_{law}_controller.zip", buf.getvalue()

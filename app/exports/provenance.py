@@ -46,15 +46,19 @@ def parameter_hash(params: object) -> str:
     return hashlib.sha256(text.encode("ascii")).hexdigest()[:16]
 
 
-def failed_checks(cmp: Comparison) -> list[Constraint]:
-    """Return the violated checks of the simulated FDSMC run (empty: the design is clean)."""
+def failed_checks(cmp: Comparison, controller: str = "fdsmc") -> list[Constraint]:
+    """Return the violated checks of the simulated run (empty: the design is clean).
+
+    The FDSMC's run, or with ``controller`` ``"optimum"`` the tracked optimum's (its C module's verdict).
+    """
     params = cmp.derived.params
-    if cmp.fdsmc is None:
+    run = cmp.optimum if controller == "optimum" else cmp.fdsmc
+    if run is None:
         pr = cmp.derived.profile
         return [Constraint("T_m", params.manoeuvre.T_m, pr.T_m_min, "s", True,
                            f"The manoeuvre is infeasible: T_m = {params.manoeuvre.T_m:g} s < "
                            f"T_m,min = {pr.T_m_min:.4g} s, nothing was simulated.")]
-    return [c for c in run_checks(params, cmp.fdsmc) if c.violated]
+    return [c for c in run_checks(params, run) if c.violated]
 
 
 def check_text(c: Constraint) -> str:
@@ -62,13 +66,14 @@ def check_text(c: Constraint) -> str:
     return f"{c.name}: {c.value:.4g} {c.unit} (limit {c.limit:.4g} {c.unit}) — {c.text.rstrip('.')}"
 
 
-def gate(fmt: str, cmp: Comparison, force: bool) -> list[Constraint]:
-    """Return the failed checks; raise :class:`ExportRefusedError` naming them unless ``force``."""
-    failed = failed_checks(cmp)
+def gate(fmt: str, cmp: Comparison, force: bool, controller: str = "fdsmc") -> list[Constraint]:
+    """Return the failed checks of ``controller``'s run; raise :class:`ExportRefusedError` naming them unless force."""
+    failed = failed_checks(cmp, controller)
     if failed and not force:
         names = "; ".join(check_text(c) for c in failed)
+        run = " (the tracked optimum's run)" if controller == "optimum" else ""
         raise ExportRefusedError(f"export --format {fmt} refused: the design of {cmp.derived.params.name!r} is not "
-                                 f"clean — {names}. Fix the design (python -m app design …) or export with "
+                                 f"clean{run} — {names}. Fix the design (python -m app design …) or export with "
                                  "--force to write it with these warnings inside")
     return failed
 

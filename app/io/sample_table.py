@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from app.io.atomic import write_atomic, write_atomic_text
-from sim.studies.robustness import CONTROLLERS, METRICS, RobustnessResult
+from sim.studies.robustness import METRICS, RobustnessResult
 
 #: SI unit of each per-sample column, by the key's last part (plant fields and metrics).
 UNITS: dict[str, str] = {
@@ -32,8 +32,8 @@ FLAGS = ("chatter", "infeasible")
 def columns(res: RobustnessResult) -> list[tuple[str, str]]:
     """(column name, SI unit) of the table, in order."""
     cols = [(k, UNITS.get(k.split(".")[-1], "")) for k in res.values]
-    cols += [(f"{c}.{m}", UNITS[m]) for c in CONTROLLERS for m in (*METRICS, *FLAGS)]
-    return cols + [("fdsmc.saving_friction_pct", "%")]
+    cols += [(f"{c}.{m}", UNITS[m]) for c in res.controllers for m in (*METRICS, *FLAGS)]
+    return cols + ([("fdsmc.saving_friction_pct", "%")] if _saving(res) else [])
 
 
 def rows(res: RobustnessResult) -> list[list[Any]]:
@@ -41,9 +41,14 @@ def rows(res: RobustnessResult) -> list[list[Any]]:
     out = []
     for i, r in enumerate(res.runs):
         drawn = [float(res.values[k][i]) for k in res.values]
-        metrics = [r[c][m] for c in CONTROLLERS for m in (*METRICS, *FLAGS)]
-        out.append(drawn + metrics + [r["fdsmc"].get("saving_friction_pct")])
+        metrics = [r[c][m] for c in res.controllers for m in (*METRICS, *FLAGS)]
+        out.append(drawn + metrics + ([r["fdsmc"].get("saving_friction_pct")] if _saving(res) else []))
     return out
+
+
+def _saving(res: RobustnessResult) -> bool:
+    """Whether the table has the FDSMC's friction saving (both controllers of [1] ran)."""
+    return {"fdsmc", "conventional"} <= set(res.controllers)
 
 
 def write_csv(path: str | Path, res: RobustnessResult) -> None:

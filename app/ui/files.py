@@ -41,6 +41,9 @@ EXPORTS = {
     "Setpoint table (CSV)": "setpoints",
 }
 
+#: Export label → (format, controller) of the exports that take another outer law: the tracked optimum's C module.
+LAW_EXPORTS = {"C controller module, tracked optimum (.h + .c, zip)": ("c", "optimum")}
+
 
 class ExportRefusedError(ValueError):
     """An export that would not describe the inputs shown; the message says why."""
@@ -126,15 +129,16 @@ class FilesPanel:
                                           hint="Write a design whose simulated run fails a check, with the failed "
                                                "checks inside the file (the CLI's --force)")
             self.buttons = {}
-            for label, fmt in EXPORTS.items():
+            choices = {label: (fmt, "fdsmc") for label, fmt in EXPORTS.items()} | LAW_EXPORTS
+            for label, (fmt, law) in choices.items():
                 button = gui.add_button(label, icon=viser.Icon.DOWNLOAD)
-                button.on_click(lambda _, fmt=fmt: self._export(fmt))
+                button.on_click(lambda _, fmt=fmt, law=law: self._export(fmt, law))
                 self.buttons[label] = button
 
-    def _export(self, fmt: str) -> None:
+    def _export(self, fmt: str, controller: str = "fdsmc") -> None:
         try:
             name, content = export_download(fmt, renamed(self._state(), self.name.value, self.source.value),
-                                            ExportOptions(force=bool(self.force.value)))
+                                            ExportOptions(force=bool(self.force.value), controller=controller))
         except (ExportRefusedError, ParameterError) as exc:
             self._client.add_notification("Not exported", str(exc), color="yellow", auto_close_seconds=12.0)
             return
@@ -155,4 +159,5 @@ class FilesPanel:
         self.name.value, self.source.value = params.name, params.source
 
 
-__all__ = ["EXPORTS", "ExportRefusedError", "FilesPanel", "parse_upload", "renamed", "safe_stem", "uncommitted"]
+__all__ = ["EXPORTS", "LAW_EXPORTS", "ExportRefusedError", "FilesPanel", "parse_upload", "renamed", "safe_stem",
+           "uncommitted"]

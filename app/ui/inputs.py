@@ -37,7 +37,7 @@ FIELDS: tuple[Field, ...] = (
     Field("motor", "L_d", "inductance"), Field("motor", "L_q", "inductance"), Field("motor", "J_r", "inertia"),
     Field("load", "J_L", "inertia"), Field("load", "F_v"), Field("load", "Gamma_Le"), Field("load", "Gamma_Le_ramp"),
     Field("controller", "V_dc"), Field("controller", "i_max", "current"), Field("controller", "T_si"),
-    Field("controller", "T_salpha"), Field("controller", "T_so"), Field("controller", "K"),
+    Field("controller", "T_salpha"), Field("controller", "T_so"), Field("controller", "T_dv"), Field("controller", "K"),
     Field("sensors", "encoder_cpr"), Field("sensors", "i_noise"), Field("sensors", "i_adc_bits"),
     Field("sensors", "i_adc_range"), Field("sensors", "seed"),
     Field("limits", "omega_max"), Field("limits", "in_position"), Field("limits", "overshoot"),

@@ -133,3 +133,30 @@ def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega: float, L0: flo
     u_d = u_d_law(i_d, i_q, omega, A, B, F, T_si)
     u_q = u_q_law(alpha_dem, alpha, i_d, i_q, omega, u_d, L1, A, B, C, D, E, F, G, H, K, M, T_salpha)
     return u_d, u_q, alpha
+
+
+@jitable
+def voltage_mismatch(dv_hat: float, i_q: float, i_q_model: float, gain: float, beta: float) -> float:
+    """Return the updated estimate of the q-axis voltage the model of eq. (2) in [1] misses [V].
+
+    The paper's acceleration law (14) inverts eq. (2) with the model's R_s, L_q and Ψ_PM and is
+    proportional in α: a voltage the model misses — p·ΔΨ_PM·ω_r of a flux a few per cent off, ΔR_s·i_q
+    — leaves the acceleration offset by H·(that voltage)/L_q·T_sα/3 (:mod:`control.fdsmc.flux_tolerance`),
+    which the FDSMC's bounded demand cannot overcome. Not in [1]: each sample compares the measured
+    i_q with the model's prediction over the last sample (:func:`control.fdsmc.inverter.predict_currents`,
+    the voltages that were applied), converts the difference to volts with the prediction's gain
+    γ_q·G [A/V] and low-pass filters it, d̂ ← d̂ + β·((i_q − i_q,model)/(γ_q·G) − d̂); the FDC subtracts
+    d̂ from its u_q. With the exact model the difference is only the sensors' noise (and the speed's change
+    within a sample, which the prediction holds constant), so the linearised loop of
+    :mod:`control.fdsmc.loop_analysis` (K limit) and the noise gain of :mod:`control.fdsmc.noise` leave it
+    out; the design's verification by simulation includes it.
+
+    Parameters
+    ----------
+    dv_hat : float     The estimate so far [V].
+    i_q : float        The measured i_q [A].
+    i_q_model : float  The model's prediction of this i_q from the last sample [A].
+    gain : float       γ_q·G, the predicted i_q's change per volt of u_q held over one sample [A/V].
+    beta : float       Filter factor T_s/T_dv (≤ 1) [-].
+    """
+    return dv_hat + beta * ((i_q - i_q_model) / gain - dv_hat)

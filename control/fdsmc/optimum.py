@@ -185,6 +185,7 @@ def closed_form(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
         theta = C * (t - (sh_r + th) / m_)
         int_dw2 = C**2 * m_**2 * (th / m_ - 0.5 * T * s2)
         int_w2 = C**2 * (T - 3.0 * th / m_ + 0.5 * T * s2)
+    theta[-1] = dth  # the move ends on Δθ exactly (the terminal slide compares θ_ref with θ_dem there)
     G = mm.J * domega + mm.F_v * omega + mm.Gamma_Le
     copper = (mm.a * (mm.J**2 * int_dw2 + mm.F_v**2 * int_w2) + 2.0 * mm.a * mm.Gamma_Le * mm.F_v * dth
               + mm.a * mm.Gamma_Le**2 * T)
@@ -262,6 +263,7 @@ def _move(mm: MoveModel, n: int, G: np.ndarray, omega: np.ndarray) -> OptimalMov
     omega[0] = omega[-1] = 0.0
     dtheta = c * omega[:-1] + d * (G - mm.Gamma_Le)
     theta = np.concatenate(([0.0], np.cumsum(dtheta)))
+    theta[-1] = mm.delta_theta  # the constraint's Δθ exactly, not the cumulative sum's rounding
     alpha = (np.append(G, G[-1]) - mm.F_v * omega - mm.Gamma_Le) / mm.J
     peak = float(np.max(np.abs(G)))
     return OptimalMove(np.linspace(0.0, mm.T_m, n + 1), theta, omega, alpha, np.append(G, G[-1]),

@@ -150,6 +150,9 @@ class Controller:
         Inverter current limit: amplitude of the phase current, |i_dq| ≤ i_max (amplitude-invariant
         dq) [A]; a datasheet's A_rms value is √2 times smaller (loader key ``i_max_Arms``). 0 = none
         (the paper).
+    T_dv : float
+        Time constant of the q-axis voltage-mismatch estimate (:func:`control.fdsmc.fdc.voltage_mismatch`)
+        [s]; 0 = none (the paper's FDC). Digital controllers only.
     """
 
     T_si: float = spec_field("s", T_MIN_S, 10.0, low_open=False, label="T_si current settling", display="ms")
@@ -165,6 +168,8 @@ class Controller:
     V_dc: float = spec_field("V", 0.0, 1e5, default=0.0, low_open=False, label="V_dc inverter DC link (0 = ideal)")
     i_max: float = spec_field("A", 0.0, 1e6, default=0.0, low_open=False, aliases=("Arms",),
                               label="i_max inverter current (0 = none)")
+    T_dv: float = spec_field("s", 0.0, 10.0, default=0.0, low_open=False, display="ms",
+                             label="T_dv q-voltage mismatch estimate (0 = none)")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""

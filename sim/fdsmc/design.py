@@ -48,7 +48,7 @@ from sim.common import sensors
 from sim.fdsmc.checks import TARGET_BAND, Constraint, run_checks
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import Comparison, RunResult, compare
-from sim.fdsmc.verdicts import comparator_notes
+from sim.fdsmc.verdicts import comparator_notes, flux_warnings
 
 #: Most K halvings while the verified run still chatters [-].
 MAX_K_HALVINGS = 4
@@ -380,4 +380,4 @@ def _notes(d: Derived) -> tuple[str, ...]:
         notes.append(f"Boundary layer ±1/K = ±{1.0 / K:.4g} rad/s is wider than ω_p = {w_p:.4g} rad/s: the "
                      "outer loop is linear (never sliding) on this manoeuvre; the K limit of the sampled "
                      "loop allows no larger K.")
-    return tuple(notes)
+    return tuple(notes + flux_warnings(d))

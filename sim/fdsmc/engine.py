@@ -30,7 +30,7 @@ from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import infeasible_T_m
-from control.fdsmc.tracking import tracking_gains
+from control.fdsmc.tracking import slide_time_constant, tracking_gains
 from sim.common import sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
@@ -60,7 +60,7 @@ COMPARATORS = CONTROLLERS + ("optimum", "stock")
 LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum", "stock": "Stock trapezoid"}
 #: The kernel's outer law (P_CTRL) of each comparator: the stock drive (a trapezoid tracked by the
 #: P–PI cascade without its integrator, :mod:`control.fdsmc.trapezoid`) is the reference-tracking law.
-KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 2.0, "stock": 2.0}
+KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "stock": 2.0, "optimum": 3.0}
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
@@ -135,9 +135,13 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
     gains = tracking_gains(d.loop, d.conventional) if controller == "optimum" else d.conventional
     prm[[kn.P_G1, kn.P_G2]] = (gains.g1, gains.g2)
+    if controller == "optimum":  # its terminal slide's own T_c
+        prm[kn.P_TC] = slide_time_constant(d.alpha.alpha_max, ctrl.K)
     if controller == "optimum":  # α(t) ≈ α_dem(t − T_sα/3) (eq. (13)), one more sample with a delay
         prm[kn.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
+    if ctrl.T_dv > 0.0 and not ctrl.is_continuous:  # β of the q-axis voltage-mismatch estimate
+        prm[kn.P_BDV] = min(1.0, 1.0 / (float(ctrl.f_s) * ctrl.T_dv))
     prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), current_limit(params))  # 0 = no limit
     prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
     m = params.motor

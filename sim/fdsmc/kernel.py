@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from control.fdsmc import conventional, fdc, inverter, model, sliding_mode
+from control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
 from sim.common import sensors
 from sim.common.borrowed import borrowed
 
@@ -41,9 +41,10 @@ from sim.common.borrowed import borrowed
 # the current predictor's ZOH factors over one sample (control.fdsmc.inverter.decay_factors); the
 # in-position window [rad] of the pass criteria.
 (P_ENC, P_INOISE, P_ISTEP, P_IFS, P_PHID, P_GMID, P_PHIQ, P_GMIQ, P_INPOS) = range(46, 55)
-# How far ahead the tracking law reads the reference's acceleration [s] (the inner loops' lag).
-P_LEAD = 55
-N_PRM = 56
+# How far ahead the tracking law reads the reference's acceleration [s] (the inner loops' lag);
+# the filter factor β of the q-axis voltage-mismatch estimate (0 = none; control.fdsmc.fdc.voltage_mismatch).
+P_LEAD, P_BDV = 55, 56
+N_PRM = 57
 
 # ---- state indices -----------------------------------------------------------------------
 (X_ID, X_IQ, X_TH, X_W, X_EF, X_ECU, X_EEL, X_EMOT, X_ELOAD, X_THH, X_WH, X_L0, X_L1) = range(13)
@@ -63,6 +64,8 @@ I_END = I_SNAP + N_X  # then N_X values of the final state
 # (−1: never); largest overshoot beyond θ_dem [rad].
 (I_PIDQ, I_TOVER, I_TOUT, I_OVS) = range(I_END + N_X, I_END + N_X + 4)
 N_INFO = I_OVS + 1
+#: The controller's memory ``hold`` of :func:`step_sample` at rest.
+HOLD0 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 #: Rows of ``win`` per chatter window: α_dem [rad/s²], ω_r [rad/s], i_q [A], u_q [V] (applied).
 WIN_ROWS = 4
 
@@ -118,10 +121,13 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
     Eqs. (44)–(46), (62), or the reference tracking law :func:`control.fdsmc.conventional.tracking_demand`
     (``P_CTRL`` = 2), all of :mod:`control`.
     """
-    if prm[P_CTRL] == 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
+    if prm[P_CTRL] >= 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
         th_r, w_r, _ = reference_at(t, ref, prm[P_TM])
         a_r = reference_at(t + prm[P_LEAD], ref, prm[P_TM])[2]
-        return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
+        if prm[P_CTRL] == 2.0:
+            return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
+        return terminal_slide.slide_in_demand(th_r, w_r, a_r, ref[0, 0], theta_hat, omega_hat, prm[P_G1], prm[P_G2],
+                                              prm[P_THDEM], prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
     if prm[P_CTRL] == 1.0:
         return conventional.conventional_demand(prm[P_THDEM], theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
     return sliding_mode.smc_demand(theta_hat - prm[P_THDEM], omega_hat, prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
@@ -162,15 +168,16 @@ def measure(k: int, p: tuple, prm: np.ndarray, noise: np.ndarray) -> tuple[float
 
 @_helper
 def control_output(t: float, y: tuple, i0: tuple, o: tuple, prm: np.ndarray,
-                   ref: np.ndarray) -> tuple[float, float, float, float, float, bool]:
+                   ref: np.ndarray, dv: float) -> tuple[float, float, float, float, float, bool]:
     """u_d, u_q [V], α_dem, α [rad/s²], S [rad/s], limited, from the readings y and the estimates o.
 
     ``i0`` are the currents [A] at the start of the sample the voltages will act over (the readings,
-    or their prediction over a computation delay): the current limit's starting point.
+    or their prediction over a computation delay): the current limit's starting point. ``dv`` [V] is the
+    q-axis voltage-mismatch estimate the FDC's u_q is corrected by (0 without one).
     """
     alpha_dem, S = outer_law(t, o[0], o[1], prm, ref)
     u_d, u_q, alpha = fdc_voltages(alpha_dem, y[1], y[2], o[1], o[2], o[3], prm)
-    u_d, u_q, sat = limit_voltage(u_d, u_q, i0[0], i0[1], o[1], prm)
+    u_d, u_q, sat = limit_voltage(u_d, u_q - dv, i0[0], i0[1], o[1], prm)
     return u_d, u_q, alpha_dem, alpha, S, sat
 
 
@@ -249,7 +256,7 @@ def full_rhs(t: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
              step_v: np.ndarray, ref: np.ndarray) -> tuple:
     """Continuous mode: plant and observer derivatives with the controller inside (ideal sensors)."""
     i = (p[X_ID], p[X_IQ])
-    u_d, u_q, _, _, _, _ = control_output(t, (p[X_TH], p[X_ID], p[X_IQ]), i, o, prm, ref)
+    u_d, u_q, _, _, _, _ = control_output(t, (p[X_TH], p[X_ID], p[X_IQ]), i, o, prm, ref, 0.0)
     return plant_rhs(t, p, u_d, u_q, prm, step_t, step_v), observer_rhs(p, o, prm)
 
 
@@ -343,22 +350,30 @@ def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: b
                 noise: np.ndarray):
     """Run the controller (and, digital, the observer update) at sample k or one continuous step.
 
-    Returns (voltages applied over the step, new observer state, new held voltages, the
+    Returns (voltages applied over the step, new observer state, new controller memory ``hold``, the
     recorded outputs (u_d, u_q, α_dem, α̂, S), limited flag). Digital: the controller reads the
     sensors (:func:`measure`); with a computation delay the current limit starts from the
-    currents predicted at the end of the held voltages' sample.
+    currents predicted at the end of the held voltages' sample. ``hold`` = (held u_d, u_q [V]; the
+    last sample's readings i_d, i_q [A], ω̂ [rad/s] and applied u_d, u_q [V]; the q-axis
+    voltage-mismatch estimate [V]), HOLD0 at rest.
     """
     if continuous:
         y = (p[X_TH], p[X_ID], p[X_IQ])
-        u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, (y[1], y[2]), o, prm, ref)
+        u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, (y[1], y[2]), o, prm, ref, 0.0)
         return (u_d, u_q), o, hold, (u_d, u_q, a_dem, a_hat, S), sat
     y = measure(k, p, prm, noise)
-    i0 = predict_currents(y[1], y[2], o[1], hold, prm) if delay == 1 else (y[1], y[2])
-    u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, i0, o, prm, ref)
+    dv = hold[7]
+    if prm[P_BDV] > 0.0:
+        i_model = predict_currents(hold[2], hold[3], hold[4], (hold[5], hold[6]), prm)[1]
+        dv = fdc.voltage_mismatch(dv, y[2], i_model, prm[P_GMIQ] * prm[P_G], prm[P_BDV])
+    held = (hold[0], hold[1])
+    i0 = predict_currents(y[1], y[2], o[1], held, prm) if delay == 1 else (y[1], y[2])
+    u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, i0, o, prm, ref, dv)
     if delay == 1:
-        hold, (u_d, u_q) = (u_d, u_q), hold
+        held, (u_d, u_q) = (u_d, u_q), held
     a_em = (prm[P_H] + prm[P_K] * y[1]) * y[2]
-    return (u_d, u_q), observer_update(y[0], o, a_em, Phi, Gam, Lo), hold, (u_d, u_q, a_dem, a_hat, S), sat
+    memory = (held[0], held[1], y[1], y[2], o[1], u_d, u_q, dv)
+    return (u_d, u_q), observer_update(y[0], o, a_em, Phi, Gam, Lo), memory, (u_d, u_q, a_dem, a_hat, S), sat
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -385,7 +400,7 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
     out, info, k_win, win, ref, noise = (borrowed(out), borrowed(info), borrowed(k_win), borrowed(win),
                                          borrowed(ref), borrowed(noise))
     p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    o, hold, pk = (0.0, 0.0, 0.0, 0.0), (0.0, 0.0), (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    o, hold, pk = (0.0, 0.0, 0.0, 0.0), HOLD0, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     pc = (0.0, -1.0, 0.0)
     n_out, t, t_sat, T_m, hit = 0, 0.0, 0.0, prm[P_TM], False
     info[:] = 0.0

@@ -2,7 +2,9 @@
 
 Chatter criterion (documented in ``docs/paper_reproduction.md``), applied to two windows:
 ``cruise`` — the middle 60 % of the planned cruise segment for the FDSMC, [0.2·T_m, T_m] for the
-conventional law (at most its central 0.25 s) — and ``hold`` — the second half of the tail after
+conventional law and the stock cascade, [0.2·T_m, T_m − 3·T_c] for the tracked optimum (its tracking
+phase, before the terminal slide's switch; T_c of :func:`control.fdsmc.tracking.slide_time_constant`),
+each at most its central 0.25 s — and ``hold`` — the second half of the tail after
 T_m (at most its last 0.25 s), where the drive should rest at θ_dem. Each window is sampled at
 every controller step (not the decimated trace, so that a limit cycle is never aliased away).
 Take the high-pass part r = α_dem − (moving average of α_dem over 5 ms). The loop chatters when
@@ -21,6 +23,7 @@ import numpy as np
 
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
+from control.fdsmc.tracking import slide_time_constant
 from sim.common import signals
 from sim.common.energy import energy_balance
 from sim.fdsmc.summary import KernelState, RunSummary
@@ -298,7 +301,10 @@ def chatter_windows(
     t_end : float  End of the simulated horizon [s].
     """
     T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
-    if controller != "fdsmc":  # the conventional law and the tracked optimum: no cruise segment
+    if controller == "optimum":  # tracking until the terminal slide (≈ 2·T_c before T_m): not its switch
+        t0 = 0.2 * T_m
+        t1 = max(T_m - 3.0 * slide_time_constant(d.alpha.alpha_max, params.controller.K), 0.5 * T_m)
+    elif controller != "fdsmc":  # the conventional law and the stock cascade: no cruise segment
         t0, t1 = 0.2 * T_m, T_m
     else:
         cruise = T_m - 4.0 * T_a

@@ -10,9 +10,14 @@ from __future__ import annotations
 import math
 
 from control.fdsmc.derivations import Derived
+from control.fdsmc.flux_tolerance import flux_tolerance
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
 from sim.fdsmc.checks import TARGET_BAND, exceeded, run_checks, saturation_matters
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
+
+#: A flux tolerance of the FDC below this is warned about [-] (a datasheet's 20 °C flux vs magnets 100 K
+#: warmer is ≈ 10 % apart for NdFeB).
+FLUX_TOLERANCE_WARN = 0.10
 
 
 def recommended_K(derived: Derived) -> float | None:
@@ -121,8 +126,26 @@ def run_warnings(comparison: Comparison) -> list[str]:
             out.append(miss)
         if run.controller == "fdsmc":
             out += _saturation(run, comparison.derived) + limit_warnings(run, comparison.derived)
-            out += criteria_warnings(run, comparison.derived)
+            out += criteria_warnings(run, comparison.derived) + flux_warnings(comparison.derived)
     return out + _saving_verdicts(comparison)
+
+
+def flux_warnings(derived: Derived) -> list[str]:
+    """Warn when the paper's FDC tolerates less than FLUX_TOLERANCE_WARN of flux error at ω_p.
+
+    :mod:`control.fdsmc.flux_tolerance`: beyond it the FDSMC runs away (weaker magnets) or stalls
+    (stronger ones). A digital controller with the q-axis voltage-mismatch estimate (controller.T_dv > 0)
+    has no such steady offset: no warning.
+    """
+    c = derived.params.controller
+    if c.T_dv > 0.0 and not c.is_continuous:
+        return []
+    x = flux_tolerance(derived.coefficients, derived.alpha.alpha_max, derived.profile.omega_p, c.T_salpha)
+    if x >= FLUX_TOLERANCE_WARN:
+        return []
+    return [f"Flux tolerance: the FDC of eq. (14) tolerates a Ψ_PM error of only ±{100 * x:.2g} % at ω_p "
+            f"(magnets ≈ {x * 1000:.0f} K warmer): a weaker flux runs the FDSMC away, a stronger one stalls it. "
+            "Set controller.T_dv (the q-axis voltage-mismatch estimate, e.g. 1 ms) on a digital controller."]
 
 
 def _saturation(run: RunResult, derived: Derived) -> list[str]:

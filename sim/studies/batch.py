@@ -182,8 +182,8 @@ def _saving(f: dict[str, Any], c: dict[str, Any]) -> float | None:
 
 
 def simulate_batch(params: DriveParams, d: Derived, plants: list[DriveParams], max_points: int,
-                   threads: int = 1) -> list[dict[str, dict[str, Any]]]:
-    """Return both controllers' metrics on each plant (the entries of ``RobustnessResult.runs``).
+                   threads: int = 1, controllers: tuple[str, ...] = CONTROLLERS) -> list[dict[str, dict[str, Any]]]:
+    """Return the controllers' metrics on each plant (the entries of ``RobustnessResult.runs``).
 
     Parameters
     ----------
@@ -193,21 +193,25 @@ def simulate_batch(params: DriveParams, d: Derived, plants: list[DriveParams], m
     max_points : int            Trace points per run [-] (the 2 % settling time is read from them).
     threads : int               numba threads over the samples of a sub-batch [-] (1 in a worker
                                 process of a pool: the processes are the parallelism).
+    controllers : tuple of str  The controllers run on every plant (the FDSMC's friction saving is
+                                added where the conventional one runs too).
     """
     if not plants:
         return []
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     per: dict[str, list[dict[str, Any]]] = {}
-    for ctrl in CONTROLLERS:
+    for ctrl in controllers:
         s = setup(params, d, ctrl, plants[0], max_points)
         bufs = _buffers(s, min(BATCH, len(plants)))
         per[ctrl] = []
         for k in range(0, len(plants), BATCH):
             _run(params, d, s, plants[k: k + BATCH], bufs)
             per[ctrl] += _metrics(params, d, s, plants[k: k + BATCH], bufs)
-    runs = []
-    for f, c in zip(per["fdsmc"], per["conventional"], strict=True):
-        saving = _saving(f, c) if f["stable"] and c["stable"] else None
-        f.pop("t_2pct_first_s"), c.pop("t_2pct_first_s")
-        runs.append({"fdsmc": {**f, "saving_friction_pct": saving}, "conventional": c})
+    runs = [{ctrl: per[ctrl][i] for ctrl in controllers} for i in range(len(plants))]
+    for r in runs:
+        if "fdsmc" in r and "conventional" in r:
+            f, c = r["fdsmc"], r["conventional"]
+            f["saving_friction_pct"] = _saving(f, c) if f["stable"] and c["stable"] else None
+        for m in r.values():
+            m.pop("t_2pct_first_s")
     return runs

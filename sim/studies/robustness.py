@@ -38,6 +38,8 @@ from sim.fdsmc.grid import check_budget
 from sim.studies.batch import simulate_batch
 from sim.studies.runner import ExecutorError
 
+#: The controllers a study can run: the two of [1] and the tracked minimum-energy optimum.
+STUDY_CONTROLLERS = ("fdsmc", "conventional", "optimum")
 #: Metrics summarised per controller; the worst case is the largest value (errors as |·|).
 METRICS = ("friction_J", "copper_J", "electrical_in_total_J", "torque_peak_Nm",
            "theta_error_abs_at_Tm_rad", "t_2pct_settle_s")
@@ -72,13 +74,15 @@ class Spread:
 class RobustnessResult:
     """Per-sample metrics (``runs[i][controller][metric]``), the drawn values and the summary.
 
-    ``complete`` is False for the part of a run that failed (``runs`` then holds its first samples).
+    ``complete`` is False for the part of a run that failed (``runs`` then holds its first samples);
+    ``controllers`` are those run on every sample.
     """
 
     values: dict[str, np.ndarray]
     runs: list[dict[str, dict[str, Any]]]
     summary: dict[str, Any]
     complete: bool = True
+    controllers: tuple[str, ...] = CONTROLLERS
 
 
 class IncompleteRunError(RuntimeError):
@@ -131,8 +135,9 @@ def _friction_saving(f: RunResult, c: RunResult) -> float | None:
     return 100.0 * (1.0 - wf / wc)
 
 
-def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None) -> dict[str, dict[str, Any]]:
-    """Return both controllers' metrics on one plant, plus ``infeasible`` and ``saving_friction_pct``.
+def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = None,
+                   controllers: tuple[str, ...] = CONTROLLERS) -> dict[str, dict[str, Any]]:
+    """Return the controllers' metrics on one plant, plus ``infeasible`` and ``saving_friction_pct``.
 
     ``infeasible``: unstable, or the peak torque beyond the plant's torque limit; ``d`` = derive(params).
 
@@ -140,7 +145,7 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
     sweep is across samples (processes), and a thread pool per sample would only add overhead.
     """
     d = derive(params) if d is None else d
-    runs = [simulate(params, c, d, plant=plant, max_points=TRACE_POINTS) for c in CONTROLLERS]
+    runs = [simulate(params, c, d, plant=plant, max_points=TRACE_POINTS) for c in controllers]
     lim = torque_limit(plant)
     out: dict[str, dict[str, Any]] = {}
     for run in runs:
@@ -149,21 +154,24 @@ def sample_metrics(params: DriveParams, plant: DriveParams, d: Derived | None = 
         m["theta_error_abs_at_Tm_rad"] = None if err is None else abs(err)
         m["infeasible"] = not run.metrics.stable or (peak is not None and peak > lim * (1.0 + LIMIT_TOLERANCE))
         out[run.controller] = {k: m[k] for k in (*METRICS, "chatter", "stable", "infeasible")}
-    out["fdsmc"]["saving_friction_pct"] = _friction_saving(runs[0], runs[1])
+    if "fdsmc" in out and "conventional" in out:
+        out["fdsmc"]["saving_friction_pct"] = _friction_saving(runs[0], runs[1])
     return out
 
 
 def simulate_chunk(params: DriveParams, rows: list[dict[str, float]], d: Derived | None = None,
-                   plant: DriveParams | None = None, threads: int = 1) -> list[dict[str, dict[str, Any]]]:
+                   plant: DriveParams | None = None, threads: int = 1,
+                   controllers: tuple[str, ...] = CONTROLLERS) -> list[dict[str, dict[str, Any]]]:
     """Return the metrics of several samples (one task); module-level so that it pickles.
 
     ``d`` = derive(params), the controller's design (the same for every sample; computed if None);
     ``plant`` the nominal plant the rows' values replace values of (None: the model); ``threads``
-    numba threads over the samples [-]. The same numbers as :func:`sample_metrics` per row (tests).
+    numba threads over the samples [-]; ``controllers`` those run. The same numbers as
+    :func:`sample_metrics` per row (tests).
     """
     d = derive(params) if d is None else d
     base = params if plant is None else plant
-    return simulate_batch(params, d, [plant_for(base, r) for r in rows], TRACE_POINTS, threads)
+    return simulate_batch(params, d, [plant_for(base, r) for r in rows], TRACE_POINTS, threads, controllers)
 
 
 def chunk_size(seconds_per_sample: float, n: int, workers: int) -> int:
@@ -194,7 +202,7 @@ def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str
     infeasible probabilities; the friction saving's distribution (worst = smallest).
     """
     out: dict[str, Any] = {"samples": len(runs), "seconds": seconds}
-    for ctrl in CONTROLLERS:
+    for ctrl in (tuple(runs[0]) if runs else ()):
         rs = [r[ctrl] for r in runs]
         entry: dict[str, Any] = {}
         for key in METRICS:
@@ -202,37 +210,43 @@ def summarise(runs: list[dict[str, dict[str, Any]]], seconds: float) -> dict[str
         entry["chatter_probability"] = float(np.mean([bool(r["chatter"]) for r in rs])) if rs else None
         entry["infeasible_probability"] = float(np.mean([bool(r["infeasible"]) for r in rs])) if rs else None
         out[ctrl] = entry
-    sav = np.array([r["fdsmc"]["saving_friction_pct"] for r in runs
-                    if isinstance(r["fdsmc"]["saving_friction_pct"], float)])
+    sav = np.array([r["fdsmc"].get("saving_friction_pct") for r in runs if "fdsmc" in r
+                    and isinstance(r["fdsmc"].get("saving_friction_pct"), float)])
     out["saving_friction_pct"] = _stats(sav, "min")
     return out
 
 
-def check_request(params: DriveParams, spreads: Sequence[Spread], samples: int) -> None:
+def check_request(params: DriveParams, spreads: Sequence[Spread], samples: int,
+                  controllers: tuple[str, ...] = CONTROLLERS) -> None:
     """Raise ParameterError for a run that cannot be made or would only repeat one run.
 
-    ≥ 1 sample; more than one sample needs a spread (else every sample is the nominal plant); one
-    sample (both controllers) must fit the single-request budget.
+    ≥ 1 sample; one to three distinct controllers of STUDY_CONTROLLERS; more than one sample needs a
+    spread (else every sample is the nominal plant); one sample (all its controllers) must fit the
+    single-request budget.
     """
+    if not controllers or len(set(controllers)) != len(controllers) or not set(controllers) <= set(STUDY_CONTROLLERS):
+        raise ParameterError(f"controllers = {','.join(controllers)[:80]!r} is not allowed: one or more distinct "
+                             f"of {', '.join(STUDY_CONTROLLERS)}")
     if samples < 1:
         raise ParameterError(f"samples = {samples} is not allowed: ≥ 1")
     if not spreads and samples > 1:
         raise ParameterError(f"samples = {samples} without a spread is not allowed: every sample would be the "
                              "nominal plant; allowed: at least one spread (e.g. plant.R_s=±20%), or samples = 1 "
                              "for one nominal run")
-    check_budget(params, 2, max_points=TRACE_POINTS)
+    check_budget(params, len(controllers), max_points=TRACE_POINTS)
 
 
 def _result(values: dict[str, np.ndarray], runs: list[dict[str, dict[str, Any]]], seconds: float,
-            nominal: bool, complete: bool = True) -> RobustnessResult:
+            nominal: bool, controllers: tuple[str, ...], complete: bool = True) -> RobustnessResult:
     summary = {**summarise(runs, seconds), "nominal_run": nominal, "complete": complete}
-    return RobustnessResult({k: v[: len(runs)] for k, v in values.items()}, runs, summary, complete)
+    return RobustnessResult({k: v[: len(runs)] for k, v in values.items()}, runs, summary, complete, controllers)
 
 
 def robustness(
     params: DriveParams, spreads: Sequence[Spread], samples: int, seed: int = 0, executor: Any = None,
     workers: int = 1, progress: Callable[[int, int], None] | None = None,
     cancelled: Callable[[], bool] | None = None, plant: DriveParams | None = None, threads: int = 1,
+    controllers: tuple[str, ...] = CONTROLLERS,
 ) -> RobustnessResult:
     """Run the Monte-Carlo analysis (see the module docstring).
 
@@ -249,6 +263,7 @@ def robustness(
     plant : DriveParams or None   The nominal plant (a preset's plant section) the spreads are
                                   drawn around and applied to; None: the controller's model.
     threads : int                 numba threads of the samples computed in this process [-].
+    controllers : tuple of str    The controllers run on every sample (of STUDY_CONTROLLERS).
 
     Raises
     ------
@@ -256,32 +271,34 @@ def robustness(
     IncompleteRunError  The executor failed (:class:`~sim.studies.runner.ExecutorError`); it holds
                         the samples finished before the failure.
     """
-    check_request(params, spreads, samples)
+    check_request(params, spreads, samples, controllers)
     t0 = time.perf_counter()
     values = draw(params if plant is None else plant, spreads, samples, seed)
     rows = [{k: float(v[i]) for k, v in values.items()} for i in range(samples)]
     d = derive(params)
     _check_feasible(d)
-    runs = simulate_chunk(params, rows[:1], d, plant, threads)  # warm-up (compiled kernel loaded) …
+    runs = simulate_chunk(params, rows[:1], d, plant, threads, controllers)  # warm-up (compiled kernel loaded) …
     t1 = time.perf_counter()
-    runs += simulate_chunk(params, rows[1:2], d, plant, threads)  # … and one timed sample
+    runs += simulate_chunk(params, rows[1:2], d, plant, threads, controllers)  # … and one timed sample
     done = len(runs)
     size = chunk_size(time.perf_counter() - t1, samples - done, workers)
     chunks = [rows[i: i + size] for i in range(done, samples, size)]
     if progress is not None:
         progress(done, samples)
-    futures = [executor.submit(simulate_chunk, params, c, d, plant) for c in chunks] if executor is not None else None
+    futures = ([executor.submit(simulate_chunk, params, c, d, plant, 1, controllers) for c in chunks]
+               if executor is not None else None)
     try:
         for j, c in enumerate(chunks):
             if cancelled is not None and cancelled():
                 raise ParameterError(f"robustness run cancelled after {len(runs)} of {samples} samples")
-            runs.extend(futures[j].result() if futures is not None else simulate_chunk(params, c, d, plant, threads))
+            runs.extend(futures[j].result() if futures is not None
+                        else simulate_chunk(params, c, d, plant, threads, controllers))
             if progress is not None:
                 progress(len(runs), samples)
     except ExecutorError as exc:
         raise IncompleteRunError(f"robustness run stopped after {len(runs)} of {samples} samples: {exc}",
-                            _result(values, runs, time.perf_counter() - t0, not spreads, False)) from None
+                            _result(values, runs, time.perf_counter() - t0, not spreads, controllers, False)) from None
     finally:
         for f in futures or []:
             f.cancel()
-    return _result(values, runs, time.perf_counter() - t0, not spreads)
+    return _result(values, runs, time.perf_counter() - t0, not spreads, controllers)

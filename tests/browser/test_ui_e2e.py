@@ -111,6 +111,10 @@ def test_import_export_round_trip_and_c_header(page, tmp_path):
         assert sorted(zf.namelist()) == ["fdsmc_controller.c", "fdsmc_controller.h", "fdsmc_test.c",
                                          "fdsmc_vectors.h"]
         header = zf.read("fdsmc_controller.h").decode()
+    name, archive = _download(page, "C controller module, tracked optimum (.h + .c, zip)")
+    assert name == "imported_case_optimum_controller.zip"  # the same files, the tracked optimum's law
+    with zipfile.ZipFile(io.BytesIO(archive)) as zf:
+        assert "#define FDSMC_OUTER_LAW_OPTIMUM 1" in zf.read("fdsmc_controller.h").decode()
     # names reach the C text only as C string literals (no comment or macro can be injected)
     assert 'Drive:  "imported_case"' in header and 'Source: "browser test"' in header
     match = re.search(r"#define FDSMC_OMEGA_P\s+\(\(fdsmc_real\)([^)]+)\)", header)
