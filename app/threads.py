@@ -11,10 +11,17 @@ Two ways, both applied by :func:`limit_blas_threads`: the ``*_NUM_THREADS`` envi
 nothing — the CLI sets them before importing numpy), and ``threadpoolctl`` for libraries already
 loaded (it scans the process's shared libraries, ≈ 20–60 ms, so it runs only when numpy is
 already imported).
+
+:func:`release_memory` hands memory freed by finished work back to the system: glibc keeps freed
+heap pages of every thread's arena for reuse, so a server whose pages have closed would stay at its
+peak size; ``malloc_trim`` returns them.
 """
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import gc
 import os
 import sys
 
@@ -34,3 +41,10 @@ def limit_blas_threads() -> None:
         from threadpoolctl import threadpool_limits
 
         _limiter = threadpool_limits(limits=1, user_api="blas")
+
+
+def release_memory() -> None:
+    """Collect garbage and return the C heap's free pages to the system (glibc; elsewhere only the collection)."""
+    gc.collect()
+    with contextlib.suppress(OSError, AttributeError):  # not glibc: nothing to trim
+        ctypes.CDLL("libc.so.6").malloc_trim(0)

@@ -1,4 +1,4 @@
-"""Print how long each parser attack of issue 28 takes to be refused (CPU seconds, best of 3).
+"""Print how long each hostile parser attack takes to be refused (CPU seconds, best of 3).
 
 Run: ``.venv/bin/python scripts/bench_hostile.py [--pure]``. The promise: every attack ≤ 0.5 s (a text
 can cost no more than its size allows). The attacks are those of ``tests/hostile_inputs.py``
@@ -21,9 +21,15 @@ PAPER = "paper_12kw_pmsm"
 
 
 def _wide() -> dict[str, tuple[str, str, str]]:
-    n = 20_000
+    """Wide texts of ≈ 250 KiB: many keys, many items, long scalars, lines without content."""
+    n, size = 20_000, 250_000
     return {"json: 20 000 keys in one object": ("json", "{" + ",".join(f'"k{i}":1' for i in range(n)) + "}", ""),
-            "yaml: 20 000 keys in one mapping": ("yaml", "".join(f"k{i}: 1\n" for i in range(n)), "")}
+            "yaml: 20 000 keys in one mapping": ("yaml", "".join(f"k{i}: 1\n" for i in range(n)), ""),
+            "yaml: 125 000 items in one flow list": ("yaml", "k: [" + "1," * (size // 2 - 4) + "1]\n", ""),
+            "yaml: 62 000 block items": ("yaml", "k:\n" + "- 1\n" * (size // 4 - 1), ""),
+            "yaml: 9 000 items of 6 lines each": ("yaml", "k:\n" + "- a\n  b\n  c\n  d\n  e\n  f\n" * 9_000, ""),
+            "yaml: 250 000 blank lines": ("yaml", "\n" * size + "k: 1\n", ""),
+            "yaml: one 250 000-character plain scalar": ("yaml", "k: " + "a" * size + "\n", "")}
 
 
 def _feed(kind: str, text: str) -> str:

@@ -19,6 +19,7 @@ from app.figures.fdsmc_comparison import (
 from app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
 from app.figures.fdsmc_replay import KEY_RATE, MAX_FRAMES, SPEEDS
 from app.figures.plain import figure_json
+from app.figures.style import FONT_PX, TEMPLATE_LAYOUT
 from app.ui.replay import phase_plane_json
 from sim.fdsmc.engine import Comparison, compare
 from sim.fdsmc.table1 import PAPER_TABLE1, Table1Row
@@ -99,9 +100,15 @@ def test_dict_figure_json_matches_plotly(comparison):
     assert set(mine["data"]) == {"scatter", "bar"} and all(mine["data"][k] == full["data"][k] for k in mine["data"])
     assert {"xaxis", "yaxis", "colorway", "plot_bgcolor", "paper_bgcolor", "font"} <= set(mine["layout"])
     # every kept value as Plotly's, but tick labels that are not measured for overflow on each redraw
+    # and the page's font sizes (app.figures.style: ≥ 14 px on plots, titles 16 px)
     for axis in ("xaxis", "yaxis"):
-        assert mine["layout"][axis] == {**full["layout"][axis], "ticklabeloverflow": "allow"}
-    assert all(mine["layout"][k] == full["layout"][k] for k in mine["layout"] if k not in ("xaxis", "yaxis"))
+        title = {**full["layout"][axis].get("title", {}), "font": {"size": FONT_PX}}
+        assert mine["layout"][axis] == {**full["layout"][axis], "ticklabeloverflow": "allow",
+                                        "tickfont": {"size": FONT_PX}, "title": title}
+    styled = {"xaxis", "yaxis", *TEMPLATE_LAYOUT}
+    assert all(mine["layout"][k] == full["layout"][k] for k in mine["layout"] if k not in styled)
+    assert mine["layout"]["font"]["size"] >= FONT_PX
+    assert all(mine["layout"][k]["font"]["size"] >= FONT_PX for k in ("legend", "annotationdefaults", "hoverlabel"))
     assert len(json.dumps(mine)) < 0.2 * len(json.dumps(full))
 
 

@@ -274,6 +274,7 @@ def test_fuzz_bldc_budget(t_end, f_s, n):
         assert "t_end" in str(exc) and "inverter.f_s" in str(exc) and "allowed ≤" in str(exc)
         return
     assert cost.steps <= budget.MAX_STEPS and cost.trace_bytes <= budget.MAX_TRACE_BYTES
+    assert cost.cpu_s <= budget.MAX_CPU_S and cost.memory_bytes <= budget.MAX_TRACE_BYTES  # the promise
 
 
 def test_accepted_runs_take_no_more_steps_than_the_budget_counted(monkeypatch):

@@ -155,7 +155,7 @@ def test_voltage_limit_binds_and_is_respected():
     cf = closed_form(mm, 400)
     assert _exact_voltage_peak(mm, cf) > 1.2 * mm.u_max
     mv = optimal_move(p, n=400)
-    assert mv.method == "clarabel" and mv.limited
+    assert mv.method == "clarabel" and mv.limited  # the first of SOLVERS
     assert _exact_voltage_peak(mm, mv) <= mm.u_max * (1.0 + 1e-6)
     assert _exact_voltage_peak(mm, mv) >= mm.u_max * (1.0 - 1e-4)  # it binds
     assert voltage_peak(mm, mv) == pytest.approx(_exact_voltage_peak(mm, mv), rel=1e-12)

@@ -78,7 +78,7 @@ def test_tracked_optimum_is_clean_recommended_and_within_10pct_of_the_optimum(na
     e = {x.controller: x.net_electrical_J for x in rec.energies}
     assert rec.controller == "optimum"
     assert e["optimum"] <= 1.10 * optimal_move(p).energy_J and e["optimum"] < e["conventional"]
-    assert slide_stability(d.loop) < 0.0  # the slide's sampled loop at its T_c and the case's K
+    assert slide_stability(d.loop, p.controller.K) < 0.0  # the slide's sampled loop at its T_c and the case's K
 
 
 def test_tracking_to_the_very_end_overshoots_the_window(monkeypatch):
@@ -93,7 +93,7 @@ def test_tracking_to_the_very_end_overshoots_the_window(monkeypatch):
 def test_tracking_gains_are_held_to_the_fdsmc_layer():
     for name in REAL:
         d = derive(load_preset(name))
-        g = tracking_gains(d.loop, d.conventional)
+        g = tracking_gains(d.loop, d.conventional, d.params.controller.K)
         layer = d.alpha.alpha_max * d.params.controller.K  # the FDSMC's boundary-layer gain α_max·K
         assert g.a <= layer / 3.0 + 1e-9
         assert slide_time_constant(d.alpha.alpha_max, d.params.controller.K) * layer == pytest.approx(3.5)

@@ -93,8 +93,8 @@ def design_constants(params: DriveParams, d: Derived) -> list[tuple[str, float, 
     ]
 
 
-def _fields(params: DriveParams, d: Derived) -> dict[str, Any]:
-    """Field name → value (float, or a list for the observer arrays) of ``fdsmc_params``."""
+def _fields(params: DriveParams, d: Derived, K: float) -> dict[str, Any]:
+    """Field name → value (float, or a list for the observer arrays) of ``fdsmc_params`` (K: the law's gain)."""
     c, ctrl, od = d.coefficients, params.controller, d.observer_discrete
     assert od is not None
     lim = {n: v for n, v, _, _ in design_constants(params, d)}
@@ -103,7 +103,7 @@ def _fields(params: DriveParams, d: Derived) -> dict[str, Any]:
     (phi_d, gam_d), (phi_q, gam_q) = (decay_factors(rate, 1.0 / float(ctrl.f_s)) for rate in (c.A, c.D))
     t_c = 0.0 if params.controller.T_c == "T_a" else float(params.controller.T_c)
     return {
-        "alpha_max": d.alpha.alpha_max, "inv_alpha_max": 1.0 / d.alpha.alpha_max, "k_bl": ctrl.K,
+        "alpha_max": d.alpha.alpha_max, "inv_alpha_max": 1.0 / d.alpha.alpha_max, "k_bl": K,
         "t_c_fixed": t_c, "t_c_min": lim["T_C_MIN"], "omega_p_max": lim["OMEGA_P_MAX"], "t_m_max": lim["T_M_MAX"],
         "a": c.A, "b": c.B, "c": c.C, "d": c.D, "e": c.E, "f": c.F, "g": c.G, "inv_f": 1.0 / c.F, "inv_g": 1.0 / c.G,
         "h": c.H, "k": c.K, "m": c.M, "three_inv_t_si": 3.0 / ctrl.T_si, "three_inv_t_salpha": 3.0 / ctrl.T_salpha,
@@ -123,15 +123,18 @@ def _beta_dv(ctrl: Any) -> float:
     return min(1.0, 1.0 / (float(ctrl.f_s) * ctrl.T_dv)) if ctrl.T_dv > 0.0 else 0.0
 
 
-def design_initializer(params: DriveParams, d: Derived, so: Any, literal: Callable[[float], str]) -> str:
+def design_initializer(params: DriveParams, d: Derived, so: Any, literal: Callable[[float], str], K: float) -> str:
     """Designated initializer of ``FDSMC_DESIGN`` (``so``: the :class:`~app.exports.c_module.ScaledObserver`).
+
+    ``K`` is the boundary-layer gain of the module's law: the case's for the FDSMC, the tracked optimum's
+    (:func:`control.fdsmc.tracking.slide_gain`) for its module.
 
     The observer matrices are the scaled ones in the float build and the simulator's (Φ, Γ, L of
     :func:`control.fdsmc.observer.discrete_observer`) in the double build.
     """
     if not 0 < d.alpha.alpha_max < math.inf:
         raise ParameterError(f"α_max = {d.alpha.alpha_max:g} rad/s² cannot be exported: allowed > 0")
-    lines = [f"    .{k} = R_({literal(v)})," for k, v in _fields(params, d).items()]
+    lines = [f"    .{k} = R_({literal(v)})," for k, v in _fields(params, d, K).items()]
     od = d.observer_discrete
     assert od is not None
 

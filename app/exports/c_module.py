@@ -33,6 +33,7 @@ from app.io.units import spec_of
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
+from control.fdsmc.tracking import slide_gain
 
 from .c_optimum import STATE_FIELDS, ReferenceTable, law_parts, optimum_constants, reference_table
 from .c_source import FDSMC_MOVE, LIMIT_CODE, SOURCE
@@ -302,7 +303,8 @@ def controller_source(params: DriveParams, d: Derived, table: ReferenceTable | N
     so = scaled_observer(d)
     law = (law_parts(table, c_literal) if table is not None else
            {"set_move": FDSMC_MOVE, "outer_law": "", "outer_call": "sliding_mode(s, th_re, w, &S)", "law_init": ""})
-    return SOURCE.substitute(name=c_string(params.name), design=design_initializer(params, d, so, c_literal),
+    K = slide_gain(d.gain, params.controller.K) if table is not None else params.controller.K
+    return SOURCE.substitute(name=c_string(params.name), design=design_initializer(params, d, so, c_literal, K),
                              limit_code=LIMIT_CODE, **law)
 
 

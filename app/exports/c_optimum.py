@@ -107,7 +107,8 @@ def optimum_constants(params: DriveParams, d: Derived, table: ReferenceTable) ->
     return [
         ("G1_TRACK", float(prm[kn.P_G1]), "1/s^2", "tracking gain a^2 (control/fdsmc/tracking.py)", False),
         ("G2_TRACK", float(prm[kn.P_G2]), "1/s", "tracking gain 2a (control/fdsmc/tracking.py)", False),
-        ("T_C_SLIDE", float(prm[kn.P_TC]), "s", "terminal slide's T_c = 3.5/(alpha_max*K), eq. (41)", False),
+        ("T_C_SLIDE", float(prm[kn.P_TC]), "s",
+         "terminal slide's T_c = 3.5/(alpha_max*K), K below the chatter limit, eq. (41)", False),
         ("REF_LEAD", lead, "s", "alpha_ref read ahead: T_salpha/3 + the computation delay", False),
         ("REF_NODES", table.nodes, "-", f"nodes of the reference table ({table.float_bytes} bytes float32)", True),
         ("REF_H", table.h, "s", "node spacing T_m/(REF_NODES - 1)", False),

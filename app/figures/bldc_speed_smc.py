@@ -8,34 +8,51 @@ it. Speeds are shown in rpm, angles in electrical degrees (display edge only).
 
 from __future__ import annotations
 
-import math
+from typing import Any
 
 import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
+from app.figures.decimate import BINS_TIME_PLOTS, envelope, f32
 from app.figures.plain import slim_template
+from app.figures.style import (
+    BLDC_COLOURS,
+    BLDC_DASHES,
+    PHASE_COLOURS,
+    PHASE_DASHES,
+    REFERENCE_COLOUR,
+    TITLE_PX,
+    WARNING_COLOUR,
+)
 from app.io.units import rad_s_to_rpm
 from control.bldc.design import BldcDesign
 from control.bldc.dqx import dqx_coefficients, ideal_coefficients
 from sim.bldc import emf as bldc_emf
 from sim.bldc.engine import LABELS, BldcComparison
 
-MAX_POINTS = 3000
-COLORS = {"smc_integral": "#1f77b4", "smc_plain": "#ff7f0e", "pi_sinusoidal": "#2ca02c", "six_step": "#9467bd"}
-PHASE_COLORS = ("#d62728", "#2ca02c", "#1f77b4")
-_MARGIN = {"l": 55, "r": 15, "t": 40, "b": 40}
+_MARGIN = {"l": 64, "r": 15, "t": 48, "b": 40}
+_IDEAL = {"dash": "dash", "color": REFERENCE_COLOUR}
+_REAL = {"color": WARNING_COLOUR}
 
 
-def _layout(fig: go.Figure, fid: str, title: str, height: int = 320) -> go.Figure:
-    fig.update_layout(meta={"id": fid}, title={"text": title, "font": {"size": 13}}, height=height,
-                      margin=_MARGIN, template=slim_template(), legend={"orientation": "h", "y": -0.2},
+def finish_layout(fig: go.Figure, fid: str, title: str, height: int = 320) -> go.Figure:
+    """Give a BLDC figure its id, title, height, the slim template (page fonts) and a legend below."""
+    fig.update_layout(meta={"id": fid}, title={"text": title, "font": {"size": TITLE_PX}}, height=height,
+                      margin=_MARGIN, template=slim_template(),
+                      legend={"orientation": "h", "y": -0.12, "yanchor": "top"},
                       hovermode="x unified")
     return fig
 
 
-def _stride(n: int) -> int:
-    return max(1, int(math.ceil(n / MAX_POINTS)))
+def xy(t: np.ndarray, y: np.ndarray, n_bins: int = BINS_TIME_PLOTS) -> dict[str, Any]:
+    """Trace keys of ``y(t)``: its min/max envelope on about one point per pixel, float32 (chatter stays a band)."""
+    axis, values = envelope(t, y, n_bins)
+    return {**axis, "y": f32(values)}
+
+
+def _line(controller: str, width: float = 1.8) -> dict[str, object]:
+    return {"color": BLDC_COLOURS[controller], "dash": BLDC_DASHES[controller], "width": width}
 
 
 def make_emf_figure(table: np.ndarray, Phi_m: float) -> go.Figure:
@@ -43,11 +60,11 @@ def make_emf_figure(table: np.ndarray, Phi_m: float) -> go.Figure:
     deg = np.degrees(bldc_emf.grid(table.size))
     fig = go.Figure()
     fig.add_scatter(x=deg, y=bldc_emf.ideal_table(Phi_m, table.size), name="ideal trapezoid",
-                    line={"dash": "dash", "color": "#555"})
-    fig.add_scatter(x=deg, y=table, name="machine (real)", line={"color": "#d62728"})
+                    line=_IDEAL)
+    fig.add_scatter(x=deg, y=table, name="machine (real)", line=_REAL)
     fig.update_xaxes(title="θ_e [deg]", dtick=60)
     fig.update_yaxes(title="Φ'_ra = e_a/ω_e [Wb]")
-    return _layout(fig, "bldc_emf", "Back-EMF shape, phase a")
+    return finish_layout(fig, "bldc_emf", "Back-EMF shape, phase a")
 
 
 def make_dqx_figure(table: np.ndarray, Phi_m: float) -> go.Figure:
@@ -57,48 +74,32 @@ def make_dqx_figure(table: np.ndarray, Phi_m: float) -> go.Figure:
     real = dqx_coefficients(th, bldc_emf.table_phases(table, th), bldc_emf.table_slopes(table, th), Phi_m)
     deg = np.degrees(th)
     fig = make_subplots(rows=2, cols=1, shared_xaxes=True, vertical_spacing=0.08)
-    for c, name, style in ((ideal, "ideal trapezoid", {"dash": "dash", "color": "#555"}),
-                           (real, "machine (real)", {"color": "#d62728"})):
+    for c, name, style in ((ideal, "ideal trapezoid", _IDEAL), (real, "machine (real)", _REAL)):
         fig.add_scatter(x=deg, y=c.a_x, name=f"a_x, {name}", line=style, row=1, col=1)
         fig.add_scatter(x=deg, y=np.degrees(c.theta_x), name=f"θ_x, {name}", line=style, row=2, col=1)
     fig.update_yaxes(title="a_x [-]", row=1, col=1)
     fig.update_yaxes(title="θ_x [deg]", row=2, col=1)
     fig.update_xaxes(title="θ_e [deg]", dtick=60, row=2, col=1)
-    return _layout(fig, "bldc_dqx", "dq_x coefficients a_x, θ_x (Figs. 5–6)", height=420)
+    return finish_layout(fig, "bldc_dqx", "dq_x coefficients a_x, θ_x (Figs. 5–6)", height=420)
 
 
 def make_speed_figure(comp: BldcComparison) -> go.Figure:
     """Speed of every drive and ω*, load torque below (Figs. 9–10, 12–13 of [2])."""
     fig = make_subplots(rows=2, cols=1, shared_xaxes=True, row_heights=[0.72, 0.28], vertical_spacing=0.06)
     tr0 = comp.runs[0].trace
-    k = _stride(tr0.t.size)
-    fig.add_scatter(x=tr0.t[::k], y=rad_s_to_rpm(tr0.omega_ref[::k]), name="ω*", line={"dash": "dot", "color": "#000"},
+    fig.add_scatter(**xy(tr0.t, rad_s_to_rpm(tr0.omega_ref)), name="ω*",
+                    line={"dash": "dot", "color": REFERENCE_COLOUR},
                     row=1, col=1)
     for r in comp.runs:
         tr = r.trace
-        fig.add_scatter(x=tr.t[::k], y=rad_s_to_rpm(tr.omega[::k]), name=LABELS[r.controller],
-                        line={"color": COLORS[r.controller]}, row=1, col=1)
-    fig.add_scatter(x=tr0.t[::k], y=tr0.T_L[::k], name="T_L", line={"color": "#8c564b", "shape": "hv"},
+        fig.add_scatter(**xy(tr.t, rad_s_to_rpm(tr.omega)), name=LABELS[r.controller],
+                        line=_line(r.controller), row=1, col=1)
+    fig.add_scatter(**xy(tr0.t, tr0.T_L), name="T_L", line={"color": REFERENCE_COLOUR, "shape": "hv"},
                     row=2, col=1)
     fig.update_yaxes(title="n [rpm]", row=1, col=1)
     fig.update_yaxes(title="T_L [N·m]", row=2, col=1)
     fig.update_xaxes(title="t [s]", row=2, col=1)
-    return _layout(fig, "bldc_speed", "Speed and load torque", height=420)
-
-
-def make_torque_figure(comp: BldcComparison) -> go.Figure:
-    """Electromagnetic torque T_EL (eq. (3)) and its reference T*, every drive (Fig. 11)."""
-    fig = go.Figure()
-    for r in comp.runs:
-        tr = r.trace
-        k = _stride(tr.t.size)
-        c = COLORS[r.controller]
-        fig.add_scatter(x=tr.t[::k], y=tr.T_EL[::k], name=f"T_EL, {r.controller}", line={"color": c})
-        fig.add_scatter(x=tr.t[::k], y=tr.T_ref[::k], name=f"T*, {r.controller}",
-                        line={"color": c, "dash": "dot", "width": 1})
-    fig.update_xaxes(title="t [s]")
-    fig.update_yaxes(title="torque [N·m]")
-    return _layout(fig, "bldc_torque", "Electromagnetic torque and reference (Fig. 11)")
+    return finish_layout(fig, "bldc_speed", "Speed and load torque", height=420)
 
 
 def make_sigma_figure(comp: BldcComparison) -> go.Figure:
@@ -106,11 +107,10 @@ def make_sigma_figure(comp: BldcComparison) -> go.Figure:
     fig = go.Figure()
     for r in comp.runs:
         tr = r.trace
-        k = _stride(tr.t.size)
-        fig.add_scatter(x=tr.t[::k], y=tr.sigma[::k], name=r.controller, line={"color": COLORS[r.controller]})
+        fig.add_scatter(**xy(tr.t, tr.sigma), name=r.controller, line=_line(r.controller))
     fig.update_xaxes(title="t [s]")
     fig.update_yaxes(title="σ_ω [rad/s]")
-    return _layout(fig, "bldc_sigma", "Sliding variable σ_ω, eq. (16)")
+    return finish_layout(fig, "bldc_sigma", "Sliding variable σ_ω, eq. (16)")
 
 
 def make_currents_figure(comp: BldcComparison,
@@ -124,14 +124,13 @@ def make_currents_figure(comp: BldcComparison,
                         subplot_titles=[LABELS[c] for c in names])
     for row, c in enumerate(names, start=1):
         tr = comp.run(c).trace
-        k = _stride(tr.t.size)
         for j, phase in enumerate("abc"):
-            fig.add_scatter(x=tr.t[::k], y=tr.i_abc[j, ::k], name=f"i_{phase}", legendgroup=phase,
-                            showlegend=row == 1, line={"color": PHASE_COLORS[j], "width": 1}, row=row, col=1)
+            fig.add_scatter(**xy(tr.t, tr.i_abc[j]), name=f"i_{phase}", legendgroup=phase,
+                            showlegend=row == 1, row=row, col=1,
+                            line={"color": PHASE_COLOURS[j], "dash": PHASE_DASHES[j], "width": 1.5})
         fig.update_yaxes(title="i [A]", row=row, col=1)
     fig.update_xaxes(title="t [s]", row=len(names), col=1)
-    fig.update_annotations(font={"size": 11})
-    return _layout(fig, "bldc_currents", "Phase currents", height=200 + 150 * len(names))
+    return finish_layout(fig, "bldc_currents", "Phase currents", height=200 + 150 * len(names))
 
 
 def make_reachability_figure(design: BldcDesign) -> go.Figure:
@@ -141,11 +140,12 @@ def make_reachability_figure(design: BldcDesign) -> go.Figure:
     bound = np.where(np.isfinite(rc.bound), rc.bound, np.nan)
     top = max(5.0 * float(np.max(rc.lam)), 1.0)
     fig.add_scatter(x=rad_s_to_rpm(rc.eps), y=np.clip(bound, -top, top), name="hyperbola, eq. (24)",
-                    line={"color": "#d62728"}, connectgaps=False)
-    fig.add_scatter(x=rad_s_to_rpm(rc.eps), y=rc.lam, name="λ(ε) = λ₀/(1 + (ε/ε_λ)²)", line={"color": "#1f77b4"})
+                    line=_REAL, connectgaps=False)
+    fig.add_scatter(x=rad_s_to_rpm(rc.eps), y=rc.lam, name="λ(ε) = λ₀/(1 + (ε/ε_λ)²)",
+                    line={"color": BLDC_COLOURS["smc_integral"]})
     for a, b in rc.violated:
-        fig.add_vrect(x0=rad_s_to_rpm(a), x1=rad_s_to_rpm(b), fillcolor="red", opacity=0.15, line_width=0)
+        fig.add_vrect(x0=rad_s_to_rpm(a), x1=rad_s_to_rpm(b), fillcolor=WARNING_COLOUR, opacity=0.15, line_width=0)
     fig.update_xaxes(title="ε_ω [rpm]")
     fig.update_yaxes(title="λ [1/s]", range=[0.0, top])
     verdict = "inside everywhere" if rc.ok else "VIOLATED (red bands)"
-    return _layout(fig, "bldc_reach", f"Reachability: λ(ε) vs hyperbola — {verdict}")
+    return finish_layout(fig, "bldc_reach", f"Reachability: λ(ε) vs hyperbola — {verdict}")

@@ -17,6 +17,7 @@ import plotly.graph_objects as go
 
 from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index
 from app.figures.plain import to_figure
+from app.figures.style import FONT_PX, POSITION_COLOURS, POSITION_DASHES, WARNING_COLOUR
 from control.fdsmc.sliding_mode import boundary_speed
 from sim.fdsmc.engine import LABELS, Comparison, RunResult
 
@@ -25,7 +26,8 @@ MAX_POINTS = 2000
 #: Most points per trace in the (24-trace) time plots: about one per pixel of the plot's width.
 MAX_POINTS_TIME = 800
 #: Line colours per controller (the tracked minimum-energy optimum when simulated).
-COLOURS = {"fdsmc": "#1f6fd1", "conventional": "#e8590c", "optimum": "#2f9e44"}
+COLOURS = {key: POSITION_COLOURS[key] for key in ("fdsmc", "conventional", "optimum")}
+DASHES = {key: POSITION_DASHES[key] for key in COLOURS}
 BOUNDARY_COLOUR = "#2b2b2b"
 BAND_COLOUR = "rgba(120, 120, 120, 0.18)"
 _MARGIN = {"l": 60, "r": 16, "t": 40, "b": 44}
@@ -153,7 +155,7 @@ def phase_plane_spec(comparison: Comparison) -> dict[str, Any]:
         data.extend(_phase_marks(comparison, key, run, (lo + hi) / 2.0))
         data.append({"type": "scatter", "x": x[-1:], "y": y[-1:], "mode": "markers+text", "text": [""],
                      "textposition": "bottom right", "name": f"{label} now", "showlegend": False,
-                     "hoverinfo": "skip", "textfont": {"size": 13},
+                     "hoverinfo": "skip", "textfont": {"size": FONT_PX},
                      "marker": {"color": colour, "size": 14, "line": {"color": "white", "width": 2}}})
     prof = d.profile
     return {"data": data, "layout": {
@@ -161,7 +163,7 @@ def phase_plane_spec(comparison: Comparison) -> dict[str, Any]:
         "title": {"text": f"Phase plane — ω_p = {prof.omega_p:.4g} rad/s, T_c = {prof.T_c:.4g} s", "x": 0.01},
         "xaxis": {"title": {"text": "θ_re = θ_r − θ_rdem [rad]"}, "range": [lo, hi], "zeroline": True},
         "yaxis": {"title": {"text": "ω_r [rad/s]"}, "zeroline": True},
-        "legend": {"orientation": "h", "y": -0.14, "x": 0.0, "font": {"size": 11}},
+        "legend": {"orientation": "h", "y": -0.14, "x": 0.0, "font": {"size": FONT_PX}},
         "margin": _MARGIN, "template": "plotly_white", "hovermode": "closest",
     }}
 
@@ -222,7 +224,7 @@ def _time_axes(n_rows: int, spacing: float = 0.025) -> tuple[dict[str, Any], lis
                                  **({} if r == 0 else {"matches": "x"})}
         title, unit, _ = TIME_ROWS[r]
         notes.append({"text": f"{title} [{unit}]", "x": 0.5, "y": top, "xref": "paper", "yref": "paper",
-                      "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 12}})
+                      "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": FONT_PX}})
     layout[f"xaxis{'' if n_rows == 1 else n_rows}"]["title"] = {"text": "t [s]"}
     return layout, notes
 
@@ -252,12 +254,13 @@ def time_plots_spec(comparison: Comparison, rows: tuple[int, ...] | None = None,
     shapes = [{"type": "line", "xref": "x", "yref": "paper", "x0": t, "x1": t, "y0": 0.0, "y1": 1.0,
                 "line": {"color": "#c92a2a", "width": 2, "dash": "dot"}} for t in load_step_times(comparison)]
     notes += [{"text": f"load step {t:.3g} s", "x": t, "y": 1.0, "xref": "x", "yref": "paper",
-               "showarrow": False, "font": {"color": "#c92a2a", "size": 11}, "xanchor": "left", "yanchor": "top"}
+               "showarrow": False, "font": {"color": WARNING_COLOUR, "size": FONT_PX}, "xanchor": "left",
+               "yanchor": "top"}
               for t in load_step_times(comparison)]
     return {"data": data, "layout": {
         **axes, "annotations": notes, "shapes": shapes, "meta": {"id": "time_plots"}, "template": "plotly_white",
         "hovermode": "x unified", "margin": {"l": 60, "r": 16, "t": 30, "b": 40},
-        "legend": {"orientation": "h", "y": -0.04, "x": 0.0}, "font": {"size": 11}}}
+        "legend": {"orientation": "h", "y": -0.04, "x": 0.0}, "font": {"size": FONT_PX}}}
 
 
 def make_time_plots_figure(comparison: Comparison) -> go.Figure:
@@ -282,7 +285,7 @@ def cursor_index(t: np.ndarray, t_now: float) -> int:
 
 
 __all__ = [
-    "COLOURS", "LABELS", "MAX_POINTS", "TIME_ROWS", "boundary_xy", "cursor_index", "decimate_index",
+    "COLOURS", "DASHES", "LABELS", "MAX_POINTS", "TIME_ROWS", "boundary_xy", "cursor_index", "decimate_index",
     "stride_index", "layer_entry_index", "load_step_times", "make_phase_plane_figure",
     "make_time_plots_figure",
     "phase_plane_extent", "phase_plane_spec", "runs", "time_plots_spec",

@@ -17,8 +17,9 @@ from typing import Any
 import numpy as np
 
 from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
-from app.figures.fdsmc_comparison import COLOURS, LABELS, load_step_times, phase_plane_spec, runs
+from app.figures.fdsmc_comparison import COLOURS, DASHES, LABELS, load_step_times, phase_plane_spec, runs
 from app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
+from app.figures.style import FONT_PX, TITLE_PX
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
 
@@ -55,8 +56,8 @@ def _row_traces(comparison: Any) -> tuple[list[dict[str, Any]], list[list[float]
         gamma = motor_torque(motor, tr.i_d, tr.i_q)
         style = {"type": "scatter", "mode": "lines", "showlegend": False}
         for row, full, name, unit, line in (
-                (0, tr.omega_r, "ω_r", "rad/s", {"width": 1.6}),
-                (1, gamma, "Γ", "N·m", {"width": 1.6}),
+                (0, tr.omega_r, "ω_r", "rad/s", {"width": 1.6, "dash": DASHES[key]}),
+                (1, gamma, "Γ", "N·m", {"width": 1.6, "dash": DASHES[key]}),
                 (1, tr.Gamma_L, "Γ_L", "N·m", {"width": 1.2, "dash": "dot"})):
             t, y = envelope(tr.t, full, BINS_OVERVIEW_ROWS)  # a chattering Γ stays a band
             data.append({**style, **t, "y": f32(y), "name": f"{name} {LABELS[key]}", "xaxis": f"x{row + 2}",
@@ -95,7 +96,7 @@ def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> di
     axes["xaxis3"]["title"] = {"text": "t [s]", "standoff": 4}
     notes = [{"text": f"motor Γ, load Γ_L dotted, ±Γ_max = {g_max:.4g} N·m dashed", "x": TIME_X[0],
               "y": ROW_Y[1][1], "xref": "paper", "yref": "paper", "xanchor": "left", "yanchor": "bottom",
-              "showarrow": False, "font": {"size": 10, "color": "#555"}}]
+              "showarrow": False, "font": {"size": FONT_PX, "color": "#555"}}]
     shapes = []
     for t in load_step_times(comparison):
         for row in (2, 3):
@@ -103,7 +104,7 @@ def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> di
                            "y0": 0.0, "y1": 1.0, "line": {"color": LOAD_STEP_COLOUR, "width": 2, "dash": "dot"}})
         notes.append({"text": f"load step {t:.3g} s", "x": t, "y": 1.0, "xref": "x2", "yref": "y2 domain",
                       "xanchor": "left", "yanchor": "top", "showarrow": False,
-                      "font": {"size": 10, "color": LOAD_STEP_COLOUR}})
+                      "font": {"size": FONT_PX, "color": LOAD_STEP_COLOUR}})
     return {**axes, "annotations": notes, "shapes": shapes}
 
 
@@ -128,10 +129,10 @@ def overview_spec(comparison: Any) -> dict[str, Any]:
     layout = spec["layout"]
     layout["xaxis"] = {**layout["xaxis"], "domain": list(PHASE_X)}
     layout["meta"] = {**layout["meta"], "overview": True}
-    layout["title"] = {**layout["title"], "font": {"size": 15}, "y": 0.995, "yref": "container", "yanchor": "top"}
-    layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": 10},
-                        "entrywidth": 0.36, "entrywidthmode": "fraction"}
-    layout["margin"] = {"l": 56, "r": 12, "t": 96, "b": 84, "autoexpand": False}
+    layout["title"] = {**layout["title"], "font": {"size": TITLE_PX}, "y": 0.995, "yref": "container", "yanchor": "top"}
+    layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": FONT_PX},
+                        "entrywidth": 0.5, "entrywidthmode": "fraction"}
+    layout["margin"] = {"l": 56, "r": 12, "t": 116, "b": 84, "autoexpand": False}  # a 3-row legend at 14 px
     if not runs(comparison):
         return spec
     traces, ranges, t_end = _row_traces(comparison)

@@ -19,6 +19,7 @@ import plotly.graph_objects as go
 from app.figures.decimate import f32, time_axis
 from app.figures.fdsmc_comparison import COLOURS, LABELS, MAX_POINTS_TIME, stride_index
 from app.figures.plain import to_figure
+from app.figures.style import FONT_PX
 from sim.fdsmc.verdicts import TARGET_BAND
 from sim.studies.multiaxis import MultiAxisResult
 from sim.studies.robustness import RobustnessResult
@@ -118,7 +119,7 @@ def robustness_spec(result: RobustnessResult, torque_limit_Nm: float) -> dict[st
         notes.append({"text": f"{title} [{unit}]" + (f"<br>({missing} of {n} samples without a value)"
                                                        if missing else ""),
                       "x": 0.5 * (dom_x[0] + dom_x[1]), "y": dom_y[1], "xref": "paper", "yref": "paper",
-                      "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11}})
+                      "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": FONT_PX}})
         drawn[key] = {ctrl: int(c.sum()) for ctrl, c in zip(series, counts, strict=True)}
     n = len(result.runs)
     return {"data": data, "layout": {
@@ -126,7 +127,7 @@ def robustness_spec(result: RobustnessResult, torque_limit_Nm: float) -> dict[st
         "meta": {"id": "robustness", "samples": n, "drawn": drawn},
         "title": {"text": f"Robustness — {n} sampled plants (controller designed on the nominal model)", "x": 0.01},
         "margin": {"l": 60, "r": 16, "t": 70, "b": 40}, "legend": {"orientation": "h", "y": -0.08},
-        "font": {"size": 11}}}
+        "font": {"size": FONT_PX}}}
 
 
 def make_robustness_figure(result: RobustnessResult, torque_limit_Nm: float) -> go.Figure:
@@ -218,7 +219,7 @@ def multiaxis_spec(result: MultiAxisResult) -> dict[str, Any]:
         "title": {"text": f"Axes finishing together at T_m = {result.T_m:.4g} s (band ±{100 * band:g} % of θ_dem)",
                   "x": 0.01},
         "margin": {"l": 60, "r": 16, "t": 40, "b": 40}, "legend": {"orientation": "h", "y": -0.12},
-        "font": {"size": 11}}}
+        "font": {"size": FONT_PX}}}
 
 
 def make_multiaxis_figure(result: MultiAxisResult) -> go.Figure:

@@ -19,6 +19,8 @@ import numpy as np
 import plotly.graph_objects as go
 import plotly.io as pio
 
+from app.figures.style import FONT_PX, TEMPLATE_LAYOUT, TITLE_PX
+
 #: Trace types whose template defaults are kept (the only ones the page draws), and the layout
 #: parts of a template that cartesian 2D figures never use (polar, ternary, 3D scene, geo, …).
 _TEMPLATE_TRACES = ("scatter", "bar")
@@ -40,7 +42,11 @@ def template_json(name: str) -> str:
     for axis in ("xaxis", "yaxis"):
         # Plotly's default ("hide past div") measures every tick label for each redraw (≈ 6 % of an
         # overview redraw in headless Chromium); the figures' margins keep the labels inside anyway
-        slim["layout"][axis] = {**slim["layout"].get(axis, {}), "ticklabeloverflow": "allow"}
+        old = slim["layout"].get(axis, {})
+        slim["layout"][axis] = {**old, "ticklabeloverflow": "allow", "tickfont": {"size": FONT_PX},
+                                "title": {**old.get("title", {}), "font": {"size": FONT_PX}}}
+    for key, value in TEMPLATE_LAYOUT.items():  # the page's font sizes (app.figures.style)
+        slim["layout"][key] = {**slim["layout"].get(key, {}), **value}
     return json.dumps(slim, separators=(",", ":"))
 
 
@@ -48,7 +54,7 @@ def template_json(name: str) -> str:
 def placeholder_json(figure_id: str, title: str, height: float = 260.0) -> str:
     """JSON of an empty figure titled ``title`` (``layout.meta.id`` = ``figure_id``), until results arrive."""
     return figure_json({"data": [], "layout": {
-        "meta": {"id": figure_id}, "title": {"text": title, "font": {"size": 13}}, "height": height,
+        "meta": {"id": figure_id}, "title": {"text": title, "font": {"size": TITLE_PX}}, "height": height,
         "template": "plotly_white", "margin": {"l": 40, "r": 10, "t": 40, "b": 30}}})
 
 

@@ -30,6 +30,8 @@ from sim.bldc.emf import MeasuredEmf, resample_measured
 
 STORE_SAMPLES = 360  # samples per period kept in a preset (1° electrical)
 MAX_BYTES = 512 * 1024
+#: Most YAML nodes of a waveform file: 4 columns and a row list per sample, and a few keys [-].
+EMF_YAML_NODES = 6 * EMF_SAMPLES_MAX
 _SPLIT = re.compile(r"[,;\t ]+")
 
 
@@ -88,7 +90,7 @@ def _to_arrays(rows: list[list[float]]) -> tuple[np.ndarray, np.ndarray]:
 
 def parse_yaml(text: str) -> tuple[np.ndarray, np.ndarray]:
     """YAML text (module docstring forms) → (θ_e [deg], values (rows, 1 or 3))."""
-    data: Any = loads_raw(text, "emf waveform")
+    data: Any = loads_raw(text, "emf waveform", max_nodes=EMF_YAML_NODES)
     if isinstance(data, dict):
         keys = ["theta_e_deg", "phi_a"] + [k for k in ("phi_b", "phi_c") if k in data]
         if "theta_e_deg" not in data or "phi_a" not in data:

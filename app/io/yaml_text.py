@@ -18,8 +18,18 @@ from app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
 from app.io.numbers import QuotedText, shorten
 from app.io.preset_schema import PresetError
 
+#: Most YAML nodes (scalars, keys and collections) one text may hold [-]: a preset needs ≈ 200, one
+#: with a measured back-EMF table ≈ 4 300. Counted as the text is parsed, it bounds the pure-Python
+#: parser's time (≈ 18 µs a node) as the size limit bounds the rest.
+MAX_NODES = 10_000
+
 
 # ---- YAML front-end: text → raw mapping of texts, lists and mappings -------------------------
+def _too_many(origin: str, mark: Any, max_nodes: int) -> PresetError:
+    return PresetError(f"{origin} has too many values at line {mark.line + 1}, column {mark.column + 1}: "
+                       f"allowed ≤ {max_nodes} YAML nodes (keys, values and lists)")
+
+
 def _too_deep(origin: str, mark: Any, kind: str) -> PresetError:
     return PresetError(f"{origin} is nested too deeply at line {mark.line + 1}, column {mark.column + 1}: "
                        f"allowed ≤ {MAX_DEPTH} levels of {kind}")
@@ -35,10 +45,13 @@ class _TextLoader(yaml.SafeLoader):
 
     The scanner counts the nesting as it reads: the ``MAX_DEPTH + 1``-th bracket or indentation level
     is refused on the spot, so no text costs more than its size (a pre-scan can be fooled by
-    quotes and comments; the scanner cannot).
+    quotes and comments; the scanner cannot). The composer counts the nodes and refuses the
+    ``max_nodes + 1``-th as it is read.
     """
 
     origin = "<text>"
+    max_nodes = MAX_NODES
+    _nodes = 0
 
     def fetch_flow_collection_start(self, TokenClass: Any) -> None:  # noqa: N803 - PyYAML's name
         """Refuse a bracket that would nest deeper than :data:`MAX_DEPTH`."""
@@ -49,6 +62,9 @@ class _TextLoader(yaml.SafeLoader):
     def compose_node(self, parent: Any, index: Any) -> Any:
         """Refuse an anchor (``&name``) or alias (``*name``) before it is composed (one pass)."""
         event = self.peek_event()
+        self._nodes += 1
+        if self._nodes > self.max_nodes:
+            raise _too_many(self.origin, event.start_mark, self.max_nodes)
         if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
             raise PresetError(f"YAML anchors/aliases (*name) at line {event.start_mark.line + 1} are not allowed "
                               "in presets: write each value out")
@@ -69,18 +85,23 @@ if getattr(yaml, "__with_libyaml__", False):
     _CLoader = type("_CTextLoader", (yaml.CSafeLoader,), {"yaml_implicit_resolvers": {}})
 
 
-def _loader(origin: str) -> type[_TextLoader]:
-    """:class:`_TextLoader` naming ``origin`` in its messages."""
-    return type("_OriginLoader", (_TextLoader,), {"origin": origin})
+def _loader(origin: str, max_nodes: int) -> type[_TextLoader]:
+    """:class:`_TextLoader` naming ``origin`` in its messages, refusing more than ``max_nodes`` nodes."""
+    return type("_OriginLoader", (_TextLoader,), {"origin": origin, "max_nodes": max_nodes})
 
 
-def _check_events(text: str, origin: str) -> None:
-    """Stream libyaml's parser events: refuse anchors, aliases and nesting deeper than :data:`MAX_DEPTH`.
+def _check_events(text: str, origin: str, max_nodes: int) -> None:
+    """Stream libyaml's parser events: refuse anchors, aliases, deep nesting and too many nodes.
 
-    The parser stops at the first refusal, having read only a bounded look-ahead past it.
+    Nesting deeper than :data:`MAX_DEPTH` and more than ``max_nodes`` nodes are refused. The parser stops
+    at the first refusal, having read only a bounded look-ahead past it.
     """
-    depth = 0
+    depth = nodes = 0
     for event in yaml.parse(text, Loader=_CLoader):
+        if isinstance(event, yaml.NodeEvent):
+            nodes += 1
+            if nodes > max_nodes:
+                raise _too_many(origin, event.start_mark, max_nodes)
         if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
             raise PresetError(f"YAML anchors/aliases (*name) at line {event.start_mark.line + 1} are not allowed "
                               "in presets: write each value out")
@@ -92,11 +113,11 @@ def _check_events(text: str, origin: str) -> None:
             depth -= 1
 
 
-def _load(text: str, origin: str) -> Any:
+def _load(text: str, origin: str, max_nodes: int) -> Any:
     """YAML text → data: libyaml after its event check, else the pure-Python guarded loader."""
     if _CLoader is None:
-        return yaml.load(text, Loader=_loader(origin))  # noqa: S506 - a SafeLoader subclass
-    _check_events(text, origin)
+        return yaml.load(text, Loader=_loader(origin, max_nodes))  # noqa: S506 - a SafeLoader subclass
+    _check_events(text, origin, max_nodes)
     return yaml.load(text, Loader=_CLoader)  # noqa: S506 - a CSafeLoader subclass, tags refused
 
 
@@ -137,15 +158,16 @@ for _cls in filter(None, (_TextLoader, _CLoader)):
     _cls.add_constructor("tag:yaml.org,2002:str", _text)
 
 
-def loads_raw(text: str, origin: str = "<text>") -> Any:
+def loads_raw(text: str, origin: str = "<text>", max_nodes: int = MAX_NODES) -> Any:
     """Parse YAML text safely into plain data whose scalars are all text (see :class:`_TextLoader`).
 
-    Size-limited, nesting-limited by the scanner itself, no aliases, no duplicate keys.
+    Size-limited, nesting-limited by the scanner itself, at most ``max_nodes`` nodes (counted as
+    they are parsed), no aliases, no duplicate keys.
     """
     origin = shorten(origin)
     check_size(text, origin)
     try:
-        return _load(text, origin)
+        return _load(text, origin, max_nodes)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
@@ -194,4 +216,4 @@ def dumps(data: Any) -> str:
     return yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, default_flow_style=False)
 
 
-__all__ = ["MAX_BYTES", "MAX_DEPTH", "dumps", "loads_any_raw", "loads_raw", "plain_scalar"]
+__all__ = ["MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "dumps", "loads_any_raw", "loads_raw", "plain_scalar"]

@@ -9,41 +9,34 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import threading
 from collections.abc import Callable
 from typing import Any
 
 import viser
 
-from app.figures.bldc_speed_smc import (
-    make_currents_figure,
-    make_dqx_figure,
-    make_emf_figure,
-    make_reachability_figure,
-    make_sigma_figure,
-    make_speed_figure,
-    make_torque_figure,
-)
-from app.figures.plain import placeholder_json
+from app.figures.bldc_speed_smc import make_dqx_figure, make_emf_figure, make_reachability_figure
 from app.io.bldc_emf import read_measured, with_measured
-from app.io.bldc_view import metric_table
 from app.io.display_units import field_hint, field_label, shown_value, si_value
 from app.io.numbers import NumberFormatError
 from app.io.presets import annotate_units, dumps_preset, load
 from app.io.units import s_to_ms, spec_of
+from app.ui.bldc_results import BldcResults
 from app.ui.choices import checked_choice
 from app.ui.files import parse_upload, upload_text
 from app.ui.number_fields import NumberInput
 from app.ui.text import md_text
-from app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
+from app.ui.viser_adapter import figure_json_of
 from app.ui.worker import Cancelled, Worker
 from control.bldc.design import bldc_design
 from control.bldc.params import EMF_SHAPES, BldcParams
 from control.common.checks import ParameterError
 from sim.bldc.emf import machine_table
-from sim.bldc.engine import CONTROLLERS, LABELS, BldcComparison, compare_bldc
+from sim.bldc.engine import CONTROLLERS, BldcComparison, BldcRunResult, compare_bldc, simulate_bldc
 
 PRESET = "bldc_smc_paper"
-ASPECT = 0.75
+#: ε_λ [rad/s] that switches the anti-windup of eq. (16) off: the largest allowed, λ(ε) = λ_0 for any reachable error.
+EPS_LAMBDA_OFF = float(spec_of("gains.eps_lambda").high)
 
 #: The machine, load, inverter and gain inputs (``section.field``); label, display unit and allowed
 #: range come from each field's spec (:func:`app.io.units.spec_of`).
@@ -71,10 +64,6 @@ def read_si(field: NumberInput, key: str) -> float | int:
     return field.read(f"{key} ({field_label(key)})", lambda x: si_value(key, x), integer=spec_of(key).integer)
 
 
-def _placeholder(gui: viser.GuiApi, figure_id: str, title: str, aspect: float) -> viser.GuiPlotlyHandle:
-    return add_figure(gui, placeholder_json(figure_id, f"{title} — press “Simulate BLDC”"), aspect)
-
-
 def _warnings_markdown(warnings: tuple[str, ...]) -> str:
     return "\n".join(f"⚠ {md_text(w)}  " for w in warnings)
 
@@ -93,13 +82,9 @@ def design_view(p: BldcParams) -> tuple[str, str, str, tuple[str, ...]]:
     return emf, dqx, reach, tuple(design.warnings)
 
 
-def metrics_markdown(comp: BldcComparison) -> str:
-    """Return the side-by-side metrics as a Markdown table (shared rows with the CLI)."""
-    rows = metric_table(comp)
-    head = "| " + " | ".join(rows[0]) + " |"
-    lines = [head, "|" + "---|" * len(rows[0])] + ["| " + " | ".join(r) + " |" for r in rows[1:]]
-    names = "; ".join(f"**{r.controller}** = {LABELS[r.controller]}" for r in comp.runs)
-    return "\n".join(lines) + f"\n\n{names}"
+def without_anti_windup(p: BldcParams) -> BldcParams:
+    """``p`` with λ(ε) = λ_0 (ε_λ = :data:`EPS_LAMBDA_OFF`): the integral of eq. (16) is never relieved."""
+    return dataclasses.replace(p, gains=dataclasses.replace(p.gains, eps_lambda=EPS_LAMBDA_OFF))
 
 
 class BldcTab:
@@ -129,6 +114,11 @@ class BldcTab:
         self.upload.on_upload(self._uploaded)
         self.run_button = gui.add_button("Simulate BLDC", icon=viser.Icon.PLAYER_PLAY, color="green")
         self.run_button.on_click(lambda _: self.simulate())
+        self.anti_windup = gui.add_checkbox(
+            "Anti-windup on λ(ε)", True, hint="λ(ε) = λ_0/(1 + (ε/ε_λ)²) of eq. (16); off: λ = λ_0 (ε_λ → ∞)")
+        self.side_by_side = gui.add_checkbox(
+            "Paper drive with / without anti-windup, side by side", False,
+            hint="Also runs the paper's drive with the other anti-windup setting; figure beside the others")
         self.cancel_button = gui.add_button("Cancel BLDC run", icon=viser.Icon.PLAYER_STOP, color="red",
                                             visible=False)
         self.cancel_button.on_click(lambda _: self._cancel())
@@ -144,16 +134,7 @@ class BldcTab:
             for key in FIELDS:
                 self.inputs[key] = number_input(gui, key)
             self._show_inputs(p)
-        with self._figures_container or gui.add_folder("Figures", expand_by_default=True):
-            with gui.add_folder("Metrics", expand_by_default=True):
-                self.metrics = gui.add_markdown("No run yet — press **Simulate BLDC**.")
-            self.fig_speed = _placeholder(gui, "bldc_speed", "Speed", ASPECT)
-            self.fig_torque = _placeholder(gui, "bldc_torque", "Torque", ASPECT)
-            self.fig_sigma = _placeholder(gui, "bldc_sigma", "σ_ω", ASPECT)
-            self.fig_currents = _placeholder(gui, "bldc_currents", "Phase currents", ASPECT)
-            self.fig_emf = add_figure(gui, emf, ASPECT)
-            self.fig_dqx = add_figure(gui, dqx, 1.0)
-            self.fig_reach = add_figure(gui, reach, ASPECT)
+        self.results = BldcResults(gui, self._figures_container or gui.add_folder("Figures"), (emf, dqx, reach))
         self.download = gui.add_button("Download BLDC preset (YAML)", icon=viser.Icon.DOWNLOAD)
         self.download.on_click(lambda _: self._download())
         self.import_preset = gui.add_upload_button("Import BLDC preset (YAML)", icon=viser.Icon.UPLOAD,
@@ -175,6 +156,8 @@ class BldcTab:
         except NumberFormatError as exc:
             raise ParameterError(str(exc)) from None
         sections["machine"]["emf"] = checked_choice(self.emf.value, EMF_SHAPES, "Machine back-EMF")
+        if not self.anti_windup.value:
+            sections["gains"]["eps_lambda"] = EPS_LAMBDA_OFF
         new = {sec: dataclasses.replace(getattr(p, sec), **vals) for sec, vals in sections.items()}
         names = tuple(c.name for c in p.scenario.cases)
         case = p.scenario.cases[names.index(checked_choice(self.scenario.value, names, "Scenario"))]
@@ -185,8 +168,7 @@ class BldcTab:
 
     def _show_design(self) -> None:
         emf, dqx, reach, warnings = design_view(self.params)
-        for handle, json_str in ((self.fig_emf, emf), (self.fig_dqx, dqx), (self.fig_reach, reach)):
-            set_figure_json(handle, json_str)
+        self.results.show_design((emf, dqx, reach))
         self.warnings.content = _warnings_markdown(warnings)
 
     # ---- actions ------------------------------------------------------------------------------
@@ -197,13 +179,24 @@ class BldcTab:
         except (ParameterError, ValueError, TypeError) as exc:
             self.status.content = f"**Rejected — nothing simulated:** {md_text(exc)}"
             return False
-        return bool(self._submit(lambda: self._run(params)))
+        pair = self.side_by_side.value
+        eps_on = read_si(self.inputs["gains.eps_lambda"], "gains.eps_lambda") if pair else None
+        return bool(self._submit(lambda: self._run(params, eps_on)))
 
-    def _run(self, params: BldcParams) -> None:
+    def _pair(self, comp: BldcComparison, eps_on: float) -> tuple[BldcRunResult, BldcRunResult]:
+        """Run the paper's drive with anti-windup (ε_λ = ``eps_on``) and without, reusing the comparison's run."""
+        p, shown = comp.params, comp.run("smc_integral")
+        if self.anti_windup.value:
+            return shown, simulate_bldc(without_anti_windup(p), "smc_integral")
+        on = dataclasses.replace(p, gains=dataclasses.replace(p.gains, eps_lambda=eps_on))
+        return simulate_bldc(on, "smc_integral"), shown
+
+    def _run(self, params: BldcParams, eps_on: float | None = None) -> None:
         self.status.content = f"Simulating… ({len(CONTROLLERS)} drives)"
         self.run_button.disabled, self.cancel_button.visible = True, self._worker is not None
         try:
             comp = compare_bldc(params)
+            pair = None if eps_on is None else self._pair(comp, eps_on)
             if self._worker is not None:
                 self._worker.checkpoint()
         except (ParameterError, ValueError) as exc:
@@ -216,10 +209,7 @@ class BldcTab:
             self.run_button.disabled, self.cancel_button.visible = False, False
         self.params, self.comparison = params, comp
         self._show_design()
-        for handle, make in ((self.fig_speed, make_speed_figure), (self.fig_torque, make_torque_figure),
-                             (self.fig_sigma, make_sigma_figure), (self.fig_currents, make_currents_figure)):
-            set_figure_json(handle, figure_json_of(make(comp)))
-        self.metrics.content = metrics_markdown(comp)
+        self.results.show(comp, pair, eps_on or params.gains.eps_lambda)
         sim_s = params.case.t_end * len(comp.runs)
         self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**, "
                                f"{sim_s:g} s simulated in {s_to_ms(comp.wall_s):.0f} ms.")
@@ -305,6 +295,17 @@ class BldcTab:
             return
         self.client.send_file_download(f"{params.name}.yaml", annotate_units(dumps_preset(params)).encode("utf-8"),
                                        save_immediately=True)
+
+
+def warm_bldc() -> None:
+    """Prepare the BLDC tab before the first page: the preset's design figures now, its kernels in the background.
+
+    The design figures are in every page's first messages; the kernels' first load (≈ 1–5 s of
+    numba cache reading) would otherwise fall on the first "Simulate BLDC".
+    """
+    params = load(PRESET, mode="bldc")
+    design_view(params)
+    threading.Thread(target=lambda: compare_bldc(params), name="bldc-warm-up", daemon=True).start()
 
 
 def add_bldc_tab(client: viser.ClientHandle, tabs: viser.GuiTabGroupHandle,

@@ -38,9 +38,9 @@ CONTROL_WIDTH, CONTROL_WIDTH_WIDE, WIDE_WINDOW = 400.0, 440.0, 1600.0
 #: Least width of the results panel [px] (narrow windows scroll rather than squash it).
 RESULTS_MIN = 320.0
 #: Vertical space of the results panel not available to the overview plot [px]: panel header and
-#: tab strip (≈ 78), the key-numbers line (≈ 44), the "Replay t" slider below the plot (≈ 40),
-#: paddings.
-CHROME_HEIGHT = 190.0
+#: tab strip (≈ 78), the key numbers (16 px, up to three lines ≈ 68), the "Replay t" slider below
+#: the plot (≈ 40), paddings.
+CHROME_HEIGHT = 216.0
 #: Horizontal padding of the results panel around a plot [px] (padding and scroll bar).
 PLOT_PADDING = 36.0
 #: Bounds of the overview plot's aspect (height / width) [-].

@@ -12,15 +12,20 @@ from collections.abc import Callable
 
 import viser
 
+from app.figures.style import fmt
 from app.io.numbers import NumberFormatError, parse_integer, parse_number
 from app.ui.props import assign
 
+#: Significant digits a field shows (the exact value stays behind an untouched field).
+FIELD_DIGITS = 5
+
 
 def shown_text(value: float | int) -> str:
-    """Display text of a value: 12 significant digits, no exponent for ordinary magnitudes."""
-    if isinstance(value, int):
-        return str(value)
-    return f"{value:.12g}"
+    """Display text of a value, rounded to its meaning (:func:`app.figures.style.fmt`, 5 significant digits).
+
+    1432.39448783 rpm shows as 1432.4; an untouched field still reads back its exact value.
+    """
+    return fmt(value, digits=FIELD_DIGITS)
 
 
 class NumberInput:

@@ -6,6 +6,7 @@ panel docked left with the two mode tabs (:mod:`app.ui.position_tab`, :mod:`app.
 results panel docked right (:mod:`app.ui.results`) with the studies (:mod:`app.ui.studies`), the 3D
 canvas between them — and sizes it from the window (:mod:`app.ui.layout`). Simulations run on the
 session's worker (never on the GUI event loop); a second Simulate while one runs is refused.
+Studies (robustness, multi-axis, Table-1 sweeps) share the server's slots (:mod:`app.ui.studies_queue`).
 """
 
 from __future__ import annotations
@@ -15,9 +16,12 @@ from dataclasses import dataclass, field
 
 import viser
 
-from app.threads import limit_blas_threads
-from app.ui.bldc_tab import add_bldc_tab
+from app.figures.style import SLIDER_CSS
+from app.threads import limit_blas_threads, release_memory
+from app.ui.bldc_results import follow_tabs_js
+from app.ui.bldc_tab import add_bldc_tab, warm_bldc
 from app.ui.case import Case, CaseState
+from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
 from app.ui.inputs import InputsPanel
 from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
@@ -27,11 +31,13 @@ from app.ui.position_tab import PositionTab, comparison_or_derived
 from app.ui.results import ResultsPanel
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import StudiesSection
+from app.ui.studies_queue import StudySlots
+from app.ui.text import md_text
 from app.ui.viser_adapter import run_script, widget_id
 from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Worker
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison
+from sim.fdsmc.engine import Comparison, start_run_threads
 
 
 @dataclass
@@ -45,6 +51,7 @@ class AppConfig:
     _lock: threading.Lock = field(default_factory=threading.Lock)
     sessions: dict[int, Session] = field(default_factory=dict)
     guard: Guard | None = None
+    slots: StudySlots = field(default_factory=StudySlots.for_machine)
 
     def initial(self) -> Comparison:
         """Return the comparison of the start-up preset (computed on first use)."""
@@ -54,14 +61,21 @@ class AppConfig:
             return self._initial
 
 
+#: The Table-1 sweep's label as a study.
+SWEEP = "Table-1 sweep"
+#: Delay from a page's disconnect to returning freed memory to the system [s] (its job stops by then).
+RELEASE_AFTER_S = 2.0
+
+
 class Session:
     """One browser tab's page: its case, its worker, the two mode tabs and the results panel."""
 
     def __init__(self, client: viser.ClientHandle, config: AppConfig) -> None:
         self.client, self.gui = client, client.gui
         self.state = CaseState(Case(config.params, config.origin, config.initial()))
+        self.slots = config.slots
         self.worker = Worker(lambda busy: self.tab.set_busy(busy), lambda exc: self.tab.job_failed(exc),
-                             name=f"ui-client-{client.client_id}")
+                             name=f"ui-client-{client.client_id}", slots=config.slots, on_queued=self._queued)
         scene = RotorScene(client.scene) if config.scene_3d else None
         self._layout(scene)  # the results panel shows the start-up comparison from its first message
         self.tab.show_text()
@@ -83,17 +97,37 @@ class Session:
             tabs = gui.add_tab_group()
             with tabs.add_tab("Position drive (FDSMC)"):
                 self.tab = PositionTab(self.client, self.state, self.worker)
-            self.results = ResultsPanel(self.client, self.state.current.comparison, scene, self.tab.sweep,
+            self.results = ResultsPanel(self.client, self.state.current.comparison, scene, self._sweep,
                                         on_3d=lambda shown: self.fit.set_3d(shown))
             self.tab.results = self.results
             self.results.panel.dock_right()
-            self.studies = StudiesSection(self.tab)
-            add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
+            self.studies = StudiesSection(self.tab, self.worker.as_study, self.slots.processes_per_study)
+            self.bldc = add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
+            with self.results.panel.add_tab("Share", viser.Icon.SHARE):
+                self.export = FigureExport(gui, self._figure_handles)
             self.fit = WindowFit(self._apply_layout)
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
         run_script(gui, window_report_js(widget_id(self._window_probe)))
+        run_script(gui, follow_tabs_js())
+        run_script(gui, install_css_js(SLIDER_CSS, "app-legibility-style"))
+
+    def _figure_handles(self) -> list[viser.GuiPlotlyHandle]:
+        r, b = self.results, self.bldc.results
+        return [r.phase, r.time_plots, r.energy, r.bars, r.table1, b.speed, b.torque, b.antiwindup, b.sigma,
+                b.currents, b.emf, b.dqx, b.reach]
+
+    def _sweep(self, T_m_values: list[float]) -> None:
+        """Start the Table-1 sweep as a study (it waits for a server-wide slot)."""
+        with self.worker.as_study(SWEEP):
+            self.tab.sweep(T_m_values)
+
+    def _queued(self, label: str, ahead: int) -> None:
+        """Say on the status line, and in the study's tab, that the study ``label`` waits (worker thread)."""
+        text = md_text(self.slots.queued_text(label, ahead))
+        self.tab.say(text)
+        self.studies.queued(label, text)
 
     def _apply_layout(self, layout: PanelLayout) -> None:
         self.results.fit(layout)  # the panel widths come from the page's CSS, not set_width
@@ -194,6 +228,7 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
         The running server and its settings (``config.sessions`` maps client id → Session).
     """
     limit_blas_threads()
+    start_run_threads()  # at normal priority, before any study's lowered thread could start one
     guard = guard or Guard.for_host(host)
     with guarded(guard):
         server = viser.ViserServer(host=host, port=port, verbose=False)
@@ -201,6 +236,8 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     if not environment_map:  # the HDRI stalls software WebGL for seconds
         server.scene.configure_environment_map(hdri=None)
     config = AppConfig(params, origin, scene_3d, guard=guard)
+    config.initial()  # the first page must not wait for the kernels' first load and the start-up run
+    warm_bldc()
 
     @server.on_client_connect
     def _(client: viser.ClientHandle) -> None:
@@ -211,6 +248,8 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
         session = config.sessions.pop(client.client_id, None)
         if session is not None:
             session.close()
+            # once its job has stopped (next checkpoint), the page's memory goes back to the system
+            threading.Timer(RELEASE_AFTER_S, release_memory).start()
 
     return server, config
 

@@ -5,12 +5,14 @@
   line and energy bar, and the share of each controller's energy it would save is shown.
 * :class:`StudiesSection` adds the "Studies" result tab with its "Robustness" and "Multi-axis" tabs
   (:mod:`app.ui.studies_robustness`, :mod:`app.ui.studies_multiaxis`). Their runs go to the
-  session's worker like every Simulate (one job per client at a time) and can be cancelled.
+  session's worker like every Simulate (one job per client at a time) as studies: they wait for a
+  server-wide slot (:mod:`app.ui.studies_queue`) and can be cancelled, queued or running.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from contextlib import AbstractContextManager
 from typing import Any
 
 import viser
@@ -21,14 +23,15 @@ from app.ui.case import CasePort
 from app.ui.props import assign
 from app.ui.studies_multiaxis import MultiAxisView
 from app.ui.studies_robustness import RobustnessView
+from app.ui.text import md_text
 from sim.fdsmc.optimum_gap import OPTIMUM_BASIS
 
 
 def optimum_markdown(comparison: Any) -> str:
     """One line: the optimum's energy [J] and the share of each controller's it would save [%]."""
     opt = getattr(comparison, "optimum", None)
-    if opt is None:
-        return ""
+    if opt is None:  # left out (its solvers failed): say why
+        return " ".join(md_text(n) for n in getattr(comparison, "notes", ()) if n.startswith("Optimum omitted"))
     w = getattr(opt.metrics, OPTIMUM_BASIS)
     gaps = optimum_gaps(comparison)
     parts = [f"{LABELS[k]}'s by **{v:.1f} %**" for k, v in gaps.items() if v is not None]
@@ -63,16 +66,25 @@ class StudiesSection:
 
     ``port`` is the position tab's :class:`~app.ui.case.CasePort`: the studies read the simulated
     inputs (``port.case.params``), run on its worker (``submit``, ``checkpoint``, ``cancel``) and
-    report on its status line (``say``).
+    report on its status line (``say``). ``as_study(label)`` marks the submissions in its block as
+    the study ``label`` (:meth:`app.ui.worker.Worker.as_study`); a robustness pool starts at most
+    ``processes`` workers.
     """
 
-    def __init__(self, port: CasePort) -> None:
+    def __init__(self, port: CasePort, as_study: Callable[[str], AbstractContextManager[Any]],
+                 processes: int) -> None:
         with port.results_tab("Studies", viser.Icon.FLASK):  # one tab: the results' tab row stays one line
             tabs = port.client.gui.add_tab_group()
             with tabs.add_tab("Robustness", viser.Icon.CHART_HISTOGRAM):
-                self.robustness = RobustnessView(port)
+                self.robustness = RobustnessView(port, as_study, processes)
             with tabs.add_tab("Multi-axis", viser.Icon.ARROWS_MAXIMIZE):
-                self.multiaxis = MultiAxisView(port)
+                self.multiaxis = MultiAxisView(port, as_study)
+
+    def queued(self, label: str, text: str) -> None:
+        """Show ``text`` (markdown) in the status of the study ``label`` while it waits for a slot."""
+        for view in (self.robustness, self.multiaxis):
+            if label == view.LABEL:
+                view.status.content = text
 
 
 __all__ = ["OptimumToggle", "StudiesSection", "optimum_markdown"]

@@ -3,9 +3,16 @@
 The axes are the YAML list the command line's ``multiaxis FILE`` takes (parsed by
 :func:`app.io.study_inputs.parse_axes`), edited in a text box, built row by row with "Add axis"
 or loaded from a file. On the page an axis names one of the shipped presets (no server paths).
+The move is a study: it waits for a server-wide slot and runs at lowered priority
+(:mod:`app.ui.studies_queue`); Cancel takes effect between axes.
 """
 
 from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from typing import Any
 
 import viser
 
@@ -75,8 +82,12 @@ def check_axes(axes: list[tuple[str, DriveParams]], T_m: float) -> float | None:
 class MultiAxisView:
     """Axes editor, Run, per-axis table and the axes' motion figure of one session."""
 
-    def __init__(self, port: CasePort) -> None:
+    #: The study's name in the queue's messages.
+    LABEL = "Multi-axis move"
+
+    def __init__(self, port: CasePort, as_study: Callable[[str], AbstractContextManager[Any]] | None = None) -> None:
         self._s = port
+        self._as_study = as_study or (lambda label: contextlib.nullcontext())
         gui = port.client.gui
         self._presets = tuple(list_presets_of("position"))
         self.axes = gui.add_text("Axes (YAML list)", default_axes(self._presets), multiline=True,
@@ -131,13 +142,14 @@ class MultiAxisView:
             self._s.client.add_notification("Multi-axis move not started", str(exc), color="red",
                                             auto_close_seconds=12.0)
             return False
-        return bool(self._s.submit(lambda: self._job(axes, T_m)))
+        with self._as_study(self.LABEL):
+            return bool(self._s.submit(lambda: self._job(axes, T_m)))
 
     def _job(self, axes: list[tuple[str, DriveParams]], T_m: float | None) -> None:
         self.status.content = f"Designing and simulating {len(axes)} axes…"
         self.run_button.disabled = True
         try:
-            result = coordinate(axes, T_m)
+            result = coordinate(axes, T_m, self._s.checkpoint)
             self._s.checkpoint()
         except ParameterError as exc:
             self.status.content = f"**Failed:** {md_text(exc)}"

@@ -6,13 +6,18 @@ by :func:`app.io.study_inputs.parse_spread`). The cost is checked before anythin
 runs go to the Dask cluster named by ``PMSM_DASK_SCHEDULER`` when it is set (checked and warmed
 first: :mod:`sim.studies.dask_runner`), else to a process pool (all cores) that is shut down when
 the run ends or is cancelled; Cancel is polled between chunks of ≥ 0.1 s and cancels every chunk
-not yet started. A lost cluster or pool is reported in one line.
+not yet started. A lost cluster or pool is reported in one line. The study waits for a
+server-wide slot; its pool has the slot's share of processes, at lowered priority
+(:mod:`app.ui.studies_queue`).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from typing import Any
 
 import viser
 
@@ -20,6 +25,7 @@ from app.figures.fdsmc_studies import robustness_spec, robustness_table_markdown
 from app.figures.plain import figure_json
 from app.io.study_inputs import parse_spread
 from app.ui.case import CasePort
+from app.ui.studies_queue import STUDY_NICE
 from app.ui.text import md_text
 from app.ui.viser_adapter import add_figure, set_figure_json
 from app.ui.worker import Cancelled
@@ -93,10 +99,19 @@ def check_study(params: DriveParams, samples: float, seed: float) -> tuple[int, 
 
 
 class RobustnessView:
-    """Inputs, Run / Cancel, progress, histograms and the summary table of one session."""
+    """Inputs, Run / Cancel, progress, histograms and the summary table of one session.
 
-    def __init__(self, port: CasePort) -> None:
+    ``as_study`` marks its runs as studies (server-wide slots); ``processes`` bounds its pool.
+    """
+
+    #: The study's name in the queue's messages.
+    LABEL = "Robustness study"
+
+    def __init__(self, port: CasePort, as_study: Callable[[str], AbstractContextManager[Any]] | None = None,
+                 processes: int | None = None) -> None:
         self._s = port
+        self._as_study = as_study or (lambda label: contextlib.nullcontext())
+        self._processes = processes or os.cpu_count() or 1
         gui = port.client.gui
         self.samples = gui.add_number("Samples", 200, min=1, max=MAX_SAMPLES, step=1)
         self.seed = gui.add_number("Seed", 0, min=0, step=1)
@@ -123,7 +138,8 @@ class RobustnessView:
         except ParameterError as exc:
             self._refuse(str(exc))
             return False
-        return bool(self._s.submit(lambda: self._job(params, spreads, samples, seed)))
+        with self._as_study(self.LABEL):
+            return bool(self._s.submit(lambda: self._job(params, spreads, samples, seed)))
 
     def cancel(self) -> bool:
         """Ask the running study to stop; False if nothing runs."""
@@ -185,8 +201,8 @@ class RobustnessView:
             with connect(os.environ[SCHEDULER_ENV]) as ex:
                 return robustness(params, spreads, samples, seed, ex, ex.workers, self._progress,
                                   self._cancel_requested)
-        workers = os.cpu_count() or 1
-        pool = RetryingPool(workers)
+        workers = self._processes
+        pool = RetryingPool(workers, nice=STUDY_NICE)
         unhook = self._s.on_cancel(pool.terminate)  # Cancel or a closed page: at once, no retry
         try:
             return robustness(params, spreads, samples, seed, pool, workers, self._progress,

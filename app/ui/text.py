@@ -12,6 +12,7 @@ import html
 import re
 from typing import Any
 
+from app.figures.style import KEY_PX, fmt
 from app.io.derived_view import derived_rows
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
@@ -106,17 +107,18 @@ def key_numbers_html(comparison: Any) -> str:
         v = r.metrics.torque_peak_Nm if r is not None else None
         if v is None:
             return "–"
-        return f'<b style="color:#c92a2a">{v:.4g} ⚠</b>' if v > g_max * 1.001 else f"{v:.4g}"
+        return f'<b style="color:#c92a2a">{fmt(v, digits=3)} ⚠</b>' if v > g_max * 1.001 else fmt(v, digits=3)
 
     energies = " · ".join(
-        f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {e.net_electrical_J:.3g} J"
-        f"{'</b>' if e.controller == rec.controller else ''} ({e.copper_J:.2g} Cu + {e.friction_J:.2g} fr.)"
+        f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {fmt(e.net_electrical_J, 'J', 3)}"
+        f"{'</b>' if e.controller == rec.controller else ''} ({fmt(e.copper_J, digits=2)} Cu + "
+        f"{fmt(e.friction_J, digits=2)} fr.)"
         for e in rec.energies)
     best = f"recommended: <b>{LABELS[rec.controller]}</b>" if rec.controller else "no controller passes every check"
     parts = [f"<b>Net electrical input</b> {energies}", best,
              f"FDSMC {_saves(comparison.saving_friction_pct)} friction vs conventional",
-             f"peak Γ {peak(f)} / {peak(c)} N·m vs Γ_max {g_max:.4g} N·m"]
-    return ('<div data-role="key-numbers" style="font-size:0.88em;line-height:1.35;padding:2px 2px 4px 2px">'
+             f"peak Γ {peak(f)} / {peak(c)} N·m vs Γ_max {fmt(g_max, digits=3)} N·m"]
+    return (f'<div data-role="key-numbers" style="font-size:{KEY_PX}px;line-height:1.3;padding:2px 2px 4px 2px">'
             + " · ".join(parts) + "</div>")
 
 

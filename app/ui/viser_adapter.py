@@ -69,6 +69,11 @@ def set_figure_json(handle: viser.GuiPlotlyHandle, json_str: str) -> None:
         handle._plotly_json_str = json_str
 
 
+def figure_json_shown(handle: viser.GuiPlotlyHandle) -> str:
+    """Return the Plotly JSON a plot widget last sent to the page."""
+    return handle._plotly_json_str
+
+
 def figure_json_of(figure: _Figure) -> str:
     """Return the Plotly JSON of a ``go.Figure`` exactly as ``GuiPlotlyHandle.figure`` would send it."""
     return figure.to_json()
@@ -137,5 +142,6 @@ def resolve_client(gui: Any, client_id: Any) -> Any | None:
 
 
 __all__ = ["GUI_UPDATES", "UPLOAD_PART", "UPLOAD_START", "WRITTEN_FOR", "add_figure", "figure_json_of",
+           "figure_json_shown",
            "input_widget", "mark_plotly_js_sent", "plotly_js_sent", "resolve_client", "run_script",
            "set_figure_json", "set_slider_marks", "upload_states", "widget_id", "widget_state", "wrap_gui_handler"]

@@ -10,13 +10,23 @@ the result of a cancelled job is discarded. The cost budget (:mod:`sim.common.bu
 kernel call to a few seconds of CPU, so a cancel takes effect within that; killing a subprocess
 instead would need the JIT-compiled kernels warmed in each process and the traces (up to the
 budget's bytes) pickled back, for a gain of at most those seconds.
+
+A job submitted as a study (``submit(fn, study=label)``, or any submission inside
+``with worker.as_study(label):``) first waits for a server-wide slot and then runs at lower
+priority (:class:`app.ui.studies_queue.StudySlots`); while it waits, ``on_queued(label, ahead)``
+tells the page how many studies are ahead of it (-1 once a Cancel took it out of the queue).
 """
 
 from __future__ import annotations
 
+import contextlib
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from app.ui.studies_queue import StudySlots
 
 
 class Cancelled(Exception):  # noqa: N818 - an outcome, not an error
@@ -34,10 +44,15 @@ class Worker:
         Called (on the worker thread) with any exception a job raised.
     name : str
         Thread-name prefix, for debugging.
+    slots : StudySlots or None
+        The server's study slots (None: studies run at once, like any job).
+    on_queued : callable(str, int) or None
+        Called (on the worker thread) with a queued study's label and the studies ahead of it.
     """
 
     def __init__(self, on_busy: Callable[[bool], None], on_error: Callable[[Exception], None],
-                 name: str = "ui-worker") -> None:
+                 name: str = "ui-worker", slots: StudySlots | None = None,
+                 on_queued: Callable[[str, int], None] | None = None) -> None:
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix=name)
         self._lock = threading.Lock()
         self._busy = False
@@ -46,21 +61,39 @@ class Worker:
         self._hooks: list[Callable[[], None]] = []
         self._on_busy = on_busy
         self._on_error = on_error
+        self._slots, self._on_queued = slots, on_queued or (lambda label, ahead: None)
+        self._study: str | None = None
 
     @property
     def busy(self) -> bool:
         """True while a job runs."""
         return self._busy
 
-    def submit(self, fn: Callable[[], None]) -> Future | None:
-        """Run ``fn`` on the worker unless a job is running; returns its future or None if refused."""
+    def submit(self, fn: Callable[[], None], study: str | None = None) -> Future | None:
+        """Run ``fn`` on the worker unless a job is running; returns its future or None if refused.
+
+        ``study`` (or an enclosing :meth:`as_study`) names a study: it waits for a server-wide slot.
+        """
+        label = study or self._study
         with self._lock:
             if self._busy or self._closed:
                 return None
             self._busy = True
             self._cancel.clear()
         self._safe_busy(True)
+        if label is not None and self._slots is not None:
+            slots, job = self._slots, fn
+            fn = lambda: slots.run(label, job, self._on_queued, self._cancel.is_set)  # noqa: E731
         return self._pool.submit(self._run, fn)
+
+    @contextlib.contextmanager
+    def as_study(self, label: str) -> Iterator[None]:
+        """Within the block, jobs submitted (from this, the GUI thread) are the study ``label``."""
+        self._study = label
+        try:
+            yield
+        finally:
+            self._study = None
 
     def cancel(self) -> bool:
         """Ask the running job to stop at its next checkpoint (and run its stop hooks); False if nothing runs."""

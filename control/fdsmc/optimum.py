@@ -33,7 +33,7 @@ with ω(0) = ω(T) = 0 is
 
 Numerical optimum (limits). Γ_em piecewise constant on N intervals, the mechanics discretised
 exactly (zero-order hold), |Γ_em| ≤ Γ_lim (the drive's torque limit including the inverter's
-i_max), solved as a QP by Clarabel through cvxpy.
+i_max), solved as a QP by Clarabel through cvxpy (SCS when Clarabel fails).
 
 Voltage limit. With a DC link (controller.V_dc > 0) the inverter applies |u_dq| ≤ u_max = V_dc/√3.
 At i_d = 0 in the steady state of each interval, eqs. (1)–(2) in [1] give
@@ -241,22 +241,48 @@ def _problem(mm: MoveModel, n: int, voltage: bool) -> tuple:
     return cp.Problem(cp.Minimize(cost), cons), g, v, w_ud, G_s, w_s
 
 
+#: Solvers tried in turn for the QP/SOCP: Clarabel (interior point), then SCS (first-order splitting),
+#: which also handles the voltage cone [-].
+SOLVERS = ("CLARABEL", "SCS")
+
+
+class OptimumSolverError(ParameterError):
+    """Every solver of :data:`SOLVERS` failed on the optimum's problem (numerical trouble, not infeasibility)."""
+
+
 def _solve(mm: MoveModel, n: int, problem: tuple) -> OptimalMove:
-    """Solve ``problem`` of :func:`_problem` (Clarabel), naming the limits if it is infeasible."""
+    """Solve ``problem`` of :func:`_problem`, naming the limits if it is infeasible.
+
+    The solvers of :data:`SOLVERS` are tried in turn; when each one fails numerically,
+    :class:`OptimumSolverError` says so in one line.
+    """
     import cvxpy as cp
 
     prob, g, v, _, G_s, w_s = problem
-    prob.solve(solver=cp.CLARABEL)
-    if prob.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-        volt = f" and |u_dq| ≤ V_dc/√3 = {mm.u_max:.4g} V" if math.isfinite(mm.u_max) else ""
-        raise ParameterError(
-            f"manoeuvre.T_m = {mm.T_m:g} s: no move of Δθ = {mm.delta_theta:g} rad stays within the torque limit "
-            f"{mm.Gamma_lim:.4g} N·m{volt} (solver status {prob.status}); allowed: a longer T_m"
-            + (" or a larger controller.V_dc" if volt else ""))
-    return _move(mm, n, G_s * np.asarray(g.value), w_s * np.asarray(v.value))
+    failures: list[str] = []
+    for solver in SOLVERS:
+        try:
+            prob.solve(solver=solver)
+        except cp.error.SolverError:
+            failures.append(f"{solver} failed")
+            continue
+        if prob.status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+            return _move(mm, n, G_s * np.asarray(g.value), w_s * np.asarray(v.value), solver.lower())
+        if prob.status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
+            break
+        failures.append(f"{solver} status {prob.status}")
+    else:
+        raise OptimumSolverError(f"manoeuvre.T_m = {mm.T_m:g} s: the minimum-energy optimum could not be solved "
+                            f"({'; '.join(failures)}); allowed: a move the solvers handle (a longer T_m or other "
+                            "limits), else the optimum is left out")
+    volt = f" and |u_dq| ≤ V_dc/√3 = {mm.u_max:.4g} V" if math.isfinite(mm.u_max) else ""
+    raise ParameterError(
+        f"manoeuvre.T_m = {mm.T_m:g} s: no move of Δθ = {mm.delta_theta:g} rad stays within the torque limit "
+        f"{mm.Gamma_lim:.4g} N·m{volt} (solver status {prob.status}); allowed: a longer T_m"
+        + (" or a larger controller.V_dc" if volt else ""))
 
 
-def _move(mm: MoveModel, n: int, G: np.ndarray, omega: np.ndarray) -> OptimalMove:
+def _move(mm: MoveModel, n: int, G: np.ndarray, omega: np.ndarray, solver: str) -> OptimalMove:
     """Return the OptimalMove of the solved torques G [N·m] (n) and speeds omega [rad/s] (n + 1)."""
     h = mm.T_m / n
     e, b, c, d = _zoh(mm, h)
@@ -269,14 +295,14 @@ def _move(mm: MoveModel, n: int, G: np.ndarray, omega: np.ndarray) -> OptimalMov
     return OptimalMove(np.linspace(0.0, mm.T_m, n + 1), theta, omega, alpha, np.append(G, G[-1]),
                        float(mm.a * h * np.sum(G**2)), float(mm.F_v * h * np.sum(omega**2)),
                        float(mm.Gamma_Le * np.sum(dtheta)),
-                       peak, peak >= mm.Gamma_lim * (1.0 - 1e-6), "clarabel")
+                       peak, peak >= mm.Gamma_lim * (1.0 - 1e-6), solver)
 
 
 def numerical_optimum(mm: MoveModel, n: int = N_INTERVALS) -> OptimalMove:
     """Solve for the optimum within the torque and voltage limits on n intervals.
 
     |Γ_em| ≤ Γ_lim (a QP) and, if u_max is finite, |u_dq| ≤ u_max (a sequence of SOCPs, module
-    docstring), solved by Clarabel via cvxpy.
+    docstring), solved by Clarabel via cvxpy, else SCS (:data:`SOLVERS`).
 
     Raises
     ------

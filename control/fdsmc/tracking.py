@@ -33,7 +33,7 @@ from __future__ import annotations
 import dataclasses
 
 from control.fdsmc.conventional import ConventionalGains
-from control.fdsmc.loop_analysis import stability_measure
+from control.fdsmc.loop_analysis import GainRecommendation, stability_measure
 from control.fdsmc.loop_model import LoopCase
 
 #: Most halvings of the tracking pole while the sampled loop is unstable [-].
@@ -44,17 +44,35 @@ LAYER_SHARE = 1.0 / 3.0
 SLIDE_RATIO = 3.5
 
 
-def tracking_gains(loop: LoopCase, slowest: ConventionalGains) -> ConventionalGains:
+def slide_gain(gain: GainRecommendation | None, K: float) -> float:
+    """Return the boundary-layer gain K [s/rad] of the tracked optimum (its layer bound and its slide).
+
+    The case's K where it is below the chatter limit of :mod:`control.fdsmc.loop_analysis`, else the
+    recommended K: the tracked optimum is the tool's own controller and never runs a K that
+    limit-cycles (the paper's K = 1000 does).
+
+    Parameters
+    ----------
+    gain : GainRecommendation or None  ``Derived.gain`` (None: no analysis, the case's K).
+    K : float                          The case's K [s/rad].
+    """
+    if gain is None or gain.K_ok or gain.K_recommended <= 0.0:
+        return K
+    return gain.K_recommended
+
+
+def tracking_gains(loop: LoopCase, slowest: ConventionalGains, K: float) -> ConventionalGains:
     """Return the double-pole gains g1 = a², g2 = 2a of the tracking law (see the module doc).
 
     Parameters
     ----------
-    loop : LoopCase                The case's linearised loop (``Derived.loop``), with α_max and K.
+    loop : LoopCase                The case's linearised loop (``Derived.loop``), with α_max.
     slowest : ConventionalGains    Eq. (61)'s gains: the slowest pole allowed [1/s², 1/s].
+    K : float                      The tracked optimum's boundary-layer gain (:func:`slide_gain`) [s/rad].
     """
     a = 1.0 / (loop.T_salpha + loop.T_so)
-    if loop.K > 0.0:
-        a = min(a, LAYER_SHARE * loop.alpha_max * loop.K)
+    if K > 0.0:
+        a = min(a, LAYER_SHARE * loop.alpha_max * K)
     for _ in range(MAX_HALVINGS):
         if a <= slowest.a:
             return slowest
@@ -76,15 +94,15 @@ def slide_time_constant(alpha_max: float, K: float) -> float:
     return SLIDE_RATIO / (alpha_max * K)
 
 
-def slide_stability(loop: LoopCase) -> float:
+def slide_stability(loop: LoopCase, K: float) -> float:
     """Stability measure of the terminal slide's linearised sampled loop (< 0: stable).
 
-    The sloped-segment law of eq. (46) in [1] at T_c = :func:`slide_time_constant` and the case's K
-    (:func:`control.fdsmc.loop_analysis.stability_measure`, law ``slope``).
+    The sloped-segment law of eq. (46) in [1] at the gain K (:func:`slide_gain`) and T_c =
+    :func:`slide_time_constant` (:func:`control.fdsmc.loop_analysis.stability_measure`, law ``slope``).
     """
-    case = dataclasses.replace(loop, T_c=slide_time_constant(loop.alpha_max, loop.K))
-    return stability_measure(case, "slope", loop.K, loop.f_s, loop.delay)
+    case = dataclasses.replace(loop, T_c=slide_time_constant(loop.alpha_max, K))
+    return stability_measure(case, "slope", K, loop.f_s, loop.delay)
 
 
-__all__ = ["LAYER_SHARE", "MAX_HALVINGS", "SLIDE_RATIO", "slide_stability", "slide_time_constant",
+__all__ = ["LAYER_SHARE", "MAX_HALVINGS", "SLIDE_RATIO", "slide_gain", "slide_stability", "slide_time_constant",
            "tracking_gains"]

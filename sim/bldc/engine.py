@@ -100,12 +100,27 @@ def pack_parameters(params: BldcParams, design: BldcDesign, controller: str) -> 
 #: doubles), the trace's contiguous copies of it and the derived rows (ω*, i_abc, v_phase and
 #: its temporary, E_kin, E_mag) [B].
 TRACE_BYTES_PER_SAMPLE = 8 * (2 * kn.N_CH + 12)
+#: Cost model, fitted by ``scripts/bench_budget.py --bldc`` (compiled kernel, one thread per drive, CPU
+#: summed): CPU seconds per RK4 sub-step beyond the first of a sample, per sample (its first step,
+#: the controller, the record row, the trace and the metrics) and per run; the peak memory above
+#: the idle process is the trace bytes times :data:`MEM_PER_TRACE_BYTE` plus :data:`MEM_PER_RUN` [B].
+CPU_PER_STEP_S = 3.0e-7
+CPU_PER_SAMPLE_S = 1.1e-6
+CPU_PER_RUN_S = 0.002
+MEM_PER_TRACE_BYTE = 1.0
+MEM_PER_RUN = 1 * 2**20
+
+
+def _cost(n_runs: int, n_ticks: int, n_sub: int) -> budget.Cost:
+    """Cost of ``n_runs`` runs of ``n_ticks`` samples of ``n_sub`` RK4 steps: steps, bytes, CPU, memory."""
+    trace = n_runs * (n_ticks + 1) * TRACE_BYTES_PER_SAMPLE
+    cpu = n_runs * (CPU_PER_STEP_S * n_ticks * (n_sub - 1) + CPU_PER_SAMPLE_S * n_ticks + CPU_PER_RUN_S)
+    return budget.Cost(n_runs * n_ticks * n_sub, trace, cpu, int(MEM_PER_TRACE_BYTE * trace + MEM_PER_RUN * n_runs))
 
 
 def run_cost(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> budget.Cost:
-    """Cost of ``n_runs`` runs of the active scenario: RK4 steps and trace bytes (parameters only)."""
-    n_ticks = int(math.ceil(params.case.t_end * params.inverter.f_s - 1e-9))
-    return budget.Cost(n_runs * n_ticks * int(n_sub), n_runs * (n_ticks + 1) * TRACE_BYTES_PER_SAMPLE)
+    """Cost of ``n_runs`` runs of the active scenario (parameters only): see :func:`_cost`."""
+    return _cost(n_runs, int(math.ceil(params.case.t_end * params.inverter.f_s - 1e-9)), int(n_sub))
 
 
 def check_budget(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> budget.Cost:
@@ -117,12 +132,10 @@ def check_budget(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> bud
     i = next(k for k, c in enumerate(params.scenario.cases) if c.name == case.name)
 
     def with_t_end(t_end: float) -> budget.Cost:
-        ticks = int(math.ceil(t_end * f_s - 1e-9))
-        return budget.Cost(n_runs * ticks * n_sub, n_runs * (ticks + 1) * TRACE_BYTES_PER_SAMPLE)
+        return _cost(n_runs, int(math.ceil(t_end * f_s - 1e-9)), n_sub)
 
     def with_f_s(rate: float) -> budget.Cost:
-        ticks = int(math.ceil(case.t_end * rate - 1e-9))
-        return budget.Cost(n_runs * ticks * n_sub, n_runs * (ticks + 1) * TRACE_BYTES_PER_SAMPLE)
+        return _cost(n_runs, int(math.ceil(case.t_end * rate - 1e-9)), n_sub)
 
     drivers = [budget.Driver(f"scenario.cases[{i}].t_end", case.t_end, "s", with_t_end, 1e-6),
                budget.Driver("inverter.f_s", f_s, "Hz", with_f_s, 1e3)]

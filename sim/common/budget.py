@@ -10,8 +10,9 @@ A request (one comparison of several controllers, a Table-1 sweep, a BLDC compar
 Both are computed from the parameters alone (no derivation, no allocation) and compared with
 :data:`MAX_STEPS` and :data:`MAX_TRACE_BYTES`. A request whose cost model also predicts CPU seconds
 and peak memory (the position drive, :func:`sim.fdsmc.grid.predict`: controller samples, RK4
-sub-steps and full-resolution chatter-window samples, calibrated by ``scripts/bench_budget.py``
-to within 2× of measured runs) is held to the promised figures themselves: ≤ :data:`MAX_CPU_S`
+sub-steps and full-resolution chatter-window samples; the BLDC drive, :func:`sim.bldc.engine.run_cost`:
+samples, sub-steps and trace bytes; both calibrated by ``scripts/bench_budget.py [--bldc]`` to
+within 2× of measured runs) is held to the promised figures themselves: ≤ :data:`MAX_CPU_S`
 CPU seconds and ≤ :data:`MAX_TRACE_BYTES` of memory above the idle process. A request over budget
 raises :class:`BudgetError` naming the fields that drive the cost and, for each, the largest (or
 smallest) value that fits with the other values kept.
@@ -26,8 +27,8 @@ from dataclasses import dataclass
 from control.common.checks import ParameterError
 
 #: Most RK4 integration steps of one request, sub-steps and all controllers included [-].
-#: The bound for engines without a calibrated CPU model (BLDC); the position drive is held to
-#: :data:`MAX_CPU_S` by its model as well.
+#: The bound for engines without a calibrated CPU model; the position and BLDC drives are held to
+#: :data:`MAX_CPU_S` by their models as well.
 MAX_STEPS = 40_000_000
 #: Most bytes of trace memory of one request (kernel output arrays and the traces built from them).
 MAX_TRACE_BYTES = 256 * 2**20
@@ -162,6 +163,14 @@ def _describe(cost: Cost) -> str:
             f"allowed ≤ {MAX_STEPS:.3g} steps and ≤ {MAX_TRACE_BYTES // 2**20} MiB per request")
 
 
+def _toward(value: float, limit: float) -> float:
+    """``value`` to 4 significant digits, rounded towards ``limit`` (the cheap end) so that it still fits."""
+    if value == 0.0 or not math.isfinite(value):
+        return value
+    unit = 10.0 ** (math.floor(math.log10(abs(value))) - 3)
+    return (math.floor if limit < value else math.ceil)(value / unit) * unit
+
+
 def check(cost: Cost, what: str, drivers: Sequence[Driver]) -> Cost:
     """Raise :class:`BudgetError` if ``cost`` is over budget; otherwise return it.
 
@@ -183,7 +192,7 @@ def check(cost: Cost, what: str, drivers: Sequence[Driver]) -> Cost:
         if best is None:
             hints.append(f"no {d.name} alone fits")
         else:
-            shown = f"{int(best)}" if d.integer else f"{best:.4g}"
+            shown = f"{int(best)}" if d.integer else f"{_toward(best, d.limit):.4g}"
             hints.append(f"{d.name} = {d.value:g} {d.unit}".rstrip() + f" → {word} accepted {shown} {d.unit}".rstrip())
     raise BudgetError(f"this run is too large ({what}): {_describe(cost)}. With the other values kept: "
                       + "; ".join(hints))

@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -28,9 +29,10 @@ from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import current_limit
 from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
+from control.fdsmc.optimum import OptimumSolverError
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import infeasible_T_m
-from control.fdsmc.tracking import slide_time_constant, tracking_gains
+from control.fdsmc.tracking import slide_gain, slide_time_constant, tracking_gains
 from sim.common import sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
@@ -64,7 +66,19 @@ KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "stock": 2.0, "optimum": 3.0}
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
-_RUNS = ThreadPoolExecutor(max_workers=max(2, os.cpu_count() or 2), thread_name_prefix="sim-run")
+RUN_THREADS = max(2, os.cpu_count() or 2)
+_RUNS = ThreadPoolExecutor(max_workers=RUN_THREADS, thread_name_prefix="sim-run")
+
+
+def start_run_threads() -> None:
+    """Start every thread of the shared run pool now, from the caller's thread.
+
+    A new thread inherits its creator's scheduling priority, so a server calls this at start-up:
+    no shared thread is then created later by a lower-priority caller (a study) and kept.
+    """
+    gate = threading.Barrier(RUN_THREADS)  # each task waits until all threads run one
+    for f in [_RUNS.submit(gate.wait, 10.0) for _ in range(RUN_THREADS)]:
+        f.result()
 
 
 #: Time series of one run on a common grid (SI units; energies cumulative from t = 0), one field per
@@ -95,7 +109,8 @@ class Comparison:
 
     ``saving_friction_pct`` compares friction over [0, T_m] (eq. (47) in [1]);
     ``saving_electrical_pct`` compares the net electrical input over the whole horizon.
-    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for.
+    ``optimum`` is the tracked minimum-energy move, ``stock`` the stock drive's trapezoid, when asked for;
+    ``notes`` say why an asked-for comparator is missing (e.g. the optimum's solvers failed).
     """
 
     derived: Derived
@@ -105,6 +120,7 @@ class Comparison:
     saving_electrical_pct: float | None
     optimum: RunResult | None = None
     stock: RunResult | None = None
+    notes: tuple[str, ...] = ()
 
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
@@ -133,10 +149,12 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
     pr, o = d.profile, d.observer
     prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
-    gains = tracking_gains(d.loop, d.conventional) if controller == "optimum" else d.conventional
+    gains = d.conventional
+    if controller == "optimum":  # its own K (below the chatter limit), tracking gains and terminal slide's T_c
+        K = slide_gain(d.gain, ctrl.K)
+        gains = tracking_gains(d.loop, d.conventional, K)
+        prm[[kn.P_TC, kn.P_KB]] = (slide_time_constant(d.alpha.alpha_max, K), K)
     prm[[kn.P_G1, kn.P_G2]] = (gains.g1, gains.g2)
-    if controller == "optimum":  # its terminal slide's own T_c
-        prm[kn.P_TC] = slide_time_constant(d.alpha.alpha_max, ctrl.K)
     if controller == "optimum":  # α(t) ≈ α_dem(t − T_sα/3) (eq. (13)), one more sample with a delay
         prm[kn.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
@@ -356,7 +374,13 @@ def compare(
     # checked once above for all runs (the budget of len(controllers) runs covers each one's)
     futures = {c: _RUNS.submit(_simulate_checked, params, c, d, plant=plant, **options) for c in controllers[1:]}
     runs = {c: _simulate_checked(params, c, d, plant=plant, **options) for c in controllers[:1]}
-    runs |= {c: f.result() for c, f in futures.items()}
+    notes: list[str] = []
+    for name, fut in futures.items():
+        try:
+            runs[name] = fut.result()
+        except OptimumSolverError as exc:  # the optimum is a yardstick: left out with a note, never a traceback
+            notes.append(f"Optimum omitted: {exc}")
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
-                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"))
+                      _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"),
+                      tuple(notes))

@@ -158,15 +158,17 @@ def _saturation(run: RunResult, derived: Derived) -> list[str]:
 def comparator_notes(comparison: Comparison) -> list[str]:
     """Note where the conventional comparator (eq. (61) gains) itself exceeds the drive's limits.
 
-    Its energy is then not a fair baseline for the saving.
+    Its energy is then not a fair baseline for the saving. The comparison's own notes (a comparator
+    left out, e.g. the optimum when its solvers failed) follow.
     """
+    notes = list(comparison.notes)  # e.g. an optimum left out because its solvers failed
     run = comparison.conventional
     if run is None or not run.metrics.stable:
-        return []
+        return notes
     issues = _saturation(run, comparison.derived) + limit_warnings(run, comparison.derived)
     if not issues:
-        return []
-    return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."]
+        return notes
+    return [f"Comparator: {' '.join(issues)} Its energy is not a fair baseline for the saving."] + notes
 
 
 def _saving_verdicts(comparison: Comparison) -> list[str]:

@@ -9,7 +9,7 @@ simulation) and simulated; its energy is compared with the axis running at its o
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from control.common.checks import ParameterError
@@ -63,8 +63,11 @@ def _with_T_m(p: DriveParams, T_m: float) -> DriveParams:
     return dataclasses.replace(p, manoeuvre=dataclasses.replace(p.manoeuvre, T_m=T_m))
 
 
-def coordinate(axes: Sequence[tuple[str, DriveParams]], T_m: float | None = None) -> MultiAxisResult:
+def coordinate(axes: Sequence[tuple[str, DriveParams]], T_m: float | None = None,
+               checkpoint: Callable[[], None] = lambda: None) -> MultiAxisResult:
     """Design and simulate every axis at the common T_m (see the module docstring).
+
+    ``checkpoint()`` is called before each axis's design (it may raise to stop the run, e.g. a Cancel).
 
     Raises
     ------
@@ -75,6 +78,7 @@ def coordinate(axes: Sequence[tuple[str, DriveParams]], T_m: float | None = None
         raise ParameterError("axes: allowed at least one axis")
     fastest = []
     for name, p in axes:
+        checkpoint()
         dd = design_drive(_with_T_m(p, SHORTEST_REQUEST_S))
         if dd.comparison is None:
             why = "; ".join(c.text for c in dd.limiting if c.violated)
@@ -85,6 +89,7 @@ def coordinate(axes: Sequence[tuple[str, DriveParams]], T_m: float | None = None
         T_common = max(T_common, float(T_m))
     out = []
     for (name, p), dd in zip(axes, fastest, strict=True):
+        checkpoint()
         common = dd if dd.params.manoeuvre.T_m == T_common else design_drive(_with_T_m(p, T_common))
         out.append(AxisResult(name, dd, common))
     return MultiAxisResult(T_common, tuple(out))

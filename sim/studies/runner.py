@@ -6,11 +6,14 @@ out of memory) ``concurrent.futures`` marks the whole pool broken and fails ever
 the pool is then replaced by a new one and every chunk not finished is submitted again, once. A
 chunk that the pool loses a second time raises :class:`ExecutorError` (one line: which chunk, what
 happened, what is allowed). Workers are started with ``spawn`` (no fork of a threaded parent) and
-each runs its chunks on one numba thread: the processes are the parallelism.
+each runs its chunks on one numba thread: the processes are the parallelism. ``nice`` lowers the
+workers' scheduling priority (so that a server's interactive work comes first).
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
 import threading
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -61,16 +64,30 @@ class RetryingFuture:
         return self.future.cancel()
 
 
-class RetryingPool:
-    """A spawn-context process pool of ``workers`` processes that survives one lost worker per chunk."""
+def _lower_priority(increment: int) -> None:
+    """Worker initializer: lower this process's scheduling priority by ``increment`` (no-op where unsupported)."""
+    if increment > 0:
+        with contextlib.suppress(AttributeError, OSError):
+            os.nice(increment)
 
-    def __init__(self, workers: int) -> None:
-        self.workers = int(workers)
+
+class RetryingPool:
+    """A spawn-context process pool of ``workers`` processes that survives one lost worker per chunk.
+
+    ``nice`` [-] lowers each worker's scheduling priority by that much (0: unchanged).
+    """
+
+    def __init__(self, workers: int, nice: int = 0) -> None:
+        self.workers, self.nice = int(workers), int(nice)
         self.generation = 0
         self.ended = False
         self._lock = threading.Lock()
-        self._pool = ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"))
+        self._pool = self._new_pool()
         self._futures: list[RetryingFuture] = []
+
+    def _new_pool(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"), initializer=_lower_priority,
+                                   initargs=(self.nice,))
 
     def raw_submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
         """Submit to the current process pool (no retry)."""
@@ -88,7 +105,7 @@ class RetryingPool:
             if broken_generation != self.generation or self.ended:
                 return  # another chunk already replaced it, or the pool was ended on purpose
             self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"))
+            self._pool = self._new_pool()
             self.generation += 1
             for f in self._futures:
                 if f.generation < self.generation and not _finished(f.future):

@@ -35,8 +35,45 @@ def test_bldc_tab_runs_paper_scenario_and_shows_metrics_and_speed_figure(page):
     names = {t["name"]: t for t in fig["traces"]}
     assert {"ω*", "T_L"} <= set(names)
     paper = names["dq_x + SMC, integral surface (paper)"]
-    assert paper["n"] > 500 and max(paper["y"]) > 990.0  # reaches 1000 rpm
-    assert figure(page, "bldc_reach") is not None and figure(page, "bldc_dqx") is not None
+    assert len(paper["y"]) > 500 and max(paper["y"]) > 990.0  # reaches 1000 rpm (x0/dx: no x array)
+    assert figure(page, "bldc_torque") is not None
+    assert figure(page, "bldc_reach") is not None and figure(page, "bldc_dqx") is not None  # in the folded folder
+
+
+VISIBLE_JS = ("(id) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"
+              " && e.layout.meta.id === id && e.getBoundingClientRect().width > 0)")
+SELECTED_JS = ("(name) => document.querySelector(`[role=\"tab\"][title=\"${name}\"]`)"
+               "?.getAttribute('aria-selected') === 'true'")
+
+
+def test_choosing_the_bldc_tab_shows_its_own_results_and_back(page):
+    """The BLDC tab selects its results tab on the right; the position tab brings the overview back."""
+    assert page.evaluate(VISIBLE_JS, "phase_plane")
+    _open_tab(page)
+    page.wait_for_function(SELECTED_JS, arg="BLDC figures")
+    page.wait_for_function(VISIBLE_JS, arg="bldc_torque")
+    assert page.evaluate(VISIBLE_JS, "bldc_speed")
+    assert not page.evaluate(VISIBLE_JS, "phase_plane")  # the FDSMC overview is no longer what the right panel shows
+    click_tab(page, "Position drive (FDSMC)")
+    page.wait_for_function(SELECTED_JS, arg="Overview")
+    page.wait_for_function(VISIBLE_JS, arg="phase_plane")
+    assert not page.evaluate(VISIBLE_JS, "bldc_speed")
+
+
+def test_anti_windup_toggle_runs_the_paper_drive_with_and_without_side_by_side(page):
+    """Side by side, the paper drive without anti-windup (λ = λ_0) overshoots 1000 rpm; with it, it does not."""
+    _open_tab(page)
+    page.get_by_text("Paper drive with / without anti-windup, side by side", exact=True).click()
+    page.wait_for_timeout(150)  # viser sends GUI updates every 50 ms
+    page.get_by_role("button", name="Simulate BLDC").click()
+    page.wait_for_function(FIG_JS, arg="bldc_antiwindup", timeout=60_000)
+    traces = figure(page, "bldc_antiwindup")["traces"]
+    speed = {t["name"]: max(t["y"]) for t in traces if t["name"].startswith(("with anti-windup", "without"))}
+    (with_name, with_max), (without_name, without_max) = sorted(speed.items())
+    assert with_name.startswith("with anti-windup") and without_name.startswith("without")
+    assert with_max < 1010.0 < 1100.0 < without_max  # ω* = 1000 rpm: the wound-up integral overshoots
+    torque = figure(page, "bldc_torque")["traces"]  # one panel per drive: 4 drives × (T_EL, T*) × 2 columns
+    assert len(torque) == 16 and {t["name"] for t in torque} >= {"T* (reference)"}
 
 
 def test_bldc_tab_rejects_bad_input_with_message(page):

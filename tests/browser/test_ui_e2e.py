@@ -208,5 +208,5 @@ def test_recommended_K_then_T_c_min_one_click_fixes(page):
     assert f"{T_c_ms:.4g} ms" in use_tc.inner_text()
     _click_and_wait_for_run(page, use_tc)
     assert "Chatter (FDSMC)" not in page.inner_text("body")
-    assert abs(float(field(page, "T_c sliding time const. [ms]").input_value()) - T_c_ms) < 1e-6
+    assert abs(float(field(page, "T_c sliding time const. [ms]").input_value()) - T_c_ms) <= 1e-4 * T_c_ms  # 5 digits
     assert not use_tc.is_visible()
