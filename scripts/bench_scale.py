@@ -131,7 +131,7 @@ def worker_pids(nannies: list[int]) -> list[int]:
 
 
 def dask_rates(params, spreads, n: int, repeat: int, pool2: float) -> None:
-    from sim.studies.dask_runner import connect, worker_plugin
+    from sim.studies.dask_runner import connect, nanny_plugin, worker_plugin
 
     with tempfile.TemporaryDirectory() as tmp:
         address, procs = start_cluster(pathlib.Path(tmp))
@@ -148,6 +148,7 @@ def dask_rates(params, spreads, n: int, repeat: int, pool2: float) -> None:
                                            lambda: worker_pids(nannies), cpu[tuned])
                         if tuned:  # back to the nanny's environment for the next untuned figure
                             ex.client.unregister_worker_plugin(worker_plugin().name)
+                            ex.client.unregister_worker_plugin(nanny_plugin().name, nanny=True)
                             ex.client.restart()
             for tuned in (False, True):
                 r = figure(f"Dask, 2 workers, {'tuned' if tuned else 'Dask defaults'}", got[tuned], "samples/s")

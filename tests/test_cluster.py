@@ -286,3 +286,27 @@ def test_a_task_that_kills_its_workers_is_one_line(cluster):
     assert "\n" not in line and line.startswith(f"chunk 0 killed the workers that ran it on the Dask cluster at "
                                                 f"{cluster.address} (KilledWorker: ")
     assert line.endswith("allowed fewer than distributed.scheduler.allowed-failures losses per task")
+
+
+_PERIODS = """
+import json, sys
+from sim.studies.dask_runner import QUIET_MS, connect, nanny_plugin
+def periods(dask_worker):
+    return {k: dask_worker.periodic_callbacks[k].callback_time for k in QUIET_MS}
+with connect(sys.argv[1], 60.0) as ex:
+    tuned = list(ex.client.run(periods).values()) + list(ex.client.run(periods, nanny=True).values())
+    ex.client.unregister_worker_plugin(nanny_plugin().name, nanny=True)
+    print(json.dumps({"tuned": tuned, "nanny_after": list(ex.client.run(periods, nanny=True).values())}))
+"""
+
+
+def test_workers_and_nannies_housekeep_less_while_tuned(cluster):
+    """The worker and nanny plugins slow the tick, memory and system monitors; removing the nanny's restores it."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    r = subprocess.run([sys.executable, "-c", _PERIODS, cluster.address], capture_output=True, text=True, cwd=ROOT,
+                       env=env, timeout=600, check=False)
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert len(out["tuned"]) == 4  # two workers, two nannies
+    assert all(p == {"tick": 1000.0, "memory_monitor": 500.0, "monitor": 2000.0} for p in out["tuned"])
+    assert all(p["tick"] == 20.0 and p["memory_monitor"] == 100.0 for p in out["nanny_after"])  # Dask's own

@@ -28,6 +28,7 @@ from numba import njit
 
 from control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
 from sim.common import sensors
+from sim.common.borrowed import borrowed
 
 # ---- prm indices -------------------------------------------------------------------------
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
@@ -394,6 +395,10 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
     sample, voltages held (one sample later if ``delay``), n_sub RK4 substeps in between.
     Continuous mode: ``n_steps`` RK4 steps of size h with the controller inside the RHS.
     """
+    prm, step_t, step_v, Phi, Gam, Lo = (borrowed(prm), borrowed(step_t), borrowed(step_v), borrowed(Phi),
+                                         borrowed(Gam), borrowed(Lo))  # no reference counts in the loop
+    out, info, k_win, win, ref, noise = (borrowed(out), borrowed(info), borrowed(k_win), borrowed(win),
+                                         borrowed(ref), borrowed(noise))
     p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     o, hold, pk = (0.0, 0.0, 0.0, 0.0), HOLD0, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     pc = (0.0, -1.0, 0.0)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from sim.common.borrowed import borrowed
 from sim.fdsmc import kernel as kn
 
 #: Per-segment values stored in ``seg_info`` (row per segment): the state at its end.
@@ -35,6 +36,9 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
     ``seg_info[j]`` receives the kernel state (``X_*`` of :mod:`sim.fdsmc.kernel`) at its end.
     ``noise`` is the sensors' table (:func:`sim.common.sensors.noise_table`), read by sample number.
     """
+    prm_all, seg_steps, ref_all, ref_off = borrowed(prm_all), borrowed(seg_steps), borrowed(ref_all), borrowed(ref_off)
+    step_t, step_v, Phi, Gam, Lo = borrowed(step_t), borrowed(step_v), borrowed(Phi), borrowed(Gam), borrowed(Lo)
+    out, seg_info, noise = borrowed(out), borrowed(seg_info), borrowed(noise)  # no reference counts in the loop
     p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     o, hold = (0.0, 0.0, 0.0, 0.0), kn.HOLD0
     t, k_all, n_out = 0.0, 0, 0
