@@ -16,6 +16,7 @@ import json
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -93,27 +94,7 @@ SCRUB_JS = """(() => {{ const P = window.Plotly; if (!P) return;
 #: from here, where the rejection of an interrupted animation (pause, scrub, another speed) is
 #: caught. ``window.__appTrail(el, t)`` shows the trail pieces ending by ``t`` [s]: their points
 #: are kept from the figure as it arrived (a replay empties them), so a scrub sends only ``t``.
-BUTTONS_JS = """(() => { if (window.__appReplayButtons) return; window.__appReplayButtons = true;
-  const stash = (el) => { if (el.__trailFor !== el.data) { el.__trailFor = el.data;
-      el.__trail = (el._fullData || []).filter(d => d.meta && typeof d.meta.trail === 'number')
-                   .map(d => [d.index, d.meta.trail, d.x, d.y]); }
-    return el.__trail; };
-  // a redraw while a replay's transition still runs is undone when it ends: wait for its end
-  window.__appAfterTransition = (el, fn) => { const go = () => el._transitioning ? requestAnimationFrame(go) : fn();
-    go(); };
-  window.__appTrail = (el, t) => { const s = stash(el); if (!s.length) return;
-    window.Plotly.restyle(el, {x: s.map(r => r[1] <= t ? r[2] : r[2].slice(0, 1)),
-                               y: s.map(r => r[1] <= t ? r[3] : r[3].slice(0, 1))},
-                          s.map(r => r[0])).catch(() => {}); };
-  setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
-    if (!(el.layout && el.layout.meta && el.layout.meta.overview && el._fullData)) continue;
-    stash(el);
-    if (el.__appReplayButtons || !el.on) continue;
-    el.__appReplayButtons = true;
-    el.on('plotly_buttonclicked', (e) => { const b = e && e.button;
-      if (b && b.method === 'animate' && b.execute === false && window.Plotly) {
-        stash(el); window.Plotly.animate(el, ...b.args).catch(() => {}); } });
-  } }, 250); })();"""
+BUTTONS_JS = (Path(__file__).resolve().parent / "assets" / "replay_buttons.js").read_text(encoding="utf-8")
 
 
 def scrub_js(comparison: Any, targets: ScrubTargets, t: float) -> str:

@@ -1,0 +1,23 @@
+// Installed once per page by app/ui/replay.py. Reads Plotly's internal el._fullData and el._transitioning
+// (no public equivalent: the trail's points as drawn, and whether a replay transition still runs).
+(() => { if (window.__appReplayButtons) return; window.__appReplayButtons = true;
+  const stash = (el) => { if (el.__trailFor !== el.data) { el.__trailFor = el.data;
+      el.__trail = (el._fullData || []).filter(d => d.meta && typeof d.meta.trail === 'number')
+                   .map(d => [d.index, d.meta.trail, d.x, d.y]); }
+    return el.__trail; };
+  // a redraw while a replay's transition still runs is undone when it ends: wait for its end
+  window.__appAfterTransition = (el, fn) => { const go = () => el._transitioning ? requestAnimationFrame(go) : fn();
+    go(); };
+  window.__appTrail = (el, t) => { const s = stash(el); if (!s.length) return;
+    window.Plotly.restyle(el, {x: s.map(r => r[1] <= t ? r[2] : r[2].slice(0, 1)),
+                               y: s.map(r => r[1] <= t ? r[3] : r[3].slice(0, 1))},
+                          s.map(r => r[0])).catch(() => {}); };
+  setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
+    if (!(el.layout && el.layout.meta && el.layout.meta.overview && el._fullData)) continue;
+    stash(el);
+    if (el.__appReplayButtons || !el.on) continue;
+    el.__appReplayButtons = true;
+    el.on('plotly_buttonclicked', (e) => { const b = e && e.button;
+      if (b && b.method === 'animate' && b.execute === false && window.Plotly) {
+        stash(el); window.Plotly.animate(el, ...b.args).catch(() => {}); } });
+  } }, 250); })();
