@@ -7,6 +7,7 @@ incomplete; a worker running other source is refused by name before anything run
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import pathlib
@@ -79,15 +80,19 @@ class Cluster:
                 child.send_signal(signal.SIGKILL)
 
     def close(self) -> None:
+        """Stop the cluster: SIGTERM, then (test clean-up, not under test) SIGKILL what is left after 2 s."""
+        tree = []
         for p in reversed(self.procs):
             if p.poll() is None:
+                with contextlib.suppress(psutil.NoSuchProcess):
+                    tree += psutil.Process(p.pid).children(recursive=True)
                 p.terminate()
+        _, alive = psutil.wait_procs([psutil.Process(p.pid) for p in self.procs if p.poll() is None] + tree, timeout=2)
+        for q in alive:
+            with contextlib.suppress(psutil.NoSuchProcess):
+                q.kill()
         for p in self.procs:
-            try:
-                p.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
+            p.wait()
 
 
 @pytest.fixture
