@@ -19,6 +19,7 @@ from typing import Any
 from app.io.units import spec_of
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived
+from control.fdsmc.fdc import mismatch_filter_factor
 from control.fdsmc.feasibility import current_limit, feasibility
 from control.fdsmc.inverter import decay_factors
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
@@ -111,16 +112,12 @@ def _fields(params: DriveParams, d: Derived, K: float) -> dict[str, Any]:
         "t_s2": od.T_s**2, "j_r": params.motor.J_r,
         "u_max": u_max, "u_max2": u_max**2, "i_max": i_lim, "i_max2": i_lim * i_lim,
         "phi_d": phi_d, "gam_d": gam_d, "inv_gam_d": 1.0 / gam_d, "phi_q": phi_q, "gam_q": gam_q,
-        "inv_gam_q": 1.0 / gam_q, "beta_dv": _beta_dv(ctrl), "gain_dv": gam_q * c.G, "inv_gain_dv": 1.0 / (gam_q * c.G),
+        "inv_gam_q": 1.0 / gam_q, "beta_dv": mismatch_filter_factor(ctrl.T_dv, float(ctrl.f_s)),
+        "gain_dv": gam_q * c.G, "inv_gain_dv": 1.0 / (gam_q * c.G),
         "i_fault2": lim["I_FAULT"] ** 2, "u_fault2": NON_FINITE_BOUND,
         "e_o_max_counts": lim["E_O_MAX"] * cpr / (2.0 * math.pi),
         "rad_per_count": 2.0 * math.pi / cpr, "counts_per_rad": cpr / (2.0 * math.pi),
     }
-
-
-def _beta_dv(ctrl: Any) -> float:
-    """Filter factor β of the q-axis voltage-mismatch estimate, as the simulator packs it (0 = none)."""
-    return min(1.0, 1.0 / (float(ctrl.f_s) * ctrl.T_dv)) if ctrl.T_dv > 0.0 else 0.0
 
 
 def design_initializer(params: DriveParams, d: Derived, so: Any, literal: Callable[[float], str], K: float) -> str:

@@ -18,7 +18,7 @@ import plotly.graph_objects as go
 from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index
 from app.figures.plain import to_figure
 from app.figures.style import FONT_PX, POSITION_COLOURS, POSITION_DASHES, WARNING_COLOUR
-from control.fdsmc.sliding_mode import boundary_speed
+from control.fdsmc.sliding_mode import boundary_speed, in_boundary_layer
 from sim.fdsmc.engine import LABELS, Comparison, RunResult
 
 #: Most points drawn per trace by :func:`decimate_index` (the drive-log overlay).
@@ -95,8 +95,8 @@ def layer_entry_index(comparison: Comparison, run: RunResult) -> int | None:
     """
     d, tr = comparison.derived, run.trace
     prof = d.profile
-    gap = np.abs(tr.omega_r - boundary_speed(tr.theta_r - d.params.manoeuvre.theta_dem, prof.omega_p, prof.T_c))
-    inside = np.flatnonzero(gap <= 1.0 / d.params.controller.K)
+    inside = np.flatnonzero(in_boundary_layer(tr.theta_r - d.params.manoeuvre.theta_dem, tr.omega_r, prof.omega_p,
+                                              prof.T_c, d.params.controller.K))
     return int(inside[0]) if inside.size else None
 
 

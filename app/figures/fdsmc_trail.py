@@ -26,7 +26,7 @@ import numpy as np
 
 from app.figures.decimate import f32, minmax_index
 from app.figures.style import POSITION_COLOURS, POSITION_DASHES, TRAIL_PHASE_COLOURS, TRAIL_PHASE_DASHES
-from control.fdsmc.sliding_mode import boundary_speed
+from control.fdsmc.sliding_mode import in_boundary_layer
 from sim.fdsmc.engine import LABELS
 
 #: Pieces per trajectory in time (more where the FDSMC changes phase), and min/max bins of the
@@ -61,9 +61,8 @@ def phase_of(theta_re: np.ndarray, omega_r: np.ndarray, omega_p: float, T_c: flo
     T_c : float         Slope time constant [s].
     K : float           Boundary-layer gain [s/rad]: the layer is ±1/K [rad/s] wide.
     """
-    theta_re, omega_r = np.asarray(theta_re, dtype=float), np.asarray(omega_r, dtype=float)
-    inside = np.abs(omega_r - boundary_speed(theta_re, omega_p, T_c)) <= 1.0 / K
-    entered = np.cumsum(inside) > 0
+    theta_re = np.asarray(theta_re, dtype=float)
+    entered = np.cumsum(in_boundary_layer(theta_re, omega_r, omega_p, T_c, K)) > 0
     linear = np.abs(theta_re) <= T_c * omega_p
     return np.where(~entered, 0, np.where(linear, 2, 1))
 

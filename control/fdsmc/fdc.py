@@ -160,3 +160,8 @@ def voltage_mismatch(dv_hat: float, i_q: float, i_q_model: float, gain: float, b
     beta : float       Filter factor T_s/T_dv (≤ 1) [-].
     """
     return dv_hat + beta * ((i_q - i_q_model) / gain - dv_hat)
+
+
+def mismatch_filter_factor(T_dv: float, f_s: float) -> float:
+    """β = T_s/T_dv ≤ 1 of :func:`voltage_mismatch` for the sample rate f_s [Hz] (0 when T_dv = 0: none) [-]."""
+    return min(1.0, 1.0 / (f_s * T_dv)) if T_dv > 0.0 else 0.0

@@ -29,6 +29,21 @@ def boundary_speed(theta_re: np.ndarray | float, omega_p: float, T_c: float) -> 
     )
 
 
+def in_boundary_layer(theta_re: np.ndarray | float, omega_r: np.ndarray | float, omega_p: float, T_c: float,
+                      K: float) -> np.ndarray:
+    """Whether each state lies inside the boundary layer |ω_r − ω_b(θ_re)| ≤ 1/K, eqs. (41), (45) in [1].
+
+    Parameters
+    ----------
+    theta_re : array_like  Position error θ_r − θ_rdem [rad].
+    omega_r : array_like   Speed [rad/s].
+    omega_p : float        Peak speed [rad/s].
+    T_c : float            Slope time constant [s].
+    K : float              Boundary-layer gain [s/rad]: the layer is ±1/K wide.
+    """
+    return np.abs(np.asarray(omega_r, dtype=float) - boundary_speed(theta_re, omega_p, T_c)) <= 1.0 / K
+
+
 @jitable
 def switching_function(theta_re: float, omega_r: float, omega_p: float, T_c: float) -> float:
     """Switching function S(θ_re, ω_r) of eq. (44) in [1] [rad/s].

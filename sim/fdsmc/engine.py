@@ -26,6 +26,7 @@ import numpy as np
 
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
+from control.fdsmc.fdc import mismatch_filter_factor
 from control.fdsmc.feasibility import current_limit
 from control.fdsmc.inverter import decay_factors
 from control.fdsmc.model import model_coefficients, torque_constant
@@ -158,8 +159,8 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
     if controller == "optimum":  # α(t) ≈ α_dem(t − T_sα/3) (eq. (13)), one more sample with a delay
         prm[kn.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
     prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
-    if ctrl.T_dv > 0.0 and not ctrl.is_continuous:  # β of the q-axis voltage-mismatch estimate
-        prm[kn.P_BDV] = min(1.0, 1.0 / (float(ctrl.f_s) * ctrl.T_dv))
+    if not ctrl.is_continuous:  # β of the q-axis voltage-mismatch estimate (0: none)
+        prm[kn.P_BDV] = mismatch_filter_factor(ctrl.T_dv, float(ctrl.f_s))
     prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), current_limit(params))  # 0 = no limit
     prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
     m = params.motor

@@ -14,8 +14,11 @@ agree. Formulas (see [1], the FDSMC paper):
 * observer: eq. (15) corrected (e_o = θ_r − θ̂_r, dθ̂/dt = ω̂ + K1·e_o); digital mode uses the
   ZOH-exact prediction form x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·e_o[k];
 * outer loop: eqs. (41)–(46) (FDSMC), eq. (62) sign-corrected (conventional), or tracking of a
-  reference move (θ_ref, ω_ref, α_ref) — the minimum-energy optimum — by α_ref fed forward plus
-  the gains of eq. (61) on the tracking error;
+  reference move (θ_ref, ω_ref, α_ref) by α_ref fed forward plus gains on the tracking error — the
+  stock cascade's trapezoid (``P_CTRL`` = 2), or the minimum-energy optimum ending on the FDSMC's
+  terminal slide (``P_CTRL`` = 3, :mod:`control.fdsmc.terminal_slide`);
+* the FDC's u_q corrected by the q-axis voltage-mismatch estimate where ``P_BDV`` > 0 (not in [1],
+  :func:`control.fdsmc.fdc.voltage_mismatch`);
 * energies as extra states of the same RK4 integration, so that the balance closes.
 """
 
@@ -118,8 +121,9 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
               ref: np.ndarray) -> tuple[float, float]:
     """Return the outer loop's demanded acceleration [rad/s²] and S [rad/s].
 
-    Eqs. (44)–(46), (62), or the reference tracking law :func:`control.fdsmc.conventional.tracking_demand`
-    (``P_CTRL`` = 2), all of :mod:`control`.
+    Eqs. (44)–(46), (62), the reference tracking law :func:`control.fdsmc.conventional.tracking_demand`
+    (``P_CTRL`` = 2) or the tracked optimum's :func:`control.fdsmc.terminal_slide.slide_in_demand`
+    (``P_CTRL`` = 3), all of :mod:`control`.
     """
     if prm[P_CTRL] >= 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
         th_r, w_r, _ = reference_at(t, ref, prm[P_TM])
@@ -384,7 +388,7 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
     """Integrate one run from rest; fills ``out`` (N_CH × samples) and ``info`` (I_* indices).
 
     ``ref`` (3 × n: θ_ref, ω_ref, α_ref on equally spaced nodes over [0, T_m]) is read only by the
-    reference-tracking outer law (``prm[P_CTRL]`` = 2); pass a 3 × 2 array of zeros otherwise.
+    reference-tracking outer laws (``prm[P_CTRL]`` = 2, 3); pass a 3 × 2 array of zeros otherwise.
 
     For each window j, rows WIN_ROWS·j … WIN_ROWS·j + 3 of ``win`` receive α_dem, ω_r, i_q and the
     applied u_q of every step k_win[j] … k_win[j] + n − 1 at full resolution (the chatter and
