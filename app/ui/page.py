@@ -28,7 +28,7 @@ from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, page
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
 from app.ui.position_tab import PositionTab, comparison_or_derived
-from app.ui.results import ResultsPanel
+from app.ui.results import ResultsPanel, empty_table1_json
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import StudiesSection
 from app.ui.studies_queue import StudySlots
@@ -238,6 +238,7 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
         server.scene.configure_environment_map(hdri=None)
     config = AppConfig(params, origin, scene_3d, guard=guard)
     config.initial()  # the first page must not wait for the kernels' first load and the start-up run
+    empty_table1_json()
     warm_bldc()
 
     @server.on_client_connect
