@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from app.figures.fdsmc_overview import CURSORS, motor_torque, overview_spec
+from app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
 from app.ui.replay import overview_json, phase_plane_json
 from sim.fdsmc.engine import Comparison, compare
 
@@ -106,4 +107,16 @@ def test_the_drag_overview_draws_the_same_curves_statically(comparison):
         assert b.get("mode") == a.get("mode")
     targets = overview_json(comparison, replay=False)[1]
     assert targets.now == targets.cursors == targets.trail == ()  # a scrub of the drag figure moves nothing
+    # drawn first after a Simulate: the same light figure with Plotly's default config (as the whole one's)
+    first = json.loads(overview_json(comparison, replay=False, static=False)[0])
+    assert first["config"] == {} and first["data"] == drag["data"] and first["layout"] == drag["layout"]
     assert next(t for t in drag["data"] if t["name"] == "FDSMC enters boundary layer")["mode"] == "markers+text"
+
+
+def test_the_overview_tells_the_page_how_to_fit_its_height(comparison):
+    """``layout.meta.fit_height``: the page sizes the plot from the window on its first draw, with the
+    rule of ``layout_for_window`` (checked against the server's aspect in tests/browser/test_layout_steady.py).
+    """
+    for replay in (True, False):
+        meta = json.loads(overview_json(comparison, replay)[0])["layout"]["meta"]
+        assert meta["fit_height"] == [CHROME_HEIGHT, ASPECT_MIN, ASPECT_MAX]

@@ -50,24 +50,29 @@ def _last_or_build(kind: str, comparison: Any, build: Callable[[], Any]) -> Any:
     return out
 
 
-def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = ()) -> tuple[str, ScrubTargets]:
+def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = (),
+                  static: bool = True) -> tuple[str, ScrubTargets]:
     """JSON of the overview figure (phase plane + compact time plot, ``pins`` as ghosts) and the traces a scrub moves.
 
     With ``replay`` the figure carries its in-browser replay (play buttons and key frames); without
     them (and without Plotly's mode bar) the browser redraws it faster: what a slider drag needs;
-    both come back when the drag stops. The page fits the figure's height to the window
+    both come back when the drag stops (``static`` False: the same light figure with Plotly's
+    default config, drawn first after a Simulate; a change of config makes Plotly draw the next
+    figure from scratch, at twice the cost). The page fits the figure's height to the window
     (``layout.meta.fit_height``, :data:`app.ui.plotly_js.SIZED_JS`).
     """
     if pins:
-        return _overview_json(comparison, replay, pins)
-    return _last_or_build(f"overview {replay}", comparison, lambda: _overview_json(comparison, replay, ()))
+        return _overview_json(comparison, replay, pins, static)
+    return _last_or_build(f"overview {replay} {static}", comparison,
+                          lambda: _overview_json(comparison, replay, (), static))
 
 
-def _overview_json(comparison: Any, replay: bool, pins: tuple[Pin, ...]) -> tuple[str, ScrubTargets]:
+def _overview_json(comparison: Any, replay: bool, pins: tuple[Pin, ...],
+                   static: bool) -> tuple[str, ScrubTargets]:
     spec = overview_spec(comparison, pins)
     spec["layout"]["meta"] = {**spec["layout"]["meta"], "fit_height": [CHROME_HEIGHT, ASPECT_MIN, ASPECT_MAX]}
     if not replay:
-        drag = _drag_figure(spec)
+        drag = _drag_figure(spec, {"staticPlot": True} if static else {})
         return figure_json(drag), ScrubTargets.of(drag["data"], points=False)
     targets = ScrubTargets.of(spec["data"])
     layout, raw = replay_layout(comparison, spec["data"])
@@ -77,17 +82,18 @@ def _overview_json(comparison: Any, replay: bool, pins: tuple[Pin, ...]) -> tupl
     return figure_json({**spec, "config": {}}, raw), targets
 
 
-def _drag_figure(spec: dict[str, Any]) -> dict[str, Any]:
-    """Return the overview as drawn while a slider is dragged: static, and only the traces that show.
+def _drag_figure(spec: dict[str, Any], config: dict[str, Any]) -> dict[str, Any]:
+    """Return the light overview, with Plotly's ``config``: only the traces that show.
 
-    A static plot (no hover, zoom or mode bar; they return with the replay once the drag stops)
-    and the whole trajectories instead of the replay's trail: Plotly's cost per redraw grows with
-    the number of traces (148 → 22 traces: 60 → 31 ms in headless Chromium), so the trail pieces
-    (empty until a replay runs), the "now" markers and the time cursors (at the end of the run,
-    where a replay leaves them) are left out, and the empty text layers of the markers.
+    While a slider is dragged it is a static plot (no hover, zoom or mode bar; they return with
+    the replay once the drag stops: ≈ 20 % off each redraw). It has the whole trajectories
+    instead of the replay's trail: Plotly's cost per redraw grows with the number of traces
+    (148 → 22 traces: 60 → 31 ms in headless Chromium), so the trail pieces (empty until a
+    replay runs), the "now" markers and the time cursors (at the end of the run, where a replay
+    leaves them) are left out, and the empty text layers of the markers.
     """
     data = [_drag_trace(tr) for tr in spec["data"] if not _replay_only(tr)]
-    return {**spec, "data": data, "config": {"staticPlot": True}}
+    return {**spec, "data": data, "config": config}
 
 
 def _replay_only(tr: dict[str, Any]) -> bool:
@@ -185,9 +191,14 @@ class Replay:
         """Show a new comparison: the phase plane first, then the time plots; rotors to the end.
 
         ``light`` (a slider being dragged): the overview without its replay controls and no time
-        plots, until :meth:`complete`.
+        plots, until :meth:`complete`. Otherwise the light overview goes out first (the browser
+        draws its 22 traces in a third of the time of the replay's 150) and the overview with its
+        replay right after it.
         """
         self.pause()
+        if not light:
+            set_figure_json(self._phase, overview_json(comparison, replay=False, pins=self.pins, static=False)[0])
+            self._flush()
         figure, targets = overview_json(comparison, replay=not light, pins=self.pins)
         set_figure_json(self._phase, figure)
         self._flush()  # the phase plane goes out before the larger figure is even built
