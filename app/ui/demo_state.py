@@ -66,7 +66,7 @@ class PageView:
     def as_json(self) -> dict[str, Any]:
         """Return the ``tab`` and ``zoom`` entries of a demo-state file."""
         return {"tab": {"mode": self.mode_tab, "results": self.results_tab},
-                "zoom": {k: [float(f"{v:.9g}") for v in r] for k, r in self.zoom.items()}}
+                "zoom": {k: [float(v) for v in r] for k, r in self.zoom.items()}}
 
 
 @dataclass(frozen=True)
