@@ -10,7 +10,7 @@ import pytest
 
 from app.figures.fdsmc_pins import Pin
 from app.ui.demo_state import MODE_TABS, RESULTS_TABS, DemoState, PageView, dumps_state, loads_state, loads_view
-from app.ui.demo_view import select_tabs_js, view_report_js, zoomed_json
+from app.ui.demo_view import PageViewProbe, select_tabs_js, view_report_js, zoomed_json
 
 VIEW = PageView("BLDC speed SMC", "Time plots", {"xaxis": (-62.5, -28.0), "yaxis2": (40.0, 80.0)})
 
@@ -66,6 +66,17 @@ def test_the_pages_report_is_read_with_the_files_checks():
                 "not json"):
         with pytest.raises(ValueError):
             loads_view(bad)
+
+
+def test_the_probe_keeps_the_last_valid_report():
+    probe = PageViewProbe.__new__(PageViewProbe)  # its logic only: no page to report into
+    probe.view = PageView()
+    probe._reported(json.dumps({"tab": {"mode": None, "results": "Energy"}, "zoom": {}}))
+    assert probe.view == PageView(None, "Energy", {})
+    long_text = json.dumps({"tab": {"mode": None, "results": None}, "zoom": {}}) + " " * 5000
+    for bad in ("", long_text, '{"tab": 1, "zoom": {}}', "[" * 100, '{"tab": {"mode": null, "results": "Nope"}}'):
+        probe._reported(bad)
+        assert probe.view == PageView(None, "Energy", {})
 
 
 def test_the_overview_is_sent_again_with_the_zoomed_axes_only():
