@@ -146,7 +146,9 @@ def rss_mb(pid: int) -> float:
 def start_server(port: int, scene_3d: bool) -> subprocess.Popen:
     env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
     extra = [] if scene_3d else ["--no-3d"]
-    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port), "--preset", PRESET, *extra],
+    # UI_BENCH_SERVER: what python runs instead of "-m app" (e.g. a script timing the server's calls)
+    server = os.environ.get("UI_BENCH_SERVER", "-m app").split()
+    proc = subprocess.Popen([sys.executable, *server, "serve", "--port", str(port), "--preset", PRESET, *extra],
                             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert proc.stdout is not None
     for line in proc.stdout:

@@ -7,6 +7,8 @@ The widths the page's CSS gives the panels in a real browser are checked against
 from __future__ import annotations
 
 import json
+import re
+from pathlib import Path
 
 import pytest
 
@@ -28,9 +30,12 @@ from app.ui.layout import (
     install_css_js,
     layout_for_window,
     page_css,
+    page_marks_js,
     parse_window,
     window_report_js,
 )
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _plot_height(lay) -> float:
@@ -93,7 +98,7 @@ def test_window_fit_refits_on_a_new_size_and_ignores_junk():
 
 
 def test_page_css_carries_the_widths_of_layout_for_window():
-    folded, shown = page_css("probe-1"), page_css("probe-1", show_3d=True)
+    folded, shown = page_css(), page_css(show_3d=True)
     assert folded != shown
     # control panel + viser's two 2 px gutters, narrow and wide windows; a folded region: the rail
     assert f"--fit-left: {CONTROL_WIDTH + BORDERS / 2:g}px" in folded
@@ -105,12 +110,29 @@ def test_page_css_carries_the_widths_of_layout_for_window():
     assert f"--fit-canvas: {CANVAS_SPARE:g}px" in folded and f"--fit-canvas: max({SCENE_MIN:g}px, 22%)" in shown
     rest = f"--fit-right: max({RESULTS_MIN + BORDERS / 2:g}px, calc(100% - var(--fit-left) - var(--fit-canvas)))"
     assert rest in folded
-    assert 'label[for="probe-1"]' in folded and "display: none" in folded  # the window field is hidden
-    assert '[title^="BLDC"]) canvas {visibility: hidden}' in folded
+    assert "[data-app-hidden] {display: none !important}" in folded  # the window field's row (page_marks_js)
+    assert "[data-app-bldc] canvas {visibility: hidden}" in folded
+
+
+def test_no_css_of_the_page_selects_with_has():
+    """No ``:has()`` in any CSS the page gets: with one, every forced layout re-styled the whole page."""
+    sources = [*(ROOT / "app").rglob("*.py"), *(ROOT / "app" / "ui" / "assets").glob("*.js")]
+    selector = re.compile(r":has\((?!\))")  # ":has()" in prose is fine
+    offenders = [str(p.relative_to(ROOT)) for p in sources if selector.search(p.read_text(encoding="utf-8"))]
+    assert offenders == []
+    assert ":has(" not in page_css() + page_css(show_3d=True)
+
+
+def test_page_marks_script_quotes_the_field_id():
+    js = page_marks_js('a"b')
+    assert f"const probe = {json.dumps('a' + chr(34) + 'b')};" in js
+    for mark in ("data-app-bldc", "data-app-rail-", "data-app-fit", "data-app-column", "data-app-overview-window",
+                 "data-app-hidden"):
+        assert mark in js and mark in page_css()
 
 
 def test_css_script_quotes_the_css():
-    css = page_css('x"); alert(1); ("')
+    css = 'x"); alert(1); ("'
     js = install_css_js(css)
     assert f"s.textContent = {json.dumps(css)};" in js  # a JSON string, not raw text
 

@@ -21,6 +21,7 @@ import re
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 #: Canvas width while the 3D view is folded [px]: a gutter (the results panel takes the rest).
 CANVAS_SPARE = 12.0
@@ -41,8 +42,9 @@ RESULTS_MIN = 320.0
 #: tab strip (≈ 78), the key numbers (16 px, up to three lines ≈ 68), the "Replay t" slider below
 #: the plot (≈ 40), paddings.
 CHROME_HEIGHT = 216.0
-#: Horizontal padding of the results panel around a plot [px] (padding and scroll bar).
-PLOT_PADDING = 36.0
+#: Horizontal padding of the results panel around a plot [px] (measured: the plot box is the results
+#: panel less 18.5 px at 1280 and at 1920 px; the page fits the height to the same rule from the first draw).
+PLOT_PADDING = 18.5
 #: Bounds of the overview plot's aspect (height / width) [-].
 ASPECT_MIN, ASPECT_MAX = 0.42, 0.85
 #: Window assumed until the browser reports its size [px].
@@ -78,7 +80,7 @@ def layout_for_window(width: float, height: float, show_3d: bool = False) -> Pan
     return PanelLayout(control, results, round(min(ASPECT_MAX, max(ASPECT_MIN, aspect)), 3), show_3d)
 
 
-def page_css(probe_uuid: str, show_3d: bool = False) -> str:
+def page_css(show_3d: bool = False) -> str:
     """Return the page's CSS: panel widths, hidden window-size field, no 3D canvas in the BLDC tabs.
 
     The docked regions, their shadows and the canvas between them get the widths of
@@ -86,32 +88,44 @@ def page_css(probe_uuid: str, show_3d: bool = False) -> str:
     A docked region folded to its rail keeps viser's rail width and the others take the rest.
     viser first shows a new panel floating, for a frame or more, before its dock command applies:
     the results panel's floating window gets the place and width it will have docked, so it
-    appears once, where it stays. The field :func:`window_report_js` writes to is hidden. viser
-    mounts only the active tab and marks it ``aria-selected``; the BLDC tabs' titles start with
-    "BLDC".
+    appears once, where it stays. The rules select the marks :func:`page_marks_js` sets, never by
+    ``:has()``: with such a rule in the page, every forced layout (each text Plotly measures)
+    re-styled the whole page.
     """
     gutters = 2 * EDGE_GAP
     canvas = f"max({SCENE_MIN:g}px, {100 * SCENE_SHARE:g}%)" if show_3d else f"{CANVAS_SPARE:g}px"
     root, child = "[data-dock-root]", "[data-dock-root] > div"
-    railed = 'body:has([data-dock-region="{}"] [data-dock-column-rail]) [data-dock-root]'
-    floating = '[data-floating-window]:has([role="tab"][title="Overview"])'
+    railed = "[data-app-rail-{}] [data-dock-root]"
     return (
-        'body:has([role="tab"][aria-selected="true"][title^="BLDC"]) canvas {visibility: hidden} '
-        f'div:has(> .mantine-Flex-root label[for="{probe_uuid}"]) {{display: none !important}} '
+        "[data-app-bldc] canvas {visibility: hidden} "
+        "[data-app-hidden] {display: none !important} "
         f"{root} {{--fit-left: {CONTROL_WIDTH + gutters:g}px; --fit-canvas: {canvas}; "
         f"--fit-right: max({RESULTS_MIN + gutters:g}px, calc(100% - var(--fit-left) - var(--fit-canvas)))}} "
         f"@media (min-width: {WIDE_WINDOW + 1:g}px) {{ {root} {{--fit-left: {CONTROL_WIDTH_WIDE + gutters:g}px}} }} "
         f"{railed.format('left')} {{--fit-left: {RAIL + gutters:g}px}} "
         f"{railed.format('right')} {{--fit-right: {RAIL + gutters:g}px}} "
-        '[data-dock-region="left"], [data-dock-root] > div:has(+ [data-dock-region="left"]) '
-        "{width: var(--fit-left) !important} "
-        '[data-dock-region="right"], [data-dock-root] > div:has(+ [data-dock-region="right"]) '
-        "{width: var(--fit-right) !important} "
-        "[data-dock-region] div:has(> [data-dock-column]) {width: 100% !important} "
+        '[data-dock-region="left"], [data-app-fit="left"] {width: var(--fit-left) !important} '
+        '[data-dock-region="right"], [data-app-fit="right"] {width: var(--fit-right) !important} '
+        "[data-app-column] {width: 100% !important} "
         f"{child}:first-child {{left: var(--fit-left) !important; right: var(--fit-right) !important}} "
-        f"{floating} {{left: auto !important; right: {EDGE_GAP:g}px !important; "
+        f"[data-app-overview-window] {{left: auto !important; right: {EDGE_GAP:g}px !important; "
         f"top: {REGION_HANDLE:g}px !important; height: calc(100% - {REGION_HANDLE:g}px) !important; "
         f"width: calc(var(--fit-right) - {gutters:g}px) !important}}")
+
+
+def page_marks_js(probe_uuid: str) -> str:
+    """Return the page script that marks the elements :func:`page_css` styles (installed once per page).
+
+    After every change of the page outside the plots (a mutation observer, before the next frame
+    is drawn) it sets: ``data-app-bldc`` on ``<html>`` while a tab titled "BLDC…" is selected (viser
+    mounts only the selected tab and marks it ``aria-selected``), ``data-app-rail-left``/``-right``
+    while that docked region is folded to its rail, ``data-app-fit`` on the shadow before each
+    docked region, ``data-app-column`` on the parent of each dock column,
+    ``data-app-overview-window`` on the floating window holding the "Overview" tab, and
+    ``data-app-hidden`` on the row of the window-size field ``probe_uuid``.
+    """
+    return (Path(__file__).resolve().parent / "assets" / "page_marks.js").read_text(encoding="utf-8").replace(
+        "PROBE_UUID", json.dumps(probe_uuid))
 
 
 def install_css_js(css: str, style_id: str = "app-page-style") -> str:
@@ -200,5 +214,5 @@ class WindowFit:
             self._apply(layout)
 
 
-__all__ = ["PanelLayout", "WindowFit", "install_css_js", "layout_for_window", "page_css", "parse_window",
-           "window_report_js"]
+__all__ = ["PanelLayout", "WindowFit", "install_css_js", "layout_for_window", "page_css", "page_marks_js",
+           "parse_window", "window_report_js"]

@@ -25,11 +25,11 @@ from app.ui.demo_view import PageViewProbe
 from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
 from app.ui.inputs import InputsPanel
-from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, window_report_js
+from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, page_marks_js, window_report_js
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
 from app.ui.position_tab import PositionTab, comparison_or_derived
-from app.ui.results import ResultsPanel
+from app.ui.results import ResultsPanel, empty_table1_json
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import StudiesSection
 from app.ui.studies_queue import StudySlots
@@ -93,6 +93,7 @@ class Session:
             gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
             self._window_probe = gui.add_text("window [px]", "")
             self._install_page_css(show_3d=False)
+            run_script(gui, page_marks_js(widget_id(self._window_probe)))
             use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
             gui.main_panel.dock_left()
             tabs = gui.add_tab_group()
@@ -139,7 +140,7 @@ class Session:
     def _install_page_css(self, show_3d: bool) -> None:
         """Put the page's CSS (:func:`app.ui.layout.page_css`) for the 3D view shown or folded into the page."""
         self._style_3d = show_3d
-        run_script(self.gui, install_css_js(page_css(widget_id(self._window_probe), show_3d)))
+        run_script(self.gui, install_css_js(page_css(show_3d)))
 
     # ---- what tests and scripts read of a session ---------------------------------------------
     @property
@@ -239,6 +240,7 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
         server.scene.configure_environment_map(hdri=None)
     config = AppConfig(params, origin, scene_3d, guard=guard)
     config.initial()  # the first page must not wait for the kernels' first load and the start-up run
+    empty_table1_json()
     warm_bldc()
 
     @server.on_client_connect

@@ -14,7 +14,9 @@ With the bundle goes :data:`SIZED_JS`: viser's plot widget calls ``Plotly.react`
 box is measured (layout width 0) and again for every prop change until it is; Plotly lays such a
 figure out at its default 700×450 px, all for nothing. On page open that was two whole draws of
 the overview (≈ 0.7 s, cold) before the one at the real width; a plot in a hidden tab (width 0)
-is now drawn when its tab is shown.
+is now drawn when its tab is shown. The overview's height follows the window from its first draw
+(viser's height is width × the aspect the server sets once the page has reported its window:
+one more whole draw on page open).
 """
 
 from __future__ import annotations
@@ -38,11 +40,22 @@ def bundle_source() -> str:
     return BUNDLE.read_text(encoding="utf-8")
 
 
-#: Wraps ``Plotly.react``: a call with layout width 0 (a box not measured yet) draws nothing.
+#: Wraps ``Plotly.react``: a call with layout width 0 (a box not measured yet) draws nothing; a figure
+#: with ``layout.meta.fit_height = [chrome, least, most]`` is as tall as the window's height less
+#: ``chrome`` [px], within [least, most] × its width (the height :func:`app.ui.layout.layout_for_window`
+#: gives it with the server's aspect, known here on the first draw instead of after the window report).
 SIZED_JS = """
 (() => { const P = window.Plotly; if (!P || P.__appSized) return; P.__appSized = true; const react = P.react;
   P.react = function (gd, data, layout, ...rest) {
-    if (layout && typeof layout === 'object' && layout.width === 0) return Promise.resolve(gd);
+    if (layout && typeof layout === 'object') {
+      if (layout.width === 0) return Promise.resolve(gd);
+      const fit = layout.meta && layout.meta.fit_height;
+      if (Array.isArray(fit) && layout.width > 0) {
+        const [chrome, least, most] = fit;
+        const h = Math.min(most * layout.width, Math.max(least * layout.width, window.innerHeight - chrome));
+        layout = {...layout, height: Math.round(h)};
+      }
+    }
     return react.call(this, gd, data, layout, ...rest); }; })();
 """
 

@@ -27,6 +27,7 @@ from app.figures.fdsmc_overview import overview_spec
 from app.figures.fdsmc_pins import Pin
 from app.figures.fdsmc_replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
 from app.figures.plain import figure_json
+from app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
 from app.ui.props import assign
 from app.ui.scene import RotorScene
 from app.ui.viser_adapter import run_script, set_figure_json
@@ -34,14 +35,37 @@ from app.ui.viser_adapter import run_script, set_figure_json
 FRAME_HZ = 25.0
 
 
+#: The last figures built without pins, by kind: (comparison, result). Every new page shows the
+#: start-up comparison: its figures are built once, not once per page.
+_LAST: dict[str, tuple[Any, Any]] = {}
+
+
+def _last_or_build(kind: str, comparison: Any, build: Callable[[], Any]) -> Any:
+    """Return ``build()``, or what it returned for this very ``comparison`` (an immutable result) last time."""
+    last = _LAST.get(kind)
+    if last is not None and last[0] is comparison:
+        return last[1]
+    out = build()
+    _LAST[kind] = (comparison, out)
+    return out
+
+
 def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = ()) -> tuple[str, ScrubTargets]:
     """JSON of the overview figure (phase plane + compact time plot, ``pins`` as ghosts) and the traces a scrub moves.
 
     With ``replay`` the figure carries its in-browser replay (play buttons and key frames); without
     them (and without Plotly's mode bar) the browser redraws it faster: what a slider drag needs;
-    both come back when the drag stops.
+    both come back when the drag stops. The page fits the figure's height to the window
+    (``layout.meta.fit_height``, :data:`app.ui.plotly_js.SIZED_JS`).
     """
+    if pins:
+        return _overview_json(comparison, replay, pins)
+    return _last_or_build(f"overview {replay}", comparison, lambda: _overview_json(comparison, replay, ()))
+
+
+def _overview_json(comparison: Any, replay: bool, pins: tuple[Pin, ...]) -> tuple[str, ScrubTargets]:
     spec = overview_spec(comparison, pins)
+    spec["layout"]["meta"] = {**spec["layout"]["meta"], "fit_height": [CHROME_HEIGHT, ASPECT_MIN, ASPECT_MAX]}
     if not replay:
         drag = _drag_figure(spec)
         return figure_json(drag), ScrubTargets.of(drag["data"], points=False)
@@ -113,7 +137,7 @@ def scrub_js(comparison: Any, targets: ScrubTargets, t: float) -> str:
 
 def time_plots_json(comparison: Any) -> str:
     """JSON of the time plots."""
-    return figure_json(time_plots_spec(comparison))
+    return _last_or_build("time plots", comparison, lambda: figure_json(time_plots_spec(comparison)))
 
 
 class Replay:
