@@ -57,6 +57,8 @@ def test_a_demo_state_brings_back_its_tabs_and_the_overviews_zoom(browser, ui_se
     page.on("pageerror", lambda e: errors.append(str(e)))
     try:
         probe = session_of(page, ui_server, before).tab.demo_files.probe
+        page.wait_for_function("() => { const l = [...document.querySelectorAll('label')]"
+                               ".find(l => l.textContent === 'page view'); return l && l.offsetParent === null; }")
         zoom = _zoom_box(page)
         saved_view = PageView("Position drive (FDSMC)", "Overview", zoom)
         _reported(page, probe, saved_view)
