@@ -100,7 +100,7 @@ def test_demo_state_round_trip_keeps_inputs_plant_ranges_and_pins(comparison):
 
 @pytest.mark.parametrize("edit, words", [
     (lambda d: d.pop("pins"), "not a demo-state file"),
-    (lambda d: d.update(demo_state=2), "demo_state = '2': allowed 1"),
+    (lambda d: d.update(demo_state=3), "demo_state = '3': allowed 1 or 2"),
     (lambda d: d["pins"][0].update(t=["1e999"]), "pins[1].t"),
     (lambda d: d["pins"][0].update(t=[1.0]), "different lengths"),
     (lambda d: d.update(ranges={"T_m": [10, 1]}), "allowed 0 < min < max"),

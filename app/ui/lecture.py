@@ -4,9 +4,11 @@
 grey ghost in the overview (:mod:`app.figures.fdsmc_pins`; at most four, oldest dropped), so a
 change of K, load, the plant's J_L or the anti-windup can be seen against it; **Clear pins**
 removes them. *Demo state (lecture)*: **Save demo state** downloads the inputs, the plant's J_L,
-the slider ranges and the pins as one JSON file (:mod:`app.ui.demo_state`); **Load demo state**
-reads one back through the upload checks of every file and simulates it. A bad file is refused
-with one line and changes nothing.
+the slider ranges, the pins, the tabs shown and the overview's zoom as one JSON file
+(:mod:`app.ui.demo_state`; the page reports its tabs and zoom through :mod:`app.ui.demo_view`);
+**Load demo state** reads one back through the upload checks of every file, selects its tabs,
+simulates it and draws the overview at its zoom. A bad file is refused with one line and changes
+nothing.
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ import viser
 
 from app.exports.model import safe_stem
 from app.figures.fdsmc_pins import MAX_PINS, Pin, pin_of, pinned
-from app.ui.demo_state import DemoState, dumps_state, loads_state
+from app.ui.demo_state import DemoState, PageView, dumps_state, loads_state
+from app.ui.demo_view import PageViewProbe
 from app.ui.files import upload_text
 from app.ui.props import assign
 from app.ui.text import pins_html
@@ -55,24 +58,31 @@ class LecturePins:
 
 
 class DemoStateFiles:
-    """The "Demo state (lecture)" folder: save to a download, load from an upload; ``tab`` is the position tab."""
+    """The "Demo state (lecture)" folder: save to a download, load from an upload; ``tab`` is the position tab.
+
+    :attr:`probe` (set by the page, outside the mode tabs: it must stay in the page whichever tab is
+    shown) reports the page's tabs and zoom; without one a state has no view.
+    """
 
     def __init__(self, gui: viser.GuiApi, tab: Any) -> None:
         self._tab = tab
+        self.probe: PageViewProbe | None = None
         with gui.add_folder("Demo state (lecture)", expand_by_default=False):
             self.save = gui.add_button("Save demo state", icon=viser.Icon.DOWNLOAD,
-                                       hint="The inputs, the plant's J_L, the slider ranges and the pinned runs "
-                                            "as one file, to load at the next lecture")
+                                       hint="The inputs, the plant's J_L, the slider ranges, the pinned runs, "
+                                            "the tabs shown and the overview's zoom as one file, to load at "
+                                            "the next lecture")
             self.load = gui.add_upload_button("Load demo state", icon=viser.Icon.UPLOAD,
                                               mime_type=".json,application/json,text/plain")
         self.save.on_click(lambda _: self._save())
         self.load.on_upload(lambda _: self._uploaded())
 
     def state(self) -> DemoState:
-        """Return the lecture's state shown: the case committed, the plant's J_L, slider ranges, pins."""
+        """Return the lecture's state shown: the case committed, the plant's J_L, slider ranges, pins, view."""
         tab = self._tab
         case = tab.case
-        return DemoState(case.params, case.plant_J_L, case.origin, tab.tuning.ranges, tab.lecture.pins)
+        view = self.probe.view if self.probe is not None else PageView()
+        return DemoState(case.params, case.plant_J_L, case.origin, tab.tuning.ranges, tab.lecture.pins, view)
 
     def _save(self) -> None:
         name = f"{safe_stem(self._tab.case.params.name or 'fdsmc')}_demo_state.json"
@@ -89,7 +99,7 @@ class DemoStateFiles:
         self.open(state)
 
     def open(self, state: DemoState) -> bool:
-        """Show ``state`` (inputs, slider ranges, pins) and simulate it with its plant; False if busy."""
+        """Show ``state`` (inputs, slider ranges, pins, tabs), simulate it with its plant, zoom; False if busy."""
         tab = self._tab
         if tab.busy:
             return tab.submit(lambda: None)  # refused, with the "busy" note
@@ -98,7 +108,16 @@ class DemoStateFiles:
         tab.tuning.ranges = state.ranges
         tab.hold_ranges()
         tab.lecture.keep(state.pins)
-        return tab.submit(lambda: tab.run_with_plant(state.params, state.plant_J_L))
+        if self.probe is not None:
+            self.probe.select_tabs(state.view)
+        return tab.submit(lambda: self._run(state))
+
+    def _run(self, state: DemoState) -> None:
+        """On the worker: simulate ``state`` with its plant, then draw the overview at its zoom."""
+        tab = self._tab
+        tab.run_with_plant(state.params, state.plant_J_L)
+        if self.probe is not None and tab.case.comparison.fdsmc is not None:
+            self.probe.zoom(tab.results.phase, state.view.zoom)
 
 
 __all__ = ["DemoStateFiles", "LecturePins"]

@@ -21,6 +21,7 @@ from app.threads import limit_blas_threads, release_memory
 from app.ui.bldc_results import follow_tabs_js
 from app.ui.bldc_tab import add_bldc_tab, warm_bldc
 from app.ui.case import Case, CaseState
+from app.ui.demo_view import PageViewProbe
 from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
 from app.ui.inputs import InputsPanel
@@ -107,6 +108,7 @@ class Session:
             with self.results.panel.add_tab("Share", viser.Icon.SHARE):
                 self.export = FigureExport(gui, self._figure_handles)
             self.fit = WindowFit(self._apply_layout)
+            self.tab.demo_files.probe = PageViewProbe(gui)  # outside the mode tabs: in the page whichever is shown
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))

@@ -1,0 +1,63 @@
+// Installed once per page by app/ui/demo_view.py (UUID, MODE_TABS and RESULTS_TABS filled in there).
+// Writes what the page shows — the selected mode and results tabs, the overview's zoomed axes — as
+// JSON into the hidden text field UUID, as if typed (so viser sends it), whenever it may have changed:
+// after a click or key press (a tab chosen) and after the overview's axes changed (plotly_relayout).
+// The zoom of an overview element starts from its figure's layout.meta.zoom (a restored zoom) at each
+// new figure (plotly_react). Reads Plotly's el.layout (the ranges as drawn), a public property.
+(() => {
+  const uuid = UUID, modeTabs = MODE_TABS, resultsTabs = RESULTS_TABS;
+  const setValue = Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set;
+  const axisKey = /^([xy]axis[2-9]?)\.(range|autorange)/;
+  const overview = () => [...document.querySelectorAll('.js-plotly-plot')]
+    .find(e => e.layout && e.layout.meta && e.layout.meta.id === 'phase_plane');
+  const selected = (titles) => {
+    const tab = [...document.querySelectorAll('[role="tab"][aria-selected="true"]')]
+      .find(t => titles.includes(t.getAttribute('title')));
+    return tab ? tab.getAttribute('title') : null;
+  };
+  const restart = (el) => { el.__appZoom = Object.assign({}, (el.layout.meta || {}).zoom || {}); };
+  const hook = (el) => {
+    if (el.__appViewHooked || !el.on) return;
+    el.__appViewHooked = true;
+    restart(el);
+    el.on('plotly_react', () => { restart(el); report(); });
+    el.on('plotly_relayout', (ev) => {
+      for (const key of Object.keys(ev || {})) {
+        const m = key.match(axisKey);
+        if (!m) continue;
+        const axis = el.layout[m[1]];
+        if (m[2] === 'autorange' && ev[key]) delete el.__appZoom[m[1]];
+        else if (axis && Array.isArray(axis.range)) el.__appZoom[m[1]] = [Number(axis.range[0]), Number(axis.range[1])];
+      }
+      report();
+    });
+  };
+  let frame = 0;
+  const report = () => {
+    const label = document.querySelector(`label[for="${uuid}"]`);
+    const flex = label && label.closest('.mantine-Flex-root');
+    const input = flex && flex.querySelector('input');
+    if (!input) {  // not mounted yet: look again next frame (for at most ≈ 1 min)
+      if (++frame < 3600) requestAnimationFrame(report);
+      return;
+    }
+    frame = 0;
+    if (flex.parentElement.style.display !== 'none') flex.parentElement.style.display = 'none';  // the field's row
+    const el = overview();
+    if (el) hook(el);
+    const view = JSON.stringify({tab: {mode: selected(modeTabs), results: selected(resultsTabs)},
+                                 zoom: (el && el.__appZoom) || {}});
+    if (input.value === view) return;
+    setValue.call(input, view);
+    input.dispatchEvent(new Event('input', {bubbles: true}));
+  };
+  const later = () => setTimeout(report, 60);  // after the tab strip took the click or key
+  if (window.__appPageView) {
+    for (const [type, fn] of window.__appPageView) document.removeEventListener(type, fn, true);
+  }
+  // pointerdown hooks the overview before a zoom drag ends; click and keydown: a tab chosen
+  window.__appPageView = [['pointerdown', () => { const el = overview(); if (el) hook(el); }],
+                          ['click', later], ['keydown', later]];
+  for (const [type, fn] of window.__appPageView) document.addEventListener(type, fn, true);
+  report();
+})();
