@@ -188,8 +188,8 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
     layout["meta"] = {**layout["meta"], "overview": True}
     layout["title"] = {**layout["title"], "font": {"size": TITLE_PX}, "y": 0.995, "yref": "container", "yanchor": "top"}
     layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": FONT_PX},
-                        "entrywidth": 0.33, "entrywidthmode": "fraction"}
-    layout["margin"] = {"l": 56, "r": 12, "t": 116, "b": 84, "autoexpand": False}  # a 3-row legend at 14 px
+                        "entrywidth": 0.3, "entrywidthmode": "fraction"}
+    layout["margin"] = {"l": 56, "r": 12, "t": 124, "b": 84, "autoexpand": False}  # title and a 3-row legend at 14 px
     if not runs(comparison):
         return {**spec, "data": ghost_traces(pins, time_row=False) + spec["data"]}
     spec["data"] = _with_trail(comparison, spec["data"])

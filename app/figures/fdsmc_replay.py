@@ -173,11 +173,16 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
             "mode": "immediate", "frame": {"duration": ms, "redraw": False}, "transition": glide}]})
     buttons.append({"label": "Pause", "method": "animate", "execute": False, "args": [[None], PAUSE]})
     return {
-        "updatemenus": [{"type": "buttons", "direction": "left", "showactive": False, "x": 1.0, "y": -0.1,
-                         "xanchor": "right", "yanchor": "top", "pad": {"t": 0, "b": 2},
+        # below the time plot's axis title at any height: a fixed pad [px] under the plot area, not a
+        # fraction of its height (at 1920×1080 y = -0.1 put the buttons past the bottom margin)
+        "updatemenus": [{"type": "buttons", "direction": "left", "showactive": False, "x": 1.0, "y": 0.0,
+                         "xanchor": "right", "yanchor": "top", "pad": {"t": BUTTONS_BELOW_PX, "b": 2},
                          "font": {"size": 11}, "buttons": buttons}],
     }, raw
 
+
+#: Gap between the bottom of the plot area and the replay buttons [px].
+BUTTONS_BELOW_PX = 34
 
 #: ``Plotly.animate`` options that stop a running replay where it stands.
 PAUSE = {"mode": "immediate", "frame": {"duration": 0, "redraw": False}, "transition": {"duration": 0}}
