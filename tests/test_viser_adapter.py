@@ -14,9 +14,11 @@ from pathlib import Path
 
 import pytest
 import viser
+from viser import _icons
 
 from app.figures.plain import figure_json
 from app.ui import viser_adapter as va
+from app.ui.viser_adapter import PAGE_ICONS, warm_icons
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -88,3 +90,14 @@ def test_no_other_module_touches_viser_privates():
             if attr.search(line) or module.search(line):
                 offenders.append(f"{path.relative_to(ROOT)}:{number}: {line.strip()}")
     assert offenders == []
+
+
+def test_the_icons_warmed_at_server_start_are_all_the_page_shows():
+    """Every ``viser.Icon.X`` the UI modules use is in PAGE_ICONS (read at server start, not on the first page)."""
+    used = set()
+    for path in (Path(__file__).resolve().parents[1] / "app" / "ui").rglob("*.py"):
+        used |= set(re.findall(r"viser\.Icon\.([A-Z0-9_]+)", path.read_text(encoding="utf-8")))
+    assert used == set(PAGE_ICONS)
+    warm_icons()
+    assert _icons.svg_from_icon.cache_info().currsize >= len(PAGE_ICONS)  # viser's cache holds them all
+    assert all(_icons.svg_from_icon(getattr(viser.Icon, name)).lstrip().startswith("<svg") for name in PAGE_ICONS)

@@ -34,7 +34,7 @@ from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import StudiesSection
 from app.ui.studies_queue import StudySlots
 from app.ui.text import md_text
-from app.ui.viser_adapter import run_script, widget_id
+from app.ui.viser_adapter import run_script, warm_icons, widget_id
 from app.ui.web_guard import Guard, guarded
 from app.ui.worker import Worker
 from control.fdsmc.params import DriveParams
@@ -241,6 +241,7 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     config = AppConfig(params, origin, scene_3d, guard=guard)
     config.initial()  # the first page must not wait for the kernels' first load and the start-up run
     empty_table1_json()
+    warm_icons()
     warm_bldc()
 
     @server.on_client_connect
