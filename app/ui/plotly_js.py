@@ -40,32 +40,14 @@ def bundle_source() -> str:
     return BUNDLE.read_text(encoding="utf-8")
 
 
-#: Wraps ``Plotly.react``: a call with layout width 0 (a box not measured yet) draws nothing; a figure
-#: with ``layout.meta.fit_height = [chrome, least, most]`` is as tall as the window's height less
-#: ``chrome`` [px], within [least, most] × its width (the height :func:`app.ui.layout.layout_for_window`
-#: gives it with the server's aspect, known here on the first draw instead of after the window report).
-#: A call with the data, layout and config of the last one draws nothing.
-SIZED_JS = """
-(() => { const P = window.Plotly; if (!P || P.__appSized) return; P.__appSized = true; const react = P.react;
-  P.react = function (gd, data, layout, ...rest) {
-    if (layout && typeof layout === 'object') {
-      if (layout.width === 0) return Promise.resolve(gd);
-      const fit = layout.meta && layout.meta.fit_height;
-      if (Array.isArray(fit) && layout.width > 0) {
-        const [chrome, least, most] = fit;
-        const h = Math.min(most * layout.width, Math.max(least * layout.width, window.innerHeight - chrome));
-        layout = {...layout, height: Math.round(h)};
-      }
-      // the same figure again (viser's new aspect, now overridden): Plotly would still take ≈ 0.1 s.
-      // Same: the same data and config objects, and a layout whose entries are the same objects
-      // or values (viser copies the parsed layout's entries; Plotly changes them in place).
-      const last = gd.__appLast, keys = Object.keys(layout);
-      if (last && last.data === data && last.config === rest[0] && last.keys.length === keys.length
-          && keys.every(k => last.layout[k] === layout[k])) return Promise.resolve(gd);
-      gd.__appLast = {data, config: rest[0], layout: {...layout}, keys};
-    }
-    return react.call(this, gd, data, layout, ...rest); }; })();
-"""
+#: Wraps ``Plotly.react`` (``assets/plotly_react.js``): a call with layout width 0 (a box not measured
+#: yet) draws nothing; a figure with ``layout.meta.fit_height = [chrome, least, most]`` is as tall
+#: as the window's height less ``chrome`` [px], within [least, most] × its width (the height
+#: :func:`app.ui.layout.layout_for_window` gives it with the server's aspect, known here on the first
+#: draw instead of after the window report); a call with the data, layout and config of the last
+#: one draws nothing; a static figure (a slider's) is drawn after the events already waiting, the
+#: slider's next move among them, so the server simulates the next figure while the browser draws.
+SIZED_JS = (Path(__file__).resolve().parent / "assets" / "plotly_react.js").read_text(encoding="utf-8")
 
 
 def bundle_version() -> str:
@@ -84,7 +66,7 @@ def use_basic_plotly(gui: viser.GuiApi) -> None:
     """
     if plotly_js_sent(gui):
         return
-    run_script(gui, bundle_source() + SIZED_JS)
+    run_script(gui, bundle_source() + "\n" + SIZED_JS)
     mark_plotly_js_sent(gui)
 
 
