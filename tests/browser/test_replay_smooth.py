@@ -67,6 +67,34 @@ def test_slowest_replay_glides_the_marker_and_the_cursor_in_the_page(page):
     _assert_smooth(samples, share=0.6, jumps=False)
 
 
+#: Presses ``label`` of the overview's replay and resolves, once per animation frame for ``ms``, with the
+#: "Replay t" slider as drawn: [thumb offset [%], number box, slider maximum [s]].
+FOLLOW_JS = """([label, ms]) => new Promise(resolve => {
+  const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
+  const name = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'Replay t [s]');
+  const row = name.closest('.mantine-Flex-root'), thumb = row.querySelector('[role="slider"]');
+  const box = row.querySelector('input.mantine-NumberInput-input');
+  window.Plotly.animate(el, ...el.layout.updatemenus[0].buttons.find(x => x.label === label).args).catch(() => {});
+  const out = []; const t0 = performance.now();
+  const f = () => { out.push([parseFloat(thumb.style.getPropertyValue('--slider-thumb-offset')), parseFloat(box.value),
+                              parseFloat(thumb.getAttribute('aria-valuemax'))]);
+    if (performance.now() - t0 < ms) requestAnimationFrame(f); else resolve(out); };
+  requestAnimationFrame(f); })"""
+
+
+def test_the_replay_t_slider_follows_the_replay(page):
+    """During the in-plot replay the "Replay t" slider is drawn at the replay's time, from 0 to the end."""
+    samples = page.evaluate(FOLLOW_JS, [f"▶ {list(SPEEDS)[0]}", 3000])  # 1×: the paper's run lasts ≈ 1.3 s
+    offsets = [o for o, _, _ in samples]
+    assert min(offsets) <= 10.0 and offsets[-1] == pytest.approx(100.0)  # start (1×: a key frame per 7.7 %) to end
+    inside = [(o, t, end) for o, t, end in samples if 5.0 < o < 95.0]
+    assert len(inside) >= 5  # seen on its way, not only at the ends
+    for o, t, end in inside:
+        assert t == pytest.approx(o / 100.0 * end, abs=2e-3)  # the number box says the same time
+    moving = offsets[offsets.index(min(offsets)):]
+    assert all(b >= a for a, b in zip(moving, moving[1:], strict=False))  # forward only
+
+
 @pytest.fixture(scope="module")
 def overview_json() -> str:
     return phase_plane_json(compare(load_preset(PAPER_PRESET)))

@@ -1,5 +1,6 @@
 // Installed once per page by app/ui/replay.py. Reads Plotly's internal el._fullData and el._transitioning
-// (no public equivalent: the trail's points as drawn, and whether a replay transition still runs).
+// (no public equivalent: the trail's points as drawn, and whether a replay transition still runs), and
+// draws the "Replay t" slider (app.ui.replay.Replay) at the replay's time.
 (() => { if (window.__appReplayButtons) return; window.__appReplayButtons = true;
   const stash = (el) => { if (el.__trailFor !== el.data) { el.__trailFor = el.data;
       el.__trail = (el._fullData || []).filter(d => d.meta && typeof d.meta.trail === 'number')
@@ -12,6 +13,21 @@
     window.Plotly.restyle(el, {x: s.map(r => r[1] <= t ? r[2] : r[2].slice(0, 1)),
                                y: s.map(r => r[1] <= t ? r[3] : r[3].slice(0, 1))},
                           s.map(r => r[0])).catch(() => {}); };
+  // the "Replay t" slider shows the replay's time: its thumb, bar and number box as drawn (viser's
+  // value is not changed: a change would go to the server as a scrub and stop the replay)
+  const follow = (frame) => { const text = frame && frame.data && frame.data[0] && frame.data[0].text;
+    const t = text ? parseFloat(String(text[0]).replace('t = ', '')) : NaN;
+    const label = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'Replay t [s]');
+    const row = label && label.closest('.mantine-Flex-root');
+    const thumb = row && row.querySelector('[role="slider"]');
+    if (!(thumb && isFinite(t))) return;
+    const end = parseFloat(thumb.getAttribute('aria-valuemax')), p = Math.min(100, Math.max(0, 100 * t / end));
+    thumb.style.setProperty('--slider-thumb-offset', `${p}%`);
+    const bar = row.querySelector('.mantine-Slider-bar');
+    if (bar) bar.style.setProperty('--slider-bar-width', `calc(${p}% + 2 * var(--slider-size))`);
+    const box = row.querySelector('input.mantine-NumberInput-input');
+    if (box && document.activeElement !== box) box.value = t.toFixed(3); };
+  window.__appFollowReplay = follow;
   setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
     if (!(el.layout && el.layout.meta && el.layout.meta.overview && el._fullData)) continue;
     stash(el);
@@ -20,4 +36,5 @@
     el.on('plotly_buttonclicked', (e) => { const b = e && e.button;
       if (b && b.method === 'animate' && b.execute === false && window.Plotly) {
         stash(el); window.Plotly.animate(el, ...b.args).catch(() => {}); } });
+    el.on('plotly_animatingframe', (e) => follow(e && e.frame));
   } }, 250); })();
