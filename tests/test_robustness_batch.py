@@ -48,7 +48,9 @@ def test_batch_gives_the_numbers_of_one_run_at_a_time(sensors):
     with ideal and with real sensors (encoder counts, current noise), on one and on two numba
     threads, across sub-batch boundaries (20 > BATCH = 16).
     """
-    params = load_preset(PRESET, ["controller.K=0.1", *sensors])  # above K_limit: some plants chatter
+    # K well below the nominal K_limit (0.107): the plants with the most load inertia limit-cycle at
+    # 11–20 Hz, the others do not
+    params = load_preset(PRESET, ["controller.K=0.03", *sensors])
     d = derive(params)
     rows = _rows(params, 20)
     one_by_one = [sample_metrics(params, plant_for(params, r), d) for r in rows]

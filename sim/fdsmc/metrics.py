@@ -11,7 +11,10 @@ Take the high-pass part r = α_dem − (moving average of α_dem over 5 ms). The
 r swings by more than 20 % of α_max peak-to-peak **and** r changes sign (with a hysteresis of
 2.5 % of α_max) at least 8 times, i.e. a sustained oscillation of the demanded acceleration with
 an amplitude comparable to the control range — the limit cycle of a too-high boundary-layer gain
-K or of a poorly damped sloped segment — not a single transient.
+K or of a poorly damped sloped segment — not a single transient. A slower limit cycle, which the
+5 ms average follows, chatters too: α_dem less its least-squares line changes sign (same
+hysteresis) at least 4 times and swings by more than 20 % of α_max over the window's second half
+(:mod:`sim.fdsmc.limit_cycle`).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from control.fdsmc.params import DriveParams
 from control.fdsmc.tracking import slide_gain, slide_time_constant
 from sim.common import signals
 from sim.common.energy import energy_balance
+from sim.fdsmc.limit_cycle import limit_cycles
 from sim.fdsmc.summary import KernelState, RunSummary
 
 #: Thresholds of the chatter criterion (fractions of α_max) and the smoothing window [s].
@@ -59,8 +63,9 @@ class ChatterVerdict:
     Attributes
     ----------
     chatter : bool              Whether the criterion is met.
-    ptp : float                 Peak-to-peak of the high-pass α_dem in the window [rad/s²].
-    sign_changes : int          Hysteretic sign changes of the high-pass α_dem [-].
+    ptp : float                 Peak-to-peak of the high-pass α_dem in the window [rad/s²] (of α_dem
+                                less its line for a slower limit cycle).
+    sign_changes : int          Hysteretic sign changes of the same signal [-].
     frequency_Hz : float        Estimated oscillation frequency sign_changes/(2·window) [Hz].
     omega_ptp : float           Peak-to-peak of ω_r in the window [rad/s].
     window : tuple of float     Evaluation window (t0, t1) [s].
@@ -105,8 +110,13 @@ def detect_chatter(
     dt = float(np.median(np.diff(ts)))
     r = a - moving_average(a, max(1, int(round(CHATTER_SMOOTHING_S / dt))))
     ptp = float(np.ptp(r))
-    changes = hysteretic_sign_changes(r, CHATTER_HYSTERESIS_FRACTION * alpha_max)
-    chatter = ptp > CHATTER_PTP_FRACTION * alpha_max and changes >= CHATTER_MIN_SIGN_CHANGES
+    hyst, ptp_min = CHATTER_HYSTERESIS_FRACTION * alpha_max, CHATTER_PTP_FRACTION * alpha_max
+    changes = hysteretic_sign_changes(r, hyst)
+    chatter = ptp > ptp_min and changes >= CHATTER_MIN_SIGN_CHANGES
+    if not chatter:  # a slower limit cycle, which the moving average follows
+        cycle, cycle_ptp, cycle_changes = limit_cycles(a[None, :], ts, hyst, ptp_min)
+        if cycle[0]:
+            chatter, ptp, changes = True, float(cycle_ptp[0]), int(cycle_changes[0])
     return ChatterVerdict(chatter, ptp, changes, changes / (2.0 * (t1 - t0)),
                           float(np.ptp(omega_r[sel])), window)
 

@@ -32,6 +32,7 @@ from sim.common import sensors, signals
 from sim.fdsmc import kernel as kn
 from sim.fdsmc.engine import CONTROLLERS, _observer_arrays, _reference, pack_parameters
 from sim.fdsmc.grid import CONTINUOUS_STEP_S, TimeGrid, load_steps, time_grid
+from sim.fdsmc.limit_cycle import limit_cycles
 from sim.fdsmc.metrics import (
     CHATTER_HYSTERESIS_FRACTION,
     CHATTER_MIN_SIGN_CHANGES,
@@ -123,8 +124,10 @@ def chatter_rows(t: np.ndarray, alpha_dem: np.ndarray, window: tuple[float, floa
     if np.count_nonzero(sel) < 8 or t1 <= t0:
         return np.zeros(alpha_dem.shape[0], dtype=bool)
     n = max(1, int(round(CHATTER_SMOOTHING_S / float(np.median(np.diff(t[sel]))))))
-    ptp, changes = chatter_stats(np.ascontiguousarray(alpha_dem[:, sel]), n, CHATTER_HYSTERESIS_FRACTION * alpha_max)
-    return (ptp > CHATTER_PTP_FRACTION * alpha_max) & (changes >= CHATTER_MIN_SIGN_CHANGES)
+    rows = np.ascontiguousarray(alpha_dem[:, sel])
+    hyst, ptp_min = CHATTER_HYSTERESIS_FRACTION * alpha_max, CHATTER_PTP_FRACTION * alpha_max
+    ptp, changes = chatter_stats(rows, n, hyst)
+    return ((ptp > ptp_min) & (changes >= CHATTER_MIN_SIGN_CHANGES)) | limit_cycles(rows, t[sel], hyst, ptp_min)[0]
 
 
 def _buffers(s: Setup, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
