@@ -45,8 +45,8 @@ def bundle_source() -> str:
 #: as the window's height less ``chrome`` [px], within [least, most] × its width (the height
 #: :func:`app.ui.layout.layout_for_window` gives it with the server's aspect, known here on the first
 #: draw instead of after the window report); a call with the data, layout and config of the last
-#: one draws nothing; a static figure (a slider's) is drawn after the events already waiting, the
-#: slider's next move among them, so the server simulates the next figure while the browser draws.
+#: one draws nothing; a static figure (a slider's) is drawn at the next animation frame, after the
+#: input waiting, and only the latest of those that arrived meanwhile.
 SIZED_JS = (Path(__file__).resolve().parent / "assets" / "plotly_react.js").read_text(encoding="utf-8")
 
 

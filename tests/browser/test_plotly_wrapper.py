@@ -61,7 +61,7 @@ def test_a_window_fitted_figure_is_as_tall_as_the_window_allows(bare):
 
 
 def test_a_sliders_figures_are_drawn_after_waiting_events_and_only_the_latest(bare):
-    """Static figures (a slider's) are drawn on a later task; one replaced before then is never drawn."""
+    """Static figures (a slider's) are drawn at the next animation frame; one replaced before then is never drawn."""
     _react(bare, "{...window.layout, width: 600, height: 300}")
     bare.evaluate(COUNT)
     drawn = bare.evaluate("""() => { const seen = [];
@@ -70,5 +70,5 @@ def test_a_sliders_figures_are_drawn_after_waiting_events_and_only_the_latest(ba
       seen.push(window.gd.data[0].name);  // not drawn yet: the events waiting go first
       Plotly.react(window.gd, [{...window.data[0], name: 'new'}], {...window.layout, width: 600, height: 300},
                    {staticPlot: true});
-      return new Promise(r => setTimeout(() => r([...seen, window.gd.data[0].name, window.draws]), 50)); }""")
+      return new Promise(r => setTimeout(() => r([...seen, window.gd.data[0].name, window.draws]), 200)); }""")
     assert drawn == ["a", "new", 1]

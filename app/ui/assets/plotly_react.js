@@ -23,10 +23,11 @@
     layout = fitted(layout);
     if (same(gd, data, layout, rest[0])) return Promise.resolve(gd);  // Plotly would still take ≈ 0.1 s
     gd.__appLast = {data, config: rest[0], layout: {...layout}, keys: Object.keys(layout)};
-    clearTimeout(gd.__appDeferred);  // a newer figure replaces one not drawn yet
+    cancelAnimationFrame(gd.__appDeferred);  // a newer figure replaces one not drawn yet
     if (rest[0] && rest[0].staticPlot) {
-      // a slider's figure: drawn after the events already waiting (the slider's next move goes to
-      // the server first, which then simulates while this one is drawn)
-      return new Promise(done => { gd.__appDeferred = setTimeout(() => done(react.call(P, gd, data, layout, ...rest)), 0); });
+      // a slider's figure: drawn at the next frame (after the input the browser delivers first), and
+      // only the latest of those that arrived meanwhile
+      return new Promise(done => {
+        gd.__appDeferred = requestAnimationFrame(() => done(react.call(P, gd, data, layout, ...rest))); });
     }
     return react.call(this, gd, data, layout, ...rest); }; })();
