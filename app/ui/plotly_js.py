@@ -45,8 +45,9 @@ def bundle_source() -> str:
 #: as the window's height less ``chrome`` [px], within [least, most] × its width (the height
 #: :func:`app.ui.layout.layout_for_window` gives it with the server's aspect, known here on the first
 #: draw instead of after the window report); a call with the data, layout and config of the last
-#: one draws nothing; a static figure (a slider's) is drawn at the next animation frame, after the
-#: input waiting, and only the latest of those that arrived meanwhile.
+#: one draws nothing; a figure waits until the last one drawn is painted (the light overview is
+#: seen before the one with its replay) and a static one (a slider's) for the next animation
+#: frame; of the figures waiting only the latest is drawn.
 SIZED_JS = (Path(__file__).resolve().parent / "assets" / "plotly_react.js").read_text(encoding="utf-8")
 
 

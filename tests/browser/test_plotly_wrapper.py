@@ -72,3 +72,16 @@ def test_a_sliders_figures_are_drawn_after_waiting_events_and_only_the_latest(ba
                    {staticPlot: true});
       return new Promise(r => setTimeout(() => r([...seen, window.gd.data[0].name, window.draws]), 200)); }""")
     assert drawn == ["a", "new", 1]
+
+
+def test_a_figure_waits_until_the_last_one_is_painted(bare):
+    """The light overview is seen before the one with its replay: the second figure is drawn a frame later."""
+    order = bare.evaluate("""() => { const seen = [];
+      const fig = (name) => [{...window.data[0], name}];
+      const layout = {...window.layout, width: 600, height: 300};
+      Plotly.react(window.gd, fig('light'), layout, window.config);
+      seen.push(window.gd.data[0].name);  // drawn at once
+      Plotly.react(window.gd, fig('whole'), layout, window.config);
+      seen.push(window.gd.data[0].name);  // waits for the paint of the light one
+      return new Promise(r => setTimeout(() => r([...seen, window.gd.data[0].name]), 200)); }""")
+    assert order == ["light", "light", "whole"]

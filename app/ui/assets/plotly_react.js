@@ -17,17 +17,30 @@
     return !!last && last.data === data && last.config === config && last.keys.length === keys.length
       && keys.every(k => last.layout[k] === layout[k]);
   };
+  // Draw now; once the browser has painted it (the task after the next frame), the figure waiting, if any.
+  const draw = (gd, args) => {
+    gd.__appPainted = false;
+    requestAnimationFrame(() => setTimeout(() => {
+      gd.__appPainted = true; const next = gd.__appNext; gd.__appNext = null; if (next) next(); }, 0));
+    return react.apply(P, args);
+  };
   P.react = function (gd, data, layout, ...rest) {
     if (!(layout && typeof layout === 'object')) return react.call(this, gd, data, layout, ...rest);
     if (layout.width === 0) return Promise.resolve(gd);  // a box not measured yet (or hidden)
     layout = fitted(layout);
     if (same(gd, data, layout, rest[0])) return Promise.resolve(gd);  // Plotly would still take ≈ 0.1 s
     gd.__appLast = {data, config: rest[0], layout: {...layout}, keys: Object.keys(layout)};
-    cancelAnimationFrame(gd.__appDeferred);  // a newer figure replaces one not drawn yet
-    if (rest[0] && rest[0].staticPlot) {
-      // a slider's figure: drawn at the next frame (after the input the browser delivers first), and
-      // only the latest of those that arrived meanwhile
-      return new Promise(done => {
-        gd.__appDeferred = requestAnimationFrame(() => done(react.call(P, gd, data, layout, ...rest))); });
-    }
-    return react.call(this, gd, data, layout, ...rest); }; })();
+    const args = [gd, data, layout, ...rest];
+    // A figure waits while the last one is not painted yet (each figure drawn is seen: the light
+    // overview before the one with its replay), and a slider's for the next frame, after the input
+    // waiting; of the figures waiting only the latest is drawn.
+    const waits = gd.__appPainted === false || !!(rest[0] && rest[0].staticPlot);
+    if (!waits) { gd.__appNext = null; return draw(gd, args); }
+    return new Promise(done => {
+      const run = () => done(draw(gd, args));
+      gd.__appNext = run;
+      if (gd.__appPainted !== false) {
+        requestAnimationFrame(() => { if (gd.__appNext === run) { gd.__appNext = null; run(); } });
+      }
+    });
+  }; })();
