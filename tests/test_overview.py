@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -9,7 +10,7 @@ import pytest
 
 from app.figures.fdsmc_overview import CURSORS, motor_torque, overview_spec
 from app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
-from app.ui.replay import overview_json, phase_plane_json
+from app.ui.replay import overview_json, phase_plane_json, prebuild_figures, time_plots_json
 from sim.fdsmc.engine import Comparison, compare
 
 
@@ -120,3 +121,13 @@ def test_the_overview_tells_the_page_how_to_fit_its_height(comparison):
     for replay in (True, False):
         meta = json.loads(overview_json(comparison, replay)[0])["layout"]["meta"]
         assert meta["fit_height"] == [CHROME_HEIGHT, ASPECT_MIN, ASPECT_MAX]
+
+
+def test_the_start_up_figures_are_built_once_and_a_new_comparison_builds_its_own(comparison):
+    """Every new page shows the start-up comparison: its figures come from the build at server start."""
+    prebuild_figures(comparison)
+    first = overview_json(comparison)
+    assert overview_json(comparison) is first and time_plots_json(comparison) is time_plots_json(comparison)
+    other = dataclasses.replace(comparison)  # equal, but another result object: built again
+    again = overview_json(other)
+    assert again is not first and again[0] == first[0]

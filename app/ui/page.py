@@ -29,6 +29,7 @@ from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, page
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
 from app.ui.position_tab import PositionTab, comparison_or_derived
+from app.ui.replay import prebuild_figures
 from app.ui.results import ResultsPanel, empty_table1_json
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import StudiesSection
@@ -239,7 +240,8 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     if not environment_map:  # the HDRI stalls software WebGL for seconds
         server.scene.configure_environment_map(hdri=None)
     config = AppConfig(params, origin, scene_3d, guard=guard)
-    config.initial()  # the first page must not wait for the kernels' first load and the start-up run
+    # the first page must not wait for the kernels' first load, the start-up run or its figures
+    prebuild_figures(config.initial())
     empty_table1_json()
     warm_icons()
     warm_bldc()

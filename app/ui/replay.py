@@ -141,6 +141,12 @@ def scrub_js(comparison: Any, targets: ScrubTargets, t: float) -> str:
                            indices=json.dumps(indices), t=json.dumps(float(t)))
 
 
+def prebuild_figures(comparison: Any) -> None:
+    """Build the figures every new page gets for ``comparison`` (the start-up one) now, at server start."""
+    overview_json(comparison)
+    time_plots_json(comparison)
+
+
 def time_plots_json(comparison: Any) -> str:
     """JSON of the time plots."""
     return _last_or_build("time plots", comparison, lambda: figure_json(time_plots_spec(comparison)))
