@@ -10,7 +10,7 @@ from plotly.offline.offline import get_plotlyjs_version
 from app.figures.fdsmc_comparison import time_plots_spec
 from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.figures.fdsmc_overview import overview_spec
-from app.ui.plotly_js import BUNDLE, SIZED_JS, TRACE_TYPES, bundle_source, bundle_version, use_basic_plotly
+from app.ui.plotly_js import BUNDLE, REACT_JS, TRACE_TYPES, bundle_source, bundle_version, use_basic_plotly
 from sim.fdsmc.engine import compare
 
 APP = Path(__file__).resolve().parents[1] / "app"
@@ -59,5 +59,5 @@ def test_use_basic_plotly_sends_the_bundle_once_and_stops_viser_sending_the_full
     use_basic_plotly(gui)
     use_basic_plotly(gui)
     assert len(gui._websock_interface.messages) == 1
-    assert gui._websock_interface.messages[0].source == bundle_source() + "\n" + SIZED_JS  # with its wrapper
+    assert gui._websock_interface.messages[0].source == bundle_source() + "\n" + REACT_JS  # with its wrapper
     assert gui._setup_plotly_js is True  # viser's own flag: add_plotly then sends no plotly.min.js

@@ -10,7 +10,7 @@ of the same version as the plotly.js inside the installed plotly package (MIT li
 
 Call :func:`use_basic_plotly` once per client, before its first ``gui.add_plotly``.
 
-With the bundle goes :data:`SIZED_JS`: viser's plot widget calls ``Plotly.react`` once before its
+With the bundle goes :data:`REACT_JS`: viser's plot widget calls ``Plotly.react`` once before its
 box is measured (layout width 0) and again for every prop change until it is; Plotly lays such a
 figure out at its default 700×450 px, all for nothing. On page open that was two whole draws of
 the overview (≈ 0.7 s, cold) before the one at the real width; a plot in a hidden tab (width 0)
@@ -48,7 +48,7 @@ def bundle_source() -> str:
 #: one draws nothing; a figure waits until the last one drawn is painted (the light overview is
 #: seen before the one with its replay) and a static one (a slider's) for the next animation
 #: frame; of the figures waiting only the latest is drawn.
-SIZED_JS = (Path(__file__).resolve().parent / "assets" / "plotly_react.js").read_text(encoding="utf-8")
+REACT_JS = (Path(__file__).resolve().parent / "assets" / "plotly_react.js").read_text(encoding="utf-8")
 
 
 def bundle_version() -> str:
@@ -67,8 +67,8 @@ def use_basic_plotly(gui: viser.GuiApi) -> None:
     """
     if plotly_js_sent(gui):
         return
-    run_script(gui, bundle_source() + "\n" + SIZED_JS)
+    run_script(gui, bundle_source() + "\n" + REACT_JS)
     mark_plotly_js_sent(gui)
 
 
-__all__ = ["BUNDLE", "SIZED_JS", "TRACE_TYPES", "bundle_source", "bundle_version", "use_basic_plotly"]
+__all__ = ["BUNDLE", "REACT_JS", "TRACE_TYPES", "bundle_source", "bundle_version", "use_basic_plotly"]

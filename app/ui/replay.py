@@ -59,7 +59,7 @@ def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = 
     both come back when the drag stops (``static`` False: the same light figure with Plotly's
     default config, drawn first after a Simulate; a change of config makes Plotly draw the next
     figure from scratch, at twice the cost). The page fits the figure's height to the window
-    (``layout.meta.fit_height``, :data:`app.ui.plotly_js.SIZED_JS`).
+    (``layout.meta.fit_height``, :data:`app.ui.plotly_js.REACT_JS`).
     """
     if pins:
         return _overview_json(comparison, replay, pins, static)
@@ -90,7 +90,7 @@ def _drag_figure(spec: dict[str, Any], config: dict[str, Any]) -> dict[str, Any]
     instead of the replay's trail: Plotly's cost per redraw grows with the number of traces
     (148 → 22 traces: 60 → 31 ms in headless Chromium), so the trail pieces (empty until a
     replay runs), the "now" markers and the time cursors (at the end of the run, where a replay
-    leaves them) are left out, and the empty text layers of the markers.
+    leaves them) are left out.
     """
     data = [_drag_trace(tr) for tr in spec["data"] if not _replay_only(tr)]
     return {**spec, "data": data, "config": config}
@@ -104,12 +104,8 @@ def _replay_only(tr: dict[str, Any]) -> bool:
 
 
 def _drag_trace(tr: dict[str, Any]) -> dict[str, Any]:
-    """One trace of the drag figure (see :func:`_drag_figure`)."""
-    if str(tr.get("name", "")).endswith(" trajectory"):
-        return {**tr, "opacity": 1.0}
-    if tr.get("mode") == "markers+text" and not any(tr.get("text", [])):
-        return {**tr, "mode": "markers"}
-    return tr
+    """One trace of the drag figure (see :func:`_drag_figure`): the trajectories drawn whole."""
+    return {**tr, "opacity": 1.0} if str(tr.get("name", "")).endswith(" trajectory") else tr
 
 
 def phase_plane_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = ()) -> str:

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 
 from app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
-from app.ui.plotly_js import SIZED_JS, bundle_source
+from app.ui.plotly_js import REACT_JS, bundle_source
 
 #: A plot, its data, layout and config as viser holds them (parsed once per figure).
 SETUP = """() => { window.draws = 0; window.gd = document.getElementById('p');
@@ -29,7 +29,7 @@ def bare(browser: Any) -> Iterator[Any]:
     context = browser.new_context(viewport={"width": 1000, "height": 700})
     page = context.new_page()
     page.set_content("<div id='p'></div>")
-    page.add_script_tag(content=bundle_source() + "\n" + SIZED_JS)
+    page.add_script_tag(content=bundle_source() + "\n" + REACT_JS)
     page.evaluate(SETUP)
     yield page
     context.close()

@@ -27,7 +27,6 @@
     if (bar) bar.style.setProperty('--slider-bar-width', `calc(${p}% + 2 * var(--slider-size))`);
     const box = row.querySelector('input.mantine-NumberInput-input');
     if (box && document.activeElement !== box) box.value = t.toFixed(3); };
-  window.__appFollowReplay = follow;
   setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
     if (!(el.layout && el.layout.meta && el.layout.meta.overview && el._fullData)) continue;
     stash(el);
