@@ -16,6 +16,7 @@ import pytest
 from app.io.preset_modes import load_mode_preset
 from control.fdsmc.derivations import derive
 from sim.fdsmc.engine import simulate
+from sim.fdsmc.limit_cycle import limit_cycle_stats
 from sim.fdsmc.metrics import CHATTER_SMOOTHING_S, detect_chatter, moving_average
 from sim.studies.batch import chatter_rows, chatter_stats
 
@@ -73,3 +74,12 @@ def test_a_model_inertia_typed_ten_times_too_small_is_no_longer_called_clean():
     m = simulate(q, "fdsmc", derive(q)).metrics
     assert m.chatter and 5.0 < m.chatter_frequency_Hz < 40.0
     assert m.cruise_omega_ptp_rad_s > 10.0  # ω_r itself swings by tens of rad/s
+
+
+def test_compiled_and_plain_python_statistics_agree_exactly():
+    rows = np.vstack(list(_signals().values()))
+    compiled = limit_cycle_stats(rows, T, 0.025 * ALPHA_MAX)
+    plain = limit_cycle_stats.py_func(rows, T, 0.025 * ALPHA_MAX)  # the same source, not compiled
+    for c, p in zip(compiled, plain, strict=True):
+        assert c.tolist() == p.tolist()
+    assert compiled[2].tolist()[0] >= 4 and compiled[2].tolist()[1] == 0  # the cycle's sign changes, the ramp's

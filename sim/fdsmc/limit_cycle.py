@@ -52,25 +52,32 @@ def limit_cycle_stats(a: np.ndarray, t: np.ndarray, hyst: float) -> tuple[np.nda
         s_tt += (t[k] - t_mean) ** 2
     ptp, late, changes = np.zeros(rows), np.zeros(rows), np.zeros(rows, dtype=np.int64)
     for i in range(rows):
-        a_mean, s_ta = 0.0, 0.0
-        for k in range(m):
-            a_mean += a[i, k]
-        a_mean /= m
-        for k in range(m):
-            s_ta += (t[k] - t_mean) * (a[i, k] - a_mean)
-        slope = s_ta / s_tt if s_tt > 0.0 else 0.0
-        lo, hi, lo2, hi2, last, count = np.inf, -np.inf, np.inf, -np.inf, 0.0, 0
-        for k in range(m):
-            r = a[i, k] - a_mean - slope * (t[k] - t_mean)
-            lo, hi = min(lo, r), max(hi, r)
-            if 2 * k >= m:
-                lo2, hi2 = min(lo2, r), max(hi2, r)
-            if abs(r) > hyst:
-                s = np.sign(r)
-                count += 1 if last != 0.0 and s != last else 0
-                last = s
-        ptp[i], late[i], changes[i] = hi - lo, hi2 - lo2, count
+        ptp[i], late[i], changes[i] = _row_stats(a[i], t, t_mean, s_tt, hyst)
     return ptp, late, changes
+
+
+@njit(cache=True, nogil=True)
+def _row_stats(a: np.ndarray, t: np.ndarray, t_mean: float, s_tt: float, hyst: float) -> tuple[float, float, int]:
+    """One row of :func:`limit_cycle_stats` (``t_mean`` [s], ``s_tt`` [s²]: the times' mean and spread)."""
+    m = a.shape[0]
+    a_mean, s_ta = 0.0, 0.0
+    for k in range(m):
+        a_mean += a[k]
+    a_mean /= m
+    for k in range(m):
+        s_ta += (t[k] - t_mean) * (a[k] - a_mean)
+    slope = s_ta / s_tt if s_tt > 0.0 else 0.0
+    lo, hi, lo2, hi2, last, count = np.inf, -np.inf, np.inf, -np.inf, 0.0, 0
+    for k in range(m):
+        r = a[k] - a_mean - slope * (t[k] - t_mean)
+        lo, hi = min(lo, r), max(hi, r)
+        if 2 * k >= m:
+            lo2, hi2 = min(lo2, r), max(hi2, r)
+        if abs(r) > hyst:
+            s = np.sign(r)
+            count += 1 if last != 0.0 and s != last else 0
+            last = s
+    return hi - lo, hi2 - lo2, count
 
 
 def limit_cycles(a: np.ndarray, t: np.ndarray, hyst: float,
