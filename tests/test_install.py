@@ -107,3 +107,18 @@ def test_console_entry_point_designs_a_shipped_preset(installed: dict[str, Path]
     clone = _run([sys.executable, "-m", "app", "design", "yaskawa_sgm7j_04a", "--json"], cwd=ROOT)
     assert clone.returncode == 0, clone.stderr
     assert r.stdout == clone.stdout  # the installed package designs exactly as the clone
+
+
+def test_the_installed_package_writes_the_c_controller_and_has_the_pages_scripts(installed: dict[str, Path],
+                                                                                 tmp_path: Path) -> None:
+    """The C texts (app/exports/c) and the page's scripts (app/ui/assets) are package data of the wheel."""
+    out = tmp_path / "c"
+    r = _run([str(installed["script"]), "export", "yaskawa_sgm7j_04a", "--format", "c", "-o", str(out)],
+             cwd=installed["cwd"], env=_env(installed))
+    assert r.returncode == 0, r.stderr
+    assert "fdsmc_step" in (out / "fdsmc_controller.c").read_text(encoding="utf-8")
+    code = "import app.ui.plotly_js as p, app.ui.replay as r; print(len(p.bundle_source()), len(r.BUTTONS_JS))"
+    r = _run([str(installed["python"]), "-c", code], cwd=installed["cwd"], env=_env(installed))
+    assert r.returncode == 0, r.stderr
+    assert all(int(n) > 100 for n in r.stdout.split())
+
