@@ -75,3 +75,17 @@ def test_simulate_cli_reports_the_omitted_optimum_without_a_traceback(monkeypatc
     out = json.loads(capsys.readouterr().out)
     assert "optimum" not in out and "saving_vs_optimum_pct" not in out["fdsmc"]
     assert any(n.startswith("Optimum omitted:") for n in out["comparator_notes"])
+
+
+def test_duty_cycle_omits_a_failed_optimum_with_a_note(monkeypatch, tmp_path, capsys):
+    _failing(monkeypatch, {"CLARABEL", "SCS"})
+    name, overrides = VOLTAGE_LIMITED
+    mv = load_preset(name, overrides).manoeuvre  # the move whose optimum is the numerical (voltage-limited) one
+    cycle = tmp_path / "cycle.yaml"
+    cycle.write_text(f"- {{theta_dem: {mv.theta_dem!r}, T_m: {mv.T_m!r}, dwell: 0.1}}\n", encoding="utf-8")
+    assert main(["dutycycle", name, str(cycle), "--set", overrides[0], "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["cycle_J"]) == {"fdsmc", "conventional"} and out["runs"]["fdsmc"]["stable"]
+    assert len(out["notes"]) == 1 and out["notes"][0].startswith("Optimum omitted:") and "\n" not in out["notes"][0]
+    assert main(["dutycycle", name, str(cycle), "--set", overrides[0]]) == 0
+    assert "Optimum omitted:" in capsys.readouterr().out  # the text output says so too

@@ -83,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
            "runs": {c: {"stable": r.stable, "electrical_in_J": r.electrical_in_J, "copper_J": r.copper_J,
                         "friction_J": r.friction_J, "load_work_J": r.load_work_J,
                         "stored_end_J": r.stored_end_J, "balance_residual_J": r.balance_residual_J,
-                        "theta_error_end_rad": r.theta_error_end_rad} for c, r in res.runs.items()}}
+                        "theta_error_end_rad": r.theta_error_end_rad} for c, r in res.runs.items()},
+           "notes": list(res.notes)}
     if args.json:
         print(json.dumps(to_json(out), indent=2, ensure_ascii=False))
         return 0
@@ -92,4 +93,6 @@ def run(args: argparse.Namespace) -> int:
         y = year[c]
         print(f"  {c:13s} {w if w is not None else float('nan'):10.4g} J per cycle"
               + (f", {y[0]:.4g} kWh and {y[1]:.4g} per year" if y else ""))
+    for note in res.notes:
+        print(f"  {note}")
     return 0

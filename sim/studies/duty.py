@@ -23,6 +23,7 @@ import numpy as np
 
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
+from control.fdsmc.optimum import OptimumSolverError
 from control.fdsmc.params import DriveParams
 from sim.common import sensors
 from sim.common.economics import J_PER_KWH, cost_per_year, kwh_per_year  # noqa: F401 - J_PER_KWH re-exported
@@ -83,13 +84,15 @@ class DutyResult:
     """A duty cycle's energies.
 
     Energy per cycle [J] per comparator (None if its run diverged), the cycle time [s], the
-    per-move energies ``moves[i][comparator]`` [J] and each comparator's run.
+    per-move energies ``moves[i][comparator]`` [J], each comparator's run and ``notes`` (one line
+    each: a comparator left out, e.g. an optimum no solver could find).
     """
 
     cycle_J: dict[str, float | None]
     cycle_s: float
     moves: tuple[dict[str, float | None], ...]
     runs: dict[str, CycleRun]
+    notes: tuple[str, ...] = ()
 
     def per_year(self, cycles_per_hour: float, hours_per_year: float, price_per_kWh: float
                  ) -> dict[str, tuple[float, float] | None]:
@@ -197,8 +200,14 @@ def duty_cycle(params: DriveParams, moves: Sequence[Move]) -> DutyResult:
         For an empty cycle, a negative dwell or an infeasible move (naming the move), or a
         cycle beyond the step budget.
     """
-    runs = {c: cycle_run(params, moves, c) for c in COMPARATORS}
+    runs: dict[str, CycleRun] = {}
+    notes: list[str] = []
+    for c in COMPARATORS:
+        try:
+            runs[c] = cycle_run(params, moves, c)
+        except OptimumSolverError as exc:  # the optimum is a yardstick: left out with a note, never a stop
+            notes.append(f"Optimum omitted: {exc}")
     per_move = tuple({c: (r.moves_J[i] if r.moves_J is not None else None) for c, r in runs.items()}
                      for i in range(len(moves)))
     total = {c: r.electrical_in_J for c, r in runs.items()}
-    return DutyResult(total, float(sum(m.T_m + m.dwell for m in moves)), per_move, runs)
+    return DutyResult(total, float(sum(m.T_m + m.dwell for m in moves)), per_move, runs, tuple(notes))
