@@ -124,8 +124,8 @@ def test_no_css_of_the_page_selects_with_has():
 
 
 def test_page_marks_script_quotes_the_field_id():
-    js = page_marks_js('a"b')
-    assert f"const probe = {json.dumps('a' + chr(34) + 'b')};" in js
+    js = page_marks_js(['a"b', "c"])
+    assert f"const hiddenFields = {json.dumps(['a' + chr(34) + 'b', 'c'])};" in js
     for mark in ("data-app-bldc", "data-app-rail-", "data-app-fit", "data-app-column", "data-app-overview-window",
                  "data-app-hidden"):
         assert mark in js and mark in page_css()

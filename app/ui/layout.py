@@ -19,7 +19,7 @@ from __future__ import annotations
 import json
 import re
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -113,7 +113,7 @@ def page_css(show_3d: bool = False) -> str:
         f"width: calc(var(--fit-right) - {gutters:g}px) !important}}")
 
 
-def page_marks_js(probe_uuid: str) -> str:
+def page_marks_js(hidden_fields: Sequence[str]) -> str:
     """Return the page script that marks the elements :func:`page_css` styles (installed once per page).
 
     After every change of the page outside the plots (a mutation observer, before the next frame
@@ -122,10 +122,11 @@ def page_marks_js(probe_uuid: str) -> str:
     while that docked region is folded to its rail, ``data-app-fit`` on the shadow before each
     docked region, ``data-app-column`` on the parent of each dock column,
     ``data-app-overview-window`` on the floating window holding the "Overview" tab, and
-    ``data-app-hidden`` on the row of the window-size field ``probe_uuid``.
+    ``data-app-hidden`` on the row of each text field of ``hidden_fields`` (their uuids: the fields
+    the page's scripts report into).
     """
     return (Path(__file__).resolve().parent / "assets" / "page_marks.js").read_text(encoding="utf-8").replace(
-        "PROBE_UUID", json.dumps(probe_uuid))
+        "HIDDEN_FIELDS", json.dumps(list(hidden_fields)))
 
 
 def install_css_js(css: str, style_id: str = "app-page-style") -> str:

@@ -94,7 +94,6 @@ class Session:
             gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
             self._window_probe = gui.add_text("window [px]", "")
             self._install_page_css(show_3d=False)
-            run_script(gui, page_marks_js(widget_id(self._window_probe)))
             use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
             gui.main_panel.dock_left()
             tabs = gui.add_tab_group()
@@ -109,7 +108,8 @@ class Session:
             with self.results.panel.add_tab("Share", viser.Icon.SHARE):
                 self.export = FigureExport(gui, self._figure_handles)
             self.fit = WindowFit(self._apply_layout)
-            self.tab.demo_files.probe = PageViewProbe(gui)  # outside the mode tabs: in the page whichever is shown
+            self.tab.demo_files.probe = probe = PageViewProbe(gui)  # outside the mode tabs: in every mode
+            run_script(gui, page_marks_js((widget_id(self._window_probe), widget_id(probe.field))))
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))

@@ -1,7 +1,7 @@
 // Installed once per page by app/ui/layout.py (page_marks_js): marks the elements the page's CSS
 // styles, instead of CSS :has() rules (with one in the page every forced layout re-styled it all).
 (() => { if (window.__appPageMarks) return; window.__appPageMarks = true;
-  const probe = PROBE_UUID;
+  const hiddenFields = HIDDEN_FIELDS;  // text fields the page's scripts write into
   const root = document.documentElement;
   const flag = (el, name, on) => { if (el.hasAttribute(name) !== on) el.toggleAttribute(name, on); };
   const only = (name, want) => {  // the attribute `name` on exactly the elements of `want` (value: want's map)
@@ -22,9 +22,11 @@
     for (const w of document.querySelectorAll('[data-floating-window]')) {
       if (w.querySelector('[role="tab"][title="Overview"]')) windows.set(w, '');
     }
-    const label = document.querySelector(`label[for="${probe}"]`);
-    const row = label && label.closest('.mantine-Flex-root');
-    if (row && row.parentElement && row.parentElement.tagName === 'DIV') hidden.set(row.parentElement, '');
+    for (const uuid of hiddenFields) {
+      const label = document.querySelector(`label[for="${uuid}"]`);
+      const row = label && label.closest('.mantine-Flex-root');
+      if (row && row.parentElement && row.parentElement.tagName === 'DIV') hidden.set(row.parentElement, '');
+    }
     only('data-app-fit', fit); only('data-app-column', columns);
     only('data-app-overview-window', windows); only('data-app-hidden', hidden);
   };

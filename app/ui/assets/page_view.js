@@ -42,7 +42,6 @@
       return;
     }
     frame = 0;
-    if (flex.parentElement.style.display !== 'none') flex.parentElement.style.display = 'none';  // the field's row
     const el = overview();
     if (el) hook(el);
     const view = JSON.stringify({tab: {mode: selected(modeTabs), results: selected(resultsTabs)},
