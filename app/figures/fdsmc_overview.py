@@ -104,7 +104,8 @@ def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> di
     axes["yaxis4"] = {"overlaying": "y3", "side": "right", "anchor": "x3", "range": ranges[2], "showgrid": False,
                       "zeroline": False, "ticklabelposition": "inside", "tickfont": {"color": LOAD_STEP_COLOUR},
                       "nticks": 4}  # no title: the row's note names it (a title at the edge hid the ticks)
-    notes = [{"text": f"motor Γ; load Γ_L dotted, own scale right (red) [N·m]; ±Γ_max = {g_max:.4g} N·m dashed",
+    # two short lines: one did not fit the column's width at 1280×720 (its end was cut off)
+    notes = [{"text": f"motor Γ [N·m]; ±Γ_max = {g_max:.4g} dashed<br>load Γ_L dotted, scale right (red)",
               "x": TIME_X[0],
               "y": ROW_Y[1][1], "xref": "paper", "yref": "paper", "xanchor": "left", "yanchor": "bottom",
               "showarrow": False, "font": {"size": FONT_PX, "color": "#555"}}]
