@@ -17,7 +17,10 @@
       if (shadow && shadow.tagName === 'DIV' && shadow.parentElement.hasAttribute('data-dock-root')) fit.set(shadow, side);
     }
     for (const col of document.querySelectorAll('[data-dock-region] [data-dock-column]')) {
-      const up = col.parentElement; if (up && up.tagName === 'DIV' && up.closest('[data-dock-region]')) columns.set(up, '');
+      const up = col.parentElement;  // a div inside a docked region, not the region itself
+      if (up && up.tagName === 'DIV' && up.parentElement && up.parentElement.closest('[data-dock-region]')) {
+        columns.set(up, '');
+      }
     }
     for (const w of document.querySelectorAll('[data-floating-window]')) {
       if (w.querySelector('[role="tab"][title="Overview"]')) windows.set(w, '');
