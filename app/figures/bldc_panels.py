@@ -17,7 +17,8 @@ from plotly.subplots import make_subplots
 
 from app.figures.bldc_speed_smc import finish_layout, xy
 from app.figures.decimate import BINS_OVERVIEW_ROWS, f32, time_axis
-from app.figures.style import BLDC_COLOURS, BLDC_DASHES, REFERENCE_COLOUR, fmt
+from app.figures.style import REFERENCE_COLOUR, fmt
+from app.figures.style import line as style_line
 from app.io.units import rad_s_to_rpm
 from sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
 
@@ -45,7 +46,7 @@ def _window(t: np.ndarray, t0: float, t1: float) -> slice:
 
 def _torque_cell(fig: go.Figure, run: BldcRunResult, row: int, col: int, part: slice | None) -> None:
     tr, c = run.trace, run.controller
-    line = {"color": BLDC_COLOURS[c], "dash": BLDC_DASHES[c], "width": 1.8}
+    line = style_line(c, 1.8)
     first = row == 1 and col == 1
     if part is None:  # the whole run: one point per pixel; the zoomed window: every sample
         t_el, t_ref = xy(tr.t, tr.T_EL, BINS_OVERVIEW_ROWS), xy(tr.t, tr.T_ref, BINS_OVERVIEW_ROWS)
@@ -91,7 +92,7 @@ def make_antiwindup_figure(with_aw: BldcRunResult, without_aw: BldcRunResult, ep
                         horizontal_spacing=0.05, row_heights=[0.55, 0.45], subplot_titles=titles)
     for col, (run, key) in enumerate(((with_aw, "smc_integral"), (without_aw, "smc_plain")), start=1):
         tr = run.trace
-        line = {"color": BLDC_COLOURS[key], "dash": BLDC_DASHES[key], "width": 1.8}
+        line = style_line(key, 1.8)
         name = titles[col - 1]
         fig.add_scatter(**xy(tr.t, rad_s_to_rpm(tr.omega_ref)), name="ω*", line=_REF, showlegend=col == 1,
                         legendgroup="ref", row=1, col=col)

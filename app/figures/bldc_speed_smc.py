@@ -18,13 +18,13 @@ from app.figures.decimate import BINS_TIME_PLOTS, envelope, f32
 from app.figures.plain import slim_template
 from app.figures.style import (
     BLDC_COLOURS,
-    BLDC_DASHES,
     PHASE_COLOURS,
     PHASE_DASHES,
     REFERENCE_COLOUR,
     TITLE_PX,
     WARNING_COLOUR,
 )
+from app.figures.style import line as style_line
 from app.io.units import rad_s_to_rpm
 from control.bldc.design import BldcDesign
 from control.bldc.dqx import dqx_coefficients, ideal_coefficients
@@ -49,10 +49,6 @@ def xy(t: np.ndarray, y: np.ndarray, n_bins: int = BINS_TIME_PLOTS) -> dict[str,
     """Trace keys of ``y(t)``: its min/max envelope on about one point per pixel, float32 (chatter stays a band)."""
     axis, values = envelope(t, y, n_bins)
     return {**axis, "y": f32(values)}
-
-
-def _line(controller: str, width: float = 1.8) -> dict[str, object]:
-    return {"color": BLDC_COLOURS[controller], "dash": BLDC_DASHES[controller], "width": width}
 
 
 def make_emf_figure(table: np.ndarray, Phi_m: float) -> go.Figure:
@@ -93,7 +89,7 @@ def make_speed_figure(comp: BldcComparison) -> go.Figure:
     for r in comp.runs:
         tr = r.trace
         fig.add_scatter(**xy(tr.t, rad_s_to_rpm(tr.omega)), name=LABELS[r.controller],
-                        line=_line(r.controller), row=1, col=1)
+                        line=style_line(r.controller, 1.8), row=1, col=1)
     fig.add_scatter(**xy(tr0.t, tr0.T_L), name="T_L", line={"color": REFERENCE_COLOUR, "shape": "hv"},
                     row=2, col=1)
     fig.update_yaxes(title="n [rpm]", row=1, col=1)
@@ -107,7 +103,7 @@ def make_sigma_figure(comp: BldcComparison) -> go.Figure:
     fig = go.Figure()
     for r in comp.runs:
         tr = r.trace
-        fig.add_scatter(**xy(tr.t, tr.sigma), name=r.controller, line=_line(r.controller))
+        fig.add_scatter(**xy(tr.t, tr.sigma), name=r.controller, line=style_line(r.controller, 1.8))
     fig.update_xaxes(title="t [s]")
     fig.update_yaxes(title="σ_ω [rad/s]")
     return finish_layout(fig, "bldc_sigma", "Sliding variable σ_ω, eq. (16)")

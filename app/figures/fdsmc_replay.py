@@ -141,7 +141,8 @@ def _n_frames(t_end: float, speed: float) -> int:
     return int(min(MAX_FRAMES, max(2, math.ceil(t_end / speed * KEY_RATE) + 1)))
 
 
-def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[dict[str, Any], dict[str, str]]:
+def replay_layout(comparison: Comparison, data: list[dict[str, Any]],
+                  targets: ScrubTargets | None = None) -> tuple[dict[str, Any], dict[str, str]]:
     """Layout entries (``updatemenus``) that replay ``comparison`` in the browser.
 
     Parameters
@@ -150,6 +151,8 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
     data : list of dict
         The figure's traces in order; the ``"<name> now"`` markers and the ``"time cursor …"``
         lines (vertical, ``x = [t, t]``) are the ones moved.
+    targets : ScrubTargets or None
+        ``ScrubTargets.of(data)`` if the caller has it already.
 
     Returns
     -------
@@ -160,7 +163,7 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]]) -> tuple[d
     rs = runs(comparison)
     if not rs:
         return {}, {}
-    targets = ScrubTargets.of(data)
+    targets = ScrubTargets.of(data) if targets is None else targets
     t_end = end_time(comparison)
     buttons, raw = [], {}
     for k, (label, speed) in enumerate(SPEEDS.items()):

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from app.figures.decimate import f32, minmax_index
+from app.figures.fdsmc_comparison import runs
 from app.figures.style import POSITION_COLOURS, POSITION_DASHES, TRAIL_PHASE_COLOURS, TRAIL_PHASE_DASHES
 from control.fdsmc.sliding_mode import in_boundary_layer
 from sim.fdsmc.engine import LABELS
@@ -76,8 +77,6 @@ def _cuts(t: np.ndarray, phase: np.ndarray, n: int) -> list[int]:
 
 def pieces(comparison: Any, n: int = N_PIECES) -> list[Piece]:
     """Cut each run's decimated trajectory into pieces (each holds the first point of the next: no gaps)."""
-    from app.figures.fdsmc_comparison import runs  # the comparison figures import this module
-
     d = comparison.derived
     prof, th = d.profile, d.params.manoeuvre.theta_dem
     out: list[Piece] = []

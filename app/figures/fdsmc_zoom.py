@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from app.figures.decimate import f32, minmax_index
+from app.figures.fdsmc_comparison import BOUNDARY_COLOUR
 from app.figures.style import FONT_PX, POSITION_COLOURS
 
 #: Inset domain in the figure [paper]: x within the phase plane's, y from its bottom.
@@ -75,7 +76,7 @@ def zoom_parts(comparison: Any) -> tuple[list[dict[str, Any]], dict[str, Any], l
          "fill": "toself", "fillcolor": "rgba(120, 120, 120, 0.25)", "line": {"width": 0}, "mode": "lines",
          "name": "zoom: boundary layer", **axes},
         {"type": "scatter", "x": [x0, x1], "y": [w_b, w_b], "mode": "lines", "name": "zoom: boundary",
-         "line": {"color": "#2b2b2b", "width": 1.5, "dash": "dash"}, **axes},
+         "line": {"color": BOUNDARY_COLOUR, "width": 1.5, "dash": "dash"}, **axes},
         {"type": "scatter", "x": f32(x_all[i]), "y": f32(y_all[i]), "mode": "lines", "name": "zoom: FDSMC",
          "line": {"color": POSITION_COLOURS["fdsmc"], "width": 1.5}, **axes},
     ]

@@ -20,6 +20,11 @@ MOTOR_FIELDS = tuple(f.name for f in dataclasses.fields(Motor))
 LOAD_FIELDS = tuple(f.name for f in dataclasses.fields(Load) if f.name != "steps")
 
 
+def with_plant_J_L(params: DriveParams, J_L: float) -> DriveParams:
+    """``params`` with the load inertia ``J_L`` [kg·m²]: the plant of a model-mismatch run."""
+    return dataclasses.replace(params, load=dataclasses.replace(params.load, J_L=J_L))
+
+
 def plant_section(field: str) -> str:
     """``motor`` or ``load`` for a plant field (a unit suffix such as ``_mH`` is allowed)."""
     for name in (field, field.rsplit("_", 1)[0]):

@@ -82,9 +82,14 @@ def design_view(p: BldcParams) -> tuple[str, str, str, tuple[str, ...]]:
     return emf, dqx, reach, tuple(design.warnings)
 
 
+def with_eps_lambda(p: BldcParams, eps_lambda: float) -> BldcParams:
+    """``p`` with the anti-windup's ε_λ [rad/s] of eq. (16)."""
+    return dataclasses.replace(p, gains=dataclasses.replace(p.gains, eps_lambda=eps_lambda))
+
+
 def without_anti_windup(p: BldcParams) -> BldcParams:
     """``p`` with λ(ε) = λ_0 (ε_λ = :data:`EPS_LAMBDA_OFF`): the integral of eq. (16) is never relieved."""
-    return dataclasses.replace(p, gains=dataclasses.replace(p.gains, eps_lambda=EPS_LAMBDA_OFF))
+    return with_eps_lambda(p, EPS_LAMBDA_OFF)
 
 
 class BldcTab:
@@ -186,10 +191,9 @@ class BldcTab:
     def _pair(self, comp: BldcComparison, eps_on: float) -> tuple[BldcRunResult, BldcRunResult]:
         """Run the paper's drive with anti-windup (ε_λ = ``eps_on``) and without, reusing the comparison's run."""
         p, shown = comp.params, comp.run("smc_integral")
-        if self.anti_windup.value:
+        if p.gains.eps_lambda != EPS_LAMBDA_OFF:  # the run shown has the anti-windup (read from the run, not the page)
             return shown, simulate_bldc(without_anti_windup(p), "smc_integral")
-        on = dataclasses.replace(p, gains=dataclasses.replace(p.gains, eps_lambda=eps_on))
-        return simulate_bldc(on, "smc_integral"), shown
+        return simulate_bldc(with_eps_lambda(p, eps_on), "smc_integral"), shown
 
     def _run(self, params: BldcParams, eps_on: float | None = None) -> None:
         self.status.content = f"Simulating… ({len(CONTROLLERS)} drives)"

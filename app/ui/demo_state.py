@@ -22,7 +22,6 @@ through the project's number grammar (:func:`app.io.json_data.loads_json_raw`,
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import re
@@ -32,6 +31,7 @@ from typing import Any
 from app.figures.fdsmc_pins import MAX_PINS, Pin
 from app.io.json_data import loads_json_raw
 from app.io.numbers import QuotedText, parse_number, shorten
+from app.io.plant_overrides import with_plant_J_L
 from app.io.preset_schema import PresetError
 from app.io.presets import dumps_preset, loads_preset_and_plant
 from control.fdsmc.params import DriveParams
@@ -83,8 +83,7 @@ class DemoState:
 
 def dumps_state(state: DemoState) -> str:
     """Return the JSON text of ``state`` (numbers with float32 precision for the pins)."""
-    plant = (None if state.plant_J_L is None else
-             dataclasses.replace(state.params, load=dataclasses.replace(state.params.load, J_L=state.plant_J_L)))
+    plant = None if state.plant_J_L is None else with_plant_J_L(state.params, state.plant_J_L)
     pins = [{"label": p.label, "t": [float(f"{v:.6g}") for v in p.t],
              "theta_re": [float(f"{v:.6g}") for v in p.theta_re], "omega_r": [float(f"{v:.6g}") for v in p.omega_r]}
             for p in state.pins]

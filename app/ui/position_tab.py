@@ -9,7 +9,6 @@ actions) and nothing else. Simulations run on the browser tab's worker, never on
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import sys
 import traceback
 from collections.abc import Callable
@@ -18,6 +17,7 @@ from typing import Any
 
 import viser
 
+from app.io.plant_overrides import with_plant_J_L
 from app.io.presets import list_presets_of, load, require_mode
 from app.ui.case import Case, CaseState
 from app.ui.choices import checked_choice
@@ -41,11 +41,6 @@ from sim.fdsmc.verdicts import T_c_advice, recommended_K
 
 #: The page's words for the design objectives (same order as :data:`sim.fdsmc.objective.OBJECTIVES`).
 OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")
-
-
-def with_plant_J_L(params: DriveParams, J_L: float) -> DriveParams:
-    """``params`` with the load inertia ``J_L`` [kg·m²]: the plant of a model-mismatch run."""
-    return dataclasses.replace(params, load=dataclasses.replace(params.load, J_L=J_L))
 
 
 def comparison_or_derived(params: DriveParams, optimum: bool = False, plant_J_L: float | None = None) -> Comparison:
@@ -394,4 +389,4 @@ class PositionTab:
         return comparison
 
 
-__all__ = ["OBJECTIVE_LABELS", "PositionTab", "comparison_or_derived", "with_plant_J_L"]
+__all__ = ["OBJECTIVE_LABELS", "PositionTab", "comparison_or_derived"]

@@ -75,7 +75,7 @@ def _overview_json(comparison: Any, replay: bool, pins: tuple[Pin, ...],
         drag = _drag_figure(spec, {"staticPlot": True} if static else {})
         return figure_json(drag), ScrubTargets.of(drag["data"], points=False)
     targets = ScrubTargets.of(spec["data"])
-    layout, raw = replay_layout(comparison, spec["data"])
+    layout, raw = replay_layout(comparison, spec["data"], targets)
     spec["layout"].update(layout)
     # Plotly.react keeps the previous figure's config when given none: the default config must be
     # explicit, or the drag figure's static mode would outlive the drag

@@ -24,6 +24,7 @@ from app.ui.props import assign
 from app.ui.studies_multiaxis import MultiAxisView
 from app.ui.studies_robustness import RobustnessView
 from app.ui.text import md_text
+from sim.fdsmc.engine import OPTIMUM_OMITTED
 from sim.fdsmc.optimum_gap import OPTIMUM_BASIS
 
 
@@ -31,7 +32,7 @@ def optimum_markdown(comparison: Any) -> str:
     """One line: the optimum's energy [J] and the share of each controller's it would save [%]."""
     opt = getattr(comparison, "optimum", None)
     if opt is None:  # left out (its solvers failed): say why
-        return " ".join(md_text(n) for n in getattr(comparison, "notes", ()) if n.startswith("Optimum omitted"))
+        return " ".join(md_text(n) for n in getattr(comparison, "notes", ()) if n.startswith(OPTIMUM_OMITTED))
     w = getattr(opt.metrics, OPTIMUM_BASIS)
     gaps = optimum_gaps(comparison)
     parts = [f"{LABELS[k]}'s by **{v:.1f} %**" for k, v in gaps.items() if v is not None]

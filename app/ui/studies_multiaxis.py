@@ -9,7 +9,6 @@ The move is a study: it waits for a server-wide slot and runs at lowered priorit
 
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable
 from contextlib import AbstractContextManager
 from typing import Any
@@ -85,9 +84,9 @@ class MultiAxisView:
     #: The study's name in the queue's messages.
     LABEL = "Multi-axis move"
 
-    def __init__(self, port: CasePort, as_study: Callable[[str], AbstractContextManager[Any]] | None = None) -> None:
+    def __init__(self, port: CasePort, as_study: Callable[[str], AbstractContextManager[Any]]) -> None:
         self._s = port
-        self._as_study = as_study or (lambda label: contextlib.nullcontext())
+        self._as_study = as_study
         gui = port.client.gui
         self._presets = tuple(list_presets_of("position"))
         self.axes = gui.add_text("Axes (YAML list)", default_axes(self._presets), multiline=True,

@@ -25,6 +25,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 from app.ui.worker import Cancelled
+from sim.studies.runner import lower_priority
 
 #: How much a study's threads and processes lower their scheduling priority (nice increment) [-].
 STUDY_NICE = 10
@@ -34,19 +35,12 @@ QUEUE_POLL_S = 0.05
 MAX_STUDIES_ENV, MAX_PROCESSES_ENV = "PMSM_MAX_STUDIES", "PMSM_MAX_STUDY_PROCESSES"
 
 
-def lower_priority(increment: int = STUDY_NICE) -> None:
-    """Lower the calling thread's scheduling priority by ``increment`` (Linux: per thread; else no-op)."""
-    with contextlib.suppress(AttributeError, OSError):
-        tid = threading.get_native_id()
-        os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + increment)
-
-
 def run_lowered(fn: Callable[[], Any], name: str) -> None:
     """Run ``fn`` on a new thread of lowered priority and wait for it; its exception is raised here."""
     failure: list[BaseException] = []
 
     def body() -> None:
-        lower_priority()
+        lower_priority(STUDY_NICE)
         try:
             fn()
         except BaseException as exc:  # handed to the waiting thread, which reports it
@@ -171,4 +165,4 @@ class StudySlots:
             run_lowered(fn, f"study-{label}")
 
 
-__all__ = ["STUDY_NICE", "StudySlots", "lower_priority", "run_lowered"]
+__all__ = ["STUDY_NICE", "StudySlots", "run_lowered"]

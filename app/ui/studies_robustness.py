@@ -107,11 +107,10 @@ class RobustnessView:
     #: The study's name in the queue's messages.
     LABEL = "Robustness study"
 
-    def __init__(self, port: CasePort, as_study: Callable[[str], AbstractContextManager[Any]] | None = None,
-                 processes: int | None = None) -> None:
+    def __init__(self, port: CasePort, as_study: Callable[[str], AbstractContextManager[Any]],
+                 processes: int) -> None:
         self._s = port
-        self._as_study = as_study or (lambda label: contextlib.nullcontext())
-        self._processes = processes or os.cpu_count() or 1
+        self._as_study, self._processes = as_study, processes
         gui = port.client.gui
         self.samples = gui.add_number("Samples", 200, min=1, max=MAX_SAMPLES, step=1)
         self.seed = gui.add_number("Seed", 0, min=0, step=1)

@@ -94,6 +94,16 @@ def slide_time_constant(alpha_max: float, K: float) -> float:
     return SLIDE_RATIO / (alpha_max * K)
 
 
+def optimum_slide(gain: GainRecommendation | None, K: float, alpha_max: float) -> tuple[float, float]:
+    """Return the tracked optimum's boundary-layer gain K [s/rad] and its terminal slide's T_c [s].
+
+    :func:`slide_gain` of the case's ``K`` [s/rad], and :func:`slide_time_constant` with it for
+    α_max [rad/s²].
+    """
+    K_slide = slide_gain(gain, K)
+    return K_slide, slide_time_constant(alpha_max, K_slide)
+
+
 def slide_stability(loop: LoopCase, K: float) -> float:
     """Stability measure of the terminal slide's linearised sampled loop (< 0: stable).
 
@@ -104,5 +114,5 @@ def slide_stability(loop: LoopCase, K: float) -> float:
     return stability_measure(case, "slope", K, loop.f_s, loop.delay)
 
 
-__all__ = ["LAYER_SHARE", "MAX_HALVINGS", "SLIDE_RATIO", "slide_gain", "slide_stability", "slide_time_constant",
-           "tracking_gains"]
+__all__ = ["LAYER_SHARE", "MAX_HALVINGS", "SLIDE_RATIO", "optimum_slide", "slide_gain", "slide_stability",
+           "slide_time_constant", "tracking_gains"]

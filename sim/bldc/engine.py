@@ -118,9 +118,14 @@ def _cost(n_runs: int, n_ticks: int, n_sub: int) -> budget.Cost:
     return budget.Cost(n_runs * n_ticks * n_sub, trace, cpu, int(MEM_PER_TRACE_BYTE * trace + MEM_PER_RUN * n_runs))
 
 
+def n_ticks_of(t_end: float, f_s: float) -> int:
+    """Return the number of controller samples [-] of a run of ``t_end`` [s] at ``f_s`` [Hz]."""
+    return int(math.ceil(t_end * f_s - 1e-9))
+
+
 def run_cost(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> budget.Cost:
     """Cost of ``n_runs`` runs of the active scenario (parameters only): see :func:`_cost`."""
-    return _cost(n_runs, int(math.ceil(params.case.t_end * params.inverter.f_s - 1e-9)), int(n_sub))
+    return _cost(n_runs, n_ticks_of(params.case.t_end, params.inverter.f_s), int(n_sub))
 
 
 def check_budget(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> budget.Cost:
@@ -132,10 +137,10 @@ def check_budget(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> bud
     i = next(k for k, c in enumerate(params.scenario.cases) if c.name == case.name)
 
     def with_t_end(t_end: float) -> budget.Cost:
-        return _cost(n_runs, int(math.ceil(t_end * f_s - 1e-9)), n_sub)
+        return _cost(n_runs, n_ticks_of(t_end, f_s), n_sub)
 
     def with_f_s(rate: float) -> budget.Cost:
-        return _cost(n_runs, int(math.ceil(case.t_end * rate - 1e-9)), n_sub)
+        return _cost(n_runs, n_ticks_of(case.t_end, rate), n_sub)
 
     drivers = [budget.Driver(f"scenario.cases[{i}].t_end", case.t_end, "s", with_t_end, 1e-6),
                budget.Driver("inverter.f_s", f_s, "Hz", with_f_s, 1e3)]
@@ -166,7 +171,7 @@ def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
     d = bldc_design(params) if design is None else design
     tab = machine_table(params.machine) if table is None else np.ascontiguousarray(table, dtype=float)
     case = params.case
-    n_ticks = int(math.ceil(case.t_end * params.inverter.f_s - 1e-9))
+    n_ticks = n_ticks_of(case.t_end, params.inverter.f_s)
     rec = np.zeros((n_ticks + 1, kn.N_CH))
     step_t = np.array([s.t for s in case.T_L_steps], dtype=float)
     step_v = np.array([s.T_L for s in case.T_L_steps], dtype=float)

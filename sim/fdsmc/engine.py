@@ -33,7 +33,7 @@ from control.fdsmc.model import model_coefficients, torque_constant
 from control.fdsmc.optimum import OptimumSolverError
 from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import infeasible_T_m
-from control.fdsmc.tracking import slide_gain, slide_time_constant, tracking_gains
+from control.fdsmc.tracking import optimum_slide, tracking_gains
 from sim.common import sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
@@ -152,9 +152,9 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
     gains = d.conventional
     if controller == "optimum":  # its own K (below the chatter limit), tracking gains and terminal slide's T_c
-        K = slide_gain(d.gain, ctrl.K)
+        K, T_c = optimum_slide(d.gain, ctrl.K, d.alpha.alpha_max)
         gains = tracking_gains(d.loop, d.conventional, K)
-        prm[[kn.P_TC, kn.P_KB]] = (slide_time_constant(d.alpha.alpha_max, K), K)
+        prm[[kn.P_TC, kn.P_KB]] = (T_c, K)
     prm[[kn.P_G1, kn.P_G2]] = (gains.g1, gains.g2)
     if controller == "optimum":  # α(t) ≈ α_dem(t − T_sα/3) (eq. (13)), one more sample with a delay
         prm[kn.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
@@ -344,6 +344,15 @@ def _saving(a: RunResult | None, b: RunResult | None, energy: Callable[[RunMetri
     return 100.0 * (1.0 - va / vb)
 
 
+#: The start of the note that says the optimum was left out of a comparison or a duty cycle.
+OPTIMUM_OMITTED = "Optimum omitted"
+
+
+def optimum_omitted(exc: OptimumSolverError) -> str:
+    """Return the one-line note of an optimum no solver found (it is a yardstick: left out, never a stop)."""
+    return f"{OPTIMUM_OMITTED}: {exc}"
+
+
 def compare(
     params: DriveParams, controllers: tuple[str, ...] = CONTROLLERS, derived: Derived | None = None,
     plant: DriveParams | None = None, **options: float,
@@ -380,7 +389,7 @@ def compare(
         try:
             runs[name] = fut.result()
         except OptimumSolverError as exc:  # the optimum is a yardstick: left out with a note, never a traceback
-            notes.append(f"Optimum omitted: {exc}")
+            notes.append(optimum_omitted(exc))
     f, c = runs.get("fdsmc"), runs.get("conventional")
     return Comparison(d, f, c, _saving(f, c, lambda m: m.friction_J),
                       _saving(f, c, lambda m: m.electrical_in_total_J), runs.get("optimum"), runs.get("stock"),

@@ -26,7 +26,7 @@ import numpy as np
 
 from control.fdsmc.derivations import Derived
 from control.fdsmc.params import DriveParams
-from control.fdsmc.tracking import slide_gain, slide_time_constant
+from control.fdsmc.tracking import optimum_slide
 from sim.common import signals
 from sim.common.energy import energy_balance
 from sim.fdsmc.limit_cycle import limit_cycles
@@ -313,7 +313,7 @@ def chatter_windows(
     T_m, T_a = params.manoeuvre.T_m, d.profile.T_a
     if controller == "optimum":  # tracking until the terminal slide (≈ 2·T_c before T_m): not its switch
         t0 = 0.2 * T_m
-        T_c = slide_time_constant(d.alpha.alpha_max, slide_gain(d.gain, params.controller.K))
+        T_c = optimum_slide(d.gain, params.controller.K, d.alpha.alpha_max)[1]
         t1 = max(T_m - 3.0 * T_c, 0.5 * T_m)
     elif controller != "fdsmc":  # the conventional law and the stock cascade: no cruise segment
         t0, t1 = 0.2 * T_m, T_m

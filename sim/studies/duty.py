@@ -28,7 +28,7 @@ from control.fdsmc.params import DriveParams
 from sim.common import sensors
 from sim.common.economics import J_PER_KWH, cost_per_year, kwh_per_year  # noqa: F401 - J_PER_KWH re-exported
 from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import pack_parameters
+from sim.fdsmc.engine import optimum_omitted, pack_parameters
 from sim.fdsmc.grid import continuous_step, plant_substeps
 from sim.fdsmc.metrics import kinetic_energy, magnetic_energy
 from sim.fdsmc.summary import decode_state
@@ -206,7 +206,7 @@ def duty_cycle(params: DriveParams, moves: Sequence[Move]) -> DutyResult:
         try:
             runs[c] = cycle_run(params, moves, c)
         except OptimumSolverError as exc:  # the optimum is a yardstick: left out with a note, never a stop
-            notes.append(f"Optimum omitted: {exc}")
+            notes.append(optimum_omitted(exc))
     per_move = tuple({c: (r.moves_J[i] if r.moves_J is not None else None) for c, r in runs.items()}
                      for i in range(len(moves)))
     total = {c: r.electrical_in_J for c, r in runs.items()}

@@ -64,11 +64,16 @@ class RetryingFuture:
         return self.future.cancel()
 
 
-def _lower_priority(increment: int) -> None:
-    """Worker initializer: lower this process's scheduling priority by ``increment`` (no-op where unsupported)."""
+def lower_priority(increment: int) -> None:
+    """Lower the calling thread's scheduling priority by ``increment`` (no-op where unsupported).
+
+    On Linux a priority is per thread: a study's thread, or a pool worker's main thread (its
+    initializer), so the worker's own threads start lowered as well.
+    """
     if increment > 0:
         with contextlib.suppress(AttributeError, OSError):
-            os.nice(increment)
+            tid = threading.get_native_id()
+            os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + increment)
 
 
 class RetryingPool:
@@ -86,7 +91,7 @@ class RetryingPool:
         self._futures: list[RetryingFuture] = []
 
     def _new_pool(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"), initializer=_lower_priority,
+        return ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"), initializer=lower_priority,
                                    initargs=(self.nice,))
 
     def raw_submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
