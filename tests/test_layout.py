@@ -27,6 +27,7 @@ from app.ui.layout import (
     SCENE_MIN,
     WIDE_WINDOW,
     WindowFit,
+    hide_field_js,
     install_css_js,
     layout_for_window,
     page_css,
@@ -141,3 +142,8 @@ def test_window_report_script_quotes_the_field_id():
     js = window_report_js('a"b')
     assert f"const uuid = {json.dumps('a' + chr(34) + 'b')};" in js  # a JSON string, not raw text
     assert "window.innerWidth" in js and "addEventListener('resize'" in js
+
+
+def test_a_field_made_after_the_marks_is_hidden_by_them_too():
+    assert hide_field_js('a"b') == f"window.__appHideField({json.dumps('a' + chr(34) + 'b')});"
+    assert "window.__appHideField = (uuid) =>" in page_marks_js(["c"])

@@ -129,6 +129,11 @@ def page_marks_js(hidden_fields: Sequence[str]) -> str:
         "HIDDEN_FIELDS", json.dumps(list(hidden_fields)))
 
 
+def hide_field_js(field_uuid: str) -> str:
+    """Return a script hiding the row of the text field ``field_uuid`` too (after :func:`page_marks_js`)."""
+    return f"window.__appHideField({json.dumps(field_uuid)});"
+
+
 def install_css_js(css: str, style_id: str = "app-page-style") -> str:
     """Return a script putting ``css`` into the page's own ``<style>`` element ``style_id`` in the document head.
 
@@ -215,5 +220,5 @@ class WindowFit:
             self._apply(layout)
 
 
-__all__ = ["PanelLayout", "WindowFit", "install_css_js", "layout_for_window", "page_css", "page_marks_js",
-           "parse_window", "window_report_js"]
+__all__ = ["PanelLayout", "WindowFit", "hide_field_js", "install_css_js", "layout_for_window", "page_css",
+           "page_marks_js", "parse_window", "window_report_js"]

@@ -25,7 +25,15 @@ from app.ui.demo_view import PageViewProbe
 from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
 from app.ui.inputs import InputsPanel
-from app.ui.layout import PanelLayout, WindowFit, install_css_js, page_css, page_marks_js, window_report_js
+from app.ui.layout import (
+    PanelLayout,
+    WindowFit,
+    hide_field_js,
+    install_css_js,
+    page_css,
+    page_marks_js,
+    window_report_js,
+)
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
 from app.ui.position_tab import PositionTab, comparison_or_derived
@@ -94,6 +102,8 @@ class Session:
             gui.configure_theme(control_width="large", show_share_button=False, show_logo=False)
             self._window_probe = gui.add_text("window [px]", "")
             self._install_page_css(show_3d=False)
+            # the marks before the panels: a panel drawn before them would take its width for a frame
+            run_script(gui, page_marks_js((widget_id(self._window_probe),)))
             use_basic_plotly(gui)  # before the first add_plotly: 0.45 MB instead of 1.7 MB on the wire
             gui.main_panel.dock_left()
             tabs = gui.add_tab_group()
@@ -109,7 +119,7 @@ class Session:
                 self.export = FigureExport(gui, self._figure_handles)
             self.fit = WindowFit(self._apply_layout)
             self.tab.demo_files.probe = probe = PageViewProbe(gui)  # outside the mode tabs: in every mode
-            run_script(gui, page_marks_js((widget_id(self._window_probe), widget_id(probe.field))))
+            run_script(gui, hide_field_js(widget_id(probe.field)))
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))

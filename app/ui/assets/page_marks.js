@@ -33,6 +33,7 @@
     only('data-app-fit', fit); only('data-app-column', columns);
     only('data-app-overview-window', windows); only('data-app-hidden', hidden);
   };
+  window.__appHideField = (uuid) => { hiddenFields.push(uuid); mark(); };  // a field made later
   // mutations inside a plot (Plotly redraws) change none of the marks
   const outside = (r) => !(r.target.closest && r.target.closest('.js-plotly-plot'));
   new MutationObserver((records) => { if (records.some(outside)) mark(); }).observe(document.body, {
