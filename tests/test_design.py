@@ -13,7 +13,6 @@ from app.io.presets import load_preset
 from control.fdsmc.feasibility import current_limit, torque_limit, voltage_limit
 from control.fdsmc.flux_tolerance import flux_tolerance
 from control.fdsmc.params import Controller, DriveParams, Load, Manoeuvre, Motor
-from sim.common.sensors import reading_noise
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.design import design_drive, run_checks
 from sim.fdsmc.objective import design_for
@@ -30,7 +29,7 @@ def _assert_clean_run(dd) -> None:
     assert m.u_peak_V <= voltage_limit(p) * 1.005
     assert m.omega_peak_rad_s <= crit.omega_max * 1.005
     if p.controller.i_max > 0:
-        assert m.i_peak_A <= (current_limit(p) + 3 * reading_noise(p.sensors)) * 1.005
+        assert m.i_peak_A <= (current_limit(p) + 3 * p.sensors.reading_noise) * 1.005
     assert abs(m.theta_error_at_Tm_rad) <= 0.02 * abs(p.manoeuvre.theta_dem)
     assert m.in_position_s is not None and (m.overshoot_rad or 0.0) <= crit.overshoot
     assert m.hold_i_q_rms_A <= crit.hold_i_rms

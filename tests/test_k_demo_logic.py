@@ -12,10 +12,10 @@ from app.ui.k_slider import K_RANGE, K_marks, K_of_position, hide_box_css, log_K
 
 
 def _comparison(K: float, K_limit: float, chatter: bool = False, freq: float | None = None,
-                stable: bool = True, ran: bool = True) -> SimpleNamespace:
+                stable: bool = True, ran: bool = True, K_noise: float = math.inf) -> SimpleNamespace:
     metrics = SimpleNamespace(chatter=chatter, chatter_frequency_Hz=freq, stable=stable)
     derived = SimpleNamespace(params=SimpleNamespace(controller=SimpleNamespace(K=K)),
-                              gain=SimpleNamespace(K_limit=K_limit))
+                              gain=SimpleNamespace(K_limit=K_limit, K_noise=K_noise))
     return SimpleNamespace(fdsmc=SimpleNamespace(metrics=metrics) if ran else None, derived=derived)
 
 
@@ -39,6 +39,24 @@ def test_verdict_comes_from_the_run_not_from_the_prediction():
     unstable = chatter_verdict(_comparison(5.0, 0.6, chatter=True, stable=False))
     assert unstable.headline == "UNSTABLE" and unstable.chatter
     assert chatter_verdict(_comparison(1.0, 0.6, ran=False)) is None  # infeasible: nothing run
+
+
+def test_verdict_names_the_sensors_noise_limit_where_it_is_below_K_limit():
+    # a coarse encoder: the noise, not the loop's stability, sets where α_dem starts to chatter
+    v = chatter_verdict(_comparison(0.0571, 0.114, chatter=True, freq=1524.0, K_noise=0.0105))
+    assert v.text == "CHATTER 1524 Hz (K > K_noise = 0.0105 (sensors))"
+    assert chatter_verdict(_comparison(0.005, 0.114, K_noise=0.0105)).detail == "K ≤ K_noise = 0.0105 (sensors)"
+    # a noise limit above the stability limit is not the binding one
+    assert chatter_verdict(_comparison(0.3, 0.6048, K_noise=0.7)).detail == "K < K_limit = 0.605"
+
+
+def test_the_K_slider_marks_and_reddens_at_the_noise_limit():
+    marks = dict((label, pos) for pos, label in K_marks(-3.0, 4.0, 0.114, 0.00525, 0.0105))
+    assert marks["noise"] == pytest.approx(math.log10(0.0105)) and marks["lim"] == pytest.approx(math.log10(0.114))
+    assert "noise" not in {label for _, label in K_marks(-3.0, 4.0, 0.114, 0.057, 0.2)}  # above K_limit: no mark
+    assert "#c92a2a" in readout_html(0.02, 0.114, 0.00525, 0.0105)  # above K_noise, below K_limit: red
+    assert "#2b8a3e" in readout_html(0.005, 0.114, 0.00525, 0.0105) and "noise 0.0105" in readout_html(
+        0.005, 0.114, 0.00525, 0.0105)
 
 
 def test_verdict_annotation_is_large_named_and_escaped():

@@ -13,7 +13,6 @@ from control.fdsmc.derivations import derive
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, current_limit, exceeds
 from control.fdsmc.nameplate import nameplate_consistency
 from control.fdsmc.transient import acceleration_overshoot
-from sim.common.sensors import reading_noise
 from sim.fdsmc.engine import compare
 from sim.fdsmc.verdicts import run_warnings
 
@@ -83,7 +82,7 @@ def test_torque_limit_caps_the_hard_current_limit(paper_params):
     assert [w for w in run_warnings(cmp) if not w.startswith("Flux tolerance")] == []  # no limit warning
     for run in (cmp.fdsmc, cmp.conventional):
         assert run.metrics.torque_peak_Nm <= 15.0 * 1.005
-        assert run.metrics.i_peak_A <= (current_limit(p) + 3 * reading_noise(p.sensors)) * 1.005
+        assert run.metrics.i_peak_A <= (current_limit(p) + 3 * p.sensors.reading_noise) * 1.005
 
 
 def test_saving_from_a_short_move_is_not_presented_as_a_saving(paper_params):

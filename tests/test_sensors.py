@@ -92,5 +92,5 @@ def test_the_design_slows_the_observer_for_a_coarse_encoder_and_verifies_it_with
     dd = design_drive(asked)
     m = dd.comparison.fdsmc.metrics
     assert dd.clean and dd.params.controller.T_so > asked.controller.T_so
-    assert m.hold_i_q_rms_A <= 2.0 and m.i_peak_A <= 40.0 + 3 * sensors.reading_noise(asked.sensors)
+    assert m.hold_i_q_rms_A <= 2.0 and m.i_peak_A <= 40.0 + 3 * asked.sensors.reading_noise
     assert m.hold_i_q_rms_A == pytest.approx(dd.noise.i_q_rms, rel=0.2)

@@ -54,7 +54,7 @@ def count_params(params: DriveParams) -> tuple[DriveParams, int]:
     """
     cpr = encoder_counts_per_rev(params)
     se = dataclasses.replace(params.sensors, encoder_cpr=cpr)
-    step = sensors.encoder_step(se)
+    step = se.encoder_step
     count = round(params.manoeuvre.theta_dem / step)
     man = dataclasses.replace(params.manoeuvre, theta_dem=count * step)
     return dataclasses.replace(params, manoeuvre=man, sensors=se), count
@@ -67,8 +67,8 @@ def readings(params: DriveParams, k: int, theta: float, i_d: float, i_q: float,
     ``noise`` is :func:`sim.common.sensors.noise_table` of ``params.sensors``; the encoder must not be ideal.
     """
     se, j = params.sensors, k % noise.shape[1]
-    i_step = sensors.adc_step(se)
-    return (math.floor(theta / sensors.encoder_step(se)),
+    i_step = se.adc_step
+    return (math.floor(theta / se.encoder_step),
             sensors.adc_current(i_d, noise[0, j], se.i_noise, i_step, se.i_adc_range),
             sensors.adc_current(i_q, noise[1, j], se.i_noise, i_step, se.i_adc_range))
 

@@ -9,6 +9,7 @@ prediction — and where K stands against K_limit.
 from __future__ import annotations
 
 import html
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,8 +35,10 @@ class Verdict:
         return f"{self.headline} ({self.detail})"
 
 
-def _k_vs_limit(K: float, K_limit: float) -> str:
-    """Say where K [s/rad] stands against the chatter limit K_limit [s/rad] (none known if ≤ 0)."""
+def _k_vs_limit(K: float, K_limit: float, K_noise: float = math.inf) -> str:
+    """Say where K [s/rad] stands against the chatter limit [s/rad]: the sensors' K_noise where lower."""
+    if K_noise < K_limit:
+        return f"K {'≤' if K_noise >= K else '>'} K_noise = {K_noise:.3g} (sensors)"
     if not K_limit > 0.0:
         return f"K = {K:.3g}"
     return f"K {'<' if K_limit > K else '≥'} K_limit = {K_limit:.3g}"
@@ -59,7 +62,7 @@ def chatter_verdict(comparison: Any) -> Verdict | None:
     if run is None:
         return None
     m, d = run.metrics, comparison.derived
-    where = _k_vs_limit(d.params.controller.K, d.gain.K_limit)
+    where = _k_vs_limit(d.params.controller.K, d.gain.K_limit, d.gain.K_noise)
     if not m.stable:
         return Verdict("UNSTABLE", where, True)
     if m.chatter:

@@ -5,11 +5,13 @@ Shared by the CLI (``derive``), the web UI's derived-values panel and the parame
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 from app.io.json_data import to_json
 from control.fdsmc.derivations import Derived
+from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
 
 
 @dataclass(frozen=True)
@@ -68,7 +70,10 @@ def _loop_rows(d: Derived) -> list[Row]:
     g, s = d.gain, d.sample_rate
     rows = [
         Row(f"K stability limit, linearised loop ({g.mode})", "K_limit", g.K_limit, "s/rad", "loop analysis"),
-        Row(f"Recommended K (gain margin {g.margin:g})", "K_rec", g.K_recommended, "s/rad", "loop analysis"),
+        Row(f"K noise limit, sensors (α_dem swings ≥ {100 * CHATTER_PTP_FRACTION:g} % of α_max)", "K_noise",
+            g.K_noise if math.isfinite(g.K_noise) else None, "s/rad", "loop analysis"),
+        Row(f"Recommended K (gain margin {g.margin:g}{', sensors' if g.noise_limited else ''})", "K_rec",
+            g.K_recommended, "s/rad", "loop analysis"),
     ]
     if s.f_s is not None:
         rows += [

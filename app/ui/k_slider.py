@@ -11,6 +11,7 @@ preset, a file, a design — moves the slider to it (:meth:`KSlider.show`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import viser
@@ -42,21 +43,32 @@ def K_of_position(position: float) -> float:
     return value_of_position(position)
 
 
-def _gain_marks(K_limit: float, K_rec: float | None) -> tuple[Mark, ...]:
-    return (("rec", K_rec if K_rec is not None else 0.0), ("lim", K_limit))
+def _gain_marks(K_limit: float, K_rec: float | None, K_noise: float = math.inf) -> tuple[Mark, ...]:
+    noise = (("noise", K_noise),) if K_noise < K_limit else ()
+    return (("rec", K_rec if K_rec is not None else 0.0), *noise, ("lim", K_limit))
 
 
-def K_marks(lo: float, hi: float, K_limit: float, K_rec: float | None) -> tuple[tuple[float, str], ...]:
-    """Return the track's marks (position [log₁₀], label): both ends, "rec" at K_rec, "lim" at K_limit."""
-    return track_marks(lo, hi, _gain_marks(K_limit, K_rec))
+def K_marks(lo: float, hi: float, K_limit: float, K_rec: float | None,
+            K_noise: float = math.inf) -> tuple[tuple[float, str], ...]:
+    """Return the track's marks (position [log₁₀], label).
+
+    Both ends, "rec" at K_rec, "noise" at the sensors' noise limit K_noise where it is below
+    K_limit, and "lim" at K_limit.
+    """
+    return track_marks(lo, hi, _gain_marks(K_limit, K_rec, K_noise))
 
 
-def readout_html(K: float, K_limit: float, K_rec: float | None) -> str:
-    """Return one line for under the slider: K [s/rad] and the marked gains, K in red at or above K_limit."""
-    over = positive(K_limit) and K_limit <= K
+def readout_html(K: float, K_limit: float, K_rec: float | None, K_noise: float = math.inf) -> str:
+    """Return one line for under the slider: K [s/rad] and the marked gains, K in red where it chatters.
+
+    K is red at or above K_limit, or above the sensors' noise limit K_noise.
+    """
+    over = (positive(K_limit) and K_limit <= K) or K_noise < K
     parts = [f'<b style="color:{"#c92a2a" if over else "#2b8a3e"}">K = {K:.4g} s/rad</b>']
     if positive(K_rec):
         parts.append(f"rec {K_rec:.3g}")
+    if K_noise < K_limit:
+        parts.append(f"noise {K_noise:.3g} (sensors)")
     if positive(K_limit):
         parts.append(f"lim {K_limit:.3g} (chatter above)")
     return readout_line("K", " · ".join(parts))
@@ -64,7 +76,7 @@ def readout_html(K: float, K_limit: float, K_rec: float | None) -> str:
 
 def _readout(K: float, marks: tuple[Mark, ...]) -> str:
     gains = dict(marks)
-    return readout_html(K, gains.get("lim", 0.0), gains.get("rec"))
+    return readout_html(K, gains.get("lim", 0.0), gains.get("rec"), gains.get("noise", math.inf))
 
 
 class KSlider(LogSlider):
@@ -74,9 +86,9 @@ class KSlider(LogSlider):
         super().__init__(gui, K_LABEL, K_RANGE, _readout, moved,
                          hint="Logarithmic: drag across 'lim' (K_limit) to see the chatter start")
 
-    def show_gains(self, K: float, K_limit: float, K_rec: float | None) -> None:
-        """Mirror ``K`` [s/rad] with K_limit and K_rec marked."""
-        self.show(K, _gain_marks(K_limit, K_rec))
+    def show_gains(self, K: float, K_limit: float, K_rec: float | None, K_noise: float = math.inf) -> None:
+        """Mirror ``K`` [s/rad] with K_limit, K_rec and (below K_limit) the noise limit K_noise marked."""
+        self.show(K, _gain_marks(K_limit, K_rec, K_noise))
 
 
 __all__ = ["K_LABEL", "K_RANGE", "KSlider", "K_marks", "K_of_position", "hide_box_css", "log_K_range",

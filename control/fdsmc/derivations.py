@@ -113,7 +113,9 @@ def derive(params: DriveParams) -> Derived:
     feas = feasibility(params, alpha, prof.omega_p)
     conv = conventional_gains(params.manoeuvre.T_m)
     loop = LoopCase.of_case(lm, params, alpha.alpha_max, prof.T_c, conv.g1, conv.g2)
-    gain, rate = recommend_K(loop), sample_rate_check(loop)
+    se = params.sensors
+    gain = recommend_K(loop, count=se.encoder_step, i_noise_rms=se.reading_noise)
+    rate = sample_rate_check(loop)
     return Derived(
         params=params,
         coefficients=coeff,
@@ -134,7 +136,7 @@ def derive(params: DriveParams) -> Derived:
 def clear_caches() -> None:
     """Forget every cached loop verdict and sampled model (benchmarks: what a new drive costs)."""
     for cached in (loop_analysis._gain_limit, loop_analysis._minimum_sample_rate, loop_model._sampled_parts,
-                   transient._acceleration_overshoot):
+                   transient._acceleration_overshoot, loop_analysis._noise_gain_limit):
         cached.cache_clear()
 
 

@@ -8,7 +8,11 @@ J_r + J_L from the preset; the controller knows only J_r.
 
 * K_limit: the smallest K at which that loop becomes unstable (a closed-loop eigenvalue crosses
   the imaginary axis / unit circle); the loop then limit-cycles against the saturation of
-  eq. (45) — the chatter seen with the paper's K = 1000. Recommended K = K_limit / margin.
+  eq. (45) — the chatter seen with the paper's K = 1000.
+* K_noise: the smallest K at which the sensors' noise alone swings α_dem as much as the chatter
+  criterion allows (:func:`noise_gain_limit`; inf for ideal sensors).
+* Recommended K = K_limit / margin, lowered where the sensors' noise would swing α_dem by more than
+  the criterion / margin: the K the real drive's sensors allow.
 * Sample-rate check: the same sampled loop with the slow conventional outer law of eq. (61)
   (i.e. inner loops + observer); its spectral radius ≥ 1 means f_s is too slow for T_so/T_sα.
 
@@ -25,10 +29,12 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import LinAlgWarning
 
 from control.fdsmc.loop_model import (
     LoopCase,
@@ -38,9 +44,13 @@ from control.fdsmc.loop_model import (
     reduce_shift_mode,
     sampled_parts,
 )
+from control.fdsmc.noise import PTP_PER_RMS, noise_gain
 
 #: Default gain margin of the recommended K [-] (2 = 6 dB).
 GAIN_MARGIN = 2.0
+#: The chatter criterion's amplitude: α_dem swinging by more than this fraction of α_max
+#: peak-to-peak over a window is chatter (``sim.fdsmc.metrics``) [-].
+CHATTER_PTP_FRACTION = 0.2
 #: Smallest acceptable damping ratio of the ideal sloped-segment loop [-].
 ZETA_SLOPE_MIN = 0.5
 LAWS = ("cruise", "slope", "conventional")
@@ -55,7 +65,7 @@ class GainRecommendation:
     K_limit : float          Smallest unstable K of the linearised loop [s/rad].
     K_limit_cruise : float   Limit of the cruise segment alone [s/rad].
     K_limit_slope : float    Limit of the sloped segment alone [s/rad].
-    margin : float           Gain margin applied, K_recommended = K_limit/margin [-].
+    margin : float           Gain margin applied to K_limit and to the noise's swing [-].
     K_recommended : float    [s/rad].
     K : float                The preset's K [s/rad].
     K_ok : bool              K < K_limit (no limit cycle expected).
@@ -64,8 +74,11 @@ class GainRecommendation:
     zeta_slope : float       Damping ratio √(α_max·K·T_c)/2 of the ideal sloped-segment loop
                              s² + α_max·K·s + α_max·K/T_c, with the preset's K if K_ok, else with
                              K_recommended [-].
-    T_c_min : float          T_c giving ζ = 1 with K_limit_cruise/margin, 4/(α_max·K) [s].
+    T_c_min : float          T_c giving ζ = 1 with min(K_limit_cruise, K_noise)/margin, 4/(α_max·K) [s].
     zeta_slope_recommended : float  The same damping ratio with K_recommended [-].
+    K_noise : float          Smallest K at which the sensors' noise makes α_dem chatter [s/rad];
+                             inf for ideal sensors or when the stability limit comes first.
+    noise_limited : bool     The sensors' noise, not K_limit/margin, sets K_recommended.
     """
 
     K_limit: float
@@ -80,6 +93,13 @@ class GainRecommendation:
     zeta_slope: float = math.nan
     T_c_min: float = math.nan
     zeta_slope_recommended: float = math.nan
+    K_noise: float = math.inf
+    noise_limited: bool = False
+
+    @property
+    def K_noise_ok(self) -> bool:
+        """K below the noise limit: the sensors' noise alone does not make α_dem chatter."""
+        return self.K_noise > self.K
 
 
 @dataclass(frozen=True)
@@ -205,8 +225,12 @@ def slope_damping(alpha_max: float, K: float, T_c: float) -> float:
     return math.sqrt(alpha_max * K * T_c) / 2.0
 
 
-def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN) -> GainRecommendation:
-    """Recommended boundary-layer gain K = K_limit/margin for the preset's implementation.
+def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
+                i_noise_rms: float = 0.0) -> GainRecommendation:
+    """Recommended boundary-layer gain K for the preset's implementation and sensors.
+
+    K_limit/margin, or less where the sensors' noise would swing α_dem by more than the chatter
+    criterion/margin (:func:`noise_gain_limit`).
 
     Parameters
     ----------
@@ -214,6 +238,10 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN) -> GainRecommendation:
         Derivations of the case (inertia J_r + J_L, observer, α_max, T_c, f_s).
     margin : float
         Gain margin [-], default 2 (6 dB).
+    count : float
+        Encoder count Δ = 2π/cpr [rad]; 0 for an ideal encoder.
+    i_noise_rms : float
+        RMS of the current-measurement error [A].
 
     Returns
     -------
@@ -228,11 +256,68 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN) -> GainRecommendation:
     K, a_max = d.K, d.alpha_max
     mode = "continuous" if f_s is None else f"f_s = {f_s:g} Hz"
     k_ok = k_lim > K
-    zeta = slope_damping(a_max, K if k_ok else k_lim / margin, d.T_c)
-    T_c_min = 4.0 * margin / (a_max * k_c) if 0.0 < k_c < math.inf else math.nan
-    zeta_rec = slope_damping(a_max, k_lim / margin, d.T_c)
-    return GainRecommendation(k_lim, k_c, k_s, margin, k_lim / margin, K, k_ok, k_lim / K, mode,
-                              zeta, T_c_min, zeta_rec)
+    K_noise = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION, k_lim)
+    k_quiet = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION / margin, k_lim / margin)
+    k_rec = min(k_lim / margin, k_quiet) if k_lim > 0.0 else 0.0
+    zeta = slope_damping(a_max, K if k_ok else k_rec, d.T_c)
+    k_cr = min(k_c, K_noise)
+    T_c_min = 4.0 * margin / (a_max * k_cr) if 0.0 < k_cr < math.inf else math.nan
+    zeta_rec = slope_damping(a_max, k_rec, d.T_c)
+    return GainRecommendation(k_lim, k_c, k_s, margin, k_rec, K, k_ok, k_lim / K, mode,
+                              zeta, T_c_min, zeta_rec, K_noise, k_quiet < k_lim / margin)
+
+
+def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: float,
+                     K_max: float) -> float:
+    """Smallest K < K_max [s/rad] at which the sensors' noise swings α_dem by ``fraction``·α_max.
+
+    The predicted swing of α_dem holding θ_dem is PTP_PER_RMS × its rms
+    (:func:`control.fdsmc.noise.noise_gain`, sloped law of eq. (46) in [1]); it grows with K
+    (α_dem = −α_max·K·(ω̂_r + θ̂_re/T_c)). In the cruise the swing is the same to ≈ 1 % (θ̂_re/T_c
+    is small against ω̂_r), so one limit serves both windows of the chatter criterion.
+
+    Parameters
+    ----------
+    d : LoopCase          The linearised loop; continuous: no limit.
+    count : float         Encoder count Δ = 2π/cpr [rad]; 0 for an ideal encoder.
+    i_noise_rms : float   RMS of the current-measurement error [A].
+    fraction : float      Allowed swing of α_dem [fraction of α_max].
+    K_max : float         Upper end of the search [s/rad], e.g. the stability limit.
+
+    Returns
+    -------
+    float
+        inf when the sensors are ideal, the controller continuous, or the swing stays below
+        ``fraction`` up to K_max. Cached on the numbers the search reads (K is not one of them).
+    """
+    if d.f_s is None or (count == 0.0 and i_noise_rms == 0.0) or not K_max > 0.0:
+        return math.inf
+    return _noise_gain_limit(law_case(d, "slope"), float(d.f_s), int(d.delay), float(count),
+                             float(i_noise_rms), float(fraction), float(K_max))
+
+
+@functools.lru_cache(maxsize=512)
+def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_noise_rms: float,
+                      fraction: float, K_max: float) -> float:
+    loop = dataclasses.replace(case, f_s=f_s, delay=delay)
+    target = fraction * loop.alpha_max / PTP_PER_RMS
+
+    def swings(K: float) -> bool:
+        with warnings.catch_warnings():  # ill-conditioned only next to the stability limit
+            warnings.simplefilter("ignore", LinAlgWarning)
+            return not noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms < target
+
+    grid = np.logspace(-5, 6, 23) * 1000.0 / loop.alpha_max
+    Ks = [float(K) for K in grid if K_max > K] + ([K_max] if math.isfinite(K_max) else [])
+    lo = None
+    for K in Ks:
+        if not swings(K):
+            lo = K
+        elif lo is None:  # the noise swings α_dem even at the smallest K searched
+            return K
+        else:
+            return geometric_bisect(swings, lo, K, 1.005)
+    return math.inf
 
 
 def loop_warnings(g: GainRecommendation, s: SampleRateCheck) -> tuple[str, ...]:
@@ -250,6 +335,13 @@ def loop_warnings(g: GainRecommendation, s: SampleRateCheck) -> tuple[str, ...]:
             f"{g.K_limit:.4g} s/rad of the linearised FDSMC loop ({g.mode}): the outer loop will "
             f"chatter (limit cycle) and waste copper energy. Recommended K = {g.K_recommended:.4g} "
             f"s/rad (gain margin {g.margin:g}).")
+    elif not g.K_noise_ok:
+        w.append(
+            f"Boundary-layer gain K = {g.K:g} s/rad is above the sensors' noise limit K_noise = "
+            f"{g.K_noise:.4g} s/rad ({g.mode}): the encoder's counts and the current noise, through "
+            f"the observer and K, swing α_dem by more than {100 * CHATTER_PTP_FRACTION:g} % of α_max — chatter "
+            f"without a limit cycle, and copper lost in the ripple. Recommended K = {g.K_recommended:.4g} "
+            f"s/rad, or slower T_so and T_sα (Design chooses them).")
     if s.stable and g.zeta_slope < ZETA_SLOPE_MIN:
         w.append(_slope_warning(g))
     return tuple(w)
@@ -264,7 +356,7 @@ def _slope_warning(g: GainRecommendation) -> str:
         fix = f"Raise K to the recommended {g.K_recommended:.4g} s/rad (ζ = {g.zeta_slope_recommended:.2g})."
     else:
         fix = (f"Set controller.T_c ≥ {g.T_c_min:.3g} s (ζ = 1 at K = "
-               f"{g.K_limit_cruise / g.margin:.4g} s/rad; T_c ≪ T_m keeps the timing).")
+               f"{min(g.K_limit_cruise, g.K_noise) / g.margin:.4g} s/rad; T_c ≪ T_m keeps the timing).")
     return (f"Sloped segment (eq. 41, deceleration) poorly damped with K = {k:.4g} s/rad: "
             f"ζ ≈ √(α_max·K·T_c)/2 = {g.zeta_slope:.2g} ({lin}). α_max·T_c is small (= ω_p when "
             f"T_c = T_a, eq. 59), so the drive will oscillate about θ_dem. {fix}")

@@ -13,6 +13,7 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from control.common.checks import ParameterError, check_fields, spec_field
@@ -259,6 +260,21 @@ class Sensors:
     def ideal(self) -> bool:
         """True when the controller measures θ_r, i_d and i_q exactly."""
         return self.encoder_cpr == 0 and self.i_noise == 0.0 and self.i_adc_bits == 0
+
+    @property
+    def encoder_step(self) -> float:
+        """One encoder count [rad]: 2π/cpr; 0 for an ideal encoder."""
+        return 2.0 * math.pi / self.encoder_cpr if self.encoder_cpr > 0 else 0.0
+
+    @property
+    def adc_step(self) -> float:
+        """One step of the current ADC [A]: 2·range/2^bits; 0 for an ideal ADC."""
+        return 2.0 * self.i_adc_range / 2.0**self.i_adc_bits if self.i_adc_bits > 0 else 0.0
+
+    @property
+    def reading_noise(self) -> float:
+        """RMS error of a current reading [A]: the noise and the ADC's rounding, √(σ² + q²/12)."""
+        return math.hypot(self.i_noise, self.adc_step / math.sqrt(12.0))
 
 
 @dataclass(frozen=True)

@@ -33,21 +33,6 @@ def noise_table(sensors: Sensors) -> np.ndarray:
     return np.random.default_rng(sensors.seed).standard_normal((NOISE_CHANNELS, NOISE_SAMPLES))
 
 
-def encoder_step(sensors: Sensors) -> float:
-    """One encoder count [rad]: 2π/cpr; 0 for an ideal encoder."""
-    return 2.0 * math.pi / sensors.encoder_cpr if sensors.encoder_cpr > 0 else 0.0
-
-
-def adc_step(sensors: Sensors) -> float:
-    """One step of the current ADC [A]: 2·range/2^bits; 0 for an ideal ADC."""
-    return 2.0 * sensors.i_adc_range / 2.0**sensors.i_adc_bits if sensors.i_adc_bits > 0 else 0.0
-
-
-def reading_noise(sensors: Sensors) -> float:
-    """RMS error of a current reading [A]: the noise and the ADC's rounding, √(σ² + q²/12)."""
-    return math.hypot(sensors.i_noise, adc_step(sensors) / math.sqrt(12.0))
-
-
 @jitable
 def encoder_angle(theta: float, step: float) -> float:
     """Angle the encoder reports for θ [rad]: whole counts, step·floor(θ/step); θ itself for step = 0."""
@@ -72,5 +57,4 @@ def adc_current(i: float, noise: float, sigma: float, step: float, full_scale: f
     return min(max(step * math.floor(x / step + 0.5), -full_scale), full_scale)
 
 
-__all__ = ["NOISE_CHANNELS", "NOISE_SAMPLES", "adc_current", "adc_step", "encoder_angle", "encoder_step",
-           "noise_table", "reading_noise"]
+__all__ = ["NOISE_CHANNELS", "NOISE_SAMPLES", "adc_current", "encoder_angle", "noise_table"]

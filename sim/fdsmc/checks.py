@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 from control.fdsmc.feasibility import current_limit, exceeds, speed_limit, torque_limit, voltage_limit
 from control.fdsmc.params import DriveParams
-from sim.common.sensors import reading_noise
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import LABELS, RunResult
 from sim.fdsmc.metrics import RunMetrics
@@ -86,7 +85,7 @@ def drive_limits(p: DriveParams) -> list[DriveLimit]:
                       "a longer T_m (lower ω_p) or a higher V_dc"),
            DriveLimit("speed", "omega_peak_rad_s", w_lim, "rad/s", f"the speed limit {w_lim:g} rad/s", "a longer T_m")]
     if i_lim > 0.0:
-        noise = CURRENT_NOISE_SIGMAS * reading_noise(p.sensors)
+        noise = CURRENT_NOISE_SIGMAS * p.sensors.reading_noise
         extra = f" + {noise:.3g} A of reading noise" if noise else ""
         out.append(DriveLimit("current", "i_peak_A", i_lim + noise, "A", f"the current limit {i_lim:.4g} A{extra}",
                               "a larger inverter or a lower acceleration"))

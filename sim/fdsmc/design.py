@@ -12,8 +12,10 @@ The choices, each from the drive model rather than a fudge factor:
   inverter's i_max, η being the inner loops' overshoot (:mod:`control.fdsmc.transient`).
 * T_m: the requested time when feasible (profile of eq. (60) in [1] exists, ω_p ≤ ω_b, voltage
   at ω_p within the inverter's); else the shortest feasible time (bisection, 0.1 %).
-* K: the recommended K (gain margin 2 below the chatter limit of the sampled loop at the drive's
-  f_s and delay, :mod:`control.fdsmc.loop_analysis`); halved while the simulation still chatters.
+* K: K_limit/2 (gain margin 2 below the chatter limit of the sampled loop at the drive's f_s and
+  delay, :mod:`control.fdsmc.loop_analysis`), halved while the simulation with the sensors still
+  chatters. Not the recommended K, which is also capped for the sensors' noise at the loops as
+  given: the design slows the loops for the noise instead, and verifies.
 * T_c: T_a (eq. (59)) unless the sloped segment is then poorly damped; then T_c,min.
 * T_so, T_sα for the sensors: the standstill ripple the encoder's quantization and the current
   noise cause is predicted in closed form (:func:`control.fdsmc.noise.noise_gain`); where it exceeds
@@ -36,7 +38,7 @@ from dataclasses import dataclass
 
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import alpha_max, feasibility, torque_limit
-from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
+from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN, GainRecommendation, slope_damping
 from control.fdsmc.loop_model import LoopModel
 from control.fdsmc.model import model_coefficients
 from control.fdsmc.noise import NoiseGain, noise_gain
@@ -44,7 +46,6 @@ from control.fdsmc.observer import observer_gains
 from control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
 from control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
 from control.fdsmc.transient import acceleration_overshoot
-from sim.common import sensors
 from sim.fdsmc.checks import TARGET_BAND, Constraint, run_checks
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import Comparison, RunResult, compare
@@ -55,7 +56,7 @@ MAX_K_HALVINGS = 4
 #: Factors applied to T_so and T_sα when the sensors' ripple exceeds the criterion [-].
 SENSOR_SLOWDOWN = (1.0, 1.5, 2.25, 3.4, 5.0, 7.6, 11.4)
 #: The predicted ripple a candidate may have, as a fraction of the criterion (the prediction is
-#: within ≈ 20 % of the simulation, ``tests/test_noise_gain.py``) [-].
+#: within ≈ 20 % of the simulation, ``tests/test_sensors.py``) [-].
 PREDICTION_MARGIN = 0.8
 #: T_m stretch per step and the most steps when the verified speed/voltage peak exceeds its limit.
 T_M_STRETCH, MAX_STRETCHES = 1.03, 6
@@ -150,14 +151,15 @@ def _overshoot(params: DriveParams) -> float:
 
 
 def _gain_and_T_c(params: DriveParams, d: Derived) -> DriveParams:
-    """K = recommended K (or 10/ω_p when the loop has no limit); T_c = T_c,min if ζ < ζ_min."""
+    """K = K_limit/margin (or 10/ω_p when the loop has no limit); T_c = T_c,min if ζ < ζ_min."""
     g = d.gain
     if g is None or g.K_limit <= 0.0:
         return params
-    K = g.K_recommended if math.isfinite(g.K_limit) else 10.0 / d.profile.omega_p
+    K = _design_K(g) if math.isfinite(g.K_limit) else 10.0 / d.profile.omega_p
+    a_max, k_c = d.alpha.alpha_max, g.K_limit_cruise
     T_c: float | str = "T_a"
-    if g.zeta_slope_recommended < ZETA_SLOPE_MIN and math.isfinite(g.T_c_min):
-        T_c = max(g.T_c_min, d.profile.T_a)
+    if slope_damping(a_max, g.K_limit / g.margin, d.loop.T_c) < ZETA_SLOPE_MIN and 0.0 < k_c < math.inf:
+        T_c = max(4.0 * g.margin / (a_max * k_c), d.profile.T_a)  # ζ = 1 at K_limit_cruise/margin
     return _with(params, "controller", K=K, T_c=T_c)
 
 
@@ -166,7 +168,7 @@ def predicted_noise(p: DriveParams, d: Derived) -> NoiseGain | None:
     if d.loop.f_s is None:
         return None
     se = p.sensors
-    return noise_gain(d.loop, "slope", p.controller.K, sensors.encoder_step(se), sensors.reading_noise(se))
+    return noise_gain(d.loop, "slope", p.controller.K, se.encoder_step, se.reading_noise)
 
 
 def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
@@ -328,10 +330,15 @@ def _scan_T_c(p: DriveParams, best: tuple[DriveParams, Derived, Comparison], n_b
 
 
 def _with_T_c(p: DriveParams, T_c: float) -> DriveParams:
-    """``p`` with the sloped segment's T_c [s] and the K recommended for it."""
+    """``p`` with the sloped segment's T_c [s] and the design's K for it."""
     q = _with(p, "controller", T_c=T_c)
     g = derive(q).gain
-    return _with(q, "controller", K=g.K_recommended) if g is not None and g.K_recommended > 0.0 else q
+    return _with(q, "controller", K=_design_K(g)) if g is not None and g.K_limit > 0.0 else q
+
+
+def _design_K(g: GainRecommendation) -> float:
+    """Return the design's first K [s/rad]: K_limit/margin (the sensors are the verification's)."""
+    return g.K_limit / g.margin
 
 
 def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> DriveDesign:

@@ -175,7 +175,7 @@ def _pack_sensors(prm: np.ndarray, params: DriveParams, d: Derived, T_step: floa
     """Sensor steps, the current predictor's factors over ``T_step`` and the in-position window."""
     se, c = params.sensors, d.coefficients
     prm[[kn.P_ENC, kn.P_INOISE, kn.P_ISTEP, kn.P_IFS]] = (
-        sensors.encoder_step(se), se.i_noise, sensors.adc_step(se), se.i_adc_range)
+        se.encoder_step, se.i_noise, se.adc_step, se.i_adc_range)
     if T_step is None:
         ctrl = params.controller
         T_step = continuous_step(params) if ctrl.is_continuous else 1.0 / float(ctrl.f_s)

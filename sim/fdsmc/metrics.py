@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.fdsmc.derivations import Derived
+from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
 from control.fdsmc.params import DriveParams
 from control.fdsmc.tracking import optimum_slide
 from sim.common import signals
@@ -32,8 +33,8 @@ from sim.common.energy import energy_balance
 from sim.fdsmc.limit_cycle import limit_cycles
 from sim.fdsmc.summary import KernelState, RunSummary
 
-#: Thresholds of the chatter criterion (fractions of α_max) and the smoothing window [s].
-CHATTER_PTP_FRACTION = 0.2
+#: Thresholds of the chatter criterion (fractions of α_max; its amplitude CHATTER_PTP_FRACTION is
+#: the loop analysis's) and the smoothing window [s].
 CHATTER_HYSTERESIS_FRACTION = 0.025
 CHATTER_MIN_SIGN_CHANGES = 8
 CHATTER_SMOOTHING_S = 0.005

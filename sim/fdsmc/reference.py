@@ -67,7 +67,7 @@ class ReferenceDrive:
         self.u_hold = (0.0, 0.0)
         se = params.sensors
         self.noise = sensors.noise_table(se)
-        self.enc_step, self.adc_step = sensors.encoder_step(se), sensors.adc_step(se)
+        self.enc_step, self.adc_step = se.encoder_step, se.adc_step
         T = d.observer_discrete.T_s if d.observer_discrete is not None else 0.0
         self.decay = decay_factors(self.c.A, T) + decay_factors(self.c.D, T)  # (φ_d, γ_d, φ_q, γ_q)
 

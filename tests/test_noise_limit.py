@@ -1,0 +1,94 @@
+"""The sensors' noise limit on K: where the encoder's counts and the current noise alone make α_dem chatter.
+
+With a coarse encoder the paper's sampled loop is stable well above the recommended K, yet the
+quantization error, through the observer (eq. (15) in [1], corrected) and the boundary-layer law
+(eq. (46)), swings α_dem by more than the chatter criterion allows. The recommended K must be the
+one the sensors allow (``control.fdsmc.loop_analysis.noise_gain_limit``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from app.io.presets import load_preset
+from control.fdsmc.derivations import derive
+from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, noise_gain_limit
+from control.fdsmc.noise import PTP_PER_RMS, noise_gain
+from control.fdsmc.params import DriveParams
+from sim.fdsmc.engine import simulate
+
+#: A Σ-7 servo with a catalogue 8192-count encoder instead of its 24-bit one; an in-position
+#: window of a few counts.
+COARSE = ["sensors.encoder_cpr=8192", "limits.in_position_rad=0.005"]
+
+
+def _with_K(p: DriveParams, K: float) -> DriveParams:
+    return dataclasses.replace(p, controller=dataclasses.replace(p.controller, K=float(K)))
+
+
+def _swing(p: DriveParams, K: float) -> float:
+    """Predicted swing of α_dem [fraction of α_max] at K."""
+    d, se = derive(_with_K(p, K)), p.sensors
+    rms = noise_gain(d.loop, "slope", K, se.encoder_step, se.reading_noise).alpha_dem_rms
+    return PTP_PER_RMS * rms / d.alpha.alpha_max
+
+
+def test_ideal_sensors_leave_the_recommendation_at_half_the_stability_limit():
+    for p in (load_preset("paper_12kw_pmsm"),
+              load_preset("yaskawa_sgm7j_04a", ["sensors.encoder_cpr=0", "sensors.i_noise=0", "sensors.i_adc_bits=0"])):
+        g = derive(p).gain
+        assert g.K_noise == math.inf and not g.noise_limited
+        assert g.K_recommended == g.K_limit / g.margin
+
+
+def test_K_noise_is_where_the_predicted_swing_reaches_the_chatter_criterion():
+    p = load_preset("yaskawa_sgm7j_04a", COARSE)
+    g = derive(p).gain
+    assert g.noise_limited and 0.0 < g.K_noise < g.K_limit / 5.0
+    assert _swing(p, g.K_noise) >= CHATTER_PTP_FRACTION > _swing(p, g.K_noise / 1.006)  # bisection to 0.5 %
+    # the recommendation keeps the gain margin on the swing: half the criterion
+    assert _swing(p, g.K_recommended) == pytest.approx(CHATTER_PTP_FRACTION / g.margin, rel=0.01)
+    # a 24-bit encoder: the noise never binds below K_limit/2, the recommendation is the loop's
+    fine = derive(load_preset("yaskawa_sgm7j_04a")).gain
+    assert not fine.noise_limited and fine.K_recommended == fine.K_limit / fine.margin
+
+
+def test_the_recommended_K_with_a_coarse_encoder_does_not_chatter_where_half_K_limit_did():
+    p = load_preset("yaskawa_sgm7j_04a", COARSE)
+    d = derive(p)
+    g = d.gain
+    old = simulate(_with_K(p, g.K_limit / g.margin), "fdsmc").metrics  # the loop-only recommendation
+    assert old.chatter and old.chatter_frequency_Hz > 500.0
+    rec = simulate(_with_K(p, g.K_recommended), "fdsmc").metrics
+    assert rec.stable and not rec.chatter
+    assert simulate(_with_K(p, 1.5 * g.K_noise), "fdsmc").metrics.chatter  # above the noise limit it does
+    # the warning names the noise limit and the recommended K
+    w = [x for x in d.warnings if "noise limit K_noise" in x]
+    assert len(w) == 1 and f"{g.K_noise:.4g}" in w[0] and f"{g.K_recommended:.4g}" in w[0]
+    assert not [x for x in derive(_with_K(p, g.K_recommended)).warnings if "K_noise" in x]
+
+
+@pytest.mark.parametrize(("name", "overrides"), [("yaskawa_sgm7j_04a", COARSE), ("odrive_d5065_belt", [])])
+def test_the_predicted_rms_of_alpha_dem_bounds_the_simulated_swing(name, overrides):
+    # below the limit the run does not chatter; its high-passed α_dem spans between a uniform
+    # distribution's √12 rms (quantization passed nearly unfiltered) and PTP_PER_RMS·rms (Gaussian)
+    p = load_preset(name, overrides)
+    g = derive(p).gain
+    K = 0.8 * g.K_noise
+    q = _with_K(p, K)
+    d, se = derive(q), q.sensors
+    rms = noise_gain(d.loop, "slope", K, se.encoder_step, se.reading_noise).alpha_dem_rms
+    m = simulate(q, "fdsmc", d).metrics
+    assert not m.chatter
+    assert 0.9 * math.sqrt(12.0) * rms <= m.chatter_alpha_ptp_rad_s2 <= 1.1 * PTP_PER_RMS * rms
+
+
+def test_a_continuous_controller_or_ideal_sensors_have_no_noise_limit():
+    p = load_preset("yaskawa_sgm7j_04a", COARSE)
+    loop = derive(p).loop
+    assert noise_gain_limit(dataclasses.replace(loop, f_s=None), 1e-3, 0.1, 0.2, 1.0) == math.inf
+    assert noise_gain_limit(loop, 0.0, 0.0, 0.2, 1.0) == math.inf
+    assert noise_gain_limit(loop, 1e-3, 0.1, 0.2, 0.0) == math.inf  # no stable K to search
