@@ -86,3 +86,19 @@ def test_k_slider_mirrors_a_preset_chosen_from_the_list(page):
     page.wait_for_function("(k) => Math.abs(parseFloat(document.querySelector"
                            "('[data-role=\"k-readout\"]').innerText.split('K = ')[1]) - k) < 1e-4", arg=K)
     _wait_position(page, K)
+
+
+def test_recommended_K_with_a_coarse_encoder_is_the_one_the_sensors_allow(page):
+    # a Σ-7 servo with a catalogue 8192-count encoder: K_limit/2 chatters on the counts' noise; the
+    # recommended K is capped at the sensors' noise limit, marked "noise" on the track, and is clean
+    choose(page, "Preset", "yaskawa_sgm7j_04a")
+    _wait_verdict(page, "no chatter")
+    set_number(page, "Encoder counts per rev (0 = ideal) [counts/rev]", "8192")
+    page.get_by_role("button", name="Simulate").click()
+    verdict = _wait_verdict(page, "CHATTER")
+    assert "K_noise" in verdict and "(sensors)" in verdict
+    assert "noise" in page.locator(".mantine-Slider-markLabel").all_inner_texts()
+    page.get_by_text("sensors' noise limit K_noise").first.wait_for()  # the warning says why
+    page.get_by_role("button", name="Use recommended K").click()
+    verdict = _wait_verdict(page, "no chatter")
+    assert "K ≤ K_noise" in verdict
