@@ -18,7 +18,8 @@ from control.fdsmc.derivations import derive
 from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, noise_gain_limit
 from control.fdsmc.noise import PTP_PER_RMS, noise_gain
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import simulate
+from sim.fdsmc.engine import compare, simulate
+from sim.fdsmc.verdicts import run_warnings
 
 #: A Σ-7 servo with a catalogue 8192-count encoder instead of its 24-bit one; an in-position
 #: window of a few counts.
@@ -69,6 +70,8 @@ def test_the_recommended_K_with_a_coarse_encoder_does_not_chatter_where_half_K_l
     w = [x for x in d.warnings if "noise limit K_noise" in x]
     assert len(w) == 1 and f"{g.K_noise:.4g}" in w[0] and f"{g.K_recommended:.4g}" in w[0]
     assert not [x for x in derive(_with_K(p, g.K_recommended)).warnings if "K_noise" in x]
+    hint = [x for x in run_warnings(compare(_with_K(p, g.K_limit / g.margin), ("fdsmc",))) if "Chatter" in x]
+    assert hint and f"noise limit K_noise = {g.K_noise:.4g}" in hint[0]
 
 
 @pytest.mark.parametrize(("name", "overrides"), [("yaskawa_sgm7j_04a", COARSE), ("odrive_d5065_belt", [])])

@@ -33,6 +33,9 @@ def _chatter_hint(derived: Derived) -> str:
         return " Reduce K, eq. (45)."
     if not g.K_ok:
         return f" Recommended K = {g.K_recommended:.4g} s/rad."
+    if not g.K_noise_ok:
+        return (f" K is above the sensors' noise limit K_noise = {g.K_noise:.4g} s/rad: recommended "
+                f"K = {g.K_recommended:.4g} s/rad.")
     if g.zeta_slope < ZETA_SLOPE_MIN and math.isfinite(g.T_c_min):
         return (f" The sloped segment is poorly damped (ζ ≈ {g.zeta_slope:.2g}): set "
                 f"controller.T_c ≥ {g.T_c_min:.3g} s.")
