@@ -14,7 +14,8 @@ import websockets
 from app.io.presets import DEFAULT_PRESET, load_preset
 from app.ui.page import create_server
 from app.ui.worker import Cancelled, Worker
-from tests.test_ui_hostile import CAMERA, PROTOCOL, _run, free_port
+from tests.net import free_port
+from tests.test_ui_hostile import CAMERA, PROTOCOL, _run
 
 #: The promise: a disconnected page's work is gone within this time [s].
 GONE_S = 2.0

@@ -19,6 +19,7 @@ import pytest
 
 from app.io import atomic
 from app.io.atomic import discard_partial, write_atomic
+from tests.net import free_port
 
 ROOT = Path(__file__).resolve().parents[1]
 OLD = b"old content that must survive\n"
@@ -124,3 +125,27 @@ def test_write_atomic_full_disk_leaves_nothing(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="No space"):
         write_atomic(target, b"new")
     assert target.read_bytes() == OLD and _no_part_files(tmp_path) == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_the_server_stops_at_once_with_130_and_one_line(sig):
+    # the web server's threads (sessions, simulations in flight) are never waited for: a SIGTERM from
+    # a service manager or Ctrl-C ends it within a second, like every other command
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    argv = [sys.executable, "-m", "app", "serve", "--port", str(free_port()), "--no-3d"]
+    proc = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:
+        for line in proc.stdout:  # wait for the URL: the server is up
+            if "http://" in line:
+                break
+        t0 = time.perf_counter()
+        os.killpg(proc.pid, sig)
+        _, err = proc.communicate(timeout=30)
+        waited = time.perf_counter() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err[-500:]
+    assert "Traceback" not in err and err.strip().splitlines()[-1].startswith("interrupted"), err
+    assert waited < 10.0

@@ -13,8 +13,9 @@ import time
 from app.io.presets import DEFAULT_PRESET, load_preset
 from app.ui.page import create_server
 from app.ui.studies_queue import StudySlots
+from tests.net import free_port
 from tests.page_client import PageClient
-from tests.test_ui_hostile import _run, free_port
+from tests.test_ui_hostile import _run
 
 #: Generous bound on a closed page's processes and study slot being gone [s] (the promise is 2 s).
 GONE_S = 5.0

@@ -24,16 +24,9 @@ from app.ui.text import md_text
 from app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
 from app.ui.worker import Cancelled, Worker
 from control.common.checks import ParameterError
+from tests.net import free_port
 
 PROTOCOL = f"viser-v{viser.__version__}"
-
-
-def free_port() -> int:
-    import socket
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
 
 
 @pytest.fixture(scope="module")

@@ -72,4 +72,4 @@ def run(args: argparse.Namespace) -> int:
             time.sleep(3600)
     except KeyboardInterrupt:
         server.stop()
-    return 0
+        raise  # the CLI then ends the process at once: a run still simulating is not waited for
