@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from app.ui.demo_state import PageView, loads_state
-from tests.browser.conftest import click_tab, open_page, session_of
+from tests.browser.conftest import click_tab, open_page, session_of, set_number
 
 OVERVIEW = "[...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane')"
 #: The phase-plane subplot's box in the page [px]: x, y, width, height.
@@ -80,6 +80,27 @@ def test_a_demo_state_brings_back_its_tabs_and_the_overviews_zoom(browser, ui_se
         _load(page, "bldc.json", json.dumps(raw))
         page.wait_for_function(f"() => ({SELECTED_JS})().includes('BLDC speed SMC')")
         _reported(page, probe, PageView("BLDC speed SMC", "BLDC figures", {}))
+        assert errors == []
+    finally:
+        context.close()
+
+
+def test_the_overviews_zoom_survives_another_results_tab(browser, ui_server):
+    # viser unmounts a hidden tab: the overview drawn again on its return gets the zoom back, while a
+    # new run (a new figure) starts unzoomed
+    context, page = open_page(browser, ui_server, viewport={"width": 1280, "height": 720})
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    try:
+        page.wait_for_function(f"() => {OVERVIEW} !== undefined && {OVERVIEW}._fullLayout !== undefined")
+        zoom = _zoom_box(page)
+        click_tab(page, "Time plots")
+        page.wait_for_function(f"() => {OVERVIEW} === undefined || {OVERVIEW}.offsetParent === null")
+        click_tab(page, "Overview")
+        page.wait_for_function(AT_JS, arg=[list(zoom["xaxis"]), list(zoom["yaxis"])])
+        set_number(page, "K boundary-layer gain [s/rad]", "2")
+        page.get_by_role("button", name="Simulate").click()
+        page.wait_for_function(f"(z) => !({AT_JS})(z)", arg=[list(zoom["xaxis"]), list(zoom["yaxis"])])
         assert errors == []
     finally:
         context.close()

@@ -3,7 +3,9 @@
 // JSON into the hidden text field UUID, as if typed (so viser sends it), whenever it may have changed:
 // after a click or key press (a tab chosen) and after the overview's axes changed (plotly_relayout).
 // The zoom of an overview element starts from its figure's layout.meta.zoom (a restored zoom) at each
-// new figure (plotly_react). Reads Plotly's el.layout (the ranges as drawn), a public property.
+// new figure (plotly_react). A results tab left and chosen again mounts a new overview element (viser
+// unmounts hidden tabs): the zoom of the same figure is kept across that (window.__appZoomKept) and
+// put back with Plotly.relayout. Reads Plotly's el.layout (the ranges as drawn), a public property.
 (() => {
   const uuid = UUID, modeTabs = MODE_TABS, resultsTabs = RESULTS_TABS;
   const setValue = Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set;
@@ -16,11 +18,22 @@
     return tab ? tab.getAttribute('title') : null;
   };
   const restart = (el) => { el.__appZoom = Object.assign({}, (el.layout.meta || {}).zoom || {}); };
+  // The figure an element shows: its title and meta (ω_p, T_c …); a new run gives a new one.
+  const figureKey = (el) => JSON.stringify([el.layout.title, el.layout.meta]);
+  const keep = (el) => { window.__appZoomKept = {key: figureKey(el), zoom: Object.assign({}, el.__appZoom)}; };
+  const putBack = (el) => {
+    const kept = window.__appZoomKept;
+    if (!kept || kept.key !== figureKey(el) || Object.keys(el.__appZoom).length) return;
+    const update = {};
+    for (const [axis, range] of Object.entries(kept.zoom)) update[axis + '.range'] = range;
+    if (Object.keys(update).length) window.Plotly.relayout(el, update);
+  };
   const hook = (el) => {
-    if (el.__appViewHooked || !el.on) return;
+    if (el.__appViewHooked || !el.on || !el._fullLayout) return;
     el.__appViewHooked = true;
     restart(el);
-    el.on('plotly_react', () => { restart(el); report(); });
+    putBack(el);
+    el.on('plotly_react', () => { restart(el); keep(el); report(); });
     el.on('plotly_relayout', (ev) => {
       for (const key of Object.keys(ev || {})) {
         const m = key.match(axisKey);
@@ -29,6 +42,7 @@
         if (m[2] === 'autorange' && ev[key]) delete el.__appZoom[m[1]];
         else if (axis && Array.isArray(axis.range)) el.__appZoom[m[1]] = [Number(axis.range[0]), Number(axis.range[1])];
       }
+      keep(el);
       report();
     });
   };
@@ -50,7 +64,13 @@
     setValue.call(input, view);
     input.dispatchEvent(new Event('input', {bubbles: true}));
   };
-  const later = () => setTimeout(report, 60);  // after the tab strip took the click or key
+  // after the tab strip took the click or key; a newly shown overview is drawn a few frames later
+  const later = () => { setTimeout(report, 60); watchMount(120); };
+  const watchMount = (frames) => {
+    const el = overview();
+    if (el && el._fullLayout && !el.__appViewHooked) { hook(el); report(); return; }
+    if (frames > 0) requestAnimationFrame(() => watchMount(frames - 1));
+  };
   if (window.__appPageView) {
     for (const [type, fn] of window.__appPageView) document.removeEventListener(type, fn, true);
   }
