@@ -86,6 +86,11 @@ def test_k_slider_mirrors_a_preset_chosen_from_the_list(page):
     page.wait_for_function("(k) => Math.abs(parseFloat(document.querySelector"
                            "('[data-role=\"k-readout\"]').innerText.split('K = ')[1]) - k) < 1e-4", arg=K)
     _wait_position(page, K)
+    # its designed K sits between the noise-capped recommendation and the noise limit, verified clean:
+    # no remedy is offered
+    _wait_verdict(page, "no chatter")
+    page.get_by_text("Ready — ").wait_for()
+    assert not page.get_by_role("button", name="Use recommended K").is_visible()
 
 
 def test_recommended_K_with_a_coarse_encoder_is_the_one_the_sensors_allow(page):
