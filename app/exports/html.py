@@ -15,6 +15,7 @@ import plotly.io as pio
 from app.exports.c_module import TOOL
 from app.figures.fdsmc_comparison import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
 from app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure
+from app.figures.style import BAD_COLOUR
 from app.io.derived_view import derived_rows
 from app.io.numbers import format_metric
 from app.io.presets import to_raw
@@ -123,7 +124,7 @@ def html_report(cmp: Comparison) -> str:
                          default_height=f"{fig.layout.height}px") for i, fig in enumerate(report_figures(cmp))]
     style = ("body{font-family:sans-serif;margin:24px;max-width:1200px}table{border-collapse:collapse;"
              "margin-bottom:16px}td,th{border:1px solid #ccc;padding:3px 8px;font-size:13px}"
-             ".warn{color:#c92a2a;font-weight:600}")
+             f".warn{{color:{BAD_COLOUR};font-weight:600}}")
     name = html_text(params.name)
     return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>FDSMC commissioning report — {name}"
             f"</title><style>{style}</style></head><body><h1>FDSMC commissioning report — {name}</h1>"

@@ -17,7 +17,7 @@ import plotly.graph_objects as go
 
 from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index
 from app.figures.plain import to_figure
-from app.figures.style import FONT_PX, POSITION_COLOURS, POSITION_DASHES, WARNING_COLOUR
+from app.figures.style import BAD_COLOUR, FONT_PX, POSITION_COLOURS, POSITION_DASHES, WARNING_COLOUR
 from control.fdsmc.sliding_mode import boundary_speed, in_boundary_layer
 from sim.fdsmc.engine import LABELS, Comparison, RunResult
 
@@ -134,8 +134,8 @@ def _phase_marks(comparison: Comparison, key: str, run: RunResult, x_mid: float)
         out.append({"type": "scatter", "x": tr.theta_r[idx] - th, "y": tr.omega_r[idx], "mode": "markers",
                     "name": f"{LABELS[key]} load step", "showlegend": key == "fdsmc",
                     # an "-thin" symbol is drawn by its line alone: the line carries the red
-                    "marker": {"symbol": "x-thin", "size": 14, "color": "#c92a2a",
-                               "line": {"width": 3, "color": "#c92a2a"}},
+                    "marker": {"symbol": "x-thin", "size": 14, "color": BAD_COLOUR,
+                               "line": {"width": 3, "color": BAD_COLOUR}},
                     "hovertemplate": "load step at t = %{customdata:.4g} s<extra></extra>",
                     "customdata": np.asarray(steps)})
     return out
@@ -255,7 +255,7 @@ def time_plots_spec(comparison: Comparison, rows: tuple[int, ...] | None = None,
              for r in (0, 1) if r in rows]
     axes, notes = _time_axes(len(rows))
     shapes = [{"type": "line", "xref": "x", "yref": "paper", "x0": t, "x1": t, "y0": 0.0, "y1": 1.0,
-                "line": {"color": "#c92a2a", "width": 2, "dash": "dot"}} for t in load_step_times(comparison)]
+                "line": {"color": BAD_COLOUR, "width": 2, "dash": "dot"}} for t in load_step_times(comparison)]
     notes += [{"text": f"load step {t:.3g} s", "x": t, "y": 1.0, "xref": "x", "yref": "paper",
                "showarrow": False, "font": {"color": WARNING_COLOUR, "size": FONT_PX}, "xanchor": "left",
                "yanchor": "top"}

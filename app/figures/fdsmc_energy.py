@@ -12,6 +12,7 @@ import plotly.graph_objects as go
 
 from app.figures.decimate import f32, time_axis
 from app.figures.fdsmc_comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
+from app.figures.style import BAD_COLOUR, GOOD_COLOUR
 from sim.fdsmc.engine import LABELS, Comparison, RunResult
 from sim.fdsmc.optimum_gap import saving_vs_optimum
 from sim.fdsmc.table1 import Table1Row, printed_reversed
@@ -144,7 +145,7 @@ def make_table1_figure(rows: Sequence[Table1Row], paper: Mapping[float, float] |
     t_m = [r.T_m for r in rows]
     series = (
         ("saving_pct", "simulated (FDSMC vs conventional)", COLOURS["fdsmc"], "lines+markers"),
-        ("saving_eq52_pct", "predicted, eqs. (52), (61)", "#2b8a3e", "lines"),
+        ("saving_eq52_pct", "predicted, eqs. (52), (61)", GOOD_COLOUR, "lines"),
         ("bound_pct", "bound 1 − 4/5.6, eq. (53)", "#555555", "lines"),
     )
     for attr, name, colour, mode in series:
@@ -153,10 +154,10 @@ def make_table1_figure(rows: Sequence[Table1Row], paper: Mapping[float, float] |
     if paper:
         xs = sorted(paper)
         fig.add_scatter(x=xs, y=[paper[x] for x in xs], mode="markers", name="paper, Table 1 as printed",
-                        marker={"symbol": "x", "size": 11, "color": "#c92a2a"})
+                        marker={"symbol": "x", "size": 11, "color": BAD_COLOUR})
         back = printed_reversed(dict(paper))
         fig.add_scatter(x=xs, y=[back[x] for x in xs], mode="markers", name="paper, columns reversed (erratum)",
-                        marker={"symbol": "circle-open", "size": 13, "color": "#c92a2a", "line": {"width": 2}})
+                        marker={"symbol": "circle-open", "size": 13, "color": BAD_COLOUR, "line": {"width": 2}})
     return _styled(fig, "table1", "Friction saving vs manoeuvre time (Table 1)", -0.2,
                    xaxis_title="T_m [s]", yaxis_title="saving [%]")
 

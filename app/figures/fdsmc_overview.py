@@ -22,7 +22,7 @@ from app.figures.fdsmc_pins import Pin, ghost_traces
 from app.figures.fdsmc_trail import piece_traces, pieces
 from app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
 from app.figures.fdsmc_zoom import zoom_parts
-from app.figures.style import FONT_PX, TITLE_PX
+from app.figures.style import BAD_COLOUR, FONT_PX, TITLE_PX
 from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
 
@@ -32,7 +32,7 @@ PHASE_X, TIME_X = (0.0, 0.55), (0.66, 1.0)
 ROW_Y = ((0.56, 1.0), (0.0, 0.44))
 #: Names of the two cursor traces the replay moves (one per time row).
 CURSORS = ("time cursor ω_r", "time cursor Γ")
-LOAD_STEP_COLOUR = "#c92a2a"
+LOAD_STEP_COLOUR = BAD_COLOUR
 REF_LINE = {"color": "#555", "width": 1.2, "dash": "dash"}
 
 

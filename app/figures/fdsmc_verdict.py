@@ -13,12 +13,13 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from app.figures.style import BAD_COLOUR, GOOD_COLOUR
+
 #: Font size of the verdict on the plot [px] (a projector's back row).
 VERDICT_FONT_PX = 20
 #: Font size of the line below it (K against K_limit) [px].
 DETAIL_FONT_PX = 16
 #: Colours of a chattering / unstable run and of a clean one.
-BAD_COLOUR, GOOD_COLOUR = "#c92a2a", "#2b8a3e"
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,9 @@ TRAIL_PHASE_DASHES: tuple[str, str, str] = ("dot", "solid", "longdash")
 #: Reference lines (ω*, T*, boundaries) and warnings (limits exceeded, load steps).
 REFERENCE_COLOUR = "#333333"
 WARNING_COLOUR = _O["vermillion"]
+#: A verdict's two colours: bad (chatter, over a limit, a load step) and good. On white, the dark red
+#: has a contrast of 5.5:1 and the green 4.4:1 (for large or bold text, where they carry words).
+BAD_COLOUR, GOOD_COLOUR = "#c92a2a", "#2b8a3e"
 
 #: Colour groups drawn together in one figure: each pair must stay distinguishable.
 FIGURE_GROUPS: dict[str, tuple[str, ...]] = {

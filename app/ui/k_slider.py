@@ -16,6 +16,7 @@ from collections.abc import Callable
 
 import viser
 
+from app.figures.style import BAD_COLOUR, GOOD_COLOUR
 from app.ui.log_slider import (
     LogSlider,
     Mark,
@@ -64,7 +65,7 @@ def readout_html(K: float, K_limit: float, K_rec: float | None, K_noise: float =
     K is red at or above K_limit, or above the sensors' noise limit K_noise.
     """
     over = (positive(K_limit) and K_limit <= K) or K_noise < K
-    parts = [f'<b style="color:{"#c92a2a" if over else "#2b8a3e"}">K = {K:.4g} s/rad</b>']
+    parts = [f'<b style="color:{BAD_COLOUR if over else GOOD_COLOUR}">K = {K:.4g} s/rad</b>']
     if positive(K_rec):
         parts.append(f"rec {K_rec:.3g}")
     if K_noise < K_limit:

@@ -13,7 +13,7 @@ import re
 from typing import Any
 
 from app.figures.fdsmc_pins import pins_note
-from app.figures.style import KEY_PX, fmt
+from app.figures.style import BAD_COLOUR, GOOD_COLOUR, KEY_PX, fmt
 from app.io.derived_view import derived_rows
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import torque_limit
@@ -67,7 +67,7 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
                     f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html_text(n)}</div>'
                     for n in notes or [])
     if error is None and not items:
-        return ('<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:#2b8a3e;'
+        return (f'<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:{GOOD_COLOUR};'
                 'font-size:0.85em">✔ No warnings.</div>' + extra)
     parts = []
     if error is not None:
@@ -81,7 +81,7 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
                      f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html_text(items[0])}'
                      f'</span></summary><ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul></details>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
-            'border:2px solid #e03131;color:#c92a2a;font-size:0.85em">' + "".join(parts) + "</div>" + extra)
+            f'border:2px solid #e03131;color:{BAD_COLOUR};font-size:0.85em">' + "".join(parts) + "</div>" + extra)
 
 
 def _saves(pct: float | None) -> str:
@@ -116,7 +116,7 @@ def key_numbers_html(comparison: Any) -> str:
         v = r.metrics.torque_peak_Nm if r is not None else None
         if v is None:
             return "–"
-        return f'<b style="color:#c92a2a">{fmt(v, digits=3)} ⚠</b>' if v > g_max * 1.001 else fmt(v, digits=3)
+        return f'<b style="color:{BAD_COLOUR}">{fmt(v, digits=3)} ⚠</b>' if v > g_max * 1.001 else fmt(v, digits=3)
 
     energies = " · ".join(
         f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {fmt(e.net_electrical_J, 'J', 3)}"
