@@ -2,7 +2,7 @@
 
 The searches of :mod:`control.fdsmc.loop_analysis` and the overshoot η of
 :mod:`control.fdsmc.transient` are cached on the numbers the loop is built from
-(:func:`~control.fdsmc.loop_analysis.law_case`, :meth:`~control.fdsmc.loop_model.LoopCase.model`).
+(:func:`~control.fdsmc.loop_model.law_case`, :meth:`~control.fdsmc.loop_model.LoopCase.model`).
 A key that left out a number the search reads would hand one case another's verdict; these tests
 change each number the key drops and check the uncached result does not move, and check that
 cached and fresh results are equal to the last bit.
@@ -16,6 +16,7 @@ import pytest
 
 from app.io.presets import load_preset
 from control.fdsmc import loop_analysis as la
+from control.fdsmc import loop_model as lm
 from control.fdsmc import transient
 from control.fdsmc.derivations import derive
 
@@ -46,7 +47,7 @@ def test_minimum_sample_rate_ignores_what_its_key_drops():
     for name, value in {"alpha_max": 1.0, "T_c": 0.5, "K": 9.0, "T_si": 1e-3, "f_s": 1.0}.items():
         assert fresh(dataclasses.replace(d, **{name: value}), d.delay) == base, name
     # …and the key keeps what it reads: the conventional gains of eq. (61) in [1] enter the loop
-    assert la.law_case(dataclasses.replace(d, g1=2 * d.g1), "conventional") != la.law_case(d, "conventional")
+    assert lm.law_case(dataclasses.replace(d, g1=2 * d.g1), "conventional") != lm.law_case(d, "conventional")
 
 
 def test_cached_verdicts_equal_fresh_ones_bit_for_bit():
@@ -71,5 +72,5 @@ def test_a_different_drive_is_a_different_key():
     """J_L enters every law (eq. (4b) in [1]): a new load inertia must not reuse the old verdict."""
     a, b = _case(), _case("load.J_L=1e-3")
     for law in la.LAWS:
-        assert la.law_case(a, law) != la.law_case(b, law)
+        assert lm.law_case(a, law) != lm.law_case(b, law)
     assert a.model() != b.model()

@@ -3,7 +3,7 @@
 With a coarse encoder the paper's sampled loop is stable well above the recommended K, yet the
 quantization error, through the observer (eq. (15) in [1], corrected) and the boundary-layer law
 (eq. (46)), swings α_dem by more than the chatter criterion allows. The recommended K must be the
-one the sensors allow (``control.fdsmc.loop_analysis.noise_gain_limit``).
+one the sensors allow (``control.fdsmc.noise.noise_gain_limit``).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ import pytest
 
 from app.io.presets import load_preset
 from control.fdsmc.derivations import derive
-from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, noise_gain_limit
-from control.fdsmc.noise import PTP_PER_RMS, noise_gain
+from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
+from control.fdsmc.noise import PTP_PER_RMS, noise_gain, noise_gain_limit
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import compare, simulate
 from sim.fdsmc.verdicts import run_warnings

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.fdsmc import loop_analysis, loop_model, transient
+from control.fdsmc import loop_analysis, loop_model, noise, transient
 from control.fdsmc.conventional import ConventionalGains, conventional_gains, friction_energy_conventional
 from control.fdsmc.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
 from control.fdsmc.loop_analysis import (
@@ -136,7 +136,7 @@ def derive(params: DriveParams) -> Derived:
 def clear_caches() -> None:
     """Forget every cached loop verdict and sampled model (benchmarks: what a new drive costs)."""
     for cached in (loop_analysis._gain_limit, loop_analysis._minimum_sample_rate, loop_model._sampled_parts,
-                   transient._acceleration_overshoot, loop_analysis._noise_gain_limit):
+                   transient._acceleration_overshoot, noise._noise_gain_limit):
         cached.cache_clear()
 
 

@@ -10,7 +10,7 @@ J_r + J_L from the preset; the controller knows only J_r.
   the imaginary axis / unit circle); the loop then limit-cycles against the saturation of
   eq. (45) — the chatter seen with the paper's K = 1000.
 * K_noise: the smallest K at which the sensors' noise alone swings α_dem as much as the chatter
-  criterion allows (:func:`noise_gain_limit`; inf for ideal sensors).
+  criterion allows (:func:`control.fdsmc.noise.noise_gain_limit`; inf for ideal sensors).
 * Recommended K = K_limit / margin, lowered where the sensors' noise would swing α_dem by more than
   the criterion / margin: the K the real drive's sensors allow.
 * Sample-rate check: the same sampled loop with the slow conventional outer law of eq. (61)
@@ -29,22 +29,21 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import warnings
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import LinAlgWarning
 
 from control.fdsmc.loop_model import (
     LoopCase,
     SampledParts,
     continuous_loop,
     discrete_loop,
+    geometric_bisect,
+    law_case,
     reduce_shift_mode,
     sampled_parts,
 )
-from control.fdsmc.noise import PTP_PER_RMS, noise_gain
+from control.fdsmc.noise import noise_gain_limit
 
 #: Default gain margin of the recommended K [-] (2 = 6 dB).
 GAIN_MARGIN = 2.0
@@ -168,19 +167,6 @@ def _measures(M0: np.ndarray, M1: np.ndarray, Ks: list[float] | np.ndarray, samp
     return out
 
 
-def law_case(d: LoopCase, law: str) -> LoopCase:
-    """``d`` with every number the loop of ``law`` does not read set to 0: the searches' cache key.
-
-    All laws read the model, observer, inertias, friction and T_sα, and the K search reads α_max
-    (its grid and the laws of eq. (46) in [1]); the sloped law reads T_c, the conventional law
-    g1 and g2. The sample rate and delay are the searches' own arguments.
-    """
-    return dataclasses.replace(
-        d, T_si=0.0, T_so=0.0, f_s=None, delay=0, K=0.0,
-        T_c=d.T_c if law == "slope" else 0.0,
-        g1=d.g1 if law == "conventional" else 0.0, g2=d.g2 if law == "conventional" else 0.0)
-
-
 def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> float:
     """Upper stability limit in K [s/rad] of the linearised loop with ``law``.
 
@@ -188,7 +174,7 @@ def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> floa
     1000/α_max); above the largest stable grid K the first unstable one is refined by bisection
     to 0.5 %. Returns 0 if the loop is unstable for every K (inner loops unstable, or a sloped
     segment too poorly damped, see :func:`slope_damping`) and ``inf`` if it never is.
-    Cached on :func:`law_case`.
+    Cached on :func:`control.fdsmc.loop_model.law_case`.
     """
     return _gain_limit(law_case(d, law), law, None if f_s is None else float(f_s), int(delay))
 
@@ -230,7 +216,7 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
     """Recommended boundary-layer gain K for the preset's implementation and sensors.
 
     K_limit/margin, or less where the sensors' noise would swing α_dem by more than the chatter
-    criterion/margin (:func:`noise_gain_limit`).
+    criterion/margin (:func:`control.fdsmc.noise.noise_gain_limit`).
 
     Parameters
     ----------
@@ -265,59 +251,6 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
     zeta_rec = slope_damping(a_max, k_rec, d.T_c)
     return GainRecommendation(k_lim, k_c, k_s, margin, k_rec, K, k_ok, k_lim / K, mode,
                               zeta, T_c_min, zeta_rec, K_noise, k_quiet < k_lim / margin)
-
-
-def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: float,
-                     K_max: float) -> float:
-    """Smallest K < K_max [s/rad] at which the sensors' noise swings α_dem by ``fraction``·α_max.
-
-    The predicted swing of α_dem holding θ_dem is PTP_PER_RMS × its rms
-    (:func:`control.fdsmc.noise.noise_gain`, sloped law of eq. (46) in [1]); it grows with K
-    (α_dem = −α_max·K·(ω̂_r + θ̂_re/T_c)). In the cruise the swing is the same to ≈ 1 % (θ̂_re/T_c
-    is small against ω̂_r), so one limit serves both windows of the chatter criterion.
-
-    Parameters
-    ----------
-    d : LoopCase          The linearised loop; continuous: no limit.
-    count : float         Encoder count Δ = 2π/cpr [rad]; 0 for an ideal encoder.
-    i_noise_rms : float   RMS of the current-measurement error [A].
-    fraction : float      Allowed swing of α_dem [fraction of α_max].
-    K_max : float         Upper end of the search [s/rad], e.g. the stability limit.
-
-    Returns
-    -------
-    float
-        inf when the sensors are ideal, the controller continuous, or the swing stays below
-        ``fraction`` up to K_max. Cached on the numbers the search reads (K is not one of them).
-    """
-    if d.f_s is None or (count == 0.0 and i_noise_rms == 0.0) or not K_max > 0.0:
-        return math.inf
-    return _noise_gain_limit(law_case(d, "slope"), float(d.f_s), int(d.delay), float(count),
-                             float(i_noise_rms), float(fraction), float(K_max))
-
-
-@functools.lru_cache(maxsize=512)
-def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_noise_rms: float,
-                      fraction: float, K_max: float) -> float:
-    loop = dataclasses.replace(case, f_s=f_s, delay=delay)
-    target = fraction * loop.alpha_max / PTP_PER_RMS
-
-    def swings(K: float) -> bool:
-        with warnings.catch_warnings():  # ill-conditioned only next to the stability limit
-            warnings.simplefilter("ignore", LinAlgWarning)
-            return not noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms < target
-
-    grid = np.logspace(-5, 6, 23) * 1000.0 / loop.alpha_max
-    Ks = [float(K) for K in grid if K_max > K] + ([K_max] if math.isfinite(K_max) else [])
-    lo = None
-    for K in Ks:
-        if not swings(K):
-            lo = K
-        elif lo is None:  # the noise swings α_dem even at the smallest K searched
-            return K
-        else:
-            return geometric_bisect(swings, lo, K, 1.005)
-    return math.inf
 
 
 def loop_warnings(g: GainRecommendation, s: SampleRateCheck) -> tuple[str, ...]:
@@ -385,7 +318,7 @@ def minimum_sample_rate(d: LoopCase, delay: int = 0) -> float | None:
     """Smallest f_s [Hz] for which the sampled inner loops + observer are stable (1 % steps).
 
     Searched between 100 Hz and 10 MHz; None if even 10 MHz is unstable. Cached on
-    :func:`law_case` without α_max (the conventional law does not read it).
+    :func:`control.fdsmc.loop_model.law_case` without α_max (the conventional law does not read it).
     """
     return _minimum_sample_rate(dataclasses.replace(law_case(d, "conventional"), alpha_max=0.0), int(delay))
 
@@ -403,20 +336,3 @@ def _minimum_sample_rate(d: LoopCase, delay: int) -> float | None:
         return lo
     return geometric_bisect(lambda fs: not unstable(fs), lo, hi, 1.01)
 
-
-def geometric_bisect(flips: Callable[[float], bool], lo: float, hi: float, ratio: float) -> float:
-    """Smallest x in (lo, hi] with ``flips(x)`` true, given flips(lo) false and flips(hi) true.
-
-    Bisection on a log scale until hi/lo ≤ ``ratio``; returns the upper end (where it flips).
-    The midpoint √lo·√hi never overflows, and at most 200 halvings are made (enough for any
-    bracket of doubles).
-    """
-    for _ in range(200):
-        if not hi / lo > ratio:
-            break
-        mid = math.sqrt(lo) * math.sqrt(hi)
-        if flips(mid):
-            hi = mid
-        else:
-            lo = mid
-    return hi

@@ -13,13 +13,19 @@ observer of eq. (15) — continuous, or the ZOH-exact discrete observer of
 two cases that differ elsewhere (T_m, K, the load steps …) compare and hash equal and
 :mod:`control.fdsmc.loop_analysis` can reuse its verdicts for them. The sampled plant and observer
 of one sample rate are cached the same way (one matrix exponential each per distinct model).
+:func:`law_case` is the searches' cache key and :func:`geometric_bisect` their bisection, shared
+by the stability limits (:mod:`control.fdsmc.loop_analysis`) and the sensors' noise limit
+(:mod:`control.fdsmc.noise`).
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -242,3 +248,34 @@ def reduce_shift_mode(M: np.ndarray) -> np.ndarray:
     Mt = T @ M @ T_inv
     keep = [i for i in range(n) if i != 3]
     return Mt[np.ix_(keep, keep)]
+
+
+def law_case(d: LoopCase, law: str) -> LoopCase:
+    """``d`` with every number the loop of ``law`` does not read set to 0: the searches' cache key.
+
+    All laws read the model, observer, inertias, friction and T_sα, and the K search reads α_max
+    (its grid and the laws of eq. (46) in [1]); the sloped law reads T_c, the conventional law
+    g1 and g2. The sample rate and delay are the searches' own arguments.
+    """
+    return dataclasses.replace(
+        d, T_si=0.0, T_so=0.0, f_s=None, delay=0, K=0.0,
+        T_c=d.T_c if law == "slope" else 0.0,
+        g1=d.g1 if law == "conventional" else 0.0, g2=d.g2 if law == "conventional" else 0.0)
+
+
+def geometric_bisect(flips: Callable[[float], bool], lo: float, hi: float, ratio: float) -> float:
+    """Smallest x in (lo, hi] with ``flips(x)`` true, given flips(lo) false and flips(hi) true.
+
+    Bisection on a log scale until hi/lo ≤ ``ratio``; returns the upper end (where it flips).
+    The midpoint √lo·√hi never overflows, and at most 200 halvings are made (enough for any
+    bracket of doubles).
+    """
+    for _ in range(200):
+        if not hi / lo > ratio:
+            break
+        mid = math.sqrt(lo) * math.sqrt(hi)
+        if flips(mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi

@@ -19,20 +19,31 @@ is √P[i_q, i_q] and that of the applied u_q follows from the control row.
 The same covariance gives the rms of the demanded acceleration, α_dem = a_θ·θ̂ + a_ω·ω̂ of the
 outer law; its expected swing over a chatter window is :data:`PTP_PER_RMS` times the rms. Where
 that swing reaches the chatter criterion's amplitude, the noise alone makes α_dem chatter without
-any instability (:func:`control.fdsmc.loop_analysis.noise_gain_limit`).
+any instability (:func:`noise_gain_limit`).
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import matrix_balance, solve_discrete_lyapunov
+from scipy.linalg import LinAlgWarning, matrix_balance, solve_discrete_lyapunov
 
-from control.fdsmc.loop_model import LoopCase, control_row, discrete_matrix, outer_gains, sampled_parts
+from control.fdsmc.loop_model import (
+    LoopCase,
+    control_row,
+    discrete_matrix,
+    geometric_bisect,
+    law_case,
+    outer_gains,
+    sampled_parts,
+)
 
 #: Peak-to-peak of the sampled noise of α_dem over a chatter window per rms [-]. A few thousand
 #: Gaussian samples span ≈ 2 × 3.5 rms; the high-passed α_dem of the chatter criterion spans
@@ -121,4 +132,57 @@ def _noise_inputs(parts, loop: LoopCase, row: np.ndarray) -> np.ndarray:
     return B
 
 
-__all__ = ["PTP_PER_RMS", "NoiseGain", "noise_gain"]
+
+def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: float,
+                     K_max: float) -> float:
+    """Smallest K < K_max [s/rad] at which the sensors' noise swings α_dem by ``fraction``·α_max.
+
+    The predicted swing of α_dem holding θ_dem is PTP_PER_RMS × its rms
+    (:func:`control.fdsmc.noise.noise_gain`, sloped law of eq. (46) in [1]); it grows with K
+    (α_dem = −α_max·K·(ω̂_r + θ̂_re/T_c)). In the cruise the swing is the same to ≈ 1 % (θ̂_re/T_c
+    is small against ω̂_r), so one limit serves both windows of the chatter criterion.
+
+    Parameters
+    ----------
+    d : LoopCase          The linearised loop; continuous: no limit.
+    count : float         Encoder count Δ = 2π/cpr [rad]; 0 for an ideal encoder.
+    i_noise_rms : float   RMS of the current-measurement error [A].
+    fraction : float      Allowed swing of α_dem [fraction of α_max].
+    K_max : float         Upper end of the search [s/rad], e.g. the stability limit.
+
+    Returns
+    -------
+    float
+        inf when the sensors are ideal, the controller continuous, or the swing stays below
+        ``fraction`` up to K_max. Cached on the numbers the search reads (K is not one of them).
+    """
+    if d.f_s is None or (count == 0.0 and i_noise_rms == 0.0) or not K_max > 0.0:
+        return math.inf
+    return _noise_gain_limit(law_case(d, "slope"), float(d.f_s), int(d.delay), float(count),
+                             float(i_noise_rms), float(fraction), float(K_max))
+
+
+@functools.lru_cache(maxsize=512)
+def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_noise_rms: float,
+                      fraction: float, K_max: float) -> float:
+    loop = dataclasses.replace(case, f_s=f_s, delay=delay)
+    target = fraction * loop.alpha_max / PTP_PER_RMS
+
+    def swings(K: float) -> bool:
+        with warnings.catch_warnings():  # ill-conditioned only next to the stability limit
+            warnings.simplefilter("ignore", LinAlgWarning)
+            return not noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms < target
+
+    grid = np.logspace(-5, 6, 23) * 1000.0 / loop.alpha_max
+    Ks = [float(K) for K in grid if K_max > K] + ([K_max] if math.isfinite(K_max) else [])
+    lo = None
+    for K in Ks:
+        if not swings(K):
+            lo = K
+        elif lo is None:  # the noise swings α_dem even at the smallest K searched
+            return K
+        else:
+            return geometric_bisect(swings, lo, K, 1.005)
+    return math.inf
+
+__all__ = ["PTP_PER_RMS", "NoiseGain", "noise_gain", "noise_gain_limit"]
