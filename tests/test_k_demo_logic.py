@@ -15,7 +15,7 @@ def _comparison(K: float, K_limit: float, chatter: bool = False, freq: float | N
                 stable: bool = True, ran: bool = True, K_noise: float = math.inf) -> SimpleNamespace:
     metrics = SimpleNamespace(chatter=chatter, chatter_frequency_Hz=freq, stable=stable)
     derived = SimpleNamespace(params=SimpleNamespace(controller=SimpleNamespace(K=K)),
-                              gain=SimpleNamespace(K_limit=K_limit, K_noise=K_noise))
+                              gain=SimpleNamespace(K_limit=K_limit, K_noise_binding=K_noise))
     return SimpleNamespace(fdsmc=SimpleNamespace(metrics=metrics) if ran else None, derived=derived)
 
 

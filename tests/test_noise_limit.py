@@ -52,9 +52,12 @@ def test_K_noise_is_where_the_predicted_swing_reaches_the_chatter_criterion():
     assert _swing(p, g.K_noise) >= CHATTER_PTP_FRACTION > _swing(p, g.K_noise / 1.006)  # bisection to 0.5 %
     # the recommendation keeps the gain margin on the swing: half the criterion
     assert _swing(p, g.K_recommended) == pytest.approx(CHATTER_PTP_FRACTION / g.margin, rel=0.01)
-    # a 24-bit encoder: the noise never binds below K_limit/2, the recommendation is the loop's
+    assert g.K_noise_binding == g.K_noise
+    # a 24-bit encoder: the noise never binds below K_limit/2, the recommendation is the loop's; its
+    # swing grows steeply only next to K_limit (poor damping), which is not a noise limit to show
     fine = derive(load_preset("yaskawa_sgm7j_04a")).gain
     assert not fine.noise_limited and fine.K_recommended == fine.K_limit / fine.margin
+    assert 0.9 * fine.K_limit < fine.K_noise < fine.K_limit and fine.K_noise_binding == math.inf
 
 
 def test_the_recommended_K_with_a_coarse_encoder_does_not_chatter_where_half_K_limit_did():

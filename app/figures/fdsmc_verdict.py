@@ -19,7 +19,6 @@ from app.figures.style import BAD_COLOUR, GOOD_COLOUR
 VERDICT_FONT_PX = 20
 #: Font size of the line below it (K against K_limit) [px].
 DETAIL_FONT_PX = 16
-#: Colours of a chattering / unstable run and of a clean one.
 
 
 @dataclass(frozen=True)
@@ -63,7 +62,7 @@ def chatter_verdict(comparison: Any) -> Verdict | None:
     if run is None:
         return None
     m, d = run.metrics, comparison.derived
-    where = _k_vs_limit(d.params.controller.K, d.gain.K_limit, d.gain.K_noise)
+    where = _k_vs_limit(d.params.controller.K, d.gain.K_limit, d.gain.K_noise_binding)
     if not m.stable:
         return Verdict("UNSTABLE", where, True)
     if m.chatter:

@@ -82,7 +82,7 @@ class LiveTuning:
         ``recentre`` (a new drive: preset, file, design): the J_L track is laid out around its J_L.
         """
         p, g = d.params, d.gain
-        self.k.show_gains(p.controller.K, g.K_limit, recommended_K(d), g.K_noise)
+        self.k.show_gains(p.controller.K, g.K_limit, recommended_K(d), g.K_noise_binding)
         T_a = _ms(d.profile.T_a)
         self.T_c.show(_ms(d.profile.T_c), (("eq.59", T_a), ("ζ=1", _ms(g.T_c_min))), _around(T_a))
         self.T_m.show(p.manoeuvre.T_m, (("min", d.profile.T_m_min),), _around(p.manoeuvre.T_m) if recentre else None)

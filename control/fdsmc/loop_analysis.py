@@ -100,6 +100,15 @@ class GainRecommendation:
         """K below the noise limit: the sensors' noise alone does not make α_dem chatter."""
         return self.K_noise > self.K
 
+    @property
+    def K_noise_binding(self) -> float:
+        """K_noise where the sensors' noise sets the recommendation, else inf [s/rad].
+
+        With fine sensors the noise's swing grows steeply only next to K_limit (the loop's poor
+        damping there), and K_noise falls just below K_limit: that is not a noise limit to show.
+        """
+        return self.K_noise if self.noise_limited else math.inf
+
 
 @dataclass(frozen=True)
 class SampleRateCheck:
