@@ -18,8 +18,10 @@ from control.fdsmc.derivations import derive
 from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
 from control.fdsmc.noise import PTP_PER_RMS, noise_gain, noise_gain_limit
 from control.fdsmc.params import DriveParams
+from sim.fdsmc.criteria import window_below_count
+from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import compare, simulate
-from sim.fdsmc.verdicts import run_warnings
+from sim.fdsmc.verdicts import criteria_warnings, run_warnings
 
 #: A Σ-7 servo with a catalogue 8192-count encoder instead of its 24-bit one; an in-position
 #: window of a few counts.
@@ -98,3 +100,21 @@ def test_a_continuous_controller_or_ideal_sensors_have_no_noise_limit():
     assert noise_gain_limit(dataclasses.replace(loop, f_s=None), 1e-3, 0.1, 0.2, 1.0) == math.inf
     assert noise_gain_limit(loop, 0.0, 0.0, 0.2, 1.0) == math.inf
     assert noise_gain_limit(loop, 1e-3, 0.1, 0.2, 0.0) == math.inf  # no stable K to search
+
+
+def test_an_in_position_window_narrower_than_one_count_is_refused_with_its_remedy():
+    # the Σ-7 preset's ±1 µm window (6.28e-4 rad) with an 8192-count encoder (7.67e-4 rad a count)
+    p = load_preset("yaskawa_sgm7j_04a", ["sensors.encoder_cpr=8192"])
+    msg = window_below_count(p)
+    assert msg is not None and "limits.in_position = 0.0006283 rad" in msg
+    assert "0.001534 rad (two counts)" in msg and "≥ 32768 counts/rev" in msg  # 4π/6.283e-4 = 2·10⁴ → 2¹⁵
+    dd = design_drive(p)
+    assert dd.comparison is None and not dd.clean  # said at once, not after every slowdown
+    assert [c.text for c in dd.limiting if c.violated] == [msg]
+    run = simulate(p, "fdsmc")
+    assert msg in criteria_warnings(run, derive(p))
+    # two counts inside the window (the default ±10 counts, or the 24-bit encoder): nothing to say
+    assert window_below_count(load_preset("yaskawa_sgm7j_04a", COARSE)) is None
+    assert window_below_count(load_preset("yaskawa_sgm7j_04a")) is None
+    assert window_below_count(load_preset("yaskawa_sgm7j_04a", ["sensors.encoder_cpr=8192",
+                                                                "limits.in_position_rad=0"])) is None

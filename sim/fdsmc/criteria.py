@@ -66,5 +66,26 @@ def pass_criteria(params: DriveParams) -> PassCriteria:
     )
 
 
+def window_below_count(params: DriveParams) -> str | None:
+    """Say why the in-position window or the overshoot limit is narrower than one encoder count, else None.
+
+    The controller reads θ_r in whole counts Δ = 2π/cpr, so it cannot tell positions within one count
+    apart: a window narrower than Δ is held, if at all, by chance. The remedy names two counts, or
+    the encoder resolution (a power of two) that puts two counts inside the window.
+    """
+    cpr = params.sensors.encoder_cpr
+    if cpr <= 0:
+        return None
+    crit, count = pass_criteria(params), 2.0 * math.pi / cpr
+    field, width = min((("limits.in_position", crit.in_position), ("limits.overshoot", crit.overshoot)),
+                       key=lambda fw: fw[1])
+    if width >= count:
+        return None
+    need = 2 ** math.ceil(math.log2(2.0 * 2.0 * math.pi / width))
+    return (f"{field} = {width:.4g} rad is narrower than one count of the {cpr}-count encoder ({count:.4g} rad): "
+            f"the controller cannot tell positions within a count apart, so a run holds it only by chance. Widen it to "
+            f"≥ {2.0 * count:.4g} rad (two counts) or use an encoder with ≥ {need} counts/rev.")
+
+
 __all__ = ["HOLD_RIPPLE_FRACTION", "IDEAL_ENCODER_CPR", "IN_POSITION_COUNTS", "PassCriteria", "drive_current",
-           "pass_criteria"]
+           "pass_criteria", "window_below_count"]

@@ -47,7 +47,7 @@ from control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
 from control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
 from control.fdsmc.transient import acceleration_overshoot
 from sim.fdsmc.checks import TARGET_BAND, Constraint, run_checks
-from sim.fdsmc.criteria import pass_criteria
+from sim.fdsmc.criteria import pass_criteria, window_below_count
 from sim.fdsmc.engine import Comparison, RunResult, compare
 from sim.fdsmc.verdicts import comparator_notes, flux_warnings
 
@@ -199,6 +199,11 @@ def design_drive(params: DriveParams, alpha_rule: str = "torque_limit") -> Drive
     DriveDesign
     """
     base = _with(params, "controller", alpha_max_rule=alpha_rule, T_c="T_a")
+    narrow = window_below_count(params)
+    if narrow is not None:  # no setting holds it: say so at once instead of trying every slowdown
+        crit = pass_criteria(params)
+        return _refused(base, [Constraint("in_position", min(crit.in_position, crit.overshoot),
+                                          2.0 * math.pi / params.sensors.encoder_cpr, "rad", True, narrow)])
     first: DriveDesign | None = None
     for factor in _slowdowns(base):
         dd = _design_at(_slowed(base, factor), params)

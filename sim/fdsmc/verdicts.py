@@ -13,6 +13,7 @@ from control.fdsmc.derivations import Derived
 from control.fdsmc.flux_tolerance import flux_tolerance
 from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
 from sim.fdsmc.checks import TARGET_BAND, exceeded, run_checks, saturation_matters
+from sim.fdsmc.criteria import window_below_count
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
 
 #: A flux tolerance of the FDC below this is warned about [-] (a datasheet's 20 °C flux vs magnets 100 K
@@ -92,8 +93,10 @@ def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
 def criteria_warnings(run: RunResult, derived: Derived) -> list[str]:
     """List the user's pass criteria the run fails: in-position window, overshoot, standstill ripple."""
     names = {"in_position", "overshoot", "hold_ripple"}
-    return [f"Criterion ({LABELS[run.controller]}): {c.text}" for c in run_checks(derived.params, run)
-            if c.name in names]
+    out = [f"Criterion ({LABELS[run.controller]}): {c.text}" for c in run_checks(derived.params, run)
+           if c.name in names]
+    narrow = window_below_count(derived.params)
+    return out if narrow is None else [*out, narrow]
 
 
 def _target_missed(run: RunResult) -> str | None:
