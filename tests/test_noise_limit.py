@@ -110,6 +110,7 @@ def test_an_in_position_window_narrower_than_one_count_is_refused_with_its_remed
     assert "0.001534 rad (two counts)" in msg and "≥ 32768 counts/rev" in msg  # 4π/6.283e-4 = 2·10⁴ → 2¹⁵
     dd = design_drive(p)
     assert dd.comparison is None and not dd.clean  # said at once, not after every slowdown
+    assert dd.params == p  # nothing designed: the inputs stay as they are
     assert [c.text for c in dd.limiting if c.violated] == [msg]
     run = simulate(p, "fdsmc")
     assert msg in criteria_warnings(run, derive(p))

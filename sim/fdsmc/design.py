@@ -200,9 +200,9 @@ def design_drive(params: DriveParams, alpha_rule: str = "torque_limit") -> Drive
     """
     base = _with(params, "controller", alpha_max_rule=alpha_rule, T_c="T_a")
     narrow = window_below_count(params)
-    if narrow is not None:  # no setting holds it: say so at once instead of trying every slowdown
+    if narrow is not None:  # no setting holds it: say so at once, inputs as they are, not after every slowdown
         crit = pass_criteria(params)
-        return _refused(base, [Constraint("in_position", min(crit.in_position, crit.overshoot),
+        return _refused(params, [Constraint("in_position", min(crit.in_position, crit.overshoot),
                                           2.0 * math.pi / params.sensors.encoder_cpr, "rad", True, narrow)])
     first: DriveDesign | None = None
     for factor in _slowdowns(base):
