@@ -342,7 +342,7 @@ def _with_T_c(p: DriveParams, T_c: float) -> DriveParams:
 
 
 def _design_K(g: GainRecommendation) -> float:
-    """Return the design's first K [s/rad]: K_limit/margin (the sensors are the verification's)."""
+    """Return the design's first K [s/rad], K_limit/margin (halved where the run with the sensors chatters)."""
     return g.K_limit / g.margin
 
 
