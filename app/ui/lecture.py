@@ -43,9 +43,14 @@ class LecturePins:
         self._tab.results.replay.pins = self.pins
 
     def show(self, pins: tuple[Pin, ...]) -> None:
-        """Keep ``pins`` and draw the overview shown again with them (on the worker)."""
+        """Keep ``pins`` and draw the overview shown again with them.
+
+        Drawn here, not on the worker: a click during a run would be refused there while the pins
+        already changed. The replay sends one overview at a time, so this waits for a run's
+        figures and then draws that run with ``pins``.
+        """
         self.keep(pins)
-        self._tab.submit(lambda: self._tab.results.replay.show_pins(self.pins))
+        self._tab.results.replay.show_pins(self.pins)
 
     def _clicked(self, label: str) -> None:
         if label == "Clear pins":

@@ -159,6 +159,9 @@ class Replay:
         self._phase, self._time_plots, self._scene, self._flush = phase, time_plots, scene, flush
         self._on_3d = on_3d
         self._lock = threading.Lock()
+        # One overview sent at a time, whole: a pin cleared while a run's figures go out waits for
+        # them, then draws that run without the pin (not the run before, nor the pin again after).
+        self._sending = threading.RLock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._gui = gui
@@ -198,18 +201,19 @@ class Replay:
         replay right after it.
         """
         self.pause()
-        if not light:
-            set_figure_json(self._phase, overview_json(comparison, replay=False, pins=self.pins, static=False)[0])
-            self._flush()
-        figure, targets = overview_json(comparison, replay=not light, pins=self.pins)
-        set_figure_json(self._phase, figure)
-        self._flush()  # the phase plane goes out before the larger figure is even built
-        if not light:
-            self.show_time_plots(comparison)
-        with self._lock:
-            self._comparison, self._targets = comparison, targets
-            rs = runs(comparison)
-            self._t_end = end_time(comparison)
+        with self._sending:
+            if not light:
+                set_figure_json(self._phase, overview_json(comparison, replay=False, pins=self.pins, static=False)[0])
+                self._flush()
+            figure, targets = overview_json(comparison, replay=not light, pins=self.pins)
+            set_figure_json(self._phase, figure)
+            self._flush()  # the phase plane goes out before the larger figure is even built
+            if not light:
+                self.show_time_plots(comparison)
+            with self._lock:
+                self._comparison, self._targets = comparison, targets
+                rs = runs(comparison)
+                self._t_end = end_time(comparison)
         # the figure shows the end of the runs
         assign(self.slider, max=self._t_end, step=self._t_end / 1000.0, value=self._t_end)
         if autoplay and self._scene is not None and self._scene.visible and rs:
@@ -219,18 +223,20 @@ class Replay:
 
     def complete(self, comparison: Any) -> None:
         """Send what a light :meth:`load` left out: the overview's replay and the time plots."""
-        set_figure_json(self._phase, phase_plane_json(comparison, pins=self.pins))
-        self.show_time_plots(comparison)
+        with self._sending:
+            set_figure_json(self._phase, phase_plane_json(comparison, pins=self.pins))
+            self.show_time_plots(comparison)
 
     def show_pins(self, pins: tuple[Pin, ...]) -> None:
         """Draw the overview of the comparison shown again with ``pins`` as its ghosts."""
-        with self._lock:
-            self.pins, comparison = pins, self._comparison
-        if comparison is not None:
-            figure, targets = overview_json(comparison, pins=pins)
-            set_figure_json(self._phase, figure)
+        with self._sending:
             with self._lock:
-                self._targets = targets
+                self.pins, comparison = pins, self._comparison
+            if comparison is not None:
+                figure, targets = overview_json(comparison, pins=pins)
+                set_figure_json(self._phase, figure)
+                with self._lock:
+                    self._targets = targets
 
     def show_time_plots(self, comparison: Any) -> None:
         """Send the time-plots figure of ``comparison`` (if this panel has one)."""

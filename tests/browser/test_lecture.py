@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -203,3 +204,33 @@ def test_the_main_story_fits_1280x720_without_scrolling(lecture):
         x, y, w, h = boxes["sliders"][int(name[-1])] if name.startswith("slider") else boxes[name]
         assert w > 0 and h > 0 and x >= 0 and y >= 0 and x + w <= 1280 and y + h <= 720, (name, x, y, w, h)
     assert boxes["phase"][2] >= 380 and boxes["phase"][3] >= 300  # the phase plane keeps its size
+
+
+def test_clearing_pins_while_a_runs_figures_go_out_leaves_no_ghost(browser, ui_server, monkeypatch):
+    # the overview with its replay is built after the light one is sent; a "Clear pins" in between
+    # must not be undone by that figure (drawn with the pins read before the click)
+    import app.ui.replay as replay
+
+    built = replay.overview_json
+
+    def slow(comparison, replay=True, pins=(), static=True):
+        if replay:
+            time.sleep(0.6)  # the full figure is still being built when the pins are cleared
+        return built(comparison, replay, pins, static)
+
+    context, page = open_page(browser, ui_server, viewport={"width": 1280, "height": 720})
+    try:
+        page.get_by_role("button", name="Pin this run").click()
+        page.wait_for_function(f"() => ({NAMES_JS})().includes('pin 1 trajectory')")
+        monkeypatch.setattr(replay, "overview_json", slow)
+        set_number(page, "K boundary-layer gain [s/rad]", 2)
+        page.get_by_role("button", name="Simulate").click()
+        page.wait_for_function(f"() => ({NAMES_JS})().some(n => n.includes('±1/K = ±0.5 rad/s'))")  # the light one
+        page.get_by_role("button", name="Clear pins").click()
+        page.get_by_text("Ready — ").wait_for()
+        page.wait_for_timeout(1500)  # every figure of the run and of the click has arrived
+        names = page.evaluate(NAMES_JS)
+        assert not [n for n in names if n.startswith("pin ")], names
+        assert any("±1/K = ±0.5 rad/s" in n for n in names)  # the new run, not the one before
+    finally:
+        context.close()
