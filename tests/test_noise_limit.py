@@ -100,6 +100,10 @@ def test_a_continuous_controller_or_ideal_sensors_have_no_noise_limit():
     assert noise_gain_limit(dataclasses.replace(loop, f_s=None), 1e-3, 0.1, 0.2, 1.0) == math.inf
     assert noise_gain_limit(loop, 0.0, 0.0, 0.2, 1.0) == math.inf
     assert noise_gain_limit(loop, 1e-3, 0.1, 0.2, 0.0) == math.inf  # no stable K to search
+    # a nanoampere of current noise swings α_dem only where the loop itself goes unstable: no noise limit
+    faint = derive(load_preset("yaskawa_sgm7j_04a", ["sensors.encoder_cpr=0", "sensors.i_noise=1e-9",
+                                                     "sensors.i_adc_bits=0"])).gain
+    assert faint.K_noise == math.inf and faint.K_recommended == faint.K_limit / faint.margin
 
 
 def test_an_in_position_window_narrower_than_one_count_is_refused_with_its_remedy():

@@ -168,10 +168,13 @@ def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_no
     loop = dataclasses.replace(case, f_s=f_s, delay=delay)
     target = fraction * loop.alpha_max / PTP_PER_RMS
 
-    def swings(K: float) -> bool:
+    def rms(K: float) -> float:
         with warnings.catch_warnings():  # ill-conditioned only next to the stability limit
             warnings.simplefilter("ignore", LinAlgWarning)
-            return not noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms < target
+            return noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms
+
+    def swings(K: float) -> bool:
+        return not rms(K) < target
 
     grid = np.logspace(-5, 6, 23) * 1000.0 / loop.alpha_max
     Ks = [float(K) for K in grid if K_max > K] + ([K_max] if math.isfinite(K_max) else [])
@@ -182,7 +185,9 @@ def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_no
         elif lo is None:  # the noise swings α_dem even at the smallest K searched
             return K
         else:
-            return geometric_bisect(swings, lo, K, 1.005)
+            K_hi = geometric_bisect(swings, lo, K, 1.005)
+            return K_hi if math.isfinite(rms(K_hi)) else math.inf  # the loop's own limit came first
     return math.inf
+
 
 __all__ = ["PTP_PER_RMS", "NoiseGain", "noise_gain", "noise_gain_limit"]
