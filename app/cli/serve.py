@@ -41,6 +41,10 @@ def is_loopback(host: str) -> bool:
         return False
 
 
+#: Longest the main thread sleeps between looks for Ctrl-C or SIGTERM [s].
+SIGNAL_POLL_S = 0.2
+
+
 def run(args: argparse.Namespace) -> int:
     """Start the server, print the URL and serve until Ctrl-C."""
     if not 1 <= args.port <= 65535:
@@ -68,8 +72,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"PMSM commissioning tool: http://{shown}:{port}{query}  (preset {args.preset}; Ctrl-C to stop)",
           flush=True)
     try:
-        while True:
-            time.sleep(3600)
+        while True:  # short sleeps: a signal the kernel hands to another thread only sets Python's flag,
+            time.sleep(SIGNAL_POLL_S)  # which the main thread reads when its sleep ends
     except KeyboardInterrupt:
         server.stop()
         raise  # the CLI then ends the process at once: a run still simulating is not waited for
