@@ -107,3 +107,32 @@ def test_recommended_K_with_a_coarse_encoder_is_the_one_the_sensors_allow(page):
     page.get_by_role("button", name="Use recommended K").click()
     verdict = _wait_verdict(page, "no chatter")
     assert "K ≤ K_noise" in verdict
+
+
+#: The K slider's mark labels as drawn: [text, left, right] [px], left to right.
+K_LABELS_JS = """() => {
+  const label = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'K [s/rad] (log)');
+  let box = label; while (box && !box.querySelector('.mantine-Slider-root')) box = box.parentElement;
+  return [...box.querySelectorAll('.mantine-Slider-markLabel')].map(l => { const r = l.getBoundingClientRect();
+    return [l.textContent, r.left, r.right]; }).sort((a, b) => a[1] - b[1]);
+}"""
+
+
+#: True once the K slider's mark labels, left to right, do not overlap.
+APART_JS = f"() => {{ const l = ({K_LABELS_JS})(); return l.every((a, i) => i === 0 || l[i - 1][2] <= a[1]); }}"
+
+
+def test_the_K_tracks_labels_never_overlap(page):
+    # K_recommended = K_limit/2 is 0.3 decade from it on a 5.7-decade track: "rec" and "lim" would
+    # overlap by a few pixels on a 1280×720 page; with a coarse encoder "noise" joins them
+    page.set_viewport_size({"width": 1280, "height": 720})
+    page.wait_for_function(f"() => ({K_LABELS_JS})().map(l => l[0]).includes('rec')")
+    page.wait_for_function(APART_JS)
+    choose(page, "Preset", "yaskawa_sgm7j_04a")
+    _wait_verdict(page, "no chatter")
+    set_number(page, "Encoder counts per rev (0 = ideal) [counts/rev]", "8192")
+    page.get_by_role("button", name="Simulate").click()
+    _wait_verdict(page, "CHATTER")
+    page.wait_for_function(f"() => ({K_LABELS_JS})().map(l => l[0]).includes('noise')")
+    page.wait_for_function(APART_JS)
+    assert {"rec", "noise", "lim"} <= {t for t, _, _ in page.evaluate(K_LABELS_JS)}

@@ -33,11 +33,52 @@
     only('data-app-fit', fit); only('data-app-column', columns);
     only('data-app-overview-window', windows); only('data-app-hidden', hidden);
   };
+  // A slider's mark labels that would overlap (K_recommended is K_limit/2: 0.3 decade on a 5.7-decade
+  // track) are moved apart (CSS `translate`, which leaves Mantine's own transform alone): a pair
+  // shares what it overlaps, except that the track's end labels (its first two marks) stay put.
+  // A few passes settle a crowd. Looked at in the next animation frame after any change (the
+  // layout is then computed anyway); moved only when a slider's marks, widths or fonts changed.
+  const spread = () => {
+    for (const slider of document.querySelectorAll('.mantine-Slider-root')) {
+      const labels = [...slider.querySelectorAll('.mantine-Slider-markLabel')];
+      const key = slider.clientWidth + '|' + labels.map(l => l.textContent + l.offsetWidth
+        + (l.parentElement.getAttribute('style') || '')).join('|');
+      if (slider.__appMarksKey === key || slider.clientWidth === 0) continue;
+      slider.__appMarksKey = key;
+      for (const l of labels) l.style.translate = '';
+      const boxes = labels.map((l, i) => ({l, r: l.getBoundingClientRect(), dx: 0, fixed: i < 2}))
+        .sort((a, b) => a.r.x - b.r.x);
+      for (let pass = 0; pass < 8; pass++) {
+        let moved = false;
+        for (let i = 1; i < boxes.length; i++) {
+          const a = boxes[i - 1], b = boxes[i], overlap = a.r.right + a.dx + 4 - (b.r.left + b.dx);
+          if (overlap <= 0.5) continue;
+          const share = a.fixed ? 0 : b.fixed ? 1 : 0.5;
+          a.dx -= overlap * share; b.dx += overlap * (1 - share); moved = true;
+        }
+        if (!moved) break;
+      }
+      for (const {l, dx} of boxes) if (dx) l.style.translate = `${dx.toFixed(1)}px 0`;
+    }
+  };
+  let queued = false;
+  const spreadSoon = () => {
+    if (!queued) { queued = true; requestAnimationFrame(() => { queued = false; spread(); }); }
+  };
   window.__appHideField = (uuid) => { hiddenFields.push(uuid); mark(); };  // a field made later
   // mutations inside a plot (Plotly redraws) change none of the marks
   const outside = (r) => !(r.target.closest && r.target.closest('.js-plotly-plot'));
-  new MutationObserver((records) => { if (records.some(outside)) mark(); }).observe(document.body, {
-    childList: true, subtree: true, attributes: true,
-    attributeFilter: ['aria-selected', 'data-dock-column-rail', 'data-dock-region', 'data-floating-window', 'title'] });
-  mark();
+  // a mark's value or label changes in place (its wrapper's style, its text): only spread() looks
+  const marksOnly = (r) => r.type === 'characterData' || r.attributeName === 'style';
+  new MutationObserver((records) => {
+    if (records.some(r => !marksOnly(r) && outside(r))) mark();
+    spreadSoon();
+  }).observe(document.body, {
+    childList: true, subtree: true, attributes: true, characterData: true,
+    attributeFilter: ['aria-selected', 'data-dock-column-rail', 'data-dock-region', 'data-floating-window', 'title',
+                      'style'] });
+  new MutationObserver(spreadSoon).observe(document.head, {childList: true});  // a style sheet added
+  window.addEventListener('resize', spreadSoon);
+  document.fonts.ready.then(spreadSoon);
+  mark(); spreadSoon();
 })();
