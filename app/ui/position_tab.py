@@ -221,12 +221,14 @@ class PositionTab:
         objective = OBJECTIVES[OBJECTIVE_LABELS.index(checked_choice(self.objective.value, OBJECTIVE_LABELS,
                                                                      "Design objective"))]
         dd = design_for(params, objective).design
-        self.inputs.populate(dd.params)
+        shown = params if dd.comparison is None else dd.params  # refused before any run: the inputs stay
+        if dd.comparison is not None:
+            self.inputs.populate(dd.params)
         self._plant_J_L = None
         self._recentre = True
         comparison = (None if self.optimum.wanted else dd.comparison) or comparison_or_derived(
-            dd.params, self.optimum.wanted)
-        self._state.ran(dd.params, comparison)
+            shown, self.optimum.wanted)
+        self._state.ran(shown, comparison)
         self.design_note.content = design_markdown(dd)
         if comparison.fdsmc is not None:
             self._results().show(comparison)

@@ -142,9 +142,12 @@ def design_markdown(dd: Any) -> str:
     head = {"clean": "**Design: CLEAN** — with the sensors: limits, in-position, overshoot and ripple all hold.",
             "not as asked": "**Design: NOT AS ASKED** — clean only at a longer T_m than requested.",
             "not clean": "**Design: NOT CLEAN** — see the constraints below."}[dd.verdict]
-    lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "
-                   f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms, "
-                   f"T_so = {c.T_so * 1e3:.4g} ms, T_sα = {c.T_salpha * 1e3:.4g} ms"]
+    if dd.comparison is None:  # refused before any simulation: there is no setting to show
+        lines = [head, "Nothing designed or simulated; the inputs stay as they were."]
+    else:
+        lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "
+                       f"K = {c.K:.4g} s/rad, T_c = {dd.derived.profile.T_c * 1e3:.4g} ms, "
+                       f"T_so = {c.T_so * 1e3:.4g} ms, T_sα = {c.T_salpha * 1e3:.4g} ms"]
     if dd.comparison is not None and dd.comparison.fdsmc is not None:
         lines.append(_verified_figures(dd))
     lines += [f"- {'✗' if x.violated else '·'} {md_text(x.text)}" for x in dd.limiting]

@@ -142,3 +142,18 @@ def test_a_robotics_servo_typed_in_arms_and_kv_with_its_encoder_designs_clean(pa
     m = session.comparison.fdsmc.metrics
     assert m.hold_i_q_rms_A <= 2.0 and m.i_peak_A <= 40.0 + 3 * 0.11 and m.in_position_s is not None
     assert f"{m.hold_i_q_rms_A:.2g} A rms" in text
+
+
+def test_a_window_narrower_than_a_count_is_refused_and_the_inputs_stay(page, default_server):
+    # the Σ-7 preset's ±1 µm window (6.28e-4 rad) with an 8192-count encoder (7.67e-4 rad a count)
+    choose(page, "Preset", "yaskawa_sgm7j_04a")
+    page.get_by_text("Ready — ").wait_for()
+    set_number(page, "Encoder counts per rev (0 = ideal) [counts/rev]", "8192")
+    K_before = field(page, "K boundary-layer gain [s/rad]").input_value()
+    page.get_by_role("button", name="Design for this drive").click()
+    page.get_by_text("Design: NOT CLEAN", exact=False).wait_for(timeout=60_000)
+    page.get_by_text("Nothing designed or simulated", exact=False).wait_for()
+    page.get_by_text("narrower than one count of the 8192-count encoder", exact=False).first.wait_for()
+    page.get_by_text("≥ 32768 counts/rev", exact=False).first.wait_for()
+    assert field(page, "K boundary-layer gain [s/rad]").input_value() == K_before
+    assert field(page, "Encoder counts per rev (0 = ideal) [counts/rev]").input_value() == "8192"
