@@ -71,12 +71,10 @@ def test_the_recommended_K_with_a_coarse_encoder_does_not_chatter_where_half_K_l
     rec = simulate(_with_K(p, g.K_recommended), "fdsmc").metrics
     assert rec.stable and not rec.chatter
     assert simulate(_with_K(p, 1.5 * g.K_noise), "fdsmc").metrics.chatter  # above the noise limit it does
-    # the warning names the noise limit and the recommended K
-    w = [x for x in d.warnings if "noise limit K_noise" in x]
-    assert len(w) == 1 and f"{g.K_noise:.4g}" in w[0] and f"{g.K_recommended:.4g}" in w[0]
-    assert not [x for x in derive(_with_K(p, g.K_recommended)).warnings if "K_noise" in x]
+    # the prediction alone warns of nothing (it is conservative); the run's chatter warning says why
+    assert not [x for x in d.warnings if "K_noise" in x]
     hint = [x for x in run_warnings(compare(_with_K(p, g.K_limit / g.margin), ("fdsmc",))) if "Chatter" in x]
-    assert hint and f"noise limit K_noise = {g.K_noise:.4g}" in hint[0]
+    assert hint and f"noise limit K_noise = {g.K_noise:.4g}" in hint[0] and f"{g.K_recommended:.4g}" in hint[0]
 
 
 @pytest.mark.parametrize(("name", "overrides"), [("yaskawa_sgm7j_04a", COARSE), ("odrive_d5065_belt", [])])

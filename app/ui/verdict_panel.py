@@ -56,9 +56,9 @@ class VerdictPanel:
         self.render((items, error, comparator_notes(comparison)))
         chatter = any(r is not None and r.metrics.chatter for r in (comparison.fdsmc, comparison.conventional))
         k_rec, g = recommended_K(d), d.gain
-        # offered where K chatters or is expected to: above K_limit/margin, or above the sensors'
-        # noise limit (a verified design may sit between the noise limit and the recommendation)
-        expected = 1.001 * min(g.K_limit / g.margin, g.K_noise) < K
+        # offered where the run chatters (with the sensors: their noise shows there) or the loop
+        # analysis expects a limit cycle; a verified design above the noise-capped K is left alone
+        expected = 1.001 * g.K_limit / g.margin < K
         assign(self.use_k, visible=k_rec is not None and (chatter or expected))
         if k_rec is not None:
             assign(self.use_k, label=f"Use recommended K = {k_rec:.4g} s/rad")

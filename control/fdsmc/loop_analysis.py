@@ -277,13 +277,6 @@ def loop_warnings(g: GainRecommendation, s: SampleRateCheck) -> tuple[str, ...]:
             f"{g.K_limit:.4g} s/rad of the linearised FDSMC loop ({g.mode}): the outer loop will "
             f"chatter (limit cycle) and waste copper energy. Recommended K = {g.K_recommended:.4g} "
             f"s/rad (gain margin {g.margin:g}).")
-    elif not g.K_noise_ok:
-        w.append(
-            f"Boundary-layer gain K = {g.K:g} s/rad is above the sensors' noise limit K_noise = "
-            f"{g.K_noise:.4g} s/rad ({g.mode}): the encoder's counts and the current noise, through "
-            f"the observer and K, swing α_dem by more than {100 * CHATTER_PTP_FRACTION:g} % of α_max — chatter "
-            f"without a limit cycle, and copper lost in the ripple. Recommended K = {g.K_recommended:.4g} "
-            f"s/rad, or slower T_so and T_sα (Design chooses them).")
     if s.stable and g.zeta_slope < ZETA_SLOPE_MIN:
         w.append(_slope_warning(g))
     return tuple(w)

@@ -11,7 +11,7 @@ import math
 
 from control.fdsmc.derivations import Derived
 from control.fdsmc.flux_tolerance import flux_tolerance
-from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
+from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, ZETA_SLOPE_MIN
 from sim.fdsmc.checks import TARGET_BAND, exceeded, run_checks, saturation_matters
 from sim.fdsmc.criteria import window_below_count
 from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
@@ -34,9 +34,11 @@ def _chatter_hint(derived: Derived) -> str:
         return " Reduce K, eq. (45)."
     if not g.K_ok:
         return f" Recommended K = {g.K_recommended:.4g} s/rad."
-    if not g.K_noise_ok:
-        return (f" K is above the sensors' noise limit K_noise = {g.K_noise:.4g} s/rad: recommended "
-                f"K = {g.K_recommended:.4g} s/rad.")
+    if not g.K_noise_ok:  # said after a run that chatters: the prediction alone is conservative
+        return (f" K is above the sensors' noise limit K_noise = {g.K_noise:.4g} s/rad ({g.mode}): the encoder's "
+                f"counts and the current noise, through the observer and K, swing α_dem by more than "
+                f"{100 * CHATTER_PTP_FRACTION:g} % of α_max. Recommended K = {g.K_recommended:.4g} s/rad, or slower "
+                f"T_so and T_sα (Design chooses them).")
     if g.zeta_slope < ZETA_SLOPE_MIN and math.isfinite(g.T_c_min):
         return (f" The sloped segment is poorly damped (ζ ≈ {g.zeta_slope:.2g}): set "
                 f"controller.T_c ≥ {g.T_c_min:.3g} s.")
