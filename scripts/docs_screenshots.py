@@ -33,7 +33,8 @@ from playwright.sync_api import sync_playwright  # noqa: E402
 
 from app.io.presets import PAPER_PRESET, load_preset  # noqa: E402
 from app.ui.page import create_server  # noqa: E402
-from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, click_tab, free_port  # noqa: E402
+from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, click_tab  # noqa: E402
+from tests.net import free_port  # noqa: E402
 
 DOCS = ROOT / "docs"
 SIZE = {"width": 1280, "height": 720}

@@ -19,7 +19,6 @@ import argparse
 import asyncio
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -28,6 +27,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from tests.net import free_port  # noqa: E402
 from tests.page_client import PageClient  # noqa: E402
 
 RUN = {"robustness": "Run robustness study", "multiaxis": "Run multi-axis move"}
@@ -35,12 +35,6 @@ RUN = {"robustness": "Run robustness study", "multiaxis": "Run multi-axis move"}
 AXES = "".join(f"- {{preset: {p}, name: A{k}}}\n" for k, p in enumerate(
     ["yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "siemens_1ft7044_ak7", "odrive_d5065_belt"] * 4))
 TICK_S = os.sysconf("SC_CLK_TCK")
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
 
 
 def _descendants(pid: int) -> list[int]:
@@ -204,7 +198,7 @@ def main() -> None:
     ap.add_argument("--study", choices=tuple(RUN), default="robustness")
     ap.add_argument("--limit", type=float, default=60.0, help="longest wait of each step [s]")
     args = ap.parse_args()
-    port = _free_port()
+    port = free_port()
     server = start_server(port)
     try:
         asyncio.run(asyncio.wait_for(run(args, server.pid, f"127.0.0.1:{port}"), 20 * args.limit))

@@ -53,7 +53,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from app.ui.k_slider import K_LABEL  # noqa: E402
-from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, VIEWPORT, field, free_port  # noqa: E402
+from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, VIEWPORT, field  # noqa: E402
+from tests.net import free_port  # noqa: E402
 
 PRESET = "paper_12kw_pmsm"
 PHASE_READY = ("(w) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"

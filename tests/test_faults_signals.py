@@ -140,6 +140,9 @@ def _to_a_side_thread(pid: int, sig: int) -> None:
         if Path(f"/proc/{pid}/task/{pid}/wchan").read_text() == "hrtimer_nanosleep":
             break
         time.sleep(0.01)  # poll the main thread's state again (a positive condition)
+    else:
+        raise AssertionError("the server's main thread was never seen asleep: the case is not set up")
+    assert os.uname().machine in TGKILL, f"no tgkill number known for {os.uname().machine}"
     number = TGKILL[os.uname().machine]
     assert ctypes.CDLL(None, use_errno=True).syscall(number, pid, tid, sig) == 0
 

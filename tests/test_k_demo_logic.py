@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import pytest
 
 from app.figures.fdsmc_verdict import VERDICT_FONT_PX, chatter_verdict, verdict_annotation
+from app.figures.style import BAD_COLOUR, GOOD_COLOUR
 from app.ui.k_slider import K_RANGE, K_marks, K_of_position, hide_box_css, log_K_range, readout_html
 
 
@@ -54,8 +55,8 @@ def test_the_K_slider_marks_and_reddens_at_the_noise_limit():
     marks = dict((label, pos) for pos, label in K_marks(-3.0, 4.0, 0.114, 0.00525, 0.0105))
     assert marks["noise"] == pytest.approx(math.log10(0.0105)) and marks["lim"] == pytest.approx(math.log10(0.114))
     assert "noise" not in {label for _, label in K_marks(-3.0, 4.0, 0.114, 0.057, 0.2)}  # above K_limit: no mark
-    assert "#c92a2a" in readout_html(0.02, 0.114, 0.00525, 0.0105)  # above K_noise, below K_limit: red
-    assert "#2b8a3e" in readout_html(0.005, 0.114, 0.00525, 0.0105) and "noise 0.0105" in readout_html(
+    assert BAD_COLOUR in readout_html(0.02, 0.114, 0.00525, 0.0105)  # above K_noise, below K_limit: red
+    assert GOOD_COLOUR in readout_html(0.005, 0.114, 0.00525, 0.0105) and "noise 0.0105" in readout_html(
         0.005, 0.114, 0.00525, 0.0105)
 
 
@@ -91,6 +92,6 @@ def test_slider_positions_become_K_with_three_significant_digits():
 
 def test_readout_says_K_in_red_at_or_above_the_limit():
     above, below = readout_html(5000.0, 0.605, 0.302), readout_html(0.302, 0.605, 0.302)
-    assert "K = 5000 s/rad" in above and "#c92a2a" in above and "#c92a2a" not in below
+    assert "K = 5000 s/rad" in above and BAD_COLOUR in above and BAD_COLOUR not in below
     assert "lim 0.605" in below and "rec 0.302" in below
     assert 'id="abc"' in hide_box_css("abc")

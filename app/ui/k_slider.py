@@ -3,10 +3,12 @@
 A lecturer drags K from the paper's 1000 s/rad down through the chatter limit K_limit (0.605 s/rad
 for the paper's drive) in one sweep, so the slider (:class:`app.ui.log_slider.LogSlider`) spans
 log₁₀ K over at least :data:`K_RANGE` and always a range holding K, K_limit and K_recommended
-(whole decades). The readout under it says K in s/rad (red at or above K_limit) with the two
-marked gains. A slider move writes K rounded to three significant digits into the K field (the
-slider's step is 0.01 decade, ≈ 2.3 %); every other change of K — typed, "Use recommended K", a
-preset, a file, a design — moves the slider to it (:meth:`KSlider.show`).
+(whole decades). Where the sensors' noise sets the recommendation, their noise limit K_noise is
+marked too ("noise", below K_limit). The readout under it says K in s/rad (red at or above
+K_limit, or above K_noise) with the marked gains. A slider move writes K rounded to three
+significant digits into the K field (the slider's step is 0.01 decade, ≈ 2.3 %); every other
+change of K — typed, "Use recommended K", a preset, a file, a design — moves the slider to it
+(:meth:`KSlider.show`).
 """
 
 from __future__ import annotations

@@ -123,7 +123,8 @@ def page_marks_js(hidden_fields: Sequence[str]) -> str:
     docked region, ``data-app-column`` on the parent of each dock column,
     ``data-app-overview-window`` on the floating window holding the "Overview" tab, and
     ``data-app-hidden`` on the row of each text field of ``hidden_fields`` (their uuids: the fields
-    the page's scripts report into).
+    the page's scripts report into; ``window.__appHideField(uuid)`` adds a field made later). In
+    the next frame after such a change it also moves a slider's overlapping mark labels apart.
     """
     return (Path(__file__).resolve().parent / "assets" / "page_marks.js").read_text(encoding="utf-8").replace(
         "HIDDEN_FIELDS", json.dumps(list(hidden_fields)))

@@ -221,9 +221,11 @@ class PositionTab:
         objective = OBJECTIVES[OBJECTIVE_LABELS.index(checked_choice(self.objective.value, OBJECTIVE_LABELS,
                                                                      "Design objective"))]
         dd = design_for(params, objective).design
-        shown = params if dd.comparison is None else dd.params  # refused before any run: the inputs stay
-        if dd.comparison is not None:
-            self.inputs.populate(dd.params)
+        if dd.comparison is None:  # refused before any run: the inputs stay
+            shown = params
+        else:
+            shown = dd.params
+            self.inputs.populate(shown)
         self._plant_J_L = None
         self._recentre = True
         comparison = (None if self.optimum.wanted else dd.comparison) or comparison_or_derived(

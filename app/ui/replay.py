@@ -161,7 +161,7 @@ class Replay:
         self._lock = threading.Lock()
         # One overview sent at a time, whole: a pin cleared while a run's figures go out waits for
         # them, then draws that run without the pin (not the run before, nor the pin again after).
-        self._sending = threading.RLock()
+        self._sending = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._gui = gui

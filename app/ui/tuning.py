@@ -1,7 +1,8 @@
 """Live tuning: logarithmic sliders for K, T_c, T_m and the plant's J_L that re-simulate while dragged.
 
 Each slider is an :class:`app.ui.log_slider.LogSlider` (K's is :class:`app.ui.k_slider.KSlider`)
-with the values a lecturer steers by marked on its track: K_limit and K_recommended on K; T_a of
+with the values a lecturer steers by marked on its track: K_limit, K_recommended and (where the
+sensors' noise sets the recommendation) K_noise on K; T_a of
 eq. (59) ("eq.59") and T_c,min ("ζ=1") on T_c; T_m,min ("min") on T_m; the nominal J_L ("nom")
 on J_L. After every committed run (Simulate, a preset, a file, a design, "Use …") each slider
 mirrors its field (:meth:`LiveTuning.show`); during a drag nothing moves under the pointer.

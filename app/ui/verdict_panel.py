@@ -58,7 +58,7 @@ class VerdictPanel:
         k_rec, g = recommended_K(d), d.gain
         # offered where the run chatters (with the sensors: their noise shows there) or the loop
         # analysis expects a limit cycle; a verified design above the noise-capped K is left alone
-        expected = 1.001 * g.K_limit / g.margin < K
+        expected = 1.001 * g.K_margin < K
         assign(self.use_k, visible=k_rec is not None and (chatter or expected))
         if k_rec is not None:
             assign(self.use_k, label=f"Use recommended K = {k_rec:.4g} s/rad")

@@ -136,7 +136,7 @@ def derive(params: DriveParams) -> Derived:
 def clear_caches() -> None:
     """Forget every cached loop verdict and sampled model (benchmarks: what a new drive costs)."""
     for cached in (loop_analysis._gain_limit, loop_analysis._minimum_sample_rate, loop_model._sampled_parts,
-                   transient._acceleration_overshoot, noise._noise_gain_limit):
+                   transient._acceleration_overshoot, noise._noise_gain_limit, noise._alpha_dem_rms):
         cached.cache_clear()
 
 

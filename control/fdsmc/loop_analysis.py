@@ -77,7 +77,6 @@ class GainRecommendation:
     zeta_slope_recommended : float  The same damping ratio with K_recommended [-].
     K_noise : float          Smallest K at which the sensors' noise makes α_dem chatter [s/rad];
                              inf for ideal sensors or when the stability limit comes first.
-    noise_limited : bool     The sensors' noise, not K_limit/margin, sets K_recommended.
     """
 
     K_limit: float
@@ -93,7 +92,16 @@ class GainRecommendation:
     T_c_min: float = math.nan
     zeta_slope_recommended: float = math.nan
     K_noise: float = math.inf
-    noise_limited: bool = False
+
+    @property
+    def K_margin(self) -> float:
+        """K_limit/margin, the loop's own recommendation before the sensors' noise [s/rad]."""
+        return self.K_limit / self.margin
+
+    @property
+    def noise_limited(self) -> bool:
+        """True when the sensors' noise, not K_limit/margin, sets K_recommended."""
+        return self.K_recommended < self.K_margin
 
     @property
     def K_noise_ok(self) -> bool:
@@ -255,11 +263,24 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
     k_quiet = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION / margin, k_lim / margin)
     k_rec = min(k_lim / margin, k_quiet) if k_lim > 0.0 else 0.0
     zeta = slope_damping(a_max, K if k_ok else k_rec, d.T_c)
-    k_cr = min(k_c, K_noise)
-    T_c_min = 4.0 * margin / (a_max * k_cr) if 0.0 < k_cr < math.inf else math.nan
+    T_c_min = unit_damping_T_c(a_max, min(k_c, K_noise), margin)
     zeta_rec = slope_damping(a_max, k_rec, d.T_c)
     return GainRecommendation(k_lim, k_c, k_s, margin, k_rec, K, k_ok, k_lim / K, mode,
-                              zeta, T_c_min, zeta_rec, K_noise, k_quiet < k_lim / margin)
+                              zeta, T_c_min, zeta_rec, K_noise)
+
+
+def unit_damping_T_c(alpha_max: float, K_limit: float, margin: float) -> float:
+    """T_c [s] giving the ideal sloped-segment loop ζ = 1 at K = K_limit/margin: 4·margin/(α_max·K_limit).
+
+    :func:`slope_damping` solved for T_c. NaN where K_limit is 0 or unbounded (no such T_c).
+
+    Parameters
+    ----------
+    alpha_max : float  [rad/s²]
+    K_limit : float    [s/rad]
+    margin : float     Gain margin [-].
+    """
+    return 4.0 * margin / (alpha_max * K_limit) if 0.0 < K_limit < math.inf else math.nan
 
 
 def loop_warnings(g: GainRecommendation, s: SampleRateCheck) -> tuple[str, ...]:

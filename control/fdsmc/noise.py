@@ -132,10 +132,9 @@ def _noise_inputs(parts, loop: LoopCase, row: np.ndarray) -> np.ndarray:
     return B
 
 
-
 def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: float,
                      K_max: float) -> float:
-    """Smallest K < K_max [s/rad] at which the sensors' noise swings α_dem by ``fraction``·α_max.
+    """Smallest K ≤ K_max [s/rad] at which the sensors' noise swings α_dem by ``fraction``·α_max.
 
     The predicted swing of α_dem holding θ_dem is PTP_PER_RMS × its rms
     (:func:`control.fdsmc.noise.noise_gain`, sloped law of eq. (46) in [1]); it grows with K
@@ -153,8 +152,10 @@ def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: fl
     Returns
     -------
     float
-        inf when the sensors are ideal, the controller continuous, or the swing stays below
-        ``fraction`` up to K_max. Cached on the numbers the search reads (K is not one of them).
+        inf when the sensors are ideal, the controller continuous, the swing stays below
+        ``fraction`` up to K_max, or the crossing is only the loop's own instability. Cached on the
+        numbers the search reads (K is not one of them); so is the rms at each K, which the searches
+        for several fractions share.
     """
     if d.f_s is None or (count == 0.0 and i_noise_rms == 0.0) or not K_max > 0.0:
         return math.inf
@@ -169,9 +170,7 @@ def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_no
     target = fraction * loop.alpha_max / PTP_PER_RMS
 
     def rms(K: float) -> float:
-        with warnings.catch_warnings():  # ill-conditioned only next to the stability limit
-            warnings.simplefilter("ignore", LinAlgWarning)
-            return noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms
+        return _alpha_dem_rms(loop, K, count, i_noise_rms)
 
     def swings(K: float) -> bool:
         return not rms(K) < target
@@ -188,6 +187,14 @@ def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_no
             K_hi = geometric_bisect(swings, lo, K, 1.005)
             return K_hi if math.isfinite(rms(K_hi)) else math.inf  # the loop's own limit came first
     return math.inf
+
+
+@functools.lru_cache(maxsize=2048)
+def _alpha_dem_rms(loop: LoopCase, K: float, count: float, i_noise_rms: float) -> float:
+    """α_dem rms of :func:`noise_gain` on the sloped law [rad/s²] (inf where the loop is unstable)."""
+    with warnings.catch_warnings():  # ill-conditioned only next to the stability limit
+        warnings.simplefilter("ignore", LinAlgWarning)
+        return noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms
 
 
 __all__ = ["PTP_PER_RMS", "NoiseGain", "noise_gain", "noise_gain_limit"]

@@ -76,7 +76,7 @@ def window_below_count(params: DriveParams) -> str | None:
     cpr = params.sensors.encoder_cpr
     if cpr <= 0:
         return None
-    crit, count = pass_criteria(params), 2.0 * math.pi / cpr
+    crit, count = pass_criteria(params), params.sensors.encoder_step
     field, width = min((("limits.in_position", crit.in_position), ("limits.overshoot", crit.overshoot)),
                        key=lambda fw: fw[1])
     if width >= count:

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.feasibility import alpha_max, feasibility, torque_limit
-from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN, GainRecommendation, slope_damping
+from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN, slope_damping, unit_damping_T_c
 from control.fdsmc.loop_model import LoopModel
 from control.fdsmc.model import model_coefficients
 from control.fdsmc.noise import NoiseGain, noise_gain
@@ -151,15 +151,15 @@ def _overshoot(params: DriveParams) -> float:
 
 
 def _gain_and_T_c(params: DriveParams, d: Derived) -> DriveParams:
-    """K = K_limit/margin (or 10/ω_p when the loop has no limit); T_c = T_c,min if ζ < ζ_min."""
+    """K = K_limit/margin (or 10/ω_p when the loop has no limit); T_c of ζ = 1 at K_limit_cruise/margin if ζ < ζ_min."""
     g = d.gain
     if g is None or g.K_limit <= 0.0:
         return params
-    K = _design_K(g) if math.isfinite(g.K_limit) else 10.0 / d.profile.omega_p
-    a_max, k_c = d.alpha.alpha_max, g.K_limit_cruise
+    K = g.K_margin if math.isfinite(g.K_limit) else 10.0 / d.profile.omega_p
+    a_max, T_c_unit = d.alpha.alpha_max, unit_damping_T_c(d.alpha.alpha_max, g.K_limit_cruise, g.margin)
     T_c: float | str = "T_a"
-    if slope_damping(a_max, g.K_limit / g.margin, d.loop.T_c) < ZETA_SLOPE_MIN and 0.0 < k_c < math.inf:
-        T_c = max(4.0 * g.margin / (a_max * k_c), d.profile.T_a)  # ζ = 1 at K_limit_cruise/margin
+    if slope_damping(a_max, g.K_margin, d.loop.T_c) < ZETA_SLOPE_MIN and math.isfinite(T_c_unit):
+        T_c = max(T_c_unit, d.profile.T_a)
     return _with(params, "controller", K=K, T_c=T_c)
 
 
@@ -203,7 +203,7 @@ def design_drive(params: DriveParams, alpha_rule: str = "torque_limit") -> Drive
     if narrow is not None:  # no setting holds it: say so at once, inputs as they are, not after every slowdown
         crit = pass_criteria(params)
         return _refused(params, [Constraint("in_position", min(crit.in_position, crit.overshoot),
-                                          2.0 * math.pi / params.sensors.encoder_cpr, "rad", True, narrow)])
+                                          params.sensors.encoder_step, "rad", True, narrow)])
     first: DriveDesign | None = None
     for factor in _slowdowns(base):
         dd = _design_at(_slowed(base, factor), params)
@@ -315,7 +315,7 @@ def _verify(p: DriveParams, asked: DriveParams) -> DriveDesign:
 
 def _scan_T_c(p: DriveParams, best: tuple[DriveParams, Derived, Comparison], n_best: int,
               step: float) -> tuple[DriveParams, Derived, Comparison]:
-    """Scan T_c = T_a·step^k (k = 0 …, K recommended for each) for the first that passes every check.
+    """Scan T_c = T_a·step^k (k = 0 …, K = K_limit/margin for each) for the first that passes every check.
 
     ``step`` > 1 (an overshoot: a slower, better damped approach) or < 1 (too slow to get in position
     within the simulated tail: a faster one). Returns the first clean case, else the one with the
@@ -338,12 +338,7 @@ def _with_T_c(p: DriveParams, T_c: float) -> DriveParams:
     """``p`` with the sloped segment's T_c [s] and the design's K for it."""
     q = _with(p, "controller", T_c=T_c)
     g = derive(q).gain
-    return _with(q, "controller", K=_design_K(g)) if g is not None and g.K_limit > 0.0 else q
-
-
-def _design_K(g: GainRecommendation) -> float:
-    """Return the design's first K [s/rad], K_limit/margin (halved where the run with the sensors chatters)."""
-    return g.K_limit / g.margin
+    return _with(q, "controller", K=g.K_margin) if g is not None and g.K_limit > 0.0 else q
 
 
 def _result(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) -> DriveDesign:

@@ -50,7 +50,8 @@ def T_c_advice(derived: Derived) -> float | None:
 
     On the −1/T_c line the ideal loop is s² + α_max·K·s + α_max·K/T_c, damping √(α_max·K·T_c)/2;
     with K capped by the chatter limit, a small T_c (e.g. T_c = T_a on slow manoeuvres) limit-cycles
-    about θ_dem. T_c,min gives ζ = 1 with the recommended K (``control.fdsmc.loop_analysis``).
+    about θ_dem. T_c,min gives ζ = 1 at min(K_limit_cruise, K_noise)/margin
+    (``control.fdsmc.loop_analysis``).
     """
     g = derived.gain
     if not math.isfinite(g.T_c_min) or g.zeta_slope_recommended >= ZETA_SLOPE_MIN:
@@ -93,7 +94,11 @@ def limit_warnings(run: RunResult, derived: Derived) -> list[str]:
 
 
 def criteria_warnings(run: RunResult, derived: Derived) -> list[str]:
-    """List the user's pass criteria the run fails: in-position window, overshoot, standstill ripple."""
+    """List the user's pass criteria the run fails (in-position window, overshoot, standstill ripple).
+
+    Also a window or overshoot limit narrower than one encoder count, whatever the run did
+    (:func:`sim.fdsmc.criteria.window_below_count`).
+    """
     names = {"in_position", "overshoot", "hold_ripple"}
     out = [f"Criterion ({LABELS[run.controller]}): {c.text}" for c in run_checks(derived.params, run)
            if c.name in names]

@@ -27,6 +27,7 @@ from numba import njit, prange
 
 from control.fdsmc.derivations import Derived
 from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
+from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
 from control.fdsmc.params import DriveParams
 from sim.common import sensors, signals
 from sim.fdsmc import kernel as kn
@@ -36,7 +37,6 @@ from sim.fdsmc.limit_cycle import limit_cycles
 from sim.fdsmc.metrics import (
     CHATTER_HYSTERESIS_FRACTION,
     CHATTER_MIN_SIGN_CHANGES,
-    CHATTER_PTP_FRACTION,
     CHATTER_SMOOTHING_S,
     chatter_window_steps,
     chatter_windows,

@@ -14,7 +14,8 @@ from typing import Any
 import pytest
 
 from app.ui.number_fields import shown_text
-from tests.browser.conftest import UiServer, field, free_port, open_page, set_number
+from tests.browser.conftest import UiServer, field, open_page, set_number
+from tests.net import free_port
 
 
 def choose(page: Any, dropdown: str, option: str) -> None:

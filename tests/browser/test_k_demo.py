@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 
+from playwright.sync_api import expect
+
 from app.ui.number_fields import shown_text
 from tests.browser.conftest import field, set_number
 from tests.browser.test_design import choose
@@ -89,8 +91,7 @@ def test_k_slider_mirrors_a_preset_chosen_from_the_list(page):
     # its designed K sits between the noise-capped recommendation and the noise limit, verified clean:
     # no remedy is offered
     _wait_verdict(page, "no chatter")
-    page.get_by_text("Ready — ").wait_for()
-    assert not page.get_by_role("button", name="Use recommended K").is_visible()
+    expect(page.get_by_role("button", name="Use recommended K")).to_be_hidden()
 
 
 def test_recommended_K_with_a_coarse_encoder_is_the_one_the_sensors_allow(page):
@@ -111,7 +112,7 @@ def test_recommended_K_with_a_coarse_encoder_is_the_one_the_sensors_allow(page):
 
 #: The K slider's mark labels as drawn: [text, left, right] [px], left to right.
 K_LABELS_JS = """() => {
-  const label = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'K [s/rad] (log)');
+  const label = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === '""" + SLIDER_LABEL + """');
   let box = label; while (box && !box.querySelector('.mantine-Slider-root')) box = box.parentElement;
   return [...box.querySelectorAll('.mantine-Slider-markLabel')].map(l => { const r = l.getBoundingClientRect();
     return [l.textContent, r.left, r.right]; }).sort((a, b) => a[1] - b[1]);

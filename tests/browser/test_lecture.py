@@ -32,8 +32,9 @@ TRAIL_JS = """() => {
     .filter(([n, _]) => n > 0);
   return [drawn.reduce((n, d) => n + d[0], 0), drawn.length, groups.length, Math.max(-1, ...drawn.map(d => d[1]))];
 }"""
-NAMES_JS = """() => [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane')
-  ._fullData.map(d => d.name)"""
+#: The overview plot element.
+OVERVIEW_EL = "[...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane')"
+NAMES_JS = f"() => {OVERVIEW_EL}._fullData.map(d => d.name)"
 
 
 @pytest.fixture(scope="module")
@@ -209,26 +210,30 @@ def test_the_main_story_fits_1280x720_without_scrolling(lecture):
 def test_clearing_pins_while_a_runs_figures_go_out_leaves_no_ghost(browser, ui_server, monkeypatch):
     # the overview with its replay is built after the light one is sent; a "Clear pins" in between
     # must not be undone by that figure (drawn with the pins read before the click)
-    import app.ui.replay as replay
+    import app.ui.replay as replay_module
 
-    built = replay.overview_json
+    built = replay_module.overview_json
 
-    def slow(comparison, replay=True, pins=(), static=True):
-        if replay:
+    def slow(comparison, *args, **kwargs):
+        if kwargs.get("replay", args[0] if args else True):
             time.sleep(0.6)  # the full figure is still being built when the pins are cleared
-        return built(comparison, replay, pins, static)
+        return built(comparison, *args, **kwargs)
 
     context, page = open_page(browser, ui_server, viewport={"width": 1280, "height": 720})
     try:
         page.get_by_role("button", name="Pin this run").click()
         page.wait_for_function(f"() => ({NAMES_JS})().includes('pin 1 trajectory')")
-        monkeypatch.setattr(replay, "overview_json", slow)
+        monkeypatch.setattr(replay_module, "overview_json", slow)
         set_number(page, "K boundary-layer gain [s/rad]", 2)
         page.get_by_role("button", name="Simulate").click()
         page.wait_for_function(f"() => ({NAMES_JS})().some(n => n.includes('±1/K = ±0.5 rad/s'))")  # the light one
         page.get_by_role("button", name="Clear pins").click()
+        # the last figure: the run's overview with its replay, without the pin (never, had the run's
+        # own full figure come last, as it did)
+        page.wait_for_function(f"""() => {{ const n = ({NAMES_JS})(), el = {OVERVIEW_EL};
+          return (el.layout.updatemenus || []).length > 0 && n.some(x => x.includes('±1/K = ±0.5 rad/s'))
+            && !n.some(x => x.startsWith('pin ')); }}""")
         page.get_by_text("Ready — ").wait_for()
-        page.wait_for_timeout(1500)  # every figure of the run and of the click has arrived
         names = page.evaluate(NAMES_JS)
         assert not [n for n in names if n.startswith("pin ")], names
         assert any("±1/K = ±0.5 rad/s" in n for n in names)  # the new run, not the one before

@@ -187,7 +187,8 @@ def server_3d() -> Iterator[Any]:
     """The web UI with the 3D view available (folded by default)."""
     from app.io.presets import PAPER_PRESET, load_preset
     from app.ui.page import create_server
-    from tests.browser.conftest import UiServer, free_port
+    from tests.browser.conftest import UiServer
+    from tests.net import free_port
 
     server, config = create_server(load_preset(PAPER_PRESET), PAPER_PRESET, port=free_port(), scene_3d=True)
     try:

@@ -33,17 +33,20 @@
     only('data-app-fit', fit); only('data-app-column', columns);
     only('data-app-overview-window', windows); only('data-app-hidden', hidden);
   };
-  // A slider's mark labels that would overlap (K_recommended is K_limit/2: 0.3 decade on a 5.7-decade
-  // track) are moved apart (CSS `translate`, which leaves Mantine's own transform alone): a pair
+  // A slider's mark labels that would overlap (with ideal sensors K_recommended is K_limit/2: 0.3 decade
+  // on a 5.7-decade track) are moved apart (CSS `translate`, which leaves Mantine's own transform alone): a pair
   // shares what it overlaps, except that the track's end labels (its first two marks) stay put.
-  // A few passes settle a crowd. Looked at in the next animation frame after any change (the
-  // layout is then computed anyway); moved only when a slider's marks, widths or fonts changed.
+  // A few passes settle a crowd. Looked at in the next animation frame after a change outside the
+  // plots (the layout is then computed anyway); moved only when a slider's marks, widths or fonts
+  // changed.
   const spread = () => {
     for (const slider of document.querySelectorAll('.mantine-Slider-root')) {
+      const width = slider.clientWidth;
+      if (width === 0) continue;  // hidden: measured when shown
       const labels = [...slider.querySelectorAll('.mantine-Slider-markLabel')];
-      const key = slider.clientWidth + '|' + labels.map(l => l.textContent + l.offsetWidth
+      const key = width + '|' + labels.map(l => l.textContent + l.offsetWidth
         + (l.parentElement.getAttribute('style') || '')).join('|');
-      if (slider.__appMarksKey === key || slider.clientWidth === 0) continue;
+      if (slider.__appMarksKey === key) continue;
       slider.__appMarksKey = key;
       for (const l of labels) l.style.translate = '';
       const boxes = labels.map((l, i) => ({l, r: l.getBoundingClientRect(), dx: 0, fixed: i < 2}))
@@ -66,13 +69,14 @@
     if (!queued) { queued = true; requestAnimationFrame(() => { queued = false; spread(); }); }
   };
   window.__appHideField = (uuid) => { hiddenFields.push(uuid); mark(); };  // a field made later
-  // mutations inside a plot (Plotly redraws) change none of the marks
-  const outside = (r) => !(r.target.closest && r.target.closest('.js-plotly-plot'));
+  // mutations inside a plot (Plotly redraws) change none of the marks, nor any slider
+  const outside = (r) => { const el = r.target.closest ? r.target : r.target.parentElement;
+    return !(el && el.closest('.js-plotly-plot')); };
   // a mark's value or label changes in place (its wrapper's style, its text): only spread() looks
   const marksOnly = (r) => r.type === 'characterData' || r.attributeName === 'style';
   new MutationObserver((records) => {
     if (records.some(r => !marksOnly(r) && outside(r))) mark();
-    spreadSoon();
+    if (records.some(outside)) spreadSoon();
   }).observe(document.body, {
     childList: true, subtree: true, attributes: true, characterData: true,
     attributeFilter: ['aria-selected', 'data-dock-column-rail', 'data-dock-region', 'data-floating-window', 'title',

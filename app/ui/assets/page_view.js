@@ -64,12 +64,19 @@
     setValue.call(input, view);
     input.dispatchEvent(new Event('input', {bubbles: true}));
   };
-  // after the tab strip took the click or key; a newly shown overview is drawn a few frames later
-  const later = () => { setTimeout(report, 60); watchMount(120); };
-  const watchMount = (frames) => {
+  // after the tab strip took the click or key; a newly shown overview is drawn a few frames later:
+  // one watch at a time, for at most 120 frames, ended by an overview hooked
+  let watchFrames = 0;
+  const watchMount = () => {
     const el = overview();
-    if (el && el._fullLayout && !el.__appViewHooked) { hook(el); report(); return; }
-    if (frames > 0) requestAnimationFrame(() => watchMount(frames - 1));
+    if (el && el._fullLayout) { if (!el.__appViewHooked) { hook(el); report(); } watchFrames = 0; return; }
+    if (watchFrames > 0) { watchFrames -= 1; requestAnimationFrame(watchMount); }
+  };
+  const later = () => {
+    setTimeout(report, 60);
+    const idle = watchFrames === 0;
+    watchFrames = 120;
+    if (idle) watchMount();
   };
   if (window.__appPageView) {
     for (const [type, fn] of window.__appPageView) document.removeEventListener(type, fn, true);
