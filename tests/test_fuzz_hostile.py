@@ -279,15 +279,15 @@ def test_fuzz_bldc_budget(t_end, f_s, n):
 
 def test_accepted_runs_take_no_more_steps_than_the_budget_counted(monkeypatch):
     """The kernel is called with exactly the steps the budget counted (sub-steps included)."""
-    import sim.fdsmc.kernel as kn
+    import sim.fdsmc.kernel_run as kernel_run
 
-    real, seen = kn.run_kernel, []
+    real, seen = kernel_run.run_kernel, []
 
     def counting(*args):
         seen.append(int(args[8]) * int(args[9]))  # n_steps × n_sub
         return real(*args)
 
-    monkeypatch.setattr(kn, "run_kernel", counting)
+    monkeypatch.setattr(kernel_run, "run_kernel", counting)
     for over in (["motor.omega_b=2000", "motor.p=10", "manoeuvre.T_m=0.5"], ["controller.f_s=continuous",
                                                                            "manoeuvre.T_m=0.5"]):
         p = load_preset("paper_12kw_pmsm", [*over, "controller.K=0.2"])

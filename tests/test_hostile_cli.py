@@ -127,7 +127,7 @@ def test_csv_path_checked_before_the_simulation(capsys, monkeypatch):
 
 def test_substeps_count_in_the_budget_and_are_refused_before_work(monkeypatch, capsys):
     """ω_b = 1e5 rad/s at p = 100 asks for 2500 RK4 sub-steps per sample: over budget, no kernel call."""
-    monkeypatch.setattr("sim.fdsmc.kernel.run_kernel", lambda *a: (_ for _ in ()).throw(AssertionError("ran")))
+    monkeypatch.setattr("sim.fdsmc.kernel_run.run_kernel", lambda *a: (_ for _ in ()).throw(AssertionError("ran")))
     err = _fails(["simulate", "paper_12kw_pmsm", "--set", "motor.omega_b=1e5", "--set", "motor.p=100"],
                  capsys, "integration steps", "motor.omega_b = 100000 rad/s → largest accepted",
                  "motor.p = 100 → largest accepted")

@@ -1,7 +1,7 @@
 """Closed-loop simulation engine: one run and the comparison of the controllers (Table 1: :mod:`sim.fdsmc.table1`).
 
 The model (plant, FDC inner loops, observer, outer loop, energies) is integrated by the
-compiled kernel :func:`sim.fdsmc.kernel.run_kernel`; this module packs the parameters, chooses the
+compiled kernel :func:`sim.fdsmc.kernel_run.run_kernel`; this module packs the parameters, chooses the
 time grid, and turns the raw arrays into frozen results with their :class:`~sim.fdsmc.metrics.RunMetrics`.
 
 Rest-to-rest manoeuvre from θ_r = 0 to θ_dem, simulated over [0, (1 + TAIL_FRACTION)·T_m] (the time
@@ -37,6 +37,7 @@ from control.fdsmc.tracking import optimum_slide, tracking_gains
 from sim.common import sensors
 from sim.common.choices import check_controller
 from sim.fdsmc import kernel as kn
+from sim.fdsmc import kernel_run
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.grid import (
     CONTINUOUS_STEP_S,
@@ -278,7 +279,7 @@ def _simulate_checked(
     steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
     win = np.zeros((kn.WIN_ROWS * len(steps), max(n for _, n in steps)))
-    kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
+    kernel_run.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
                   params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller),
                   sensors.noise_table(params.sensors))
     summary = decode_info(info)
@@ -311,7 +312,7 @@ def run_steps(
     Phi, Gam, Lo = _observer_arrays(d)
     out = np.zeros((kn.N_CH, 1))
     info = np.zeros(kn.N_INFO)
-    kn.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
+    kernel_run.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
                   params.controller.delay_samples, int(n_steps) + 1, out, info,
                   np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller),
                   sensors.noise_table(params.sensors))

@@ -1,7 +1,8 @@
-"""Compiled closed-loop kernel: PMSM + FDC inner loops + observer + outer loop, one run.
+"""Compiled closed-loop kernel: PMSM + FDC inner loops + observer + outer loop, one sample step.
 
 Everything a run needs is packed into flat float arrays (indices below) so that one numba
-function integrates the whole manoeuvre. :mod:`sim.fdsmc.reference` holds the readable plain-Python
+function, :func:`sim.fdsmc.kernel_run.run_kernel`, integrates the whole manoeuvre with the step
+written here (:func:`step_sample`, the plant's RK4 steps). :mod:`sim.fdsmc.reference` holds the readable plain-Python
 version of the same step, built from the laws in :mod:`control`, and the tests check that both
 agree. Formulas (see [1], the FDSMC paper):
 
@@ -24,14 +25,11 @@ agree. Formulas (see [1], the FDSMC paper):
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
 from control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
 from sim.common import sensors
-from sim.common.borrowed import borrowed
 
 # ---- prm indices -------------------------------------------------------------------------
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
@@ -79,13 +77,13 @@ WIN_ROWS = 4
 # into different trajectories — so only bit-identical arithmetic lets both agree on every metric
 # and flag (tests/test_compiled_vs_python.py).
 # The hot path works on tuples of scalars (plant p = the first X_THH states, observer o = the
-# last four) and every helper is inlined into run_kernel (inline="always"), so numba keeps the
+# last four) and every helper is inlined into the run loop (inline="always"), so numba keeps the
 # states in registers. The earlier array-based version (states in small arrays, stores inside
 # the loop) took ≈ 240 ns per 20 kHz sample; this one ≈ 75 ns (``python -m app bench``).
-_helper = njit(cache=True, error_model="numpy", inline="always")
+inlined = njit(cache=True, error_model="numpy", inline="always")
 
 
-@_helper
+@inlined
 def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) -> float:
     """External load torque Γ_Le(t) [N·m]: last step value (or Γ_Le0) plus the ramp."""
     g = prm[P_GLE0]
@@ -95,7 +93,7 @@ def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) 
     return g + prm[P_GRAMP] * t
 
 
-@_helper
+@inlined
 def reference_at(t: float, ref: np.ndarray, T_m: float) -> tuple[float, float, float]:
     """Return θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] at t [s] between the rows of ``ref``.
 
@@ -116,7 +114,7 @@ def reference_at(t: float, ref: np.ndarray, T_m: float) -> tuple[float, float, f
             (1.0 - f) * ref[2, j] + f * ref[2, j + 1])
 
 
-@_helper
+@inlined
 def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
               ref: np.ndarray) -> tuple[float, float]:
     """Return the outer loop's demanded acceleration [rad/s²] and S [rad/s].
@@ -137,7 +135,7 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
     return sliding_mode.smc_demand(theta_hat - prm[P_THDEM], omega_hat, prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
 
 
-@_helper
+@inlined
 def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0: float,
                  L1: float, prm: np.ndarray) -> tuple[float, float, float]:
     """u_d of eq. (9), u_q of eq. (14) [V] and α of eq. (7) [rad/s²]: :func:`control.fdsmc.fdc.fdc_voltages`."""
@@ -145,14 +143,14 @@ def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0:
                             prm[P_E], prm[P_F], prm[P_G], prm[P_H], prm[P_K], prm[P_M], prm[P_TSI], prm[P_TSA])
 
 
-@_helper
+@inlined
 def predict_currents(i_d: float, i_q: float, omega_hat: float, u: tuple, prm: np.ndarray) -> tuple[float, float]:
     """Currents [A] one sample on with the voltages u held: :func:`control.fdsmc.inverter.predict_currents`."""
     return inverter.predict_currents(i_d, i_q, omega_hat, u[0], u[1], prm[P_PHID], prm[P_GMID], prm[P_PHIQ],
                                      prm[P_GMIQ], prm[P_B], prm[P_C], prm[P_E], prm[P_F], prm[P_G])
 
 
-@_helper
+@inlined
 def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
                   prm: np.ndarray) -> tuple[float, float, bool]:
     """Apply the inverter limits of :func:`control.fdsmc.inverter.limit_voltage`; return u_d, u_q, flag."""
@@ -161,7 +159,7 @@ def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: flo
                                   prm[P_F], prm[P_G])
 
 
-@_helper
+@inlined
 def measure(k: int, p: tuple, prm: np.ndarray, noise: np.ndarray) -> tuple[float, float, float]:
     """Return what the controller reads at sample k: (θ_r [rad], i_d, i_q [A]) through :mod:`sim.common.sensors`."""
     j = k % noise.shape[1]
@@ -170,7 +168,7 @@ def measure(k: int, p: tuple, prm: np.ndarray, noise: np.ndarray) -> tuple[float
             sensors.adc_current(p[X_IQ], noise[1, j], prm[P_INOISE], prm[P_ISTEP], prm[P_IFS]))
 
 
-@_helper
+@inlined
 def control_output(t: float, y: tuple, i0: tuple, o: tuple, prm: np.ndarray,
                    ref: np.ndarray, dv: float) -> tuple[float, float, float, float, float, bool]:
     """u_d, u_q [V], α_dem, α [rad/s²], S [rad/s], limited, from the readings y and the estimates o.
@@ -185,13 +183,13 @@ def control_output(t: float, y: tuple, i0: tuple, o: tuple, prm: np.ndarray,
     return u_d, u_q, alpha_dem, alpha, S, sat
 
 
-@_helper
+@inlined
 def electromagnetic_torque(i_d: float, i_q: float, prm: np.ndarray) -> float:
     """Γ_em of eq. (5) [N·m] (:func:`control.fdsmc.model.electromagnetic_torque` on the packed parameters)."""
     return model.electromagnetic_torque(prm[P_P], prm[P_PSI], prm[P_LD], prm[P_LQ], i_d, i_q)
 
 
-@_helper
+@inlined
 def plant_rhs(t: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray, step_t: np.ndarray,
               step_v: np.ndarray) -> tuple:
     """Return the derivatives of the plant and energy states p (eqs. 1–3, 4b, 5) [SI/s]."""
@@ -210,7 +208,7 @@ def plant_rhs(t: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray, step_
             g_le * w)
 
 
-@_helper
+@inlined
 def observer_rhs(p: tuple, o: tuple, prm: np.ndarray) -> tuple[float, float, float, float]:
     """Corrected continuous observer, eq. (15) with e_o = θ_r − θ̂_r [rad/s, rad/s², …]."""
     e_o = p[X_TH] - o[0]
@@ -219,32 +217,32 @@ def observer_rhs(p: tuple, o: tuple, prm: np.ndarray) -> tuple[float, float, flo
             o[3] + prm[P_K3] * e_o, prm[P_K4] * e_o)
 
 
-@_helper
+@inlined
 def axpy9(x: tuple, a: float, k: tuple) -> tuple:
     """Return x + a·k for 9-tuples."""
     return (x[0] + a * k[0], x[1] + a * k[1], x[2] + a * k[2], x[3] + a * k[3], x[4] + a * k[4],
             x[5] + a * k[5], x[6] + a * k[6], x[7] + a * k[7], x[8] + a * k[8])
 
 
-@_helper
+@inlined
 def axpy4(x: tuple, a: float, k: tuple) -> tuple:
     """Return x + a·k for 4-tuples."""
     return (x[0] + a * k[0], x[1] + a * k[1], x[2] + a * k[2], x[3] + a * k[3])
 
 
-@_helper
+@inlined
 def rk4_sum9(x: tuple, h: float, k1: tuple, k2: tuple, k3: tuple, k4: tuple) -> tuple:
     """Return x + h/6·(k1 + 2k2 + 2k3 + k4) for 9-tuples."""
     return axpy9(x, h / 6.0, axpy9(axpy9(k1, 2.0, axpy9(k2, 1.0, k3)), 1.0, k4))
 
 
-@_helper
+@inlined
 def rk4_sum4(x: tuple, h: float, k1: tuple, k2: tuple, k3: tuple, k4: tuple) -> tuple:
     """Return x + h/6·(k1 + 2k2 + 2k3 + k4) for 4-tuples."""
     return axpy4(x, h / 6.0, axpy4(axpy4(k1, 2.0, axpy4(k2, 1.0, k3)), 1.0, k4))
 
 
-@_helper
+@inlined
 def rk4_plant(t: float, h: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray,
               step_t: np.ndarray, step_v: np.ndarray) -> tuple:
     """One classical Runge–Kutta step [s] of the plant with held voltages (digital mode)."""
@@ -255,7 +253,7 @@ def rk4_plant(t: float, h: float, p: tuple, u_d: float, u_q: float, prm: np.ndar
     return rk4_sum9(p, h, k1, k2, k3, k4)
 
 
-@_helper
+@inlined
 def full_rhs(t: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
              step_v: np.ndarray, ref: np.ndarray) -> tuple:
     """Continuous mode: plant and observer derivatives with the controller inside (ideal sensors)."""
@@ -264,7 +262,7 @@ def full_rhs(t: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
     return plant_rhs(t, p, u_d, u_q, prm, step_t, step_v), observer_rhs(p, o, prm)
 
 
-@_helper
+@inlined
 def rk4_continuous(t: float, h: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
                    step_v: np.ndarray, ref: np.ndarray) -> tuple:
     """One RK4 step [s] of plant + observer with the controller evaluated in every stage."""
@@ -275,13 +273,13 @@ def rk4_continuous(t: float, h: float, p: tuple, o: tuple, prm: np.ndarray, step
     return rk4_sum9(p, h, a1, a2, a3, a4), rk4_sum4(o, h, b1, b2, b3, b4)
 
 
-@_helper
+@inlined
 def _row4(M: np.ndarray, i: int, o: tuple) -> float:
     """Row i of the 4×4 matrix M times the 4-tuple o."""
     return M[i, 0] * o[0] + M[i, 1] * o[1] + M[i, 2] * o[2] + M[i, 3] * o[3]
 
 
-@_helper
+@inlined
 def observer_update(theta_m: float, o: tuple, a_em: float, Phi: np.ndarray, Gam: np.ndarray,
                     Lo: np.ndarray) -> tuple[float, float, float, float]:
     """Discrete observer x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·(θ_r,meas[k] − θ̂_r[k])."""
@@ -292,63 +290,7 @@ def observer_update(theta_m: float, o: tuple, a_em: float, Phi: np.ndarray, Gam:
             Gam[3] * a_em + Lo[3] * e_o + _row4(Phi, 3, o))
 
 
-@_helper
-def record(row: np.ndarray, t: float, p: tuple, o: tuple, u: tuple, prm: np.ndarray,
-           step_t: np.ndarray, step_v: np.ndarray) -> None:
-    """Write one trace sample (channels in CHANNELS order); u = (u_d, u_q, α_dem, α̂, S)."""
-    dp = plant_rhs(t, p, u[0], u[1], prm, step_t, step_v)
-    T_em = electromagnetic_torque(p[X_ID], p[X_IQ], prm)
-    row[0], row[1], row[2], row[3], row[4] = t, p[X_TH], p[X_W], p[X_ID], p[X_IQ]
-    row[5], row[6], row[7], row[8] = u[0], u[1], dp[X_W], u[2]
-    row[9] = T_em - prm[P_JR] * dp[X_W]  # Γ_L of eq. (4a)
-    row[10], row[11], row[12], row[13] = o[2], o[0], o[1], u[4]
-    row[14], row[15], row[16], row[17] = p[X_EF], p[X_ECU], p[X_EEL], u[3]
-    row[18], row[19] = p[X_EMOT], p[X_ELOAD]
-
-
-@_helper
-def peaks(pk: tuple, p: tuple, u_d: float, u_q: float, prm: np.ndarray) -> tuple:
-    """Return the running peaks updated with this step (|ω_r|, |i_q|, |u_dq|, |Γ_em|, |i_d|, |i_dq|)."""
-    return (max(pk[0], abs(p[X_W])), max(pk[1], abs(p[X_IQ])),
-            max(pk[2], math.sqrt(u_d * u_d + u_q * u_q)),
-            max(pk[3], abs(electromagnetic_torque(p[X_ID], p[X_IQ], prm))),
-            max(pk[4], abs(p[X_ID])), max(pk[5], math.sqrt(p[X_ID] * p[X_ID] + p[X_IQ] * p[X_IQ])))
-
-
-@_helper
-def position_checks(pc: tuple, t: float, p: tuple, dt: float, prm: np.ndarray) -> tuple:
-    """Update (time over i_max [s], last time outside the in-position window [s], overshoot [rad]) at t."""
-    i_dq = math.sqrt(p[X_ID] * p[X_ID] + p[X_IQ] * p[X_IQ])
-    over = prm[P_IMAX] > 0.0 and i_dq > prm[P_IMAX]
-    err = p[X_TH] - prm[P_THDEM]
-    out = abs(err) > prm[P_INPOS]
-    return (pc[0] + (dt if over else 0.0), t if out else pc[1],
-            max(pc[2], err if prm[P_THDEM] > 0.0 else -err))
-
-
-@_helper
-def diverged(p: tuple, o: tuple, prm: np.ndarray) -> bool:
-    """Return True when a state is not finite or beyond the divergence limits."""
-    total = 0.0
-    for v in p:
-        total += v
-    total += o[0] + o[1] + o[2] + o[3]
-    if not math.isfinite(total):  # one NaN/inf anywhere makes the sum non-finite
-        return True
-    return (abs(p[X_W]) > prm[P_WLIM] or abs(p[X_IQ]) > prm[P_ILIM]
-            or abs(p[X_ID]) > prm[P_ILIM] or abs(o[1]) > 10.0 * prm[P_WLIM])
-
-
-@_helper
-def store_state(info: np.ndarray, at: int, p: tuple, o: tuple, w: float, p0: tuple) -> None:
-    """info[at:at+N_X] = (1 − w)·p0 + w·p (plant, linear interpolation) followed by o."""
-    for i in range(X_THH):
-        info[at + i] = (1.0 - w) * p0[i] + w * p[i]
-    for i in range(4):
-        info[at + X_THH + i] = o[i]
-
-
-@_helper
+@inlined
 def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: bool, delay: int,
                 prm: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray, ref: np.ndarray,
                 noise: np.ndarray):
@@ -378,67 +320,3 @@ def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: b
     a_em = (prm[P_H] + prm[P_K] * y[1]) * y[2]
     memory = (held[0], held[1], y[1], y[2], o[1], u_d, u_q, dv)
     return (u_d, u_q), observer_update(y[0], o, a_em, Phi, Gam, Lo), memory, (u_d, u_q, a_dem, a_hat, S), sat
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.ndarray,
-               Gam: np.ndarray, Lo: np.ndarray, continuous: bool, h: float, n_steps: int,
-               n_sub: int, delay: int, decim: int, out: np.ndarray, info: np.ndarray,
-               k_win: np.ndarray, win: np.ndarray, ref: np.ndarray, noise: np.ndarray) -> None:
-    """Integrate one run from rest; fills ``out`` (N_CH × samples) and ``info`` (I_* indices).
-
-    ``ref`` (3 × n: θ_ref, ω_ref, α_ref on equally spaced nodes over [0, T_m]) is read only by the
-    reference-tracking outer laws (``prm[P_CTRL]`` = 2, 3); pass a 3 × 2 array of zeros otherwise.
-
-    For each window j, rows WIN_ROWS·j … WIN_ROWS·j + 3 of ``win`` receive α_dem, ω_r, i_q and the
-    applied u_q of every step k_win[j] … k_win[j] + n − 1 at full resolution (the chatter and
-    standstill-ripple windows, independent of the trace decimation). ``noise`` is the sensors'
-    standard-normal table (:func:`sim.common.sensors.noise_table`).
-
-    Digital mode: ``n_steps`` samples of period n_sub·h; controller and observer at each
-    sample, voltages held (one sample later if ``delay``), n_sub RK4 substeps in between.
-    Continuous mode: ``n_steps`` RK4 steps of size h with the controller inside the RHS.
-    """
-    prm, step_t, step_v, Phi, Gam, Lo = (borrowed(prm), borrowed(step_t), borrowed(step_v), borrowed(Phi),
-                                         borrowed(Gam), borrowed(Lo))  # no reference counts in the loop
-    out, info, k_win, win, ref, noise = (borrowed(out), borrowed(info), borrowed(k_win), borrowed(win),
-                                         borrowed(ref), borrowed(noise))
-    p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    o, hold, pk = (0.0, 0.0, 0.0, 0.0), HOLD0, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    pc = (0.0, -1.0, 0.0)
-    n_out, t, t_sat, T_m, hit = 0, 0.0, 0.0, prm[P_TM], False
-    info[:] = 0.0
-    for k in range(n_steps):
-        u, o_next, hold, rec, sat = step_sample(k, t, p, o, hold, continuous, delay, prm, Phi, Gam, Lo, ref,
-                                                noise)
-        if k % decim == 0 and n_out < out.shape[1]:
-            record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
-            n_out += 1
-        for j in range(k_win.size):
-            i = k - k_win[j]
-            if 0 <= i < win.shape[1]:
-                r = WIN_ROWS * j
-                win[r, i], win[r + 1, i], win[r + 2, i], win[r + 3, i] = rec[2], p[X_W], p[X_IQ], u[1]
-        pk = peaks(pk, p, u[0], u[1], prm)
-        pc = position_checks(pc, t, p, h * n_sub, prm)
-        t_sat += h * n_sub if sat else 0.0
-        p0, o, t0 = p, o_next, t
-        for _ in range(n_sub):
-            if continuous:
-                p, o = rk4_continuous(t, h, p, o, prm, step_t, step_v, ref)
-            else:
-                p = rk4_plant(t, h, p, u[0], u[1], prm, step_t, step_v)
-            t += h
-        if not hit and t0 < T_m <= t:
-            store_state(info, I_SNAP, p, o, (T_m - t0) / (t - t0), p0)
-            hit = True
-        if diverged(p, o, prm):
-            info[I_FAILED], info[I_TFAIL] = 1.0, t
-            break
-    info[I_NOUT], info[I_TSAT], info[I_TM_HIT] = n_out, t_sat, 1.0 if hit else 0.0
-    pc = position_checks(pc, t, p, 0.0, prm)  # the final state counts too: outside at the end → inf
-    if pc[1] == t:
-        pc = (pc[0], math.inf, pc[2])
-    info[I_PW], info[I_PIQ], info[I_PU], info[I_PTQ], info[I_PID], info[I_PIDQ] = pk
-    info[I_TOVER], info[I_TOUT], info[I_OVS] = pc
-    store_state(info, I_END, p, o, 1.0, p)

@@ -1,4 +1,4 @@
-"""Many Monte-Carlo samples per compiled call: :func:`sim.fdsmc.kernel.run_kernel` under ``prange``.
+"""Many Monte-Carlo samples per compiled call: :func:`sim.fdsmc.kernel_run.run_kernel` under ``prange``.
 
 A robustness sample is one plant (the controller keeps its model ``params`` and its design ``d``),
 so every sample of one controller shares the time grid, the observer matrices, the load steps and
@@ -31,6 +31,7 @@ from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
 from control.fdsmc.params import DriveParams
 from sim.common import sensors, signals
 from sim.fdsmc import kernel as kn
+from sim.fdsmc import kernel_run
 from sim.fdsmc.engine import CONTROLLERS, _observer_arrays, _reference, pack_parameters
 from sim.fdsmc.grid import CONTINUOUS_STEP_S, TimeGrid, load_steps, time_grid
 from sim.fdsmc.limit_cycle import limit_cycles
@@ -52,14 +53,14 @@ def run_batch(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.n
               Lo: np.ndarray, continuous: bool, h: float, n_steps: int, n_sub: int, delay: int, decim: int,
               out: np.ndarray, info: np.ndarray, k_win: np.ndarray, win: np.ndarray, ref: np.ndarray,
               noise: np.ndarray, n: int) -> None:
-    """Run :func:`sim.fdsmc.kernel.run_kernel` for rows 0 … n − 1 of ``prm`` (one sample each).
+    """Run :func:`sim.fdsmc.kernel_run.run_kernel` for rows 0 … n − 1 of ``prm`` (one sample each).
 
     ``prm`` (samples × N_PRM), ``out`` (samples × N_CH × points), ``info`` (samples × N_INFO) and
     ``win`` (samples × WIN_ROWS·windows × steps) stack the kernel's per-run arrays; the other arguments
     are shared and mean what they mean for ``run_kernel`` (SI units).
     """
     for i in prange(n):
-        kn.run_kernel(prm[i], step_t, step_v, Phi, Gam, Lo, continuous, h, n_steps, n_sub, delay, decim,
+        kernel_run.run_kernel(prm[i], step_t, step_v, Phi, Gam, Lo, continuous, h, n_steps, n_sub, delay, decim,
                       out[i], info[i], k_win, win[i], ref, noise)
 
 

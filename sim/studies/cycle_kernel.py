@@ -1,7 +1,7 @@
 """Compiled duty-cycle run: the moves of a cycle back to back in one continuous simulation.
 
 The same plant, FDC inner loops, observer and outer laws as the single-move kernel
-(:func:`sim.fdsmc.kernel.run_kernel`, whose inlined steps are reused here, not rewritten), with
+(:func:`sim.fdsmc.kernel_run.run_kernel`, whose inlined steps are reused here, not rewritten), with
 the state — currents, position, speed, the observer's estimates, the held voltages and the
 energy integrals — carried from one segment (a move and its dwell) into the next. At a segment's
 start the outer loop switches to that move's design (row of ``prm_all``: its θ_dem as an absolute
@@ -16,6 +16,7 @@ from numba import njit
 
 from sim.common.borrowed import borrowed
 from sim.fdsmc import kernel as kn
+from sim.fdsmc import kernel_run
 
 #: Per-segment values stored in ``seg_info`` (row per segment): the state at its end.
 SEG_X = kn.N_X
@@ -50,7 +51,7 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
             u, o_next, hold, rec, sat = kn.step_sample(k_all, t - t_start, p, o, hold, continuous, delay, prm,
                                                        Phi, Gam, Lo, ref, noise)
             if k_all % decim == 0 and n_out < out.shape[1]:
-                kn.record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
+                kernel_run.record(out[:, n_out], t, p, o, rec, prm, step_t, step_v)
                 n_out += 1
             o = o_next
             for _ in range(n_sub):
@@ -60,7 +61,7 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
                     p = kn.rk4_plant(t, h, p, u[0], u[1], prm, step_t, step_v)
                 t += h
             k_all += 1
-            if kn.diverged(p, o, prm):
+            if kernel_run.diverged(p, o, prm):
                 return -(n_out + 1)
-        kn.store_state(seg_info[j], 0, p, o, 1.0, p)
+        kernel_run.store_state(seg_info[j], 0, p, o, 1.0, p)
     return n_out
