@@ -15,7 +15,7 @@ import pytest
 
 from app.io.presets import load_preset
 from control.fdsmc.derivations import derive
-from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
+from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, slope_damping
 from control.fdsmc.noise import PTP_PER_RMS, noise_gain, noise_gain_limit
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.criteria import window_below_count
@@ -60,6 +60,19 @@ def test_K_noise_is_where_the_predicted_swing_reaches_the_chatter_criterion():
     fine = derive(load_preset("yaskawa_sgm7j_04a")).gain
     assert not fine.noise_limited and fine.K_recommended == fine.K_limit / fine.margin
     assert 0.9 * fine.K_limit < fine.K_noise < fine.K_limit and fine.K_noise_binding == math.inf
+
+
+def test_T_c_min_damps_the_recommended_K_critically_where_the_noise_sets_it():
+    """ζ = √(α_max·K·T_c)/2 = 1 at T_c = T_c_min with the K the page recommends (the advice is one
+    setting, not two); with ideal sensors it is the cruise segment's K_limit/margin.
+    """
+    coarse = derive(load_preset("yaskawa_sgm7j_04a", COARSE))
+    ideal = derive(load_preset("paper_12kw_pmsm"))
+    for d, K in ((coarse, coarse.gain.K_recommended), (ideal, ideal.gain.K_limit_cruise / ideal.gain.margin)):
+        g = d.gain
+        assert g.K_unit_damping == K
+        assert slope_damping(d.alpha.alpha_max, K, g.T_c_min) == pytest.approx(1.0, rel=1e-12)
+    assert coarse.gain.noise_limited and not ideal.gain.noise_limited
 
 
 def test_the_recommended_K_with_a_coarse_encoder_does_not_chatter_where_half_K_limit_did():

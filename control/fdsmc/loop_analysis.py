@@ -73,7 +73,7 @@ class GainRecommendation:
     zeta_slope : float       Damping ratio √(α_max·K·T_c)/2 of the ideal sloped-segment loop
                              s² + α_max·K·s + α_max·K/T_c, with the preset's K if K_ok, else with
                              K_recommended [-].
-    T_c_min : float          T_c giving ζ = 1 with min(K_limit_cruise, K_noise)/margin, 4/(α_max·K) [s].
+    T_c_min : float          T_c giving ζ = 1 at :attr:`K_unit_damping`, 4/(α_max·K) [s].
     zeta_slope_recommended : float  The same damping ratio with K_recommended [-].
     K_noise : float          Smallest K at which the sensors' noise makes α_dem chatter [s/rad];
                              inf for ideal sensors or when the stability limit comes first.
@@ -102,6 +102,16 @@ class GainRecommendation:
     def noise_limited(self) -> bool:
         """True when the sensors' noise, not K_limit/margin, sets K_recommended."""
         return self.K_recommended < self.K_margin
+
+    @property
+    def K_unit_damping(self) -> float:
+        """The K that :attr:`T_c_min` damps critically [s/rad].
+
+        K_recommended where the sensors' noise sets it, else K_limit_cruise/margin: a sloped
+        segment unstable for every K is a damping problem, which T_c_min cures, so its own limit
+        does not bound the K it is cured with.
+        """
+        return self.K_recommended if self.noise_limited else self.K_limit_cruise / self.margin
 
     @property
     def K_noise_ok(self) -> bool:
@@ -263,10 +273,10 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
     k_quiet = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION / margin, k_lim / margin)
     k_rec = min(k_lim / margin, k_quiet) if k_lim > 0.0 else 0.0
     zeta = slope_damping(a_max, K if k_ok else k_rec, d.T_c)
-    T_c_min = unit_damping_T_c(a_max, min(k_c, K_noise), margin)
     zeta_rec = slope_damping(a_max, k_rec, d.T_c)
-    return GainRecommendation(k_lim, k_c, k_s, margin, k_rec, K, k_ok, k_lim / K, mode,
-                              zeta, T_c_min, zeta_rec, K_noise)
+    g = GainRecommendation(k_lim, k_c, k_s, margin, k_rec, K, k_ok, k_lim / K, mode, zeta, math.nan,
+                           zeta_rec, K_noise)
+    return dataclasses.replace(g, T_c_min=unit_damping_T_c(a_max, margin * g.K_unit_damping, margin))
 
 
 def unit_damping_T_c(alpha_max: float, K_limit: float, margin: float) -> float:
@@ -311,8 +321,8 @@ def _slope_warning(g: GainRecommendation) -> str:
     if g.zeta_slope_recommended >= ZETA_SLOPE_MIN:
         fix = f"Raise K to the recommended {g.K_recommended:.4g} s/rad (ζ = {g.zeta_slope_recommended:.2g})."
     else:
-        fix = (f"Set controller.T_c ≥ {g.T_c_min:.3g} s (ζ = 1 at K = "
-               f"{min(g.K_limit_cruise, g.K_noise) / g.margin:.4g} s/rad; T_c ≪ T_m keeps the timing).")
+        fix = (f"Set controller.T_c ≥ {g.T_c_min:.3g} s (ζ = 1 at K = {g.K_unit_damping:.4g} s/rad; "
+               f"T_c ≪ T_m keeps the timing).")
     return (f"Sloped segment (eq. 41, deceleration) poorly damped with K = {k:.4g} s/rad: "
             f"ζ ≈ √(α_max·K·T_c)/2 = {g.zeta_slope:.2g} ({lin}). α_max·T_c is small (= ω_p when "
             f"T_c = T_a, eq. 59), so the drive will oscillate about θ_dem. {fix}")
