@@ -75,7 +75,6 @@ def _open(browser: Any, port: int, size: dict[str, int]) -> Any:
     page = browser.new_page(viewport=size)
     page.set_default_timeout(120_000)
     page.goto(f"http://127.0.0.1:{port}")
-    page.add_style_tag(content=".mantine-Notifications-root {display: none !important}")  # WebGL notice
     page.wait_for_function(FIGURE_DRAWN, arg="phase_plane")
     _settle(page)
     return page

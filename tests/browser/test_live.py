@@ -47,8 +47,6 @@ def sent_bytes(ui_server) -> list[int]:
 
 
 def test_in_plot_replay_moves_the_marker_without_server_traffic(page, ui_server):
-    for close in page.locator(".mantine-Notification-closeButton").all():
-        close.click()  # e.g. viser's "software WebGL" notice
     received = sent_bytes(ui_server)
     start = page.evaluate(MARKER_JS)
     t_end = float(ui_server.config.initial().fdsmc.trace.t[-1])

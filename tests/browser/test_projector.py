@@ -13,7 +13,15 @@ import pytest
 
 from app.figures.fdsmc_overview import CURSORS
 from app.figures.fdsmc_replay import SPEEDS
-from tests.browser.conftest import ARTIFACTS, TIMEOUT_MS, UiServer, click_tab, session_of, wait_for_layout
+from tests.browser.conftest import (
+    ARTIFACTS,
+    TIMEOUT_MS,
+    UiServer,
+    click_tab,
+    open_page,
+    session_of,
+    wait_for_layout,
+)
 
 #: Bounding boxes (page pixels) of the phase-plane subplot, the two time rows, the key numbers and
 #: the "Replay t" slider row.
@@ -63,8 +71,6 @@ def _open(browser: Any, ui: UiServer, width: int, height: int) -> tuple[Any, Any
     page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')]"
                            ".some(e => e.layout && e.layout.meta && e.layout.meta.overview"
                            " && e._fullLayout && e._fullLayout.xaxis2)", timeout=3 * TIMEOUT_MS)
-    for close in page.locator(".mantine-Notification-closeButton").all():
-        close.click()  # e.g. viser's "software WebGL" notice
     wait_for_layout(page, session_of(page, ui, before))
     return context, page
 
@@ -216,5 +222,29 @@ def test_3d_view_folds_by_default_and_hides_in_the_bldc_tab(browser, server_3d):
         page.wait_for_function(f"() => ({CANVAS_JS})() === 'hidden'")
         click_tab(page, "Position drive (FDSMC)")
         page.wait_for_function(f"() => ({CANVAS_JS})() === 'visible'")
+    finally:
+        context.close()
+
+
+#: Keeps the page's console.log lines in ``window.__logs`` (viser logs its WebGL renderer there).
+LOGS_INIT = ("window.__logs = []; const log = console.log;"
+             " console.log = (...a) => { window.__logs.push(a.map(String).join(' ')); log(...a); };")
+WEBGL_NOTICE_JS = ("() => [...document.querySelectorAll('.mantine-Notification-title')]"
+                   ".some(t => t.textContent.includes('WebGL'))")
+
+
+def test_viser_software_webgl_notice_is_closed_while_no_3d_view_is_shown(browser, server_3d):
+    # viser's notice stays until closed, over the results' tab row and the key numbers; the plots
+    # are SVG, only the (folded) 3D view uses WebGL
+    context, page = open_page(browser, server_3d, {"width": 1280, "height": 720}, init_script=LOGS_INIT)
+    try:
+        renderer = page.wait_for_function(
+            "() => window.__logs.find(m => m.startsWith('WebGL support'))").json_value()
+        # the case is set up: headless Chromium renders WebGL in software, where viser shows its notice
+        assert "swiftshader" in renderer.lower() or "software" in renderer.lower(), renderer
+        page.wait_for_function(f"() => !({WEBGL_NOTICE_JS})()")
+        page.wait_for_timeout(500)  # and it stays closed
+        assert not page.evaluate(WEBGL_NOTICE_JS)
+        assert "Net electrical input" in page.inner_text('[data-role="key-numbers"]')
     finally:
         context.close()

@@ -166,8 +166,6 @@ def test_two_browser_contexts_keep_separate_values(browser, ui_server):
 def test_screenshot_of_main_view(page):
     """The main view after "Use recommended K" (the README's picture comes from this artifact)."""
     _click_and_wait_for_run(page, page.get_by_role("button", name=re.compile(r"^Use recommended K")))
-    for close in page.locator(".mantine-Notification-closeButton").all():
-        close.click()  # e.g. viser's "software WebGL" notice would cover the plots
     page.wait_for_timeout(1500)  # part of the replay
     names = {t["name"] for t in figure(page, "phase_plane")["traces"]}
     assert {"FDSMC trajectory", "Conventional trajectory"} <= names

@@ -32,6 +32,20 @@
     }
     only('data-app-fit', fit); only('data-app-column', columns);
     only('data-app-overview-window', windows); only('data-app-hidden', hidden);
+    closeWebGlNotices();
+  };
+  // viser's notices of a software (or missing) WebGL stay until closed, over the results' tab row and
+  // key numbers. They concern the 3D view only (the plots are SVG): closed while no 3D view is shown.
+  const WEBGL_NOTICES = ['Software WebGL rendering detected', 'WebGL unavailable'];
+  const closeWebGlNotices = () => {
+    for (const title of document.querySelectorAll('.mantine-Notification-title')) {
+      if (!WEBGL_NOTICES.includes(title.textContent.trim())) continue;
+      const shown3d = [...document.querySelectorAll('canvas')]
+        .some(c => c.clientWidth > SCENE_MIN_PX && getComputedStyle(c).visibility !== 'hidden');
+      const close = title.closest('.mantine-Notification-root');
+      const button = close && close.querySelector('.mantine-Notification-closeButton');
+      if (!shown3d && button) button.click();
+    }
   };
   // A slider's mark labels that would overlap (with ideal sensors K_recommended is K_limit/2: 0.3 decade
   // on a 5.7-decade track) are moved apart (CSS `translate`, which leaves Mantine's own transform alone): a pair
