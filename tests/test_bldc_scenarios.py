@@ -12,7 +12,8 @@ from app.cli.main import main
 from app.io.presets import load_preset
 from app.io.units import rad_s_to_rpm
 from control.bldc.plain_smc import steady_state_error
-from sim.bldc.engine import compare_bldc
+from sim.bldc import engine
+from sim.bldc.engine import compare_bldc, simulate_bldc
 from sim.bldc.metrics import steady_windows
 
 RPM = 60.0 / (2.0 * math.pi)
@@ -102,6 +103,28 @@ def test_anti_windup_keeps_overshoot_small(run1000):
     m = run1000.run("smc_integral").metrics
     assert rad_s_to_rpm(m.overshoot_rad_s) < 10.0
     assert m.torque_peak_Nm < 1.1 * run1000.params.gains.T_max
+
+
+def test_without_anti_windup_the_integral_winds_up_and_the_case_keeps_its_eps_lambda(run1000, monkeypatch):
+    """λ = λ_0 (ε_λ = ∞): the torque-limited 0 → 1000 rpm step winds the integral of eq. (16) up and
+    overshoots by more than half of ω*, against < 1 % with λ(ε); the case keeps the ε_λ it has.
+    """
+    p = run1000.params
+    off = compare_bldc(p, ("smc_integral",), anti_windup=False)
+    assert not off.anti_windup and off.params == p
+    wound = off.run("smc_integral")
+    assert wound.metrics.overshoot_rad_s > 0.5 * p.case.omega_ref > 50.0 * run1000.run(
+        "smc_integral").metrics.overshoot_rad_s
+    # ε_λ = ∞ is λ = λ_0 to the last bit: the run of a finite ε_λ far beyond every error is the same
+    monkeypatch.setattr(engine, "NO_ANTI_WINDUP", 1e12)
+    assert np.array_equal(simulate_bldc(p, "smc_integral", anti_windup=False).trace.omega, wound.trace.omega)
+
+
+def test_cli_no_anti_windup_says_so_and_keeps_the_preset(capsys):
+    assert main(["bldc", "bldc_smc_paper", "--json", "--no-anti-windup", "--controllers", "smc_integral"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["anti_windup"] is False
+    assert data["controllers"]["smc_integral"]["overshoot_rpm"] > 500.0
 
 
 def test_cli_json_has_the_contract_keys(capsys):

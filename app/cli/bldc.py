@@ -25,6 +25,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
     p.add_argument("--controllers", default=",".join(CONTROLLERS),
                    help=f"comma-separated subset of {', '.join(CONTROLLERS)}")
+    p.add_argument("--no-anti-windup", action="store_true",
+                   help="integral speed surfaces with λ = λ_0: eq. (16) without its anti-windup (ε_λ is kept)")
     p.add_argument("--bench", action="store_true",
                    help="print simulated seconds per wall second of the paper's 2000 rpm scenario")
 
@@ -60,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         fast = [*args.overrides, "scenario.active=2000rpm"]
         print(bench_figure(load_preset(args.preset, fast) if "2000rpm" in names else params))
         return 0
-    comp = compare_bldc(params, _controllers(args.controllers))
+    comp = compare_bldc(params, _controllers(args.controllers), anti_windup=not args.no_anti_windup)
     if args.json:
         print(json.dumps(comparison_json(comp), indent=2, ensure_ascii=False))
         return 0
@@ -68,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"Preset: {params.name}  ({params.source})")
     print(f"Scenario {case.name}: ω {rad_s_to_rpm(case.omega_0):g} → "
           f"{rad_s_to_rpm(case.omega_ref):g} rpm over {case.t_end:g} s; machine back-EMF: "
-          f"{params.machine.emf}\n")
+          f"{params.machine.emf}; anti-windup {'on' if comp.anti_windup else 'off (λ = λ_0)'}\n")
     rows = metric_table(comp)
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     for r in rows:

@@ -76,6 +76,7 @@ def comparison_json(comp: BldcComparison) -> dict[str, Any]:
         "scenario": {"name": case.name, "omega_0_rad_s": case.omega_0, "omega_ref_rad_s": case.omega_ref,
                      "t_end_s": case.t_end, "emf": comp.params.machine.emf},
         "design": design_json(comp.design),
+        "anti_windup": comp.anti_windup,
         "controllers": {r.controller: {"label": LABELS[r.controller], **metrics_json(r.metrics)}
                         for r in comp.runs},
         "warnings": list(comp.design.warnings),

@@ -35,8 +35,6 @@ from sim.bldc.emf import machine_table
 from sim.bldc.engine import CONTROLLERS, BldcComparison, BldcRunResult, compare_bldc, simulate_bldc
 
 PRESET = "bldc_smc_paper"
-#: ε_λ [rad/s] that switches the anti-windup of eq. (16) off: the largest allowed, λ(ε) = λ_0 for any reachable error.
-EPS_LAMBDA_OFF = float(spec_of("gains.eps_lambda").high)
 
 #: The machine, load, inverter and gain inputs (``section.field``); label, display unit and allowed
 #: range come from each field's spec (:func:`app.io.units.spec_of`).
@@ -80,16 +78,6 @@ def design_view(p: BldcParams) -> tuple[str, str, str, tuple[str, ...]]:
                make_reachability_figure(design))
     emf, dqx, reach = (figure_json_of(f) for f in figures)
     return emf, dqx, reach, tuple(design.warnings)
-
-
-def with_eps_lambda(p: BldcParams, eps_lambda: float) -> BldcParams:
-    """``p`` with the anti-windup's ε_λ [rad/s] of eq. (16)."""
-    return dataclasses.replace(p, gains=dataclasses.replace(p.gains, eps_lambda=eps_lambda))
-
-
-def without_anti_windup(p: BldcParams) -> BldcParams:
-    """``p`` with λ(ε) = λ_0 (ε_λ = :data:`EPS_LAMBDA_OFF`): the integral of eq. (16) is never relieved."""
-    return with_eps_lambda(p, EPS_LAMBDA_OFF)
 
 
 class BldcTab:
@@ -161,8 +149,6 @@ class BldcTab:
         except NumberFormatError as exc:
             raise ParameterError(str(exc)) from None
         sections["machine"]["emf"] = checked_choice(self.emf.value, EMF_SHAPES, "Machine back-EMF")
-        if not self.anti_windup.value:
-            sections["gains"]["eps_lambda"] = EPS_LAMBDA_OFF
         new = {sec: dataclasses.replace(getattr(p, sec), **vals) for sec, vals in sections.items()}
         names = tuple(c.name for c in p.scenario.cases)
         case = p.scenario.cases[names.index(checked_choice(self.scenario.value, names, "Scenario"))]
@@ -184,23 +170,22 @@ class BldcTab:
         except (ParameterError, ValueError, TypeError) as exc:
             self.status.content = f"**Rejected — nothing simulated:** {md_text(exc)}"
             return False
-        pair = self.side_by_side.value
-        eps_on = read_si(self.inputs["gains.eps_lambda"], "gains.eps_lambda") if pair else None
-        return bool(self._submit(lambda: self._run(params, eps_on)))
+        anti_windup, pair = bool(self.anti_windup.value), bool(self.side_by_side.value)
+        return bool(self._submit(lambda: self._run(params, anti_windup, pair)))
 
-    def _pair(self, comp: BldcComparison, eps_on: float) -> tuple[BldcRunResult, BldcRunResult]:
-        """Run the paper's drive with anti-windup (ε_λ = ``eps_on``) and without, reusing the comparison's run."""
-        p, shown = comp.params, comp.run("smc_integral")
-        if p.gains.eps_lambda != EPS_LAMBDA_OFF:  # the run shown has the anti-windup (read from the run, not the page)
-            return shown, simulate_bldc(without_anti_windup(p), "smc_integral")
-        return simulate_bldc(with_eps_lambda(p, eps_on), "smc_integral"), shown
+    @staticmethod
+    def _pair(comp: BldcComparison) -> tuple[BldcRunResult, BldcRunResult]:
+        """Return the paper's drive with anti-windup and without (the comparison's run for its own setting)."""
+        shown = comp.run("smc_integral")
+        other = simulate_bldc(comp.params, "smc_integral", comp.design, comp.table, anti_windup=not comp.anti_windup)
+        return (shown, other) if comp.anti_windup else (other, shown)
 
-    def _run(self, params: BldcParams, eps_on: float | None = None) -> None:
+    def _run(self, params: BldcParams, anti_windup: bool = True, pair: bool = False) -> None:
         self.status.content = f"Simulating… ({len(CONTROLLERS)} drives)"
         self.run_button.disabled, self.cancel_button.visible = True, self._worker is not None
         try:
-            comp = compare_bldc(params)
-            pair = None if eps_on is None else self._pair(comp, eps_on)
+            comp = compare_bldc(params, anti_windup=anti_windup)
+            runs = self._pair(comp) if pair else None
             if self._worker is not None:
                 self._worker.checkpoint()
         except (ParameterError, ValueError) as exc:
@@ -213,7 +198,7 @@ class BldcTab:
             self.run_button.disabled, self.cancel_button.visible = False, False
         self.params, self.comparison = params, comp
         self._show_design()
-        self.results.show(comp, pair, eps_on or params.gains.eps_lambda)
+        self.results.show(comp, runs, params.gains.eps_lambda)
         sim_s = params.case.t_end * len(comp.runs)
         self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**, "
                                f"{sim_s:g} s simulated in {s_to_ms(comp.wall_s):.0f} ms.")

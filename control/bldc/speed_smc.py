@@ -8,7 +8,8 @@ Choice of λ(ε) (the paper leaves it open): the Lorentzian λ(ε) = λ_0/(1 + (
 decays as |ε| grows, so the integrand λ(ε)·ε is bounded by λ_0·ε_λ/2 and vanishes for large
 errors — the gradual "conditional integration" anti-windup described in section V of [2] — and
 it decays like 1/ε², faster than the 1/ε reachability hyperbola of eq. (24), so it can stay
-inside the hyperbola for all errors.
+inside the hyperbola for all errors. ε_λ = ∞ (:data:`NO_ANTI_WINDUP`) switches the anti-windup
+off: ε/∞ = 0 in IEEE arithmetic, so λ(ε) = λ_0 exactly for every error.
 
 [2] Monteiro, de Castro, de Almeida, the SMC-BLDC paper.
 """
@@ -19,6 +20,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
+#: ε_λ [rad/s] without anti-windup: λ(ε) = λ_0 for every error, exactly (the integral of eq. (16)
+#: is never relieved).
+NO_ANTI_WINDUP = math.inf
 
 
 def lambda_of_error(eps: float, lambda_0: float, eps_lambda: float) -> float:

@@ -27,6 +27,7 @@ import numpy as np
 
 from control.bldc.design import BldcDesign, bldc_design
 from control.bldc.params import BldcParams
+from control.bldc.speed_smc import NO_ANTI_WINDUP
 from sim.bldc import kernel as kn
 from sim.bldc.emf import machine_table
 from sim.bldc.metrics import BldcMetrics, run_metrics
@@ -66,6 +67,7 @@ class BldcComparison:
     table : numpy.ndarray      The machine's Φ'_ra table [Wb] (one period).
     runs : tuple               :class:`BldcRunResult` in the requested order.
     wall_s : float             Wall-clock time of the simulations [s].
+    anti_windup : bool         The integral surfaces had the anti-windup λ(ε) of eq. (16) (else λ = λ_0).
     """
 
     params: BldcParams
@@ -73,20 +75,26 @@ class BldcComparison:
     table: np.ndarray
     runs: tuple[BldcRunResult, ...]
     wall_s: float
+    anti_windup: bool = True
 
     def run(self, controller: str) -> BldcRunResult:
         """Return the run of ``controller``."""
         return next(r for r in self.runs if r.controller == controller)
 
 
-def pack_parameters(params: BldcParams, design: BldcDesign, controller: str) -> np.ndarray:
-    """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.bldc.kernel`)."""
+def pack_parameters(params: BldcParams, design: BldcDesign, controller: str, anti_windup: bool = True) -> np.ndarray:
+    """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.bldc.kernel`).
+
+    Without ``anti_windup`` the integral surfaces run with λ = λ_0 (ε_λ = :data:`NO_ANTI_WINDUP`);
+    ``params`` keeps its ε_λ.
+    """
     m, mech, g, inv, case = params.machine, params.mechanics, params.gains, params.inverter, params.case
     prm = np.zeros(kn.N_PRM)
     prm[[kn.P_R, kn.P_L, kn.P_NPP, kn.P_PHIM, kn.P_J, kn.P_B]] = (
         m.R_s, m.L_s_minus_M_s, m.n_pp, m.Phi_m, mech.J, mech.B)
     prm[[kn.P_VDC, kn.P_TS, kn.P_KI, kn.P_KW, kn.P_TMAX, kn.P_LAM0, kn.P_EPSL]] = (
-        inv.V_dc, 1.0 / inv.f_s, g.k_I, g.k_omega, g.T_max, g.lambda_0, g.eps_lambda)
+        inv.V_dc, 1.0 / inv.f_s, g.k_I, g.k_omega, g.T_max, g.lambda_0,
+        g.eps_lambda if anti_windup else NO_ANTI_WINDUP)
     prm[[kn.P_WREF, kn.P_W0]] = (case.omega_ref, case.omega_0)
     pi = design.pi
     prm[[kn.P_KPW, kn.P_KIW, kn.P_KPI, kn.P_KII]] = (pi.K_p_w, pi.K_i_w, pi.K_p_i, pi.K_i_i)
@@ -150,7 +158,7 @@ def check_budget(params: BldcParams, n_runs: int = 1, n_sub: int = N_SUB) -> bud
 
 def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
                   design: BldcDesign | None = None, table: np.ndarray | None = None,
-                  n_sub: int = N_SUB) -> BldcRunResult:
+                  n_sub: int = N_SUB, anti_windup: bool = True) -> BldcRunResult:
     """Simulate the active scenario with one drive.
 
     Parameters
@@ -160,6 +168,7 @@ def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
     design : BldcDesign     ``bldc_design(params)`` if already computed.
     table : numpy.ndarray   The machine's Φ'_ra table [Wb]; default from ``params.machine``.
     n_sub : int             RK4 steps per sample [-].
+    anti_windup : bool      λ(ε) of eq. (16) in the integral surfaces; False: λ = λ_0.
 
     Returns
     -------
@@ -175,7 +184,7 @@ def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
     rec = np.zeros((n_ticks + 1, kn.N_CH))
     step_t = np.array([s.t for s in case.T_L_steps], dtype=float)
     step_v = np.array([s.T_L for s in case.T_L_steps], dtype=float)
-    rows = kn.run_kernel(pack_parameters(params, d, controller), tab, step_t, step_v,
+    rows = kn.run_kernel(pack_parameters(params, d, controller, anti_windup), tab, step_t, step_v,
                          float(case.T_L_0), n_ticks, int(n_sub), rec)
     trace = _trace(params, rec[: max(rows, 2)])
     return BldcRunResult(controller, trace, run_metrics(params, trace, diverged=rows <= n_ticks))
@@ -199,7 +208,7 @@ def _trace(params: BldcParams, rec: np.ndarray) -> BldcTrace:
 
 
 def compare_bldc(params: BldcParams, controllers: tuple[str, ...] = CONTROLLERS,
-                 table: np.ndarray | None = None) -> BldcComparison:
+                 table: np.ndarray | None = None, anti_windup: bool = True) -> BldcComparison:
     """Simulate several drives on the same case (threads; the kernel is compiled numba code).
 
     Parameters
@@ -207,6 +216,7 @@ def compare_bldc(params: BldcParams, controllers: tuple[str, ...] = CONTROLLERS,
     params : BldcParams            The case.
     controllers : tuple of str     Any of :data:`CONTROLLERS`.
     table : numpy.ndarray or None  Machine Φ'_ra table [Wb]; default from ``params.machine``.
+    anti_windup : bool             λ(ε) of eq. (16) in the integral surfaces; False: λ = λ_0.
     """
     for c in controllers:
         check_controller(c, CONTROLLERS)
@@ -215,6 +225,6 @@ def compare_bldc(params: BldcParams, controllers: tuple[str, ...] = CONTROLLERS,
     tab = machine_table(params.machine) if table is None else np.asarray(table, dtype=float)
     t0 = time.perf_counter()
     with ThreadPoolExecutor(max_workers=max(1, len(controllers))) as pool:
-        futures = [pool.submit(simulate_bldc, params, c, d, tab) for c in controllers]
+        futures = [pool.submit(simulate_bldc, params, c, d, tab, N_SUB, anti_windup) for c in controllers]
         runs = tuple(f.result() for f in futures)
-    return BldcComparison(params, d, tab, runs, time.perf_counter() - t0)
+    return BldcComparison(params, d, tab, runs, time.perf_counter() - t0, anti_windup)

@@ -80,6 +80,24 @@ def test_anti_windup_toggle_runs_the_paper_drive_with_and_without_side_by_side(p
     assert len(torque) == 16 and {t["name"] for t in torque} >= {"T* (reference)"}
 
 
+def test_anti_windup_off_keeps_the_typed_eps_lambda_in_the_inputs_and_the_downloaded_preset(page):
+    """Unticking the anti-windup runs λ = λ_0; ε_λ stays what was typed (it was replaced by 1e5 rad/s)."""
+    from pathlib import Path
+
+    from app.io.presets import load_preset, loads_preset
+
+    typed = load_preset("bldc_smc_paper").gains.eps_lambda
+    _open_tab(page)
+    page.get_by_text("Anti-windup on λ(ε)", exact=True).click()
+    page.wait_for_timeout(150)  # viser sends GUI updates every 50 ms
+    page.get_by_role("button", name="Simulate BLDC").click()
+    page.get_by_text("Done: scenario", exact=False).first.wait_for(timeout=60_000)
+    with page.expect_download() as info:
+        page.get_by_role("button", name="Download BLDC preset (YAML)").click()
+    exported = loads_preset(Path(info.value.path()).read_text(encoding="utf-8"), "export.yaml")
+    assert exported.gains.eps_lambda == typed
+
+
 def test_bldc_tab_rejects_bad_input_with_message(page):
     _open_tab(page)
     page.get_by_text("Machine, load, inverter, gains", exact=True).click()
