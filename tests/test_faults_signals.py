@@ -132,16 +132,17 @@ def test_write_atomic_full_disk_leaves_nothing(tmp_path, monkeypatch):
 TGKILL = {"x86_64": 234, "aarch64": 131}
 
 
-def _to_a_side_thread(pid: int, sig: int) -> None:
-    """Send ``sig`` to a thread of ``pid`` other than its main thread (as the kernel may for a kill)."""
-    tid = max(int(t) for t in os.listdir(f"/proc/{pid}/task"))  # the main thread's id is the pid
-    assert tid != pid
-    for _ in range(500):  # the main thread asleep in the serve loop, where the flag goes unread
-        if Path(f"/proc/{pid}/task/{pid}/wchan").read_text() == "hrtimer_nanosleep":
+def _to_a_side_thread(pid: int, sig: int, asleep_in: str = "hrtimer_nanosleep") -> None:
+    """Send ``sig`` to a thread of ``pid`` other than its main thread (as the kernel may for a kill),
+    once the main thread is seen asleep in the kernel function ``asleep_in`` (its wchan, a prefix).
+    """
+    for _ in range(1000):  # a side thread runs; the main thread is asleep, where the signal's flag goes unread
+        tid = max(int(t) for t in os.listdir(f"/proc/{pid}/task"))  # the main thread's id is the pid
+        if tid != pid and Path(f"/proc/{pid}/task/{pid}/wchan").read_text().startswith(asleep_in):
             break
-        time.sleep(0.01)  # poll the main thread's state again (a positive condition)
+        time.sleep(0.01)  # poll the threads again (a positive condition)
     else:
-        raise AssertionError("the server's main thread was never seen asleep: the case is not set up")
+        raise AssertionError(f"no side thread, or the main thread never asleep in {asleep_in}: the case is not set up")
     assert os.uname().machine in TGKILL, f"no tgkill number known for {os.uname().machine}"
     number = TGKILL[os.uname().machine]
     assert ctypes.CDLL(None, use_errno=True).syscall(number, pid, tid, sig) == 0
@@ -175,3 +176,48 @@ def test_the_server_stops_at_once_with_130_and_one_line(sig, side):
     assert proc.returncode == 130, err[-500:]
     assert "Traceback" not in err and err.strip().splitlines()[-1].startswith("interrupted"), err
     assert waited < 10.0
+
+
+def test_robustness_stops_at_once_on_sigterm_to_a_side_thread_and_ends_its_workers():
+    # the main thread waits for a chunk of ≈ 3000 samples (≈ 10 s); it used to read the signal's flag
+    # only when that chunk ended, and then waited for the running chunks of the other worker too
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    argv = [sys.executable, "-m", "app", "robustness", "paper_12kw_pmsm", "--samples", "100000", "--workers", "2",
+            "--spread", "plant.J_L=±20%"]
+    proc = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:
+        seen = ""
+        while "samples 2/" not in seen and proc.poll() is None:  # the chunks are about to be submitted
+            seen += proc.stderr.read(1)
+        children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children")
+        for _ in range(3000):  # the pool's two workers started
+            if len(children.read_text().split()) == 2:
+                break
+            time.sleep(0.01)  # poll the children again (a positive condition)
+        workers = children.read_text().split()
+        t0 = time.perf_counter()
+        _to_a_side_thread(proc.pid, signal.SIGTERM, asleep_in="futex")
+        _, err = proc.communicate(timeout=120)
+        waited = time.perf_counter() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err[-500:]
+    assert "Traceback" not in err and "leaked" not in err and err.strip().splitlines()[-1].startswith("interrupted")
+    assert waited < 3.0  # a chunk takes longer than that
+    for _ in range(1000):  # the ended workers are gone (reaped by init once their parent exited)
+        if not _running(workers):
+            break
+        time.sleep(0.01)  # poll the workers again (a positive condition)
+    assert _running(workers) == []
+
+
+def _running(pids: list[str]) -> list[str]:
+    """The processes of ``pids`` that still exist and are not zombies."""
+    alive = []
+    for pid in pids:
+        with contextlib.suppress(OSError):
+            if Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z":
+                alive.append(pid)
+    return alive

@@ -23,6 +23,10 @@ from typing import Any
 
 #: How often a chunk may be submitted again after its worker was lost [-].
 RETRIES = 1
+#: Longest single wait for a chunk without a timeout [s]. The kernel may hand a process's signal to
+#: any of its threads; Python's handler then only sets a flag, which the main thread reads when it
+#: wakes: a wait in slices keeps Ctrl-C and SIGTERM prompt however long the chunk runs.
+WAIT_SLICE_S = 0.2
 
 
 class ExecutorError(RuntimeError):
@@ -48,7 +52,7 @@ class RetryingFuture:
         """Return the chunk's result, replacing a broken pool once; ExecutorError after that."""
         while True:
             try:
-                return self.future.result(timeout)
+                return self._wait(timeout)
             except BrokenProcessPool as exc:
                 if self._pool.ended:
                     raise ExecutorError(f"chunk {self.index} stopped: the local pool was ended (the run was "
@@ -58,6 +62,16 @@ class RetryingFuture:
                         f"chunk {self.index} lost its worker process {self.attempts + 1} times ({exc}): allowed "
                         f"{RETRIES} retry; see the system log for a process killed (e.g. out of memory)") from None
                 self._pool.renew(self.generation)
+
+    def _wait(self, timeout: float | None) -> Any:
+        """``future.result(timeout)``; without a timeout in slices of :data:`WAIT_SLICE_S`."""
+        if timeout is not None:
+            return self.future.result(timeout)
+        while True:
+            try:
+                return self.future.result(WAIT_SLICE_S)
+            except TimeoutError:
+                continue  # not done yet: back to the interpreter, which runs a pending signal's handler
 
     def cancel(self) -> bool:
         """Cancel the chunk if it has not started."""
@@ -135,9 +149,15 @@ class RetryingPool:
         """Return self."""
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        """Shut down, cancelling what has not started."""
-        self.shutdown(wait=True, cancel_futures=True)
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        """Shut down, cancelling what has not started; after an error or an interrupt, end the workers now.
+
+        Nothing of a run that stops early is kept, so its running chunks are not waited for
+        (Ctrl-C or a SIGTERM from a service manager ends the command at once).
+        """
+        if exc_type is not None:
+            self.terminate()
+        self.shutdown(wait=True, cancel_futures=True)  # ended workers: returns at once
 
 
 def _finished(f: Future[Any]) -> bool:
