@@ -120,7 +120,16 @@ def test_without_anti_windup_the_integral_winds_up_and_the_case_keeps_its_eps_la
     assert np.array_equal(simulate_bldc(p, "smc_integral", anti_windup=False).trace.omega, wound.trace.omega)
 
 
-def test_cli_no_anti_windup_says_so_and_keeps_the_preset(capsys):
+def test_the_side_by_side_pair_is_with_then_without_anti_windup_for_either_setting(run1000):
+    from app.ui.bldc_tab import BldcTab
+
+    for comp in (run1000, compare_bldc(run1000.params, ("smc_integral",), anti_windup=False)):
+        with_aw, without = BldcTab._pair(comp)
+        assert with_aw.metrics.overshoot_rad_s < 0.01 * comp.params.case.omega_ref
+        assert without.metrics.overshoot_rad_s > 0.5 * comp.params.case.omega_ref
+
+
+def test_cli_no_anti_windup_says_so_and_winds_up(capsys):
     assert main(["bldc", "bldc_smc_paper", "--json", "--no-anti-windup", "--controllers", "smc_integral"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["anti_windup"] is False

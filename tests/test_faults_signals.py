@@ -14,7 +14,9 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -136,13 +138,12 @@ def _to_a_side_thread(pid: int, sig: int, asleep_in: str = "hrtimer_nanosleep") 
     """Send ``sig`` to a thread of ``pid`` other than its main thread (as the kernel may for a kill),
     once the main thread is seen asleep in the kernel function ``asleep_in`` (its wchan, a prefix).
     """
-    for _ in range(1000):  # a side thread runs; the main thread is asleep, where the signal's flag goes unread
+    def side_thread() -> int | None:  # a side thread runs; the main thread sleeps where the signal's flag goes unread
         tid = max(int(t) for t in os.listdir(f"/proc/{pid}/task"))  # the main thread's id is the pid
-        if tid != pid and Path(f"/proc/{pid}/task/{pid}/wchan").read_text().startswith(asleep_in):
-            break
-        time.sleep(0.01)  # poll the threads again (a positive condition)
-    else:
-        raise AssertionError(f"no side thread, or the main thread never asleep in {asleep_in}: the case is not set up")
+        asleep = Path(f"/proc/{pid}/task/{pid}/wchan").read_text().startswith(asleep_in)
+        return tid if tid != pid and asleep else None
+
+    tid = _wait_until(side_thread, 60.0, f"a side thread, the main thread asleep in {asleep_in}")
     assert os.uname().machine in TGKILL, f"no tgkill number known for {os.uname().machine}"
     number = TGKILL[os.uname().machine]
     assert ctypes.CDLL(None, use_errno=True).syscall(number, pid, tid, sig) == 0
@@ -187,30 +188,44 @@ def test_robustness_stops_at_once_on_sigterm_to_a_side_thread_and_ends_its_worke
     proc = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     try:
-        seen = ""
-        while "samples 2/" not in seen and proc.poll() is None:  # the chunks are about to be submitted
-            seen += proc.stderr.read(1)
-        children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children")
-        for _ in range(3000):  # the pool's two workers started
-            if len(children.read_text().split()) == 2:
-                break
-            time.sleep(0.01)  # poll the children again (a positive condition)
-        workers = children.read_text().split()
+        def started() -> list[str] | None:
+            assert proc.poll() is None, proc.communicate()[1][-500:]  # ended before its pool started
+            return _pool_workers(proc.pid, 2)
+
+        workers = _wait_until(started, 120.0, "the pool's two workers")
         t0 = time.perf_counter()
-        _to_a_side_thread(proc.pid, signal.SIGTERM, asleep_in="futex")
+        _to_a_side_thread(proc.pid, signal.SIGTERM, asleep_in="futex")  # waiting for a chunk
         _, err = proc.communicate(timeout=120)
         waited = time.perf_counter() - t0
     finally:
         if proc.poll() is None:
-            proc.kill()
+            os.killpg(proc.pid, signal.SIGKILL)  # the workers too
     assert proc.returncode == 130, err[-500:]
     assert "Traceback" not in err and "leaked" not in err and err.strip().splitlines()[-1].startswith("interrupted")
     assert waited < 3.0  # a chunk takes longer than that
-    for _ in range(1000):  # the ended workers are gone (reaped by init once their parent exited)
-        if not _running(workers):
-            break
-        time.sleep(0.01)  # poll the workers again (a positive condition)
-    assert _running(workers) == []
+    # the ended workers are gone (reaped by init once their parent exited)
+    _wait_until(lambda: not _running(workers), 10.0, "the workers gone")
+
+
+def _wait_until(ready: Callable[[], Any], timeout_s: float, what: str) -> Any:
+    """Poll ``ready()`` until it returns a true value (returned) within ``timeout_s``; else fail naming ``what``."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        value = ready()
+        if value:
+            return value
+        time.sleep(0.01)  # poll again (a positive condition)
+    raise AssertionError(f"not seen within {timeout_s:g} s: {what} (the case is not set up)")
+
+
+def _pool_workers(pid: int, n: int) -> list[str] | None:
+    """The process ids of the ``n`` pool workers of ``pid`` (spawned children; not its resource tracker)."""
+    workers = []
+    for child in Path(f"/proc/{pid}/task/{pid}/children").read_text().split():
+        with contextlib.suppress(OSError):
+            if b"spawn_main" in Path(f"/proc/{child}/cmdline").read_bytes():
+                workers.append(child)
+    return workers if len(workers) == n else None
 
 
 def _running(pids: list[str]) -> list[str]:

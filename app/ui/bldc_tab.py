@@ -200,8 +200,9 @@ class BldcTab:
         self._show_design()
         self.results.show(comp, runs, params.gains.eps_lambda)
         sim_s = params.case.t_end * len(comp.runs)
-        self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**, "
-                               f"{sim_s:g} s simulated in {s_to_ms(comp.wall_s):.0f} ms.")
+        aw = "" if comp.anti_windup else ", anti-windup off (λ = λ_0)"
+        self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**"
+                               f"{aw}, {sim_s:g} s simulated in {s_to_ms(comp.wall_s):.0f} ms.")
 
     def _cancel(self) -> None:
         if self._worker is not None and self._worker.cancel():

@@ -124,7 +124,7 @@ def page_marks_js(hidden_fields: Sequence[str]) -> str:
     ``data-app-overview-window`` on the floating window holding the "Overview" tab, and
     ``data-app-hidden`` on the row of each text field of ``hidden_fields`` (their uuids: the fields
     the page's scripts report into; ``window.__appHideField(uuid)`` adds a field made later). It
-    closes viser's notice of a software (or missing) WebGL while no 3D view (a canvas wider than
+    closes viser's notice of a software WebGL while no 3D view (a canvas wider than
     :data:`SCENE_MIN` − 1 px) is shown: it would cover the results' tab row and key numbers until
     closed, for a view not in use. In the next frame after such a change it also moves a slider's
     overlapping mark labels apart.

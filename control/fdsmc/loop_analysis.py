@@ -276,7 +276,7 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
     zeta_rec = slope_damping(a_max, k_rec, d.T_c)
     g = GainRecommendation(k_lim, k_c, k_s, margin, k_rec, K, k_ok, k_lim / K, mode, zeta, math.nan,
                            zeta_rec, K_noise)
-    return dataclasses.replace(g, T_c_min=unit_damping_T_c(a_max, margin * g.K_unit_damping, margin))
+    return dataclasses.replace(g, T_c_min=unit_damping_T_c(a_max, g.K_unit_damping, 1.0))  # no margin left to take
 
 
 def unit_damping_T_c(alpha_max: float, K_limit: float, margin: float) -> float:

@@ -280,8 +280,8 @@ def _simulate_checked(
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
     win = np.zeros((kn.WIN_ROWS * len(steps), max(n for _, n in steps)))
     kernel_run.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
-                  params.controller.delay_samples, g.decim, out, info, k_win, win, _reference(d, controller),
-                  sensors.noise_table(params.sensors))
+                          params.controller.delay_samples, g.decim, out, info, k_win, win,
+                          _reference(d, controller), sensors.noise_table(params.sensors))
     summary = decode_info(info)
     trace = _trace(out[:, : summary.n_out])
     rows = kn.WIN_ROWS
@@ -313,9 +313,9 @@ def run_steps(
     out = np.zeros((kn.N_CH, 1))
     info = np.zeros(kn.N_INFO)
     kernel_run.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
-                  params.controller.delay_samples, int(n_steps) + 1, out, info,
-                  np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller),
-                  sensors.noise_table(params.sensors))
+                          params.controller.delay_samples, int(n_steps) + 1, out, info,
+                          np.zeros(0, dtype=np.int64), np.zeros((0, 0)), _reference(d, controller),
+                          sensors.noise_table(params.sensors))
     return info[kn.I_END: kn.I_END + kn.N_X].copy()
 
 

@@ -50,7 +50,7 @@ def T_c_advice(derived: Derived) -> float | None:
 
     On the −1/T_c line the ideal loop is s² + α_max·K·s + α_max·K/T_c, damping √(α_max·K·T_c)/2;
     with K capped by the chatter limit, a small T_c (e.g. T_c = T_a on slow manoeuvres) limit-cycles
-    about θ_dem. T_c,min gives ζ = 1 at min(K_limit_cruise, K_noise)/margin
+    about θ_dem. T_c,min gives ζ = 1 at ``GainRecommendation.K_unit_damping``
     (``control.fdsmc.loop_analysis``).
     """
     g = derived.gain

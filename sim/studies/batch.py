@@ -60,8 +60,8 @@ def run_batch(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.n
     are shared and mean what they mean for ``run_kernel`` (SI units).
     """
     for i in prange(n):
-        kernel_run.run_kernel(prm[i], step_t, step_v, Phi, Gam, Lo, continuous, h, n_steps, n_sub, delay, decim,
-                      out[i], info[i], k_win, win[i], ref, noise)
+        kernel_run.run_kernel(prm[i], step_t, step_v, Phi, Gam, Lo, continuous, h, n_steps, n_sub, delay,
+                              decim, out[i], info[i], k_win, win[i], ref, noise)
 
 
 @dataclass(frozen=True)

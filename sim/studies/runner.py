@@ -23,8 +23,8 @@ from typing import Any
 
 #: How often a chunk may be submitted again after its worker was lost [-].
 RETRIES = 1
-#: Longest single wait for a chunk without a timeout [s]. The kernel may hand a process's signal to
-#: any of its threads; Python's handler then only sets a flag, which the main thread reads when it
+#: Longest single wait for a chunk without a timeout [s]. The operating system may hand a process's
+#: signal to any of its threads; Python's handler then only sets a flag, which the main thread reads when it
 #: wakes: a wait in slices keeps Ctrl-C and SIGTERM prompt however long the chunk runs.
 WAIT_SLICE_S = 0.2
 
@@ -71,7 +71,9 @@ class RetryingFuture:
             try:
                 return self.future.result(WAIT_SLICE_S)
             except TimeoutError:
-                continue  # not done yet: back to the interpreter, which runs a pending signal's handler
+                if self.future.done():
+                    raise  # the chunk's own TimeoutError
+                # not done yet: back to the interpreter, which runs a pending signal's handler
 
     def cancel(self) -> bool:
         """Cancel the chunk if it has not started."""

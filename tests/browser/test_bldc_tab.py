@@ -91,7 +91,10 @@ def test_anti_windup_off_keeps_the_typed_eps_lambda_in_the_inputs_and_the_downlo
     page.get_by_text("Anti-windup on λ(ε)", exact=True).click()
     page.wait_for_timeout(150)  # viser sends GUI updates every 50 ms
     page.get_by_role("button", name="Simulate BLDC").click()
-    page.get_by_text("Done: scenario", exact=False).first.wait_for(timeout=60_000)
+    page.get_by_text("anti-windup off", exact=False).first.wait_for(timeout=60_000)  # the run had it off
+    click_tab(page, "BLDC figures")
+    overshoot = page.locator("tr", has_text="Overshoot").first.locator("td").all_inner_texts()
+    assert float(overshoot[2]) > 500.0  # the paper drive's integral wound up [rpm]
     with page.expect_download() as info:
         page.get_by_role("button", name="Download BLDC preset (YAML)").click()
     exported = loads_preset(Path(info.value.path()).read_text(encoding="utf-8"), "export.yaml")

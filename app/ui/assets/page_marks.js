@@ -34,12 +34,12 @@
     only('data-app-overview-window', windows); only('data-app-hidden', hidden);
     closeWebGlNotices();
   };
-  // viser's notices of a software (or missing) WebGL stay until closed, over the results' tab row and
-  // key numbers. They concern the 3D view only (the plots are SVG): closed while no 3D view is shown.
-  const WEBGL_NOTICES = ['Software WebGL rendering detected', 'WebGL unavailable'];
+  // viser's notice of a software WebGL stays until closed, over the results' tab row and key numbers.
+  // It concerns the 3D view's speed only (the plots are SVG): closed while no 3D view is shown. (Its
+  // "WebGL unavailable" notice stays: then the 3D view cannot work at all.)
   const closeWebGlNotices = () => {
     for (const title of document.querySelectorAll('.mantine-Notification-title')) {
-      if (!WEBGL_NOTICES.includes(title.textContent.trim())) continue;
+      if (title.textContent.trim() !== 'Software WebGL rendering detected') continue;
       const shown3d = [...document.querySelectorAll('canvas')]
         .some(c => c.clientWidth > SCENE_MIN_PX && getComputedStyle(c).visibility !== 'hidden');
       const close = title.closest('.mantine-Notification-root');
