@@ -13,7 +13,7 @@ from app.io.presets import load_preset
 from app.io.units import rad_s_to_rpm
 from control.bldc.plain_smc import steady_state_error
 from sim.bldc import engine
-from sim.bldc.engine import compare_bldc, simulate_bldc
+from sim.bldc.engine import anti_windup_pair, compare_bldc, simulate_bldc
 from sim.bldc.metrics import steady_windows
 
 RPM = 60.0 / (2.0 * math.pi)
@@ -121,10 +121,8 @@ def test_without_anti_windup_the_integral_winds_up_and_the_case_keeps_its_eps_la
 
 
 def test_the_side_by_side_pair_is_with_then_without_anti_windup_for_either_setting(run1000):
-    from app.ui.bldc_tab import BldcTab
-
     for comp in (run1000, compare_bldc(run1000.params, ("smc_integral",), anti_windup=False)):
-        with_aw, without = BldcTab._pair(comp)
+        with_aw, without = anti_windup_pair(comp)
         assert with_aw.metrics.overshoot_rad_s < 0.01 * comp.params.case.omega_ref
         assert without.metrics.overshoot_rad_s > 0.5 * comp.params.case.omega_ref
 

@@ -21,6 +21,7 @@ from control.fdsmc.params import DriveParams
 from sim.fdsmc.criteria import window_below_count
 from sim.fdsmc.design import design_drive
 from sim.fdsmc.engine import compare, simulate
+from sim.fdsmc.grid import with_field
 from sim.fdsmc.verdicts import criteria_warnings, run_warnings
 
 #: A Σ-7 servo with a catalogue 8192-count encoder instead of its 24-bit one; an in-position
@@ -28,13 +29,9 @@ from sim.fdsmc.verdicts import criteria_warnings, run_warnings
 COARSE = ["sensors.encoder_cpr=8192", "limits.in_position_rad=0.005"]
 
 
-def _with_K(p: DriveParams, K: float) -> DriveParams:
-    return dataclasses.replace(p, controller=dataclasses.replace(p.controller, K=float(K)))
-
-
 def _swing(p: DriveParams, K: float) -> float:
     """Predicted swing of α_dem [fraction of α_max] at K."""
-    d, se = derive(_with_K(p, K)), p.sensors
+    d, se = derive(with_field(p, "controller.K", K)), p.sensors
     rms = noise_gain(d.loop, "slope", K, se.encoder_step, se.reading_noise).alpha_dem_rms
     return PTP_PER_RMS * rms / d.alpha.alpha_max
 
@@ -79,14 +76,16 @@ def test_the_recommended_K_with_a_coarse_encoder_does_not_chatter_where_half_K_l
     p = load_preset("yaskawa_sgm7j_04a", COARSE)
     d = derive(p)
     g = d.gain
-    old = simulate(_with_K(p, g.K_limit / g.margin), "fdsmc").metrics  # the loop-only recommendation
+    old = simulate(with_field(p, "controller.K", g.K_limit / g.margin), "fdsmc").metrics  # the loop-only recommendation
     assert old.chatter and old.chatter_frequency_Hz > 500.0
-    rec = simulate(_with_K(p, g.K_recommended), "fdsmc").metrics
+    rec = simulate(with_field(p, "controller.K", g.K_recommended), "fdsmc").metrics
     assert rec.stable and not rec.chatter
-    assert simulate(_with_K(p, 1.5 * g.K_noise), "fdsmc").metrics.chatter  # above the noise limit it does
+    above = with_field(p, "controller.K", 1.5 * g.K_noise)
+    assert simulate(above, "fdsmc").metrics.chatter  # above the noise limit it does
     # the prediction alone warns of nothing (it is conservative); the run's chatter warning says why
     assert not [x for x in d.warnings if "K_noise" in x]
-    hint = [x for x in run_warnings(compare(_with_K(p, g.K_limit / g.margin), ("fdsmc",))) if "Chatter" in x]
+    half_limit = with_field(p, "controller.K", g.K_limit / g.margin)
+    hint = [x for x in run_warnings(compare(half_limit, ("fdsmc",))) if "Chatter" in x]
     assert hint and f"noise limit K_noise = {g.K_noise:.4g}" in hint[0] and f"{g.K_recommended:.4g}" in hint[0]
 
 
@@ -97,7 +96,7 @@ def test_the_predicted_rms_of_alpha_dem_bounds_the_simulated_swing(name, overrid
     p = load_preset(name, overrides)
     g = derive(p).gain
     K = 0.8 * g.K_noise
-    q = _with_K(p, K)
+    q = with_field(p, "controller.K", K)
     d, se = derive(q), q.sensors
     rms = noise_gain(d.loop, "slope", K, se.encoder_step, se.reading_noise).alpha_dem_rms
     m = simulate(q, "fdsmc", d).metrics

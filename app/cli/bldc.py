@@ -11,7 +11,7 @@ import json
 import time
 
 from app.cli.main import add_preset_arguments
-from app.io.bldc_view import comparison_json, metric_table
+from app.io.bldc_view import anti_windup_text, comparison_json, metric_table
 from app.io.presets import load, load_preset
 from app.io.units import Hz_to_kHz, rad_s_to_rpm, s_to_ms
 from control.bldc.params import BldcParams
@@ -70,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"Preset: {params.name}  ({params.source})")
     print(f"Scenario {case.name}: ω {rad_s_to_rpm(case.omega_0):g} → "
           f"{rad_s_to_rpm(case.omega_ref):g} rpm over {case.t_end:g} s; machine back-EMF: "
-          f"{params.machine.emf}; anti-windup {'on' if comp.anti_windup else 'off (λ = λ_0)'}\n")
+          f"{params.machine.emf}; {anti_windup_text(comp)}\n")
     rows = metric_table(comp)
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     for r in rows:

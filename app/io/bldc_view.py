@@ -68,6 +68,11 @@ def design_json(d: BldcDesign) -> dict[str, Any]:
     }
 
 
+def anti_windup_text(comp: BldcComparison) -> str:
+    """``"anti-windup on"`` or ``"anti-windup off (λ = λ_0)"``: how the integral surfaces of eq. (16) ran."""
+    return "anti-windup on" if comp.anti_windup else "anti-windup off (λ = λ_0)"
+
+
 def comparison_json(comp: BldcComparison) -> dict[str, Any]:
     """Return the stable JSON form: scenario, design, per-controller metrics, warnings."""
     case = comp.params.case

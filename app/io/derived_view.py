@@ -71,7 +71,7 @@ def _loop_rows(d: Derived) -> list[Row]:
     rows = [
         Row(f"K stability limit, linearised loop ({g.mode})", "K_limit", g.K_limit, "s/rad", "loop analysis"),
         Row(f"K noise limit, sensors (α_dem swings ≥ {100 * CHATTER_PTP_FRACTION:g} % of α_max)", "K_noise",
-            g.K_noise if math.isfinite(g.K_noise) else None, "s/rad", "loop analysis"),
+            g.K_noise_binding if math.isfinite(g.K_noise_binding) else None, "s/rad", "loop analysis"),
         Row(f"Recommended K (gain margin {g.margin:g}{', sensors' if g.noise_limited else ''})", "K_rec",
             g.K_recommended, "s/rad", "loop analysis"),
     ]

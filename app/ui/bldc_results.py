@@ -65,15 +65,15 @@ class BldcResults:
         for handle, json_str in zip((self.emf, self.dqx, self.reach), design, strict=True):
             set_figure_json(handle, json_str)
 
-    def show(self, comp: BldcComparison, pair: tuple[BldcRunResult, BldcRunResult] | None,
-             eps_lambda: float) -> None:
-        """Show a comparison; ``pair`` = the paper drive with and without anti-windup (ε_λ [rad/s]), or None."""
+    def show(self, comp: BldcComparison, pair: tuple[BldcRunResult, BldcRunResult] | None) -> None:
+        """Show a comparison; ``pair`` = the paper drive with and without anti-windup, or None."""
         for handle, json_str in zip((self.speed, self.torque, self.sigma, self.currents), comparison_json(comp),
                                     strict=True):
             set_figure_json(handle, json_str)
         self.metrics.content = metrics_markdown(comp)
         if pair is not None:
-            set_figure_json(self.antiwindup, figure_json_of(make_antiwindup_figure(*pair, eps_lambda)))
+            figure = make_antiwindup_figure(*pair, comp.params.gains.eps_lambda)
+            set_figure_json(self.antiwindup, figure_json_of(figure))
         self.antiwindup.visible = pair is not None
 
 

@@ -17,6 +17,7 @@ import viser
 
 from app.figures.bldc_speed_smc import make_dqx_figure, make_emf_figure, make_reachability_figure
 from app.io.bldc_emf import read_measured, with_measured
+from app.io.bldc_view import anti_windup_text
 from app.io.display_units import field_hint, field_label, shown_value, si_value
 from app.io.numbers import NumberFormatError
 from app.io.presets import annotate_units, dumps_preset, load
@@ -32,7 +33,7 @@ from control.bldc.design import bldc_design
 from control.bldc.params import EMF_SHAPES, BldcParams
 from control.common.checks import ParameterError
 from sim.bldc.emf import machine_table
-from sim.bldc.engine import CONTROLLERS, BldcComparison, BldcRunResult, compare_bldc, simulate_bldc
+from sim.bldc.engine import CONTROLLERS, BldcComparison, anti_windup_pair, compare_bldc
 
 PRESET = "bldc_smc_paper"
 
@@ -173,19 +174,12 @@ class BldcTab:
         anti_windup, pair = bool(self.anti_windup.value), bool(self.side_by_side.value)
         return bool(self._submit(lambda: self._run(params, anti_windup, pair)))
 
-    @staticmethod
-    def _pair(comp: BldcComparison) -> tuple[BldcRunResult, BldcRunResult]:
-        """Return the paper's drive with anti-windup and without (the comparison's run for its own setting)."""
-        shown = comp.run("smc_integral")
-        other = simulate_bldc(comp.params, "smc_integral", comp.design, comp.table, anti_windup=not comp.anti_windup)
-        return (shown, other) if comp.anti_windup else (other, shown)
-
     def _run(self, params: BldcParams, anti_windup: bool = True, pair: bool = False) -> None:
         self.status.content = f"Simulating… ({len(CONTROLLERS)} drives)"
         self.run_button.disabled, self.cancel_button.visible = True, self._worker is not None
         try:
             comp = compare_bldc(params, anti_windup=anti_windup)
-            runs = self._pair(comp) if pair else None
+            runs = anti_windup_pair(comp) if pair else None
             if self._worker is not None:
                 self._worker.checkpoint()
         except (ParameterError, ValueError) as exc:
@@ -198,9 +192,9 @@ class BldcTab:
             self.run_button.disabled, self.cancel_button.visible = False, False
         self.params, self.comparison = params, comp
         self._show_design()
-        self.results.show(comp, runs, params.gains.eps_lambda)
+        self.results.show(comp, runs)
         sim_s = params.case.t_end * len(comp.runs)
-        aw = "" if comp.anti_windup else ", anti-windup off (λ = λ_0)"
+        aw = "" if comp.anti_windup else f", {anti_windup_text(comp)}"
         self.status.content = (f"Done: scenario **{md_text(params.case.name)}**, back-EMF **{params.machine.emf}**"
                                f"{aw}, {sim_s:g} s simulated in {s_to_ms(comp.wall_s):.0f} ms.")
 

@@ -113,6 +113,11 @@ def page_css(show_3d: bool = False) -> str:
         f"width: calc(var(--fit-right) - {gutters:g}px) !important}}")
 
 
+#: The page script of :func:`page_marks_js`, read once per process (its fields filled in per page).
+_PAGE_MARKS_JS = (Path(__file__).resolve().parent / "assets" / "page_marks.js").read_text(
+    encoding="utf-8").replace("SCENE_MIN_PX", f"{SCENE_MIN - 1:g}")
+
+
 def page_marks_js(hidden_fields: Sequence[str]) -> str:
     """Return the page script that marks the elements :func:`page_css` styles (installed once per page).
 
@@ -129,8 +134,7 @@ def page_marks_js(hidden_fields: Sequence[str]) -> str:
     closed, for a view not in use. In the next frame after such a change it also moves a slider's
     overlapping mark labels apart.
     """
-    text = (Path(__file__).resolve().parent / "assets" / "page_marks.js").read_text(encoding="utf-8")
-    return text.replace("HIDDEN_FIELDS", json.dumps(list(hidden_fields))).replace("SCENE_MIN_PX", f"{SCENE_MIN - 1:g}")
+    return _PAGE_MARKS_JS.replace("HIDDEN_FIELDS", json.dumps(list(hidden_fields)))
 
 
 def hide_field_js(field_uuid: str) -> str:

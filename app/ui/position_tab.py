@@ -221,17 +221,17 @@ class PositionTab:
         objective = OBJECTIVES[OBJECTIVE_LABELS.index(checked_choice(self.objective.value, OBJECTIVE_LABELS,
                                                                      "Design objective"))]
         dd = design_for(params, objective).design
-        if dd.comparison is None:  # refused before any run: the inputs stay
-            shown = params
-        else:
-            shown = dd.params
-            self.inputs.populate(shown)
+        self.design_note.content = design_markdown(dd)
+        if dd.refused:  # nothing designed or simulated: the inputs, the plant and the results stay
+            self.status.content = "Design refused before any run — see the design note."
+            return
+        shown = dd.params
+        self.inputs.populate(shown)
         self._plant_J_L = None
         self._recentre = True
         comparison = (None if self.optimum.wanted else dd.comparison) or comparison_or_derived(
             shown, self.optimum.wanted)
         self._state.ran(shown, comparison)
-        self.design_note.content = design_markdown(dd)
         if comparison.fdsmc is not None:
             self._results().show(comparison)
         self.show_text()

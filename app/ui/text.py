@@ -142,7 +142,7 @@ def design_markdown(dd: Any) -> str:
     head = {"clean": "**Design: CLEAN** — with the sensors: limits, in-position, overshoot and ripple all hold.",
             "not as asked": "**Design: NOT AS ASKED** — clean only at a longer T_m than requested.",
             "not clean": "**Design: NOT CLEAN** — see the constraints below."}[dd.verdict]
-    if dd.comparison is None:  # refused before any simulation: there is no setting to show
+    if dd.refused:  # there is no setting to show
         lines = [head, "Nothing designed or simulated; the inputs stay as they were."]
     else:
         lines = [head, f"α_max = {dd.derived.alpha.alpha_max:.5g} rad/s², T_m = {dd.params.manoeuvre.T_m:g} s, "

@@ -34,6 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.fdsmc.loop_model import (
+    K_SEARCH_RATIO,
+    K_search_grid,
     LoopCase,
     SampledParts,
     continuous_loop,
@@ -115,8 +117,8 @@ class GainRecommendation:
 
     @property
     def K_noise_ok(self) -> bool:
-        """K below the noise limit: the sensors' noise alone does not make α_dem chatter."""
-        return self.K_noise > self.K
+        """K below the noise limit where it binds: the sensors' noise alone does not make α_dem chatter."""
+        return self.K_noise_binding > self.K
 
     @property
     def K_noise_binding(self) -> float:
@@ -210,7 +212,7 @@ def gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int = 0) -> floa
 def _gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int) -> float:
     M0, M1 = affine_loop(d, law, f_s, delay, None if f_s is None else sampled_parts(d, f_s))
     sampled = f_s is not None
-    grid = np.logspace(-5, 6, 23) * 1000.0 / d.alpha_max
+    grid = K_search_grid(d.alpha_max)
     flags = _measures(M0, M1, grid, sampled) >= 0.0
     if flags.all():
         return 0.0
@@ -218,7 +220,7 @@ def _gain_limit(d: LoopCase, law: str, f_s: float | None, delay: int) -> float:
     if last_stable == len(grid) - 1:
         return math.inf
     return geometric_bisect(lambda K: _measure(M0 + K * M1, sampled) >= 0.0,
-                            float(grid[last_stable]), float(grid[last_stable + 1]), 1.005)
+                            float(grid[last_stable]), float(grid[last_stable + 1]), K_SEARCH_RATIO)
 
 
 def slope_damping(alpha_max: float, K: float, T_c: float) -> float:

@@ -263,6 +263,18 @@ def law_case(d: LoopCase, law: str) -> LoopCase:
         g1=d.g1 if law == "conventional" else 0.0, g2=d.g2 if law == "conventional" else 0.0)
 
 
+#: Resolution of the K searches (stability limit, noise limit): bisected until hi/lo ≤ this [-].
+K_SEARCH_RATIO = 1.005
+
+
+def K_search_grid(alpha_max: float) -> np.ndarray:
+    """Return the K searches' log grid [s/rad]: 23 points over 11 decades around 1000/α_max.
+
+    K enters the laws of eq. (46) in [1] as α_max·K, so the grid scales with 1/α_max.
+    """
+    return np.logspace(-5, 6, 23) * 1000.0 / alpha_max
+
+
 def geometric_bisect(flips: Callable[[float], bool], lo: float, hi: float, ratio: float) -> float:
     """Smallest x in (lo, hi] with ``flips(x)`` true, given flips(lo) false and flips(hi) true.
 

@@ -36,6 +36,8 @@ import numpy as np
 from scipy.linalg import LinAlgWarning, matrix_balance, solve_discrete_lyapunov
 
 from control.fdsmc.loop_model import (
+    K_SEARCH_RATIO,
+    K_search_grid,
     LoopCase,
     control_row,
     discrete_matrix,
@@ -175,8 +177,7 @@ def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_no
     def swings(K: float) -> bool:
         return not rms(K) < target
 
-    grid = np.logspace(-5, 6, 23) * 1000.0 / loop.alpha_max
-    Ks = [float(K) for K in grid if K_max > K] + ([K_max] if math.isfinite(K_max) else [])
+    Ks = [float(K) for K in K_search_grid(loop.alpha_max) if K_max > K] + ([K_max] if math.isfinite(K_max) else [])
     lo = None
     for K in Ks:
         if not swings(K):
@@ -184,7 +185,7 @@ def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_no
         elif lo is None:  # the noise swings α_dem even at the smallest K searched
             return K
         else:
-            K_hi = geometric_bisect(swings, lo, K, 1.005)
+            K_hi = geometric_bisect(swings, lo, K, K_SEARCH_RATIO)
             return K_hi if math.isfinite(rms(K_hi)) else math.inf  # the loop's own limit came first
     return math.inf
 

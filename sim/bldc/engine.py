@@ -190,6 +190,16 @@ def simulate_bldc(params: BldcParams, controller: str = "smc_integral",
     return BldcRunResult(controller, trace, run_metrics(params, trace, diverged=rows <= n_ticks))
 
 
+def anti_windup_pair(comp: BldcComparison) -> tuple[BldcRunResult, BldcRunResult]:
+    """Return the paper's drive (``smc_integral``) with the anti-windup of eq. (16) and without.
+
+    The comparison's own run serves for its setting; the other setting is simulated.
+    """
+    shown = comp.run("smc_integral")
+    other = simulate_bldc(comp.params, "smc_integral", comp.design, comp.table, anti_windup=not comp.anti_windup)
+    return (shown, other) if comp.anti_windup else (other, shown)
+
+
 def _trace(params: BldcParams, rec: np.ndarray) -> BldcTrace:
     c = {name: np.ascontiguousarray(rec[:, i]) for i, name in enumerate(kn.CHANNELS)}
     m, mech = params.machine, params.mechanics

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from control.fdsmc.feasibility import current_limit, speed_limit
 from control.fdsmc.model import torque_constant
-from control.fdsmc.params import DriveParams
+from control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
 
 #: Default in-position window [encoder counts].
 IN_POSITION_COUNTS = 10
@@ -66,6 +66,12 @@ def pass_criteria(params: DriveParams) -> PassCriteria:
     )
 
 
+def encoder_cpr_for(counts_per_rev: float) -> int | None:
+    """Smallest power-of-two encoder resolution ≥ ``counts_per_rev`` [counts/rev]; None above the largest allowed."""
+    cpr = 2 ** max(0, math.ceil(math.log2(counts_per_rev)))
+    return cpr if cpr <= ENCODER_CPR_MAX else None
+
+
 def window_below_count(params: DriveParams) -> str | None:
     """Say why the in-position window or the overshoot limit is narrower than one encoder count, else None.
 
@@ -81,11 +87,12 @@ def window_below_count(params: DriveParams) -> str | None:
                        key=lambda fw: fw[1])
     if width >= count:
         return None
-    need = 2 ** math.ceil(math.log2(2.0 * 2.0 * math.pi / width))
+    need = encoder_cpr_for(2.0 * 2.0 * math.pi / width)
+    finer = f" or use an encoder with ≥ {need} counts/rev" if need is not None else ""
     return (f"{field} = {width:.4g} rad is narrower than one count of the {cpr}-count encoder ({count:.4g} rad): "
             f"the controller cannot tell positions within a count apart, so a run holds it only by chance. Widen it to "
-            f"≥ {2.0 * count:.4g} rad (two counts) or use an encoder with ≥ {need} counts/rev.")
+            f"≥ {2.0 * count:.4g} rad (two counts){finer}.")
 
 
 __all__ = ["HOLD_RIPPLE_FRACTION", "IDEAL_ENCODER_CPR", "IN_POSITION_COUNTS", "PassCriteria", "drive_current",
-           "pass_criteria", "window_below_count"]
+           "encoder_cpr_for", "pass_criteria", "window_below_count"]

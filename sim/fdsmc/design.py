@@ -43,11 +43,11 @@ from control.fdsmc.loop_model import LoopModel
 from control.fdsmc.model import model_coefficients
 from control.fdsmc.noise import NoiseGain, noise_gain
 from control.fdsmc.observer import observer_gains
-from control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
+from control.fdsmc.params import DriveParams
 from control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
 from control.fdsmc.transient import acceleration_overshoot
 from sim.fdsmc.checks import TARGET_BAND, Constraint, run_checks
-from sim.fdsmc.criteria import pass_criteria, window_below_count
+from sim.fdsmc.criteria import encoder_cpr_for, pass_criteria, window_below_count
 from sim.fdsmc.engine import Comparison, RunResult, compare
 from sim.fdsmc.verdicts import comparator_notes, flux_warnings
 
@@ -97,6 +97,11 @@ class DriveDesign:
     as_asked: bool = True
     noise: NoiseGain | None = None
     encoder_cpr_needed: int | None = None
+
+    @property
+    def refused(self) -> bool:
+        """True when the design was refused before any run (nothing designed or simulated)."""
+        return self.comparison is None
 
     @property
     def verdict(self) -> str:
@@ -175,9 +180,7 @@ def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
     """Smallest power-of-two counts per rev whose quantization alone gives ≤ ``criterion`` [A] of ripple."""
     if noise is None or not math.isfinite(noise.i_q_per_rad) or noise.i_q_per_rad <= 0.0:
         return None
-    cpr = 2.0 * math.pi * noise.i_q_per_rad / criterion
-    bits = max(0, math.ceil(math.log2(cpr)))
-    return 2**bits if 2**bits <= ENCODER_CPR_MAX else None
+    return encoder_cpr_for(2.0 * math.pi * noise.i_q_per_rad / criterion)
 
 
 def design_drive(params: DriveParams, alpha_rule: str = "torque_limit") -> DriveDesign:
@@ -208,7 +211,7 @@ def design_drive(params: DriveParams, alpha_rule: str = "torque_limit") -> Drive
     for factor in _slowdowns(base):
         dd = _design_at(_slowed(base, factor), params)
         first = first or dd
-        if dd.comparison is not None and not _sensor_limited(dd):
+        if not dd.refused and not _sensor_limited(dd):
             return dd
     return first if first is not None else _design_at(base, params)
 
