@@ -339,7 +339,7 @@ class PositionTab:
             self.tuning.show(d, case.plant_J_L, recentre=self._recentre)
             self._recentre = False
         nameplate = self.inputs.nameplate_warnings(case.params.motor)
-        self.verdicts.show(case.comparison, case.params.controller.K, case.error, nameplate)
+        self.verdicts.show(case.comparison, case.error, nameplate)
         if status:
             self.status.content = f"Ready — {case.runs} run(s) in this session. Preset: {md_text(case.origin)}."
 

@@ -15,7 +15,7 @@ import viser
 from app.ui.props import assign
 from app.ui.text import warnings_html
 from sim.fdsmc.engine import Comparison
-from sim.fdsmc.verdicts import T_c_advice, comparator_notes, recommended_K, run_warnings
+from sim.fdsmc.verdicts import K_advice, T_c_advice, comparator_notes, run_warnings
 
 #: What the warnings box shows: warnings, input error (or None) and grey notes.
 WarningParts = tuple[list[str], str | None, list[str]]
@@ -47,19 +47,15 @@ class VerdictPanel:
         """Show an input error: nothing was simulated."""
         self.render(([], message, []))
 
-    def show(self, comparison: Comparison, K: float, error: str | None, extra: list[str]) -> None:
-        """Show the verdicts of ``comparison`` (run with boundary-layer gain ``K`` [s/rad]) and its remedies."""
+    def show(self, comparison: Comparison, error: str | None, extra: list[str]) -> None:
+        """Show the verdicts of ``comparison`` and its remedies (:func:`~sim.fdsmc.verdicts.K_advice`, T_c)."""
         d = comparison.derived
         items = list(d.warnings) + run_warnings(comparison) + extra
         if comparison.fdsmc is None:
             items.append("Not simulated: the manoeuvre is infeasible (see above).")
         self.render((items, error, comparator_notes(comparison)))
-        chatter = any(r is not None and r.metrics.chatter for r in (comparison.fdsmc, comparison.conventional))
-        k_rec, g = recommended_K(d), d.gain
-        # offered where the run chatters (with the sensors: their noise shows there) or the loop
-        # analysis expects a limit cycle; a verified design above the noise-capped K is left alone
-        expected = 1.001 * g.K_margin < K
-        assign(self.use_k, visible=k_rec is not None and (chatter or expected))
+        k_rec = K_advice(comparison)
+        assign(self.use_k, visible=k_rec is not None)
         if k_rec is not None:
             assign(self.use_k, label=f"Use recommended K = {k_rec:.4g} s/rad")
         T_c = T_c_advice(d)

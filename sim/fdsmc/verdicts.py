@@ -27,6 +27,19 @@ def recommended_K(derived: Derived) -> float | None:
     return g.K_recommended if g.K_recommended > 0.0 else None
 
 
+def K_advice(comparison: Comparison) -> float | None:
+    """Return the recommended K [s/rad] to offer after ``comparison``, or None.
+
+    Offered where a run chatters (with the sensors: their noise shows there) or where the loop
+    analysis expects a limit cycle (K above K_limit/margin); a verified setting above the
+    noise-capped K is left alone.
+    """
+    d = comparison.derived
+    k_rec, g = recommended_K(d), d.gain
+    chatter = any(r is not None and r.metrics.chatter for r in (comparison.fdsmc, comparison.conventional))
+    return k_rec if k_rec is not None and (chatter or 1.001 * g.K_margin < g.K) else None
+
+
 def _chatter_hint(derived: Derived) -> str:
     """Say what to change: K above its limit, or a poorly damped sloped segment (T_c too small)."""
     g = derived.gain
