@@ -9,7 +9,9 @@ at two places:
 * the encoder's quantization error n_θ (θ_r read in whole counts Δ = 2π/cpr) enters the observer's
   innovation e_o = θ_r + n_θ − θ̂_r (eq. (15), corrected);
 * the current noise n_i (rms σ, plus the ADC's step q) enters the FDC law (14) through the
-  measured i_q and the observer's acceleration a_em = H·i_q.
+  measured i_q and the observer's acceleration a_em = H·i_q, and, where the controller runs the
+  q-axis voltage-mismatch estimate (``controller.T_dv``, not in [1]), that estimate's comparison of
+  the measured i_q with its one-sample prediction (:func:`sampled_noise_loop`).
 
 With n_θ modelled as white, uniform over one count (variance Δ²/12, the usual model once the
 rotor jitters over several counts) and n_i white (σ² + q²/12), the steady-state covariance P of
@@ -35,12 +37,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import LinAlgWarning, matrix_balance, solve_discrete_lyapunov
 
+from control.fdsmc.fdc import mismatch_filter_factor
+from control.fdsmc.inverter import decay_factors
 from control.fdsmc.loop_model import (
     K_SEARCH_RATIO,
+    N_STATES,
     K_search_grid,
     LoopCase,
     control_row,
-    discrete_matrix,
     geometric_bisect,
     law_case,
     outer_gains,
@@ -74,7 +78,8 @@ class NoiseGain:
     alpha_dem_rms: float
 
 
-def noise_gain(loop: LoopCase, law: str, K: float, count: float, i_noise_rms: float) -> NoiseGain:
+def noise_gain(loop: LoopCase, law: str, K: float, count: float, i_noise_rms: float,
+               T_dv: float = 0.0) -> NoiseGain:
     """Predict the standstill ripple of i_q and u_q from encoder quantization and current noise.
 
     Parameters
@@ -84,6 +89,8 @@ def noise_gain(loop: LoopCase, law: str, K: float, count: float, i_noise_rms: fl
     K : float             Boundary-layer gain of eq. (45) in [1] [s/rad].
     count : float         Encoder count Δ = 2π/cpr [rad]; 0 for an ideal encoder.
     i_noise_rms : float   RMS of the current-measurement error, noise and ADC step [A].
+    T_dv : float          Filter time of the q-axis voltage-mismatch estimate (``controller.T_dv``,
+                          :func:`control.fdsmc.fdc.voltage_mismatch`; not in [1]) [s]; 0: none.
 
     Returns
     -------
@@ -91,21 +98,70 @@ def noise_gain(loop: LoopCase, law: str, K: float, count: float, i_noise_rms: fl
     """
     if loop.f_s is None:
         raise ValueError("noise_gain needs a sampled loop: loop.f_s is None")
-    parts = sampled_parts(loop, loop.f_s)
-    row = control_row(loop, law, K)
-    Z = discrete_matrix(parts, loop.coefficients.H, row, loop.delay)
+    beta = mismatch_filter_factor(T_dv, float(loop.f_s))
+    Z, B, u = sampled_noise_loop(loop, control_row(loop, law, K), beta)
     if not np.all(np.isfinite(Z)) or np.max(np.abs(np.linalg.eigvals(Z))) >= 1.0:
         return NoiseGain(math.inf, math.inf, math.inf, math.inf)
-    B = _noise_inputs(parts, loop, row)
-    var_theta, var_i = count**2 / 12.0, i_noise_rms**2
+    W = np.diag([count**2 / 12.0, i_noise_rms**2])
     P_theta, P_i = (_covariance(Z, B[:, j]) for j in (0, 1))
-    P = var_theta * P_theta + var_i * P_i
-    u_rms = math.sqrt(max(P[-1, -1], 0.0)) if loop.delay else math.sqrt(
-        max(float(row @ P[:7, :7] @ row) + row[0] ** 2 * var_i, 0.0))
+    P = W[0, 0] * P_theta + W[1, 1] * P_i
+    n = Z.shape[0]
+    u_rms = math.sqrt(max(float(u[:n] @ P @ u[:n] + u[n:] @ W @ u[n:]), 0.0))
     per_rad = math.sqrt(max(P_theta[0, 0], 0.0) / 12.0)
     a = np.array(outer_gains(loop, law, K))  # α_dem = a_θ·θ̂ + a_ω·ω̂ (states 3 and 4)
     alpha_rms = math.sqrt(max(float(a @ P[3:5, 3:5] @ a), 0.0))
     return NoiseGain(math.sqrt(max(P[0, 0], 0.0)), u_rms, per_rad, alpha_rms)
+
+
+def sampled_noise_loop(loop: LoopCase, row: np.ndarray, beta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return the sample step of the drive at standstill: s[k+1] = Z·s[k] + B·[n_θ[k], n_i[k]].
+
+    The state s is z = [i_q, θ_r, ω_r, θ̂_r, ω̂_r, L̂0, L̂1] of :mod:`control.fdsmc.loop_model`, then
+    the held u_q with a computation delay, then, with the q-axis voltage-mismatch estimate (β > 0),
+    the estimate d̂ [V] and what its next update reads from this sample: the measured i_q [A], ω̂_r
+    [rad/s] and the applied u_q [V]. Each sample, as the kernel's step does: read θ_r + n_θ and
+    i_q + n_i; update d̂ ← d̂ + β·((i_q,meas − i_q,model)/(γ_q·G) − d̂) with i_q,model the one-sample
+    prediction φ_q·i_q,meas⁻ + γ_q·(G·u_q⁻ − E·ω̂_r⁻) from the last sample's readings
+    (:func:`control.fdsmc.fdc.voltage_mismatch`, :func:`control.fdsmc.inverter.predict_currents`);
+    u_q = row·z − d̂ of eq. (14) in [1] (the measured i_q in row[0]), applied now or one sample
+    later; the plant held over the sample (ZOH-exact) and the observer of eq. (15) updated with
+    a_em = H·i_q,meas.
+
+    Parameters
+    ----------
+    loop : LoopCase     The sampled loop (``loop.f_s``, ``loop.delay``).
+    row : numpy.ndarray u_q = row·z of eq. (14) in [1] (:func:`control.fdsmc.loop_model.control_row`) [V per state].
+    beta : float        Filter factor T_s/T_dv of the estimate (:func:`control.fdsmc.fdc.mismatch_filter_factor`);
+                        0: none [-].
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Z (n × n), B (n × 2) and the applied u_q as a row over [s, n_θ, n_i] (n + 2) [V per state].
+    """
+    sp, c = sampled_parts(loop, float(loop.f_s)), loop.coefficients
+    n0 = N_STATES + loop.delay
+    n = n0 + (4 if beta > 0.0 else 0)
+    e = np.eye(n + 2)  # rows: the states, then n_θ, n_i (a row of e picks one of them)
+    y_th, y_i = e[1] + e[n], e[0] + e[n + 1]  # the encoder's and the ADC's readings
+    u_c = row[0] * y_i + row[3:N_STATES] @ e[3:N_STATES]
+    M = np.zeros((n, n + 2))
+    if beta > 0.0:
+        dv, y_prev, w_prev, u_prev = n0, n0 + 1, n0 + 2, n0 + 3
+        phi_q, gam_q = decay_factors(c.D, 1.0 / float(loop.f_s))
+        i_model = phi_q * e[y_prev] + gam_q * (c.G * e[u_prev] - c.E * e[w_prev])
+        M[dv] = (1.0 - beta) * e[dv] + beta * (y_i - i_model) / (gam_q * c.G)
+        u_c = u_c - M[dv]
+        M[y_prev], M[w_prev] = y_i, e[4]
+    u = e[N_STATES] if loop.delay else u_c
+    if loop.delay:
+        M[N_STATES] = u_c
+    if beta > 0.0:
+        M[n0 + 3] = u
+    M[:3] = sp.Ad @ e[:3] + np.outer(sp.bd, u)
+    od = sp.observer
+    M[3:N_STATES] = od.Phi @ e[3:N_STATES] + np.outer(od.Gamma * c.H, y_i) + np.outer(od.L, y_th - e[3])
+    return M[:, :n], M[:, n:], u
 
 
 def _covariance(Z: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -118,20 +174,6 @@ def _covariance(Z: np.ndarray, b: np.ndarray) -> np.ndarray:
     s = D[0]
     P_b = solve_discrete_lyapunov(Z_b, np.outer(b / s, b / s))
     return P_b * np.outer(s, s)
-
-
-def _noise_inputs(parts, loop: LoopCase, row: np.ndarray) -> np.ndarray:
-    """Input columns (n × 2) of the encoder error n_θ and the i_q measurement error n_i."""
-    n = 7 + loop.delay
-    B = np.zeros((n, 2))
-    od = parts.observer
-    B[3:7, 0] = od.L  # innovation e_o = θ + n_θ − θ̂
-    B[3:7, 1] = od.Gamma * loop.coefficients.H  # a_em = H·(i_q + n_i)
-    if loop.delay:
-        B[7, 1] = row[0]  # the held u_q is computed from the measured i_q
-    else:
-        B[:3, 1] += parts.bd * row[0]
-    return B
 
 
 def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: float,
@@ -198,4 +240,4 @@ def _alpha_dem_rms(loop: LoopCase, K: float, count: float, i_noise_rms: float) -
         return noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms
 
 
-__all__ = ["PTP_PER_RMS", "NoiseGain", "noise_gain", "noise_gain_limit"]
+__all__ = ["PTP_PER_RMS", "NoiseGain", "noise_gain", "noise_gain_limit", "sampled_noise_loop"]
