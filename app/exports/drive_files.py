@@ -1,9 +1,10 @@
 """The stock-drive export formats of the one export model: ODrive, moteus, VESC and the setpoint table.
 
-:func:`drive_file` simulates the stock route (and the tracked optimum) when the case lacks them, so
-that every file's header carries the energy it promises next to FDSMC and the optimum
-(:func:`app.exports.provenance.header_lines`), then writes the format from the one set of SI
-settings (:func:`app.exports.stock.stock_settings`).
+:func:`drive_file` writes the format from the drive's tuned SI settings
+(:func:`app.exports.stock.stock_settings`), reads the draft back with the strict parser and simulates
+the drive's own loops from it (:func:`app.exports.stock_route.file_verdict`): **that** verdict gates
+the export (refused unless ``force`` when a check fails) and heads the file, next to the energies of
+the FDSMC and the tracked optimum (:func:`app.exports.provenance.header_lines`).
 """
 
 from __future__ import annotations
@@ -13,9 +14,10 @@ from dataclasses import dataclass
 
 from app.exports.moteus import moteus_text
 from app.exports.odrive import odrive_json
-from app.exports.provenance import header_lines
+from app.exports.provenance import ExportRefusedError, check_text, header_lines
 from app.exports.setpoints import setpoints_csv
-from app.exports.stock import stock_settings, with_stock_runs
+from app.exports.stock import StockSettings, stock_settings, with_stock_runs
+from app.exports.stock_route import ROUTE_NAMES, file_verdict
 from app.exports.vesc import vesc_xml
 from control.common.checks import ParameterError
 from sim.fdsmc.design import Constraint
@@ -44,26 +46,41 @@ class ExportOptions:
     controller: str = "fdsmc"
 
 
+def _write(fmt: str, s: StockSettings, header: list[str], options: ExportOptions) -> str:
+    if fmt == "odrive":
+        return odrive_json(s, header)
+    if fmt == "moteus":
+        return moteus_text(s, header)
+    if fmt == "vesc":
+        return vesc_xml(s, header)
+    return setpoints_csv(s, header, options.angle_unit, options.cycle_s)
+
+
 def drive_file(fmt: str, cmp: Comparison, failed: Sequence[Constraint], stem: str,
                options: ExportOptions) -> tuple[str, str]:
     """Return (file name, text) of stock-drive format ``fmt`` for the case ``cmp``.
 
+    ``failed`` are the FDSMC design's failed checks (named in the header, not the gate).
+
     Raises
     ------
     ParameterError
-        For an infeasible manoeuvre (there is no move to write) or a bad setpoint option.
+        For an infeasible manoeuvre (there is no move to write) or a bad setpoint option;
+        :class:`~app.exports.provenance.ExportRefusedError` naming the stock route's failed checks
+        unless ``options.force``.
     """
     if cmp.fdsmc is None:
         raise ParameterError(f"nothing to export as {fmt}: manoeuvre.T_m = {cmp.derived.params.manoeuvre.T_m:g} s "
                              "is infeasible, there is no move")
     full = with_stock_runs(cmp)
-    s = stock_settings(full)
-    header = header_lines(full, failed)
-    name = stem + DRIVE_FORMATS[fmt]
-    if fmt == "odrive":
-        return name, odrive_json(s, header)
-    if fmt == "moteus":
-        return name, moteus_text(s, header)
-    if fmt == "vesc":
-        return name, vesc_xml(s, header)
-    return name, setpoints_csv(s, header, options.angle_unit, options.cycle_s)
+    s = stock_settings(full, fmt)
+    p = full.derived.params
+    verdict = file_verdict(fmt, _write(fmt, s, header_lines(full, failed), options), p, full.derived)
+    if verdict.failed and not options.force:
+        names = "; ".join(check_text(c) for c in verdict.failed)
+        raise ExportRefusedError(f"export --format {fmt} refused: the stock route of {p.name!r} "
+                                 f"({ROUTE_NAMES[fmt]}, simulated from the file) is not clean — {names}. "
+                                 "Lengthen T_m or widen the pass criteria, or export with --force to write it "
+                                 "with these warnings inside")
+    header = header_lines(full, failed, (ROUTE_NAMES[fmt], verdict.run, verdict.failed))
+    return stem + DRIVE_FORMATS[fmt], _write(fmt, s, header, options)

@@ -229,11 +229,11 @@ def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPT
     law = c_law(fmt, options.controller)
     if law == "optimum":
         cmp = with_optimum_run(cmp)
-    failed = gate(fmt, cmp, options.force, law)
     stem = safe_stem(cmp.derived.params.name)
-    if fmt in DRIVE_FORMATS:
-        name, text = drive_file(fmt, cmp, failed, stem, options)
+    if fmt in DRIVE_FORMATS:  # gated on the stock route simulated from the file, not on the FDSMC
+        name, text = drive_file(fmt, cmp, failed_checks(cmp), stem, options)
         return {name: text.encode("utf-8")}
+    failed = gate(fmt, cmp, options.force, law)
     if fmt == "c":  # the gate above has refused an unclean design unless forced; the header gates the build
         run = cmp.optimum if law == "optimum" else cmp.fdsmc
         checks = run_checks(cmp.derived.params, run) if run is not None else None

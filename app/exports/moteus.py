@@ -8,9 +8,9 @@ revolution (ki), N·m per revolution/s (kd); the trajectory limits in rev/s and 
 output, after ``motor_position.rotor_to_output_ratio`` (written as 1: this tool's load is referred
 to the rotor); ``motor.poles`` counts poles, not pole pairs; ``servo.inertia_feedforward`` in kg·m².
 
-moteus runs a parallel PID, not a cascade: kp = g1·J, kd = g2·J with the inertia feed-forward is
-exactly the tracking law the "stock" comparator simulates; ki and its clamp ``ilimit`` are the
-documented integrator choice of :mod:`control.fdsmc.trapezoid` (not simulated).
+moteus runs a parallel PID, not a cascade; its gains, the current PI (``servo.pid_dq``), the encoder
+PLL and the control rate are tuned on the simulated stock route (:mod:`sim.stock.tuning`: no
+integrator, moteus' advice for a high torque bandwidth) and :func:`moteus_loop` reads them back.
 
 The header is written as ``#`` lines, which moteus_tool would send as commands: strip them first
 (``grep -v '^#' FILE > restore.cfg``, see docs/drives/moteus.md). :func:`parse_moteus` accepts them.
@@ -18,19 +18,26 @@ The header is written as ``#`` lines, which moteus_tool would send as commands: 
 
 from __future__ import annotations
 
+import math
 import re
 
 from app.exports.drive_units import (
     per_rad_to_per_turn,
+    per_turn_to_per_rad,
     pole_pairs_to_poles,
     poles_to_pole_pairs,
     psi_from_kv,
     rad_to_turn,
-    torque_constant,
+    turn_to_rad,
 )
 from app.exports.stock import StockSettings
 from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
 from control.common.checks import ParameterError
+from control.fdsmc.model import torque_constant
+from control.fdsmc.params import DriveParams
+from control.fdsmc.trapezoid import trapezoid_from_limits
+from sim.stock.route import StockLoop
+from sim.stock.tuning import setpoint_table
 
 _REF = "moteus docs/reference.md, configurable parameters"
 _FW = "moteus fw/bldc_servo_structs.h"
@@ -47,6 +54,10 @@ KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
     VendorKey("servo.default_accel_limit", "float", "rev/s^2", f"{_REF}: servo.default_accel_limit", True),
     VendorKey("servo.inertia_feedforward", "float", "kg*m^2", f"{_REF}: servo.inertia_feedforward"),
     VendorKey("motor_position.rotor_to_output_ratio", "float", "-", f"{_REF}: motor_position.rotor_to_output_ratio"),
+    VendorKey("servo.pid_dq.kp", "float", "V/A", f"{_REF}: servo.pid_dq (current loop, kp = L·ω_c)"),
+    VendorKey("servo.pid_dq.ki", "float", "V/A/s", f"{_REF}: servo.pid_dq (current loop, ki = R·ω_c)"),
+    VendorKey("motor_position.sources.0.pll_filter_hz", "float", "Hz", f"{_REF}: encoder PLL bandwidth"),
+    VendorKey("servo.pwm_rate_hz", "float", "Hz", f"{_REF}: servo.pwm_rate_hz (the control loop's rate)"),
 )}
 #: Keys only read on import (written by moteus' own calibration): Kv and the dq inductances.
 READ_KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
@@ -54,18 +65,16 @@ READ_KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
     VendorKey("motor.inductance_d_H", "float", "H", f"{_FW}: BldcServoMotor::inductance_d_H"),
     VendorKey("motor.inductance_q_H", "float", "H", f"{_FW}: BldcServoMotor::inductance_q_H"),
 )}
-#: The integrator clamp as a fraction of the torque limit [-] (documented choice).
-ILIMIT_FRACTION = 0.1
 _LINE = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*) (\S+)$")
 
 
 def moteus_values(s: StockSettings) -> dict[str, float]:
     """Every written key → value in moteus' units (the one conversion from SI)."""
-    g, tr = s.gains, s.trapezoid
-    torque_lim = torque_constant(s.psi_pm, s.p) * s.current_limit
+    g, tr, loop = s.gains, s.trapezoid, s.tuning.loop
     values = [pole_pairs_to_poles(s.p), s.R_s, s.current_limit, per_rad_to_per_turn(g.kp),
-              per_rad_to_per_turn(g.ki), per_rad_to_per_turn(g.kd), ILIMIT_FRACTION * torque_lim,
-              rad_to_turn(abs(tr.omega_c)), rad_to_turn(tr.alpha), g.inertia, 1.0]
+              per_rad_to_per_turn(g.ki), per_rad_to_per_turn(g.kd), loop.i_lim,
+              rad_to_turn(abs(tr.omega_c)), rad_to_turn(tr.alpha), g.inertia, 1.0, loop.current_kp,
+              loop.current_ki, s.pll_bandwidth / (2.0 * math.pi), s.f_loop]
     return dict(zip(KEYS, values, strict=True))
 
 
@@ -111,3 +120,32 @@ def moteus_motor(f: VendorFile) -> tuple[float, float | None, float | None, floa
     psi = psi_from_kv(kv, p) if kv is not None else None
     return (f.require("motor.resistance_ohm", "the phase resistance [Ohm]"), f.get("motor.inductance_d_H"),
             f.get("motor.inductance_q_H"), psi, p, f.require("servo.max_current_A", "the current limit [A]"))
+
+
+def moteus_loop(f: VendorFile, params: DriveParams) -> StockLoop:
+    """The stock route of a parsed configuration: moteus' PID, current PI and PLL at its PWM rate (SI).
+
+    The torque constant is the case's (moteus calibrates Kv on the motor itself; the file leaves it
+    out); the move is the trajectory from the file's limits over the case's θ_dem.
+
+    Raises
+    ------
+    ParameterError
+        Naming the key, for a missing setting or a rotor-to-output ratio other than 1.
+    """
+    if f.require("motor_position.rotor_to_output_ratio", "the ratio") != 1.0:
+        raise ParameterError("motor_position.rotor_to_output_ratio is not allowed here: 1 (the simulated load "
+                             "is referred to the rotor)")
+    tr = trapezoid_from_limits(params.manoeuvre.theta_dem,
+                               turn_to_rad(f.require("servo.default_velocity_limit", "the speed limit [rev/s]")),
+                               turn_to_rad(f.require("servo.default_accel_limit", "the acceleration [rev/s^2]")))
+    rate = f.require("servo.pwm_rate_hz", "the control rate [Hz]")
+    gains = [per_turn_to_per_rad(f.require(f"servo.pid_position.{k}", f"the position PID's {k}"))
+             for k in ("kp", "kd", "ki")]
+    return StockLoop(
+        "moteus", rate, "pid", *gains, f.require("servo.pid_position.ilimit", "the integrator clamp [Nm]"),
+        math.inf, f.require("servo.inertia_feedforward", "the inertia [kg*m^2]"), torque_constant(params.motor),
+        f.require("servo.max_current_A", "the current limit [A]"),
+        2.0 * math.pi * f.require("motor_position.sources.0.pll_filter_hz", "the PLL bandwidth [Hz]"), False,
+        f.require("servo.pid_dq.kp", "the current kp [V/A]"), f.require("servo.pid_dq.ki", "the current ki"),
+        setpoint_table(tr, 1.0 / rate), 1.0 / rate)

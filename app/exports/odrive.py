@@ -5,7 +5,8 @@ that has a ``config`` child keeps its path (``{"axis0": {"motor": {"config": {..
 are the properties of ``odrive-interface.yaml`` (fw 0.5.x) in their declared types and units; enums
 are integers (ControlMode POSITION_CONTROL = 3, InputMode TRAP_TRAJ = 5). :func:`odrive_json` writes
 axis 0's motor constants, current limit, the P–PI cascade (pos_gain, vel_gain, vel_integrator_gain,
-inertia feed-forward, speed limit) and the trapezoidal planner's limits (turn, turn/s, turn/s²),
+inertia feed-forward, speed limit), the current-loop and encoder-PLL bandwidths and the trapezoidal
+planner's limits (turn, turn/s, turn/s²), all tuned on the simulated stock route (:mod:`sim.stock.tuning`),
 with a ``_comment`` key holding the header (odrivetool reports it as "property not found" and
 restores the rest). Firmware 0.6.x moved the motor settings to ``axis0.config.motor`` and is not
 written.
@@ -17,10 +18,21 @@ import json
 import math
 from typing import Any
 
-from app.exports.drive_units import per_rad_to_per_turn, psi_from_torque_constant, rad_to_turn, torque_constant
+from app.exports.drive_units import (
+    per_rad_to_per_turn,
+    per_turn_to_per_rad,
+    psi_from_torque_constant,
+    rad_to_turn,
+    torque_constant,
+    turn_to_rad,
+)
 from app.exports.stock import StockSettings
 from app.exports.vendor_keys import VendorFile, VendorKey, vendor_file
 from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
+from control.fdsmc.trapezoid import trapezoid_from_limits
+from sim.stock.route import StockLoop
+from sim.stock.tuning import DRIVES, setpoint_table
 
 _IF = "odrive-interface.yaml (fw 0.5.x)"
 #: Every key written, with its ODrive type and unit (units as the interface file states them, those
@@ -31,6 +43,9 @@ KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
     VendorKey("axis0.motor.config.phase_inductance", "float", "H", f"{_IF}: phase_inductance float32"),
     VendorKey("axis0.motor.config.torque_constant", "float", "Nm/A", f"{_IF}: torque_constant float32"),
     VendorKey("axis0.motor.config.current_lim", "float", "A", f"{_IF}: current_lim float32"),
+    VendorKey("axis0.motor.config.current_control_bandwidth", "float", "rad/s",
+              f"{_IF}: current_control_bandwidth (current PI kp = L·bw, ki = R·bw)"),
+    VendorKey("axis0.encoder.config.bandwidth", "float", "rad/s", f"{_IF}: Encoder config bandwidth (PLL)"),
     VendorKey("axis0.controller.config.control_mode", "enum", "-", f"{_IF}: ControlMode (3 = POSITION_CONTROL)"),
     VendorKey("axis0.controller.config.input_mode", "enum", "-", f"{_IF}: InputMode (5 = TRAP_TRAJ)"),
     VendorKey("axis0.controller.config.pos_gain", "float", "(turn/s) / turn", f"{_IF}: pos_gain"),
@@ -51,7 +66,7 @@ def odrive_values(s: StockSettings) -> dict[str, float]:
     tr, g = s.trapezoid, s.gains
     accel = rad_to_turn(tr.alpha)
     values = [s.p, s.R_s, 0.5 * (s.L_d + s.L_q), torque_constant(s.psi_pm, s.p), s.current_limit,
-              CONTROL_MODE_POSITION_CONTROL, INPUT_MODE_TRAP_TRAJ, g.pos_gain, per_rad_to_per_turn(g.vel_gain),
+              s.current_bandwidth, s.pll_bandwidth, CONTROL_MODE_POSITION_CONTROL, INPUT_MODE_TRAP_TRAJ, g.pos_gain, per_rad_to_per_turn(g.vel_gain),
               per_rad_to_per_turn(g.vel_integrator_gain), rad_to_turn(s.speed_limit), per_rad_to_per_turn(g.inertia),
               rad_to_turn(abs(tr.omega_c)), accel, accel]
     return dict(zip(KEYS, values, strict=True))
@@ -131,3 +146,44 @@ def odrive_motor(f: VendorFile) -> tuple[float, float, float, int, float]:
     return (f.require("axis0.motor.config.phase_resistance", "the phase resistance [Ohm]"),
             f.require("axis0.motor.config.phase_inductance", "the phase inductance [H]"),
             psi_from_torque_constant(kt, p), p, f.require("axis0.motor.config.current_lim", "the current limit [A]"))
+
+
+def _key(f: VendorFile, leaf: str, what: str) -> float:
+    return f.require(f"axis0.{leaf}", what)
+
+
+def odrive_loop(f: VendorFile, params: DriveParams) -> StockLoop:
+    """The stock route of a parsed backup: ODrive fw 0.5.x's loops at 8 kHz with the file's settings (SI).
+
+    The move is the planner's trapezoid from the file's limits over the case's θ_dem.
+
+    Raises
+    ------
+    ParameterError
+        Naming the key, for a missing setting, another control/input mode or accel ≠ decel.
+    """
+    for leaf, want in (("controller.config.control_mode", CONTROL_MODE_POSITION_CONTROL),
+                       ("controller.config.input_mode", INPUT_MODE_TRAP_TRAJ)):
+        if _key(f, leaf, "the mode") != want:
+            raise ParameterError(f"axis0.{leaf} = {f.get('axis0.' + leaf)!r} is not allowed: {want} (trap move)")
+    accel = _key(f, "trap_traj.config.accel_limit", "the planner's acceleration [turn/s^2]")
+    if _key(f, "trap_traj.config.decel_limit", "the planner's deceleration [turn/s^2]") != accel:
+        raise ParameterError("axis0.trap_traj.config.decel_limit is not allowed to differ from accel_limit: "
+                             "the simulated planner is symmetric")
+    tr = trapezoid_from_limits(params.manoeuvre.theta_dem,
+                               turn_to_rad(_key(f, "trap_traj.config.vel_limit", "the planner's speed [turn/s]")),
+                               turn_to_rad(accel))
+    bw = _key(f, "motor.config.current_control_bandwidth", "the current-loop bandwidth [rad/s]")
+    R = _key(f, "motor.config.phase_resistance", "the phase resistance [Ohm]")
+    L = _key(f, "motor.config.phase_inductance", "the phase inductance [H]")
+    rate = DRIVES["odrive"].f_loop
+    return StockLoop(
+        "odrive", rate, "cascade", _key(f, "controller.config.pos_gain", "pos_gain"),
+        per_turn_to_per_rad(_key(f, "controller.config.vel_gain", "vel_gain")),
+        per_turn_to_per_rad(_key(f, "controller.config.vel_integrator_gain", "vel_integrator_gain")), math.inf,
+        turn_to_rad(_key(f, "controller.config.vel_limit", "the speed limit [turn/s]")),
+        per_turn_to_per_rad(_key(f, "controller.config.inertia", "the inertia feed-forward")),
+        _key(f, "motor.config.torque_constant", "the torque constant [Nm/A]"),
+        _key(f, "motor.config.current_lim", "the current limit [A]"),
+        _key(f, "encoder.config.bandwidth", "the encoder PLL bandwidth [rad/s]"), True, L * bw, R * bw,
+        setpoint_table(tr, 1.0 / rate), 1.0 / rate)

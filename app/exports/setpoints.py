@@ -17,8 +17,10 @@ import numpy as np
 
 from app.exports.drive_units import ANGLE_UNITS, rad_to_angle_unit
 from app.exports.stock import StockSettings
+from app.exports.stock_lines import CASCADE_UNITS, cascade_lines, parse_cascade
 from control.common.checks import ParameterError
 from control.fdsmc.trapezoid import trapezoid_samples
+from sim.stock.route import StockLoop
 
 #: Most rows of a setpoint table (a longer table needs a longer cycle time).
 MAX_ROWS = 2_000_000
@@ -51,6 +53,18 @@ def setpoint_times(T_m: float, cycle_s: float) -> np.ndarray:
     return np.arange(n) * cycle_s
 
 
+#: The cascade lines of a setpoint table (every key of the comment block but the planner's limits).
+CASCADE_KEYS = tuple(k for k in CASCADE_UNITS if k not in ("vel_limit", "accel_limit"))
+
+
+def cascade_values(s: StockSettings) -> dict[str, float]:
+    """The loops (SI) a setpoint table carries as comment lines: cascade, PLL, rate, current loop, motor."""
+    g, L = s.gains, 0.5 * (s.L_d + s.L_q)
+    return dict(zip(CASCADE_KEYS, (g.pos_gain, g.vel_gain, g.vel_integrator_gain, g.inertia, s.pll_bandwidth,
+                                   s.f_loop, s.current_bandwidth, 1.5 * s.p * s.psi_pm, s.current_limit, s.R_s, L),
+                    strict=True))
+
+
 def setpoints_csv(s: StockSettings, header: list[str], unit: str = "rad", cycle_s: float | None = None) -> str:
     """Return the setpoint table of the stock trapezoid (see the module doc)."""
     if unit not in ANGLE_UNITS:
@@ -59,8 +73,10 @@ def setpoints_csv(s: StockSettings, header: list[str], unit: str = "rad", cycle_
     t = setpoint_times(s.trapezoid.T_m, cycle)
     theta, omega, alpha = (rad_to_angle_unit(1.0, unit) * x for x in trapezoid_samples(s.trapezoid, t))
     out = io.StringIO()
-    for line in header + [f"setpoints: symmetric trapezoid, cycle {cycle:.9g} s, angles in {unit} "
-                          "(no jerk column: the trapezoid's jerk is unbounded)"]:
+    notes = [f"setpoints: symmetric trapezoid, cycle {cycle:.9g} s, angles in {unit} (no jerk column: the "
+             "trapezoid's jerk is unbounded)", "the drive's position/speed cascade and current loop this table was "
+             "verified with (SI units):"] + cascade_lines(cascade_values(s))
+    for line in header + notes:
         out.write(f"# {line}\n")
     out.write(",".join(columns(unit)) + "\n")
     np.savetxt(out, np.column_stack((t, theta, omega, alpha)), fmt="%.9g", delimiter=",")
@@ -95,3 +111,24 @@ def parse_setpoints(text: str) -> SetpointTable:
     if np.any(np.diff(data[:, 0]) <= 0.0):
         raise ParameterError("setpoint times are not increasing: allowed t strictly rising row by row")
     return SetpointTable(unit, *data.T)
+
+
+def setpoints_loop(text: str) -> StockLoop:
+    """The stock route of a setpoint table: its rows (in rad) held a cycle each, run by its ``cascade.*`` loops.
+
+    Raises
+    ------
+    ParameterError
+        For a malformed table, missing cascade lines or rows that are not equally spaced from t = 0.
+    """
+    table = parse_setpoints(text)
+    c = parse_cascade((ln.lstrip("#").strip() for ln in text.splitlines() if ln.startswith("#")), CASCADE_KEYS)
+    dt = float(table.t[1] - table.t[0]) if table.t.size > 1 else 1.0 / c["loop_rate"]
+    if table.t[0] != 0.0 or not np.allclose(np.diff(table.t), dt, rtol=1e-6, atol=0.0):
+        raise ParameterError("setpoint times are not allowed: equally spaced rows from t = 0 s (one per cycle)")
+    to_rad = 1.0 / rad_to_angle_unit(1.0, table.unit)
+    rows = np.ascontiguousarray(np.vstack((table.theta, table.omega, table.alpha)) * to_rad)
+    bw = c["current_bandwidth"]
+    return StockLoop("setpoints", c["loop_rate"], "cascade", c["pos_gain"], c["vel_gain"], c["vel_integrator_gain"],
+                     math.inf, math.inf, c["inertia"], c["torque_constant"], c["current_limit"], c["pll_bandwidth"],
+                     False, c["inductance"] * bw, c["resistance"] * bw, rows, dt)

@@ -1,11 +1,12 @@
 """The stock-drive settings of one simulated case, in SI units (the vendor writers convert at the edge).
 
-One function, :func:`stock_settings`, decides every number a stock drive's file carries:
+One function, :func:`stock_settings`, decides every number a stock drive's file carries, from the
+drive's own loops tuned on the simulated checks (:func:`sim.stock.tuning.tune`):
 
-* the trapezoid at the designed α_max whose cruise ends the move at T_m
-  (:func:`control.fdsmc.trapezoid.trapezoid_timing`); the planner's speed limit is its cruise speed;
-* the P–PI cascade of the comparator's gains g1, g2 (eq. (61) in [1]) for the total inertia
-  J_r + J_L (:func:`control.fdsmc.trapezoid.cascade_gains`);
+* the trapezoid ending the move at T_m at the tuned acceleration (a fraction of the design's α_max
+  that leaves the drive's feedback torque headroom); the planner's speed limit is its cruise speed;
+* the position/speed loop's gains (P–PI cascade, or moteus' parallel PID) with the inertia
+  feed-forward J_r + J_L and the encoder PLL's bandwidth;
 * the motor constants R_s, L_d, L_q, Ψ_PM, p and the current limit (the inverter's i_max, else the
   current of Γ_max);
 * the current-loop bandwidth 3/T_si [rad/s] (first order, 5 % settling in T_si, eq. (8) in [1]);
@@ -19,9 +20,11 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from control.fdsmc.trapezoid import CascadeGains, TrapezoidTiming, cascade_gains, trapezoid_timing
+from control.fdsmc.trapezoid import CascadeGains, TrapezoidTiming
 from sim.fdsmc.criteria import drive_current
 from sim.fdsmc.engine import Comparison, simulate
+from sim.stock.route import StockLoop
+from sim.stock.tuning import DRIVES, StockTuning, tuned
 
 #: Cycle time of a continuous-time case's setpoint table [s].
 CONTINUOUS_CYCLE_S = 1e-3
@@ -44,6 +47,9 @@ class StockSettings:
     speed_limit : float          The drive's hard speed limit, max(ω_b, |ω_c|) [rad/s].
     current_bandwidth : float    Current-loop bandwidth 3/T_si [rad/s].
     cycle_s : float              The drive's cycle time [s].
+    pll_bandwidth : float        Encoder PLL bandwidth [rad/s].
+    f_loop : float               The drive's loop rate [Hz].
+    tuning : StockTuning         The tuned route (its verifying run and checks).
     """
 
     trapezoid: TrapezoidTiming
@@ -57,19 +63,29 @@ class StockSettings:
     speed_limit: float
     current_bandwidth: float
     cycle_s: float
+    pll_bandwidth: float
+    f_loop: float
+    tuning: StockTuning
 
 
-def stock_settings(cmp: Comparison) -> StockSettings:
-    """Return the stock-drive settings of the simulated case ``cmp`` (see the module doc)."""
+def loop_gains(loop: StockLoop) -> CascadeGains:
+    """The loop's gains in both forms: the cascade's (pos_gain, vel_gain, k_i) and the parallel PID's."""
+    if loop.law == "pid":
+        return CascadeGains(loop.kp / loop.kd, loop.kd, 0.0, loop.J_ff, loop.kp, loop.kd, loop.ki)
+    return CascadeGains(loop.kp, loop.kd, loop.ki, loop.J_ff, loop.kp * loop.kd, loop.kd, loop.kp * loop.ki)
+
+
+def stock_settings(cmp: Comparison, drive: str = "setpoints") -> StockSettings:
+    """Return the settings of stock drive ``drive`` (a key of DRIVES) for the case ``cmp`` (see the module doc)."""
     d = cmp.derived
     p = d.params
     m, c = p.motor, p.controller
-    tr = trapezoid_timing(p.manoeuvre.theta_dem, d.alpha.alpha_max, p.manoeuvre.T_m)
-    gains = cascade_gains(d.conventional.g1, d.conventional.g2, p.J_total)
+    tu = tuned(DRIVES[drive], p, d)
+    tr, loop = tu.trapezoid, tu.loop
     i_lim = drive_current(p)  # the simulated hard limit min(i_max, Γ_max/K_t), else Γ_max/K_t
     cycle = CONTINUOUS_CYCLE_S if c.is_continuous else 1.0 / float(c.f_s)
-    return StockSettings(tr, gains, m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, i_lim, max(m.omega_b, abs(tr.omega_c)),
-                         3.0 / c.T_si, cycle)
+    return StockSettings(tr, loop_gains(loop), m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, i_lim,
+                         max(m.omega_b, abs(tr.omega_c)), 3.0 / c.T_si, cycle, loop.omega_e, loop.f_loop, tu)
 
 
 def with_stock_runs(cmp: Comparison) -> Comparison:

@@ -9,19 +9,26 @@ amplitude-invariant Ψ_PM), ``l_current_max``/``l_current_min`` [A] (motor curre
 (poles, not pole pairs), ``foc_current_kp`` [V/A] and ``foc_current_ki`` [V/(A·s)] (the current PI,
 bandwidth 3/T_si: kp = L·ω_c, ki = R·ω_c, VESC Tool's own rule).
 
-VESC has no position trajectory planner: only the motor part is written; the move itself needs
-the setpoint table (:mod:`app.exports.setpoints`) fed by a host, or the C module.
+VESC has no position trajectory planner: the file writes the motor part and, as ``cascade.*`` comment
+lines (:mod:`app.exports.stock_lines`), the trapezoid and the position/speed cascade that a VESC app or
+the host runs on VESC's current loop; :func:`vesc_loop` reads all of it back for the stock route.
 """
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from xml.sax.saxutils import escape
 
 from app.exports.drive_units import pole_pairs_to_poles, poles_to_pole_pairs
 from app.exports.stock import StockSettings
+from app.exports.stock_lines import cascade_lines, parse_cascade
 from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
 from control.common.checks import ParameterError
+from control.fdsmc.params import DriveParams
+from control.fdsmc.trapezoid import trapezoid_from_limits
+from sim.stock.route import StockLoop
+from sim.stock.tuning import setpoint_table
 
 _DOC = "VESC Tool res/config parameters_mcconf.xml (fw 5.03+ / 6.x)"
 #: Root element and version element of VESC Tool's mcconf XML.
@@ -40,6 +47,7 @@ KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
     VendorKey("si_motor_poles", "int", "-", f"{_DOC}: si_motor_poles, Motor Poles"),
     VendorKey("foc_current_kp", "float", "V/A", f"{_DOC}: foc_current_kp, Current Controller Kp"),
     VendorKey("foc_current_ki", "float", "V/(A*s)", f"{_DOC}: foc_current_ki, Current Controller Ki"),
+    VendorKey("foc_f_zv", "float", "Hz", f"{_DOC}: foc_f_zv, Zero Vector Frequency (current loop once per 2/f_zv)"),
 )}
 FOC = 2
 
@@ -48,14 +56,27 @@ def vesc_values(s: StockSettings) -> dict[str, float]:
     """Every written key → value in VESC's stored units (the one conversion from SI)."""
     L = 0.5 * (s.L_d + s.L_q)
     values = [FOC, s.current_limit, -s.current_limit, s.R_s, L, s.L_q - s.L_d, s.psi_pm, pole_pairs_to_poles(s.p),
-              L * s.current_bandwidth, s.R_s * s.current_bandwidth]
+              L * s.current_bandwidth, s.R_s * s.current_bandwidth, 2.0 * s.f_loop]
     return dict(zip(KEYS, values, strict=True))
+
+
+#: The cascade lines of a VESC file.
+CASCADE_KEYS = ("pos_gain", "vel_gain", "vel_integrator_gain", "inertia", "pll_bandwidth", "vel_limit", "accel_limit")
+
+
+def cascade_values(s: StockSettings) -> dict[str, float]:
+    """The stock route's cascade and trapezoid (SI) that a VESC file carries as comment lines."""
+    g = s.gains
+    return dict(zip(CASCADE_KEYS, (g.pos_gain, g.vel_gain, g.vel_integrator_gain, g.inertia, s.pll_bandwidth,
+                                   abs(s.trapezoid.omega_c), s.trapezoid.alpha), strict=True))
 
 
 def vesc_xml(s: StockSettings, header: list[str]) -> str:
     """Return the mcconf XML: declaration, the header as an XML comment, ``<MCConfiguration>`` with the motor part."""
-    note = header + ["VESC: motor part only (VESC has no position trajectory planner); load it in VESC Tool "
-                     "(Motor Settings, Load XML) or with vesc_tool's setMcConf option, see docs/drives/vesc.md"]
+    note = header + ["VESC: motor part (VESC has no position trajectory planner); load it in VESC Tool "
+                     "(Motor Settings, Load XML) or with vesc_tool's setMcConf option, see docs/drives/vesc.md",
+                     "the move's trapezoid and the position/speed cascade a VESC app or the host runs each current-loop "
+                     "cycle (SI units):"] + cascade_lines(cascade_values(s))
     body = "\n".join(f"    {escape(line).replace('--', '- -')}" for line in note)
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', f"<!--\n{body}\n-->", f"<{ROOT}>",
              f"    <{VERSION_TAG}>{CONFIG_VERSION}</{VERSION_TAG}>"]
@@ -114,3 +135,21 @@ def vesc_motor(f: VendorFile) -> tuple[float, float, float, float, int, float]:
     return (f.require("foc_motor_r", "the motor resistance [Ohm]"), L - 0.5 * diff, L + 0.5 * diff,
             f.require("foc_motor_flux_linkage", "the flux linkage [Wb]"), p,
             f.require("l_current_max", "the motor current limit [A]"))
+
+
+def vesc_loop(f: VendorFile, params: DriveParams) -> StockLoop:
+    """The stock route of a parsed mcconf: VESC's current PI once per switching period, fed by the file's cascade.
+
+    Raises
+    ------
+    ParameterError
+        Naming the key or comment line for a missing or malformed setting.
+    """
+    c = parse_cascade(f.comment, CASCADE_KEYS)
+    rate = 0.5 * f.require("foc_f_zv", "the zero-vector frequency [Hz]")
+    _, _, _, psi, p, i_lim = vesc_motor(f)
+    tr = trapezoid_from_limits(params.manoeuvre.theta_dem, c["vel_limit"], c["accel_limit"])
+    return StockLoop("vesc", rate, "cascade", c["pos_gain"], c["vel_gain"], c["vel_integrator_gain"], math.inf,
+                     math.inf, c["inertia"], 1.5 * p * psi, i_lim, c["pll_bandwidth"], False,
+                     f.require("foc_current_kp", "the current kp [V/A]"), f.require("foc_current_ki", "the current ki"),
+                     setpoint_table(tr, 1.0 / rate), 1.0 / rate)

@@ -137,3 +137,23 @@ def cascade_gains(g1: float, g2: float, J: float) -> CascadeGains:
     zero = INTEGRATOR_ZERO_FRACTION * 0.5 * g2
     vel_gain, kp = g2 * J, g1 * J
     return CascadeGains(g1 / g2, vel_gain, vel_gain * zero, J, kp, vel_gain, kp * zero)
+
+
+def trapezoid_from_limits(delta_theta: float, v_max: float, a_max: float) -> TrapezoidTiming:
+    """Return the rest-to-rest move a drive's planner makes from its limits (ODrive ``TrapezoidalTrajectory``).
+
+    Cruise at ``v_max`` [rad/s] after T_a = v_max/a_max when the move is long enough,
+    |Δθ| ≥ v_max²/a_max; otherwise the triangle that peaks at √(|Δθ|·a_max). T_m = 2·T_a + the cruise.
+
+    Raises
+    ------
+    ParameterError
+        When a limit is not > 0.
+    """
+    if not (v_max > 0.0 and a_max > 0.0):
+        raise ParameterError(f"planner limits vel = {v_max!r} rad/s, accel = {a_max!r} rad/s² are not allowed: > 0")
+    dist = abs(delta_theta)
+    v = min(v_max, math.sqrt(dist * a_max))
+    T_a = v / a_max
+    T_m = 2.0 * T_a + (dist - v * T_a) / v if v > 0.0 else 0.0
+    return TrapezoidTiming(delta_theta, a_max, T_a, T_m, math.copysign(v, delta_theta))

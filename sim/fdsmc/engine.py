@@ -267,7 +267,17 @@ def _simulate_checked(
     params: DriveParams, controller: str, d: Derived, *, n_sub: int = 1, h_continuous: float = CONTINUOUS_STEP_S,
     max_points: int = MAX_POINTS, plant: DriveParams | None = None,
 ) -> RunResult:
-    """:func:`simulate` once the controller, the budget and the feasibility are checked (by the caller)."""
+    """:func:`simulate` once the controller, the budget and the feasibility are checked (by the caller).
+
+    ``"stock"`` is the stock route of a setpoint-table drive: its own P–PI cascade, PLL and current PI at
+    f_s, tuned on the simulated checks (:mod:`sim.stock.tuning`), run on ``plant`` when given.
+    """
+    if controller == "stock":
+        from sim.stock.route import simulate_stock
+        from sim.stock.tuning import DRIVES, tuned
+
+        tu = tuned(DRIVES["setpoints"], params, d)
+        return tu.run if plant is None else simulate_stock(params, tu.loop, d, plant)
     g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
     T_step = g.h * g.n_sub
     prm = pack_parameters(params, d, controller, plant, T_step)

@@ -18,6 +18,9 @@ agree. Formulas (see [1], the FDSMC paper):
   reference move (θ_ref, ω_ref, α_ref) by α_ref fed forward plus gains on the tracking error — the
   stock cascade's trapezoid (``P_CTRL`` = 2), or the minimum-energy optimum ending on the FDSMC's
   terminal slide (``P_CTRL`` = 3, :mod:`control.fdsmc.terminal_slide`);
+* or, instead of all of the above but the plant and sensors, a stock drive's own loops (``P_CTRL`` = 4,
+  :mod:`control.stock.loops`): encoder PLL, position/speed law on a setpoint table held between its
+  rows, dq current PI;
 * the FDC's u_q corrected by the q-axis voltage-mismatch estimate where ``P_BDV`` > 0 (not in [1],
   :func:`control.fdsmc.fdc.voltage_mismatch`);
 * energies as extra states of the same RK4 integration, so that the balance closes.
@@ -29,6 +32,7 @@ import numpy as np
 from numba import njit
 
 from control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
+from control.stock import loops
 from sim.common import sensors
 
 # ---- prm indices -------------------------------------------------------------------------
@@ -45,7 +49,15 @@ from sim.common import sensors
 # How far ahead the tracking law reads the reference's acceleration [s] (the inner loops' lag);
 # the filter factor β of the q-axis voltage-mismatch estimate (0 = none; control.fdsmc.fdc.voltage_mismatch).
 P_LEAD, P_BDV = 55, 56
-N_PRM = 57
+# The stock drive's own loops (P_CTRL = 4, :mod:`control.stock.loops`): position/speed law code, its
+# gains kp, kd, ki, integrator clamp [N·m], speed-demand clamp [rad/s], inertia feed-forward [kg·m²];
+# torque constant [N·m/A] and i_q demand clamp [A]; PLL bandwidth [rad/s] and speed snap [rad/s];
+# current PI kp [V/A], ki [V/(A·s)], voltage circle [V]; the cycle T [s] and the setpoint table's step [s].
+(P_DLAW, P_DKP, P_DKD, P_DKI, P_DILIM, P_DWLIM, P_DJFF, P_DKT, P_DIMAX, P_DWE, P_DSNAP, P_DCKP, P_DCKI,
+ P_DUMAX, P_DT, P_DREFDT) = range(57, 73)
+N_PRM = 73
+#: P_CTRL of the stock drive's own loops.
+LAW_DRIVE = 4.0
 
 # ---- state indices -----------------------------------------------------------------------
 (X_ID, X_IQ, X_TH, X_W, X_EF, X_ECU, X_EEL, X_EMOT, X_ELOAD, X_THH, X_WH, X_L0, X_L1) = range(13)
@@ -303,6 +315,8 @@ def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: b
     last sample's readings i_d, i_q [A], ω̂ [rad/s] and applied u_d, u_q [V]; the q-axis
     voltage-mismatch estimate [V]), HOLD0 at rest.
     """
+    if prm[P_CTRL] == LAW_DRIVE:
+        return drive_sample(k, t, p, o, hold, delay, prm, ref, noise)
     if continuous:
         y = (p[X_TH], p[X_ID], p[X_IQ])
         u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, (y[1], y[2]), o, prm, ref, 0.0)
@@ -320,3 +334,40 @@ def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: b
     a_em = (prm[P_H] + prm[P_K] * y[1]) * y[2]
     memory = (held[0], held[1], y[1], y[2], o[1], u_d, u_q, dv)
     return (u_d, u_q), observer_update(y[0], o, a_em, Phi, Gam, Lo), memory, (u_d, u_q, a_dem, a_hat, S), sat
+
+
+@inlined
+def table_at(t: float, ref: np.ndarray, dt: float) -> tuple[float, float, float]:
+    """Return the setpoint table's row (θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²]) in force at t [s].
+
+    The rows are k·dt apart from t = 0; each holds until the next (the last one ever after).
+    """
+    j = min(int(t / dt + 1e-9), ref.shape[1] - 1)
+    return ref[0, j], ref[1, j], ref[2, j]
+
+
+@inlined
+def drive_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, delay: int, prm: np.ndarray,
+                 ref: np.ndarray, noise: np.ndarray):
+    """One cycle of a stock drive's own loops (:mod:`control.stock.loops`); returns as :func:`step_sample`.
+
+    ``o`` = (PLL θ̂ [rad], ω̂ [rad/s], the position/speed law's integrator [N·m], 0); ``hold`` = (held
+    u_d, u_q [V]; the current PI's integrators v_d, v_q [V]; 0, 0, 0, 0). The recorded α_dem is the
+    torque demand over J_ff (over the plant's J without feed-forward).
+    """
+    T = prm[P_DT]
+    y = measure(k, p, prm, noise)
+    th, w = loops.pll_update(o[0], o[1], y[0], prm[P_DWE], T, prm[P_DSNAP])
+    th_r, w_r, a_r = table_at(t, ref, prm[P_DREFDT])
+    torque, integ, lim = loops.position_torque(prm[P_DLAW], th_r, w_r, a_r, th, w, o[2], prm[P_DKP], prm[P_DKD],
+                                               prm[P_DKI], prm[P_DILIM], prm[P_DWLIM], prm[P_DJFF],
+                                               prm[P_DKT] * prm[P_DIMAX], T)
+    i_q_dem = loops.clamp(torque / prm[P_DKT], prm[P_DIMAX])
+    u_d, u_q, v_d, v_q, sat = loops.current_pi(0.0, i_q_dem, y[1], y[2], hold[2], hold[3], prm[P_DCKP],
+                                               prm[P_DCKI], prm[P_DUMAX], T)
+    held = (hold[0], hold[1])
+    if delay == 1:
+        held, (u_d, u_q) = (u_d, u_q), held
+    a_dem = torque / (prm[P_DJFF] if prm[P_DJFF] > 0.0 else prm[P_JT])
+    return ((u_d, u_q), (th, w, integ, 0.0), (held[0], held[1], v_d, v_q, 0.0, 0.0, 0.0, 0.0),
+            (u_d, u_q, a_dem, a_dem, 0.0), sat or lim)

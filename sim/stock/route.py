@@ -1,0 +1,159 @@
+"""Simulate a stock drive running its own loops on the move it was given: the stock route.
+
+A :class:`StockLoop` holds every number of a stock drive's control structure in SI units — its
+cycle, the encoder PLL, the position/speed law and its gains, the current PI, the limits and the
+setpoint table it follows (:mod:`control.stock.loops`). The vendor files are read back into one
+(:mod:`app.exports`), so what :func:`simulate_stock` runs is what the drive loads.
+
+The plant, the sensors (encoder counts, current noise and ADC), the energy bookkeeping, the
+metrics and the checks are the FDSMC run's (:mod:`sim.fdsmc.kernel`, :mod:`sim.fdsmc.metrics`,
+:mod:`sim.fdsmc.checks`); the drive's cycle replaces the controller's f_s, with one cycle of
+computation delay (the voltages computed in a cycle are applied in the next, as on ODrive, moteus
+and VESC).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.common.checks import ParameterError
+from control.fdsmc.derivations import Derived, derive
+from control.fdsmc.params import DriveParams
+from control.stock.loops import LAW_CASCADE, LAW_PID
+from sim.common import sensors
+from sim.fdsmc import kernel as kn
+from sim.fdsmc import kernel_run
+from sim.fdsmc.engine import RunResult, pack_parameters
+from sim.fdsmc.grid import check_budget, load_steps, time_grid
+from sim.fdsmc.metrics import WindowSamples, chatter_window_steps, chatter_windows, run_metrics
+from sim.fdsmc.summary import decode_info
+
+#: Position/speed laws by name.
+LAWS = {"cascade": LAW_CASCADE, "pid": LAW_PID}
+
+
+@dataclass(frozen=True)
+class StockLoop:
+    """A stock drive's control structure and settings, SI units (what its file sets, read back).
+
+    Attributes
+    ----------
+    drive : str            Which drive runs it (``odrive``, ``moteus``, ``vesc``, ``setpoints``).
+    f_loop : float         Cycle rate of the position, speed and current loops [Hz].
+    law : str              ``cascade`` (P–PI) or ``pid`` (parallel PID on position).
+    kp : float             pos_gain [1/s] (cascade) or kp [N·m/rad] (pid).
+    kd : float             vel_gain or kd [N·m·s/rad].
+    ki : float             Speed integrator gain [N·m/rad] (cascade) or ki [N·m/(rad·s)] (pid).
+    i_lim : float          Integrator clamp [N·m] (pid; inf: none).
+    omega_lim : float      Speed-demand clamp [rad/s] (cascade; inf: none).
+    J_ff : float           Inertia feed-forward [kg·m²] (0: none).
+    K_t : float            Torque per ampere of i_q the drive assumes [N·m/A].
+    current_limit : float  Clamp of the i_q demand [A].
+    omega_e : float        Encoder PLL bandwidth [rad/s].
+    snap : bool            The PLL's speed is snapped to 0 below 0.5·T·ki counts/s (ODrive).
+    current_kp : float     Current PI proportional gain [V/A].
+    current_ki : float     Current PI integral gain [V/(A·s)].
+    table : numpy.ndarray  Setpoints, 3 × n: θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] …
+    table_dt : float       … one row per table_dt [s] from t = 0, each held until the next.
+    """
+
+    drive: str
+    f_loop: float
+    law: str
+    kp: float
+    kd: float
+    ki: float
+    i_lim: float
+    omega_lim: float
+    J_ff: float
+    K_t: float
+    current_limit: float
+    omega_e: float
+    snap: bool
+    current_kp: float
+    current_ki: float
+    table: np.ndarray = dataclasses.field(repr=False)
+    table_dt: float = 1e-3
+
+    def __post_init__(self) -> None:
+        if self.law not in LAWS:
+            raise ParameterError(f"stock law = {self.law!r} is not allowed: one of {', '.join(LAWS)}")
+        for name in ("f_loop", "K_t", "current_limit", "omega_e", "current_kp", "table_dt"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0.0):
+                raise ParameterError(f"{self.drive} {name} = {v!r} is not allowed: a finite number > 0")
+        for name in ("kp", "kd", "ki", "J_ff", "current_ki"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 0.0):
+                raise ParameterError(f"{self.drive} {name} = {v!r} is not allowed: a finite number ≥ 0")
+
+
+def at_loop_rate(params: DriveParams, f_loop: float) -> DriveParams:
+    """Return ``params`` with the controller sampled at the drive's cycle rate with one cycle of delay."""
+    ctrl = dataclasses.replace(params.controller, f_s=float(f_loop), delay_samples=1)
+    return dataclasses.replace(params, controller=ctrl)
+
+
+def pack_loop(prm: np.ndarray, loop: StockLoop, u_max: float, encoder_step: float) -> None:
+    """Write the stock drive's indices ``P_D*`` of the kernel's parameter vector (P_CTRL = 4)."""
+    T = 1.0 / loop.f_loop
+    snap = 0.5 * T * 0.25 * (2.0 * loop.omega_e) ** 2 * encoder_step if loop.snap else 0.0
+    prm[kn.P_CTRL] = kn.LAW_DRIVE
+    prm[[kn.P_DLAW, kn.P_DKP, kn.P_DKD, kn.P_DKI, kn.P_DILIM, kn.P_DWLIM, kn.P_DJFF]] = (
+        LAWS[loop.law], loop.kp, loop.kd, loop.ki, loop.i_lim, loop.omega_lim, loop.J_ff)
+    prm[[kn.P_DKT, kn.P_DIMAX, kn.P_DWE, kn.P_DSNAP]] = (loop.K_t, loop.current_limit, loop.omega_e, snap)
+    prm[[kn.P_DCKP, kn.P_DCKI, kn.P_DUMAX, kn.P_DT, kn.P_DREFDT]] = (
+        loop.current_kp, loop.current_ki, u_max, T, loop.table_dt)
+
+
+def simulate_stock(params: DriveParams, loop: StockLoop, derived: Derived | None = None,
+                   plant: DriveParams | None = None) -> RunResult:
+    """Simulate the stock drive ``loop`` on the case ``params`` (its plant, sensors, limits, criteria).
+
+    Parameters
+    ----------
+    params : DriveParams   The case; its controller's f_s is replaced by the drive's cycle.
+    loop : StockLoop       The drive's loops and setpoints (read back from its file).
+    derived : Derived      ``derive(params)`` if already computed (only its model coefficients are used).
+    plant : DriveParams    The drive's true motor and load when they differ from ``params``.
+
+    Returns
+    -------
+    RunResult
+        Controller ``"stock"``; never raises for an unstable run (``metrics.stable`` False).
+    """
+    p = at_loop_rate(params, loop.f_loop)
+    check_budget(p, 1)
+    d = derive(params) if derived is None else derived
+    g = time_grid(p, 1, 0.0, 20000)
+    T_step = g.h * g.n_sub
+    prm = pack_parameters(params, d, "stock", plant, T_step)
+    V_dc = params.controller.V_dc  # 0: no voltage limit
+    pack_loop(prm, loop, V_dc / math.sqrt(3.0) if V_dc > 0.0 else math.inf, params.sensors.encoder_step)
+    step_t, step_v = load_steps(params if plant is None else plant)
+    out, info = np.zeros((kn.N_CH, g.n_out)), np.zeros(kn.N_INFO)
+    windows = chatter_windows(p, d, "stock", g.n_steps * T_step)
+    steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
+    k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
+    win = np.zeros((kn.WIN_ROWS * len(steps), max(n for _, n in steps)))
+    kernel_run.run_kernel(prm, step_t, step_v, np.zeros((4, 4)), np.zeros(4), np.zeros(4), False, g.h, g.n_steps,
+                          g.n_sub, 1, g.decim, out, info, k_win, win, np.ascontiguousarray(loop.table),
+                          sensors.noise_table(params.sensors))
+    return _result(params, d, out, info, windows, steps, win, plant, T_step)
+
+
+def _result(params, d, out, info, windows, steps, win, plant, T_step) -> RunResult:
+    """The run's trace and metrics from the kernel's buffers (as :func:`sim.fdsmc.engine.simulate`)."""
+    from sim.fdsmc.engine import _trace
+
+    summary = decode_info(info)
+    trace = _trace(out[:, : summary.n_out])
+    rows = kn.WIN_ROWS
+    samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, *win[rows * j: rows * (j + 1), :n])
+               for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
+    met = run_metrics(params, d, "stock", trace.t, trace.theta_r, samples, summary, plant, T_step=T_step)
+    return RunResult("stock", trace, met)
