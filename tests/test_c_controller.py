@@ -162,7 +162,9 @@ def test_set_move_computes_the_profile_of_eq_60(tmp_path, single):
         assert m.lib.fdsmc_set_move(ctypes.byref(s), count, T_m) == 0
         pr = velocity_profile(count * step, alpha, T_m)
         rel = 1e-6 if single else 1e-15
-        assert s.omega_p == pytest.approx(pr.omega_p, rel=rel) and s.t_c == pytest.approx(pr.T_c, rel=rel)
+        req = s.move_req  # handed over, taken by the next step
+        assert req.omega_p == pytest.approx(pr.omega_p, rel=rel) and req.t_c == pytest.approx(pr.T_c, rel=rel)
+        assert s.move_pending == 1 and s.theta_dem == 0
 
 
 def test_run_time_moves_run_as_simulated(tmp_path):
@@ -186,9 +188,8 @@ def test_set_move_refuses_with_a_status_and_keeps_the_move(tmp_path):
     d, step = derive(params), 2.0 * 3.141592653589793 / params.sensors.encoder_cpr
     s = m.new_state(0)
     count = round(60.0 / step)
-    assert m.lib.fdsmc_set_move(ctypes.byref(s), count, 1.3) == 0
-    before = (s.omega_p, s.t_c, s.theta_dem)
-    # The rotor is still at θ̂ = 0: moves are measured from there.
+    before = (s.omega_p, s.t_c, s.theta_dem, s.move_pending)
+    # The rotor is at rest at θ̂ = 0: moves are measured from there.
     t_min = velocity_profile(120.0, d.alpha.alpha_max, 1.0).T_m_min
     far = round(1000.0 / step)
     t_far = velocity_profile(1000.0, d.alpha.alpha_max, 1.0).T_m_min
@@ -196,4 +197,11 @@ def test_set_move_refuses_with_a_status_and_keeps_the_move(tmp_path):
              (2 * count, float("inf"), -1), (far, 1.01 * t_far, -3), (3, 1e3, -4)]
     for target, T_m, code in cases:
         assert m.lib.fdsmc_set_move(ctypes.byref(s), target, T_m) == code, (target, T_m)
-        assert (s.omega_p, s.t_c, s.theta_dem) == before and s.status.last_move == code
+        assert (s.omega_p, s.t_c, s.theta_dem, s.move_pending) == before and s.status.last_move == code
+    out = m.Output()
+    assert m.lib.fdsmc_set_move(ctypes.byref(s), count, 1.3) == 0
+    assert m.lib.fdsmc_set_move(ctypes.byref(s), 2 * count, 1.3) == -8  # FDSMC_ERR_BUSY: not yet taken
+    m.lib.fdsmc_step(ctypes.byref(s), 0, 0.0, 0.0, ctypes.byref(out))
+    assert s.theta_dem == count and s.move_pending == 0 and out.fault == 0  # taken at the step's start
+    assert m.lib.fdsmc_set_move(ctypes.byref(s), 2 * count, 1.3) == -7  # FDSMC_ERR_MOVING: θ̂ far from θ_dem
+    assert s.theta_dem == count and s.status.last_move == -7

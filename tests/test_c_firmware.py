@@ -268,7 +268,7 @@ def test_hostile_names_compile_strictly_and_define_no_extra_symbol(tmp_path):
                         text=True, check=True).stdout
     assert {line.split()[-1] for line in nm.splitlines()} == {
         "FDSMC_DESIGN", "fdsmc_init", "fdsmc_set_move", "fdsmc_step", "fdsmc_step_conventional",
-        "fdsmc_electrical_angle"}
+        "fdsmc_electrical_angle", "fdsmc_angle_init", "fdsmc_angle_update"}
     pre = _cc(tmp_path, "-trigraphs", "-E", "-dM", accept_flag(tmp_path), "fdsmc_controller.c")
     macros = {line.split()[1].split("(")[0] for line in pre.stdout.splitlines() if line.startswith("#define ")}
     assert not {"INJ", "EVIL"} & macros and "FDSMC_DRIVE_NAME" in macros

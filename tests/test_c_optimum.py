@@ -108,8 +108,14 @@ def test_set_move_accepts_only_the_designed_move_and_keeps_the_move(tmp_path):
         assert code == (-1 if t != t else -6), (target, t)
         assert s.status.last_move == code and s.ref_on == 0 and s.theta_dem == 1000
     assert m.lib.fdsmc_set_move(ctypes.byref(s), 1000 + delta, T_m) == 0
-    assert s.ref_on == 1 and s.theta_dem == 1000 + delta and s.ref_k == 0
-    assert m.lib.fdsmc_set_move(ctypes.byref(s), 1000 + 2 * delta, T_m) == 0  # the next move from the held demand
+    assert s.ref_on == 0 and s.theta_dem == 1000  # handed over: the next step takes it
+    out = m.Output()
+    m.lib.fdsmc_step(ctypes.byref(s), 1000, 0.0, 0.0, ctypes.byref(out))
+    assert s.ref_on == 1 and s.theta_dem == 1000 + delta and s.ref_k == 1 and out.fault == 0
+    assert m.lib.fdsmc_set_move(ctypes.byref(s), 1000 + 2 * delta, T_m) == -7  # FDSMC_ERR_MOVING
+    r = m.new_state(1000 + delta)  # at rest on the held demand: the next move goes from there
+    r.theta_dem = 1000 + delta
+    assert m.lib.fdsmc_set_move(ctypes.byref(r), 1000 + 2 * delta, T_m) == 0
 
 
 def test_the_table_is_the_simulators_and_its_size_is_limited():
@@ -175,4 +181,4 @@ def test_float_build_for_cortex_m4f(tmp_path):
     assert double_symbols(obj) == []
     assert code_size(obj)["text"] > NODE_BYTES_FLOAT * 2001 and code_size(obj)["data"] == 0
     n = count_instructions(tmp_path)
-    assert n.max <= 360, n  # 331 measured (FDSMC module: 253)
+    assert n.max <= 385, n  # measured: mean 361, 380 on the sample that takes the move (FDSMC module: 284)

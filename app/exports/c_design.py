@@ -33,6 +33,9 @@ IDEAL_COUNTS_PER_REV = 1 << 22
 COUNT_RANGE = 2**30
 #: Current plausibility bound as a multiple of i_max [-] (the limit keeps |i_dq| ≤ i_max; noise, ringing).
 I_FAULT_FACTOR = 2.0
+#: "At rest" for a new move: |θ̂ − θ_dem| ≤ this fraction of the innovation fault's quarter electrical
+#: turn, and |ω̂| ≤ this fraction of the designed move's peak speed [-].
+REST_FRACTION_E_O, REST_FRACTION_OMEGA = 0.125, 0.01
 #: Bound on |u_dq|² and |i_dq|² used only to catch non-finite values when no limit is given [V², A²].
 NON_FINITE_BOUND = 1e30
 
@@ -88,6 +91,10 @@ def design_constants(params: DriveParams, d: Derived) -> list[tuple[str, float, 
         ("T_M_MAX", float(spec_of("manoeuvre.T_m").high or 1e4), "s", "longest move"),
         ("E_O_MAX", math.pi / (2.0 * params.motor.p), "rad",
          "innovation fault: a quarter electrical turn (field orientation lost)"),
+        ("REST_ANGLE", REST_FRACTION_E_O * math.pi / (2.0 * params.motor.p), "rad",
+         "fdsmc_set_move: at rest when |theta_hat - theta_dem| <= this (E_O_MAX/8)"),
+        ("REST_SPEED", REST_FRACTION_OMEGA * d.profile.omega_p, "rad/s",
+         "fdsmc_set_move: at rest when |omega_hat| <= this (1 % of the designed move's omega_p)"),
         ("I_LIMIT", i_max, "A", "hard |i_dq| limit min(i_max, Gamma_max/K_t) (0 = none)"),
         ("I_FAULT", I_FAULT_FACTOR * i_max if i_max > 0.0 else math.sqrt(NON_FINITE_BOUND), "A",
          f"current fault: {I_FAULT_FACTOR:g}*I_LIMIT (no limit: non-finite only)"),
@@ -116,6 +123,7 @@ def _fields(params: DriveParams, d: Derived, K: float) -> dict[str, Any]:
         "gain_dv": gam_q * c.G, "inv_gain_dv": 1.0 / (gam_q * c.G),
         "i_fault2": lim["I_FAULT"] ** 2, "u_fault2": NON_FINITE_BOUND,
         "e_o_max_counts": lim["E_O_MAX"] * cpr / (2.0 * math.pi),
+        "rest_angle": lim["REST_ANGLE"], "rest_speed": lim["REST_SPEED"],
         "rad_per_count": 2.0 * math.pi / cpr, "counts_per_rad": cpr / (2.0 * math.pi),
     }
 

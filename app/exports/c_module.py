@@ -302,7 +302,8 @@ def controller_source(params: DriveParams, d: Derived, table: ReferenceTable | N
     """Text of ``fdsmc_controller.c`` for the derived design ``d`` of ``params`` (``table``: the optimum's)."""
     so = scaled_observer(d)
     law = (law_parts(table, c_literal) if table is not None else
-           {"set_move": FDSMC_MOVE, "outer_law": "", "outer_call": "sliding_mode(s, th_re, w, &S)", "law_init": ""})
+           {"set_move": FDSMC_MOVE, "outer_law": "", "outer_call": "sliding_mode(s, th_re, w, &S)", "law_init": "",
+            "take_law": ""})
     K = slide_gain(d.gain, params.controller.K) if table is not None else params.controller.K
     return SOURCE.substitute(name=c_string(params.name), design=design_initializer(params, d, so, c_literal, K),
                              limit_code=LIMIT_CODE, **law)

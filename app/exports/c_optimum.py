@@ -150,31 +150,34 @@ LAW_INIT = """\
 
 SET_MOVE = """\
 /* The tracked optimum's reference is the designed move's table: only theta_dem = the held demand +
- * FDSMC_REF_DELTA counts in FDSMC_T_M is accepted (FDSMC_ERR_TABLE otherwise); call at rest. */
+ * FDSMC_REF_DELTA counts in FDSMC_T_M is accepted (FDSMC_ERR_TABLE otherwise); at rest, outside the ISR. */
 int32_t fdsmc_set_move(fdsmc_state *s, fdsmc_count theta_dem, fdsmc_real T_m)
 {
-    int32_t rc = FDSMC_OK;
-    if (s->status.fault != 0u) {
-        rc = FDSMC_ERR_FAULT;
-    } else if (!(T_m > R_(0) && T_m <= s->p->t_m_max)) {
+    fdsmc_real dtheta = R_(0);
+    int32_t rc = move_start(s, theta_dem, &dtheta);
+    if (rc == FDSMC_OK && !(within(T_m, s->p->t_m_max) && T_m > R_(0))) {
         rc = FDSMC_ERR_ARG;
-    } else if (count_diff(theta_dem, s->theta_dem) != FDSMC_REF_DELTA
-               || FDSMC_FABS(T_m - FDSMC_T_M) > R_(1.0e-6) * FDSMC_T_M) {
+    } else if (rc == FDSMC_OK && (count_diff(theta_dem, s->theta_dem) != FDSMC_REF_DELTA
+                                  || FDSMC_FABS(T_m - FDSMC_T_M) > R_(1.0e-6) * FDSMC_T_M)) {
         rc = FDSMC_ERR_TABLE;
     }
     s->status.last_move = rc;
     if (rc == FDSMC_OK) {
-#ifdef FDSMC_USE_FLOAT
-        s->ref_k = 0u;
-#else
-        s->ref_t = 0.0;
-        s->ref_start_rad = s->theta_dem_rad;
-#endif
-        (void)move_distance(s, theta_dem, 1);
-        s->ref_on = 1;
+        publish_move(s, theta_dem, s->omega_p, s->t_c); /* the slide's T_c and the designed omega_p */
     }
     return rc;
 }
+"""
+
+#: What the step does when it takes a move (before the demand is re-referenced): the move's clock from 0.
+TAKE_LAW = """\
+#ifdef FDSMC_USE_FLOAT
+    s->ref_k = 0u;
+#else
+    s->ref_t = 0.0;
+    s->ref_start_rad = s->theta_dem_rad;
+#endif
+    s->ref_on = 1;
 """
 
 OUTER_LAW = """\
@@ -262,4 +265,4 @@ static fdsmc_real tracked_optimum(fdsmc_state *s, fdsmc_real theta_re, fdsmc_rea
 def law_parts(table: ReferenceTable, literal: Callable[[float], str]) -> dict[str, str]:
     """Placeholders of :data:`app.exports.c_source.SOURCE` and the header for the tracked optimum."""
     return {"set_move": SET_MOVE, "outer_law": OUTER_LAW.replace("$table", table_initializer(table, literal)),
-            "outer_call": "tracked_optimum(s, th_re, w, &S)", "law_init": LAW_INIT}
+            "outer_call": "tracked_optimum(s, th_re, w, &S)", "law_init": LAW_INIT, "take_law": TAKE_LAW}

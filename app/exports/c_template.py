@@ -26,25 +26,42 @@ HEADER = Template("""\
 $checks *
  * ---- Integration (full text: docs/firmware.md) -----------------------------------------------
  * Angles. theta_r is the MECHANICAL rotor angle as a multi-turn, unwrapped encoder count
- *   (fdsmc_count, FDSMC_COUNTS_PER_REV per revolution). Only differences matter: a free-running
- *   32-bit counter may wrap, as long as |theta_dem - theta_r| < 2^31 counts. Positive = the
- *   direction a positive i_q (positive torque 1.5*p*Psi_PM*i_q) accelerates the rotor.
+ *   (fdsmc_count, FDSMC_COUNTS_PER_REV per revolution, any value). Only differences matter: a
+ *   free-running 32-bit counter may wrap, as long as |theta_dem - theta_r| < 2^31 counts. Positive =
+ *   the direction a positive i_q (positive torque 1.5*p*Psi_PM*i_q) accelerates the rotor.
  * Park transform. Use the ELECTRICAL angle theta_e = p*theta_r - theta_offset, not theta_r:
- *   fdsmc_electrical_angle(count, offset_count) returns it in [0, 2*pi) for the single-turn
- *   count offset_count at which the rotor d-axis is aligned with phase a.
+ *   fdsmc_angle_init(&a, count, offset_count) once, then fdsmc_angle_update(&a, count) every
+ *   sample returns it in [0, 2*pi), offset_count being the count at which the rotor d-axis is aligned
+ *   with phase a. It follows the count by differences, so it stays continuous across the 2^32 wrap
+ *   for any counts per revolution. fdsmc_electrical_angle(count, offset_count) is the stateless form:
+ *   exact across the wrap only when FDSMC_COUNTS_PER_REV divides 2^32 (a power of two).
  * Currents and voltages. i_d, i_q [A] and u_d, u_q [V] are amplitude-invariant dq quantities
  *   (i_q = phase current peak at i_d = 0); |u_dq| <= FDSMC_U_MAX = V_dc/sqrt(3) (SVPWM linear).
  * When to call. fdsmc_step() once per FDSMC_T_S, in the PWM interrupt, right after the encoder and
- *   the phase currents are sampled (same instant). Timing with FDSMC_DELAY_SAMPLES = 1:
- *       sample k       sample k+1      sample k+2
- *       |-- compute k --|-- u(k) applied --|
- *   fdsmc_step() returns the voltages computed at the previous call (delay compensation as
- *   simulated): write them to the PWM shadow registers, loaded at the next period start. With
- *   FDSMC_DELAY_SAMPLES = 0 the voltages apply in the same period (computation time negligible).
+ *   the phase currents are sampled at instant k (same instant). Timing (the simulator's and the
+ *   verified one) with FDSMC_DELAY_SAMPLES = 1:
+ *       instant k: sample, call k            instant k+1                  instant k+2
+ *       |-- applied: out.u_d/u_q of call k --|-- out.u_d_next/u_q_next of call k --|
+ *   out.u_d, out.u_q are the voltages computed at call k-1; the simulator applies them over
+ *   [k, k+1]. out.u_d_next, out.u_q_next (computed now) are the ones for [k+1, k+2]: write THEM
+ *   to the PWM shadow registers loaded at the next period start (k+1) -- then the voltage applied
+ *   over [k, k+1] is exactly out.u_d/u_q of call k. Writing out.u_d/u_q to shadow registers instead
+ *   delays them by two samples: the hard current limit then fails. Inverse Park angle for the
+ *   voltage written at call k (it acts over [k+1, k+2]): theta_e(k) + p*out.omega_hat*1.5*T_s.
+ *   FDSMC_DELAY_SAMPLES = 0: out.u = out.u_next act over [k, k+1], written at once (computation
+ *   negligible, no shadow register), angle theta_e(k) + p*out.omega_hat*0.5*T_s.
  * Moves. fdsmc_init() holds the angle it is given; fdsmc_set_move(&s, theta_dem, T_m) starts a
  *   minimum-energy move to theta_dem [counts] in T_m [s] from rest (profile of eq. (60) of [1]
  *   computed on the target). It returns FDSMC_OK or an FDSMC_ERR_* code and then keeps the
- *   previous move: FDSMC_ERR_T_M when T_m < T_m,min = sqrt(2*(5 + 2e^-3)*|dtheta|/alpha_max).
+ *   previous move: FDSMC_ERR_T_M when T_m < T_m,min = sqrt(2*(5 + 2e^-3)*|dtheta|/alpha_max);
+ *   FDSMC_ERR_MOVING unless at rest (|theta_hat - theta_dem| <= FDSMC_REST_ANGLE and |omega_hat|
+ *   <= FDSMC_REST_SPEED); FDSMC_ERR_BUSY while the last move accepted is not yet taken.
+ * ISR safety. fdsmc_step, fdsmc_step_conventional and fdsmc_angle_update run in the PWM interrupt.
+ *   fdsmc_set_move may be called from a lower-priority context (main loop, RTOS task) while that
+ *   interrupt runs: it only reads the step's state (read again when a step ran meanwhile) and hands
+ *   the move over through s.move_req and then s.move_pending (volatile); the next fdsmc_step takes it at
+ *   its start, at a sample boundary. One caller of fdsmc_set_move at a time. fdsmc_init is not
+ *   ISR-safe: call it with the PWM interrupt disabled. fdsmc_electrical_angle is pure.
  * Limits. The voltages returned keep the currents predicted at the end of the next sample within
  *   |i_dq| <= FDSMC_I_LIMIT = min(i_max, Gamma_max/K_t) (hard, from eqs. (1)-(2) of [1]; i_d first),
  *   then |u_dq| <= FDSMC_U_MAX; out.saturated = 1 when a limit acted.
@@ -56,6 +73,8 @@ $checks *
  * Build. Double by default (host); -DFDSMC_USE_FLOAT for float32 (Cortex-M4F: -mcpu=cortex-m4
  *   -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 -fno-math-errno -ffp-contract=fast: no double operation,
  *   sqrtf is one VSQRT, multiply-adds fuse to VFMA; the double build is the simulator's arithmetic).
+ *   -ffast-math, -Ofast and -ffinite-math-only stop the build (#error): add -fno-finite-math-only.
+ *   The NaN/inf checks test the bit pattern, so they hold even then (FDSMC_ALLOW_FINITE_MATH).
  *
  * Observer state. Double build: x = (theta_hat [rad], omega_hat, Gamma_L_hat, its rate), updated
  *   x[k+1] = Phi*x[k] + Gamma*a_em[k] + L*e_o[k] exactly as the simulator (bit-identical results on
@@ -113,6 +132,8 @@ $constants
 #define FDSMC_ERR_T_C (-4)   /* T_c < FDSMC_T_C_MIN: sloped segment poorly damped (move too short) */
 #define FDSMC_ERR_FAULT (-5) /* a fault is latched: fdsmc_init() first */
 #define FDSMC_ERR_TABLE (-6) /* tracked-optimum module: not the designed move of its reference table */
+#define FDSMC_ERR_MOVING (-7) /* not at rest (FDSMC_REST_ANGLE, FDSMC_REST_SPEED): a move is running */
+#define FDSMC_ERR_BUSY (-8)   /* the move accepted last is not yet taken by fdsmc_step */
 #define FDSMC_FAULT_CURRENT 1u    /* i_d or i_q not finite, or |i_dq| > FDSMC_I_FAULT */
 #define FDSMC_FAULT_INNOVATION 2u /* |theta_r - theta_hat| > FDSMC_E_O_MAX */
 #define FDSMC_FAULT_STATE 4u      /* a voltage or estimate not finite or beyond range */
@@ -125,7 +146,7 @@ typedef struct {
     fdsmc_real u_max, u_max2, i_max, i_max2, phi_d, inv_gam_d, gam_d, phi_q, inv_gam_q, gam_q;
     fdsmc_real beta_dv, gain_dv, inv_gain_dv;
     fdsmc_real i_fault2, u_fault2, e_o_max_counts;
-    fdsmc_real rad_per_count, counts_per_rad;
+    fdsmc_real rad_per_count, counts_per_rad, rest_angle, rest_speed;
     fdsmc_real phi[4][4], gamma[4], l[4];
 } fdsmc_params;
 
@@ -141,6 +162,15 @@ typedef struct {
     fdsmc_real e_o_peak;        /* largest |theta_r - theta_hat| so far [rad] */
     int32_t last_move;          /* result of the last fdsmc_set_move() */
 } fdsmc_status;
+
+/* A move handed over from fdsmc_set_move to the step (see "ISR safety" above). */
+typedef struct {
+    fdsmc_count theta_dem;  /* demanded angle [counts] */
+    fdsmc_real omega_p;     /* peak speed [rad/s] */
+    fdsmc_real t_c;         /* sliding-mode time constant [s] */
+    fdsmc_real inv_t_c;     /* 1/t_c [1/s] */
+    fdsmc_real slope_end;   /* t_c*omega_p [rad] */
+} fdsmc_move;
 
 /* Controller state (see "Observer state" above) and the current move. */
 typedef struct {
@@ -162,14 +192,19 @@ typedef struct {
     fdsmc_real inv_t_c;     /* 1/t_c [1/s] */
     fdsmc_real slope_end;   /* t_c*omega_p: |theta_re| where the sloped segment starts [rad] */
     fdsmc_status status;
+    volatile fdsmc_move move_req;   /* written by fdsmc_set_move, taken by the step */
+    volatile uint32_t move_pending; /* 1 from fdsmc_set_move (move_req complete) until the step took it */
 $state_fields} fdsmc_state;
 
-/* One sample's outputs: the voltages to apply [V] and diagnostics: theta_hat - theta_dem [rad],
- * omega_hat [rad/s], Gamma_L_hat [N*m], acceleration demand [rad/s^2], switching function S
- * [rad/s], whether an inverter limit acted (1) and the latched fault bits. */
+/* One sample's outputs (every field written, zero on a fault): the voltages u_d, u_q [V] applied over
+ * [k, k+1] and u_d_next, u_q_next [V] for [k+1, k+2] (see "When to call" above), and diagnostics:
+ * theta_hat - theta_dem [rad], omega_hat [rad/s], Gamma_L_hat [N*m], acceleration demand [rad/s^2],
+ * switching function S [rad/s], whether an inverter limit acted (1) and the latched fault bits. */
 typedef struct {
     fdsmc_real u_d;
     fdsmc_real u_q;
+    fdsmc_real u_d_next;
+    fdsmc_real u_q_next;
     fdsmc_real theta_re;
     fdsmc_real omega_hat;
     fdsmc_real Gamma_L_hat;
@@ -183,7 +218,7 @@ typedef struct {
  * it with the designed move's T_c; clears faults. */
 void fdsmc_init(fdsmc_state *s, const fdsmc_params *p, fdsmc_count theta_r0);
 
-/* Start a minimum-energy move to theta_dem [counts] lasting T_m [s] (call at rest). */
+/* Start a minimum-energy move to theta_dem [counts] lasting T_m [s], at rest; taken by the next step. */
 int32_t fdsmc_set_move(fdsmc_state *s, fdsmc_count theta_dem, fdsmc_real T_m);
 
 /* One sample of the module's outer law (see "Outer law" above) + FDC inner loops + limits + observer update. */
@@ -193,8 +228,21 @@ void fdsmc_step(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real 
 void fdsmc_step_conventional(fdsmc_state *s, fdsmc_count theta_r, fdsmc_real i_d, fdsmc_real i_q,
                              fdsmc_output *out);
 
-/* Electrical angle p*theta_r - theta_offset in [0, 2*pi) [rad] for the Park transform. */
+/* Electrical angle p*theta_r - theta_offset in [0, 2*pi) [rad] for the Park transform (stateless: exact
+ * across the counter's wrap only for a power-of-two FDSMC_COUNTS_PER_REV). */
 fdsmc_real fdsmc_electrical_angle(fdsmc_count theta_r, fdsmc_count offset);
+
+/* The electrical angle followed by count differences: continuous across the wrap for any counts/rev. */
+typedef struct {
+    fdsmc_count last; /* the count of the last call */
+    int32_t e;        /* p*(theta_r - offset) modulo FDSMC_COUNTS_PER_REV [counts] */
+} fdsmc_angle;
+
+/* Start following the electrical angle at theta_r [counts] (offset: see "Park transform" above). */
+void fdsmc_angle_init(fdsmc_angle *a, fdsmc_count theta_r, fdsmc_count offset);
+
+/* The electrical angle at theta_r [counts] in [0, 2*pi) [rad]; once per sample (|step| < 2^31 counts). */
+fdsmc_real fdsmc_angle_update(fdsmc_angle *a, fdsmc_count theta_r);
 
 #ifdef __cplusplus
 }

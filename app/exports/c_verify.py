@@ -121,16 +121,24 @@ class CModule:
         # The tracked optimum's module appends its move clock (the FDSMC's struct is the prefix).
         clock = ([("ref_k", u32)] if single else [("ref_t", ctypes.c_double), ("ref_start_rad", ctypes.c_double)])
 
+        class Move(ctypes.Structure):
+            _fields_ = [("theta_dem", i32), ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real)]
+
         class State(ctypes.Structure):
             _fields_ = [("p", ctypes.c_void_p), ("theta_dem", i32), *observer, ("u_hold", real * 2),
                         ("dv_mem", real * 6), ("omega_p", real), ("t_c", real), ("inv_t_c", real), ("slope_end", real),
-                        ("status", Status), *clock, ("ref_on", i32)]
+                        ("status", Status), ("move_req", Move), ("move_pending", u32), *clock,
+                        ("ref_on", i32)]
+
+        class Angle(ctypes.Structure):
+            _fields_ = [("last", i32), ("e", i32)]
 
         class Output(ctypes.Structure):
-            _fields_ = [("u_d", real), ("u_q", real), ("theta_re", real), ("omega_hat", real),
+            _fields_ = [("u_d", real), ("u_q", real), ("u_d_next", real), ("u_q_next", real), ("theta_re", real),
+                        ("omega_hat", real),
                         ("Gamma_L_hat", real), ("alpha_dem", real), ("S", real), ("saturated", i32), ("fault", u32)]
 
-        self.lib, self.State, self.Output = lib, State, Output
+        self.lib, self.State, self.Output, self.Angle = lib, State, Output, Angle
         self.design = ctypes.addressof(ctypes.c_char.in_dll(lib, "FDSMC_DESIGN"))
         ps = ctypes.POINTER(State)
         lib.fdsmc_init.argtypes = [ps, ctypes.c_void_p, i32]
@@ -138,6 +146,8 @@ class CModule:
         for f in (lib.fdsmc_step, lib.fdsmc_step_conventional):
             f.argtypes = [ps, i32, real, real, ctypes.POINTER(Output)]
         lib.fdsmc_electrical_angle.argtypes, lib.fdsmc_electrical_angle.restype = [i32, i32], real
+        lib.fdsmc_angle_init.argtypes = [ctypes.POINTER(Angle), i32, i32]
+        lib.fdsmc_angle_update.argtypes, lib.fdsmc_angle_update.restype = [ctypes.POINTER(Angle), i32], real
 
     def new_state(self, theta_r0: int = 0) -> ctypes.Structure:
         """Return an initialised state at the count ``theta_r0``."""
@@ -153,6 +163,11 @@ def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller:
     to θ_dem in counts, in T_m); the module reads the sensors of :func:`readings`. ``controller``:
     ``"conventional"`` runs ``fdsmc_step_conventional``, else ``fdsmc_step`` (the module's outer law:
     the FDSMC, or the tracked optimum in its module).
+
+    The voltages reach the plant as the header documents for a PWM with shadow registers: call k
+    writes ``out.u_d_next``/``u_q_next`` to the shadow registers, which load at instant k+1 and act
+    over [k+1, k+2] (with no computation delay, ``out.u_d``/``u_q`` act at once over [k, k+1]). The
+    voltage loaded at k must be the ``out.u_d``/``u_q`` of call k: checked at every sample.
     """
     m = CModule(lib, single)
     state, out = m.new_state(0), m.Output()
@@ -163,11 +178,18 @@ def closed_loop(lib: ctypes.CDLL, single: bool, params: DriveParams, controller:
     step = lib.fdsmc_step_conventional if controller == "conventional" else lib.fdsmc_step
     plant, noise = PlantInTheLoop(params), sensors.noise_table(params.sensors)
     rows = np.zeros((plant.n_samples, len(plant.x)))
+    shadow, delayed = (0.0, 0.0), params.controller.delay_samples == 1
     for k in range(plant.n_samples):
         x = plant.x
         rows[k] = x
         step(ctypes.byref(state), *readings(params, k, x[2], x[0], x[1], noise), ctypes.byref(out))
-        plant.step(out.u_d, out.u_q)
+        active = shadow if delayed else (out.u_d_next, out.u_q_next)  # loaded at k / written at once
+        if out.fault != 0:
+            active = (0.0, 0.0)  # the inverter opened: no voltage
+        elif active != (out.u_d, out.u_q):
+            raise RuntimeError(f"call {k}: the voltage acting over [k, k+1] {active} is not out.u {out.u_d, out.u_q}")
+        plant.step(*active)
+        shadow = (out.u_d_next, out.u_q_next)
     return rows
 
 
