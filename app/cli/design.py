@@ -1,4 +1,8 @@
-"""``python -m app design PRESET [--set …] [--json] [-o FILE]``: a clean design for this drive."""
+"""``python -m app design PRESET [--set …] [--json] [-o FILE] [--objective …]``: a clean design for this drive.
+
+Exit status: 0 clean, 3 not as asked (clean only at a longer T_m, or in position later than asked),
+4 not clean (:data:`sim.fdsmc.design.EXIT_STATUS`); 2 bad input, 130 interrupted.
+"""
 
 from __future__ import annotations
 
@@ -28,7 +32,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
     p.add_argument("-o", "--output", metavar="FILE", help="write the designed preset (YAML) to FILE")
     p.add_argument("--objective", choices=OBJECTIVES, default=OBJECTIVES[0],
-                   help="what the design minimises: net electrical input (default) or the paper's friction loss")
+                   help="what the design minimises: net electrical input (default) or the paper's friction loss; "
+                        "in_position_by_T_m: the axis in position by T_m (the move ends earlier), least energy")
     p.add_argument("--name", help="name written in the designed preset (default: the preset's)")
     p.add_argument("--source", help="source written in the designed preset, e.g. the motor's data sheet")
 
@@ -55,6 +60,10 @@ def design_json(od: ObjectiveDesign) -> dict[str, Any]:
         "recommended": {"controller": rec.controller, "why": rec.why} if rec else None,
         "clean": dd.clean,
         "verdict": dd.verdict,
+        "exit_status": dd.exit_status,
+        "T_m_asked": dd.T_m_asked,
+        "T_m": dd.params.manoeuvre.T_m,
+        "in_position_s": dd.in_position_s,
         "as_asked": dd.as_asked,
         "criteria": {"omega_max_rad_s": crit.omega_max, "in_position_rad": crit.in_position,
                      "overshoot_rad": crit.overshoot, "hold_i_rms_A": crit.hold_i_rms},
@@ -62,6 +71,8 @@ def design_json(od: ObjectiveDesign) -> dict[str, Any]:
         "encoder_cpr_needed": dd.encoder_cpr_needed,
         "limiting": [{"name": x.name, "value": x.value, "limit": x.limit, "unit": x.unit,
                       "violated": x.violated, "text": x.text} for x in dd.limiting],
+        "alternatives": [{"field": a.field, "value": a.value, "unit": a.unit, "verdict": a.verdict, "T_m": a.T_m,
+                          "in_position_s": a.in_position_s, "text": a.text} for a in dd.alternatives],
         "notes": list(dd.notes),
         "comparator_notes": list(dd.comparator),
         "design": {"alpha_max": dd.derived.alpha.alpha_max, "T_m": dd.params.manoeuvre.T_m, "K": c.K,
@@ -93,15 +104,18 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"cannot write -o {args.output!r}: {exc.strerror or exc}") from None
     if args.json:
         print(json.dumps(out, indent=2, ensure_ascii=False))
-        return 0
+        return dd.exit_status
     d = out["design"]
+    t_in = "never" if dd.in_position_s is None else f"{dd.in_position_s:.4g} s"
     print(f"Design for {params.name} (objective: {od.objective}, α_max rule {d['alpha_max_rule']}): "
-          f"{dd.verdict.upper()}")
+          f"{dd.verdict.upper()} — T_m = {d['T_m']:g} s, in position at {t_in}")
     print(f"  α_max = {d['alpha_max']:.5g} rad/s²  T_m = {d['T_m']:g} s  K = {d['K']:.4g} s/rad  "
           f"T_c = {d['T_c']:.4g} s  T_so = {d['T_so'] * 1e3:.4g} ms  T_sα = {d['T_salpha'] * 1e3:.4g} ms  "
           f"f_s = {d['f_s']}  (η = {d['overshoot_eta']:.3g})")
     for x in dd.limiting:
         print(f"  {'✗' if x.violated else '·'} {x.text}")
+    for a in dd.alternatives:
+        print(f"  alternative: {a.text}")
     for n in dd.notes + dd.comparator:
         print(f"  note: {n}")
     if od.recommendation is not None:
@@ -113,4 +127,5 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {name}: peak {v['torque_peak_Nm']:.4g} N·m, |i_dq| {v['i_peak_A']:.4g} A, {v['u_peak_V']:.4g} V; "
               f"error at T_m {v['theta_error_at_Tm_rad']:.3g} rad; overshoot {v['overshoot_rad']:.3g} rad; "
               f"in position {inpos}; standstill ripple {v['hold_i_q_rms_A']:.3g} A rms; chatter {v['chatter']}")
-    return 0
+    print(f"  exit status {dd.exit_status} ({dd.verdict})")
+    return dd.exit_status

@@ -2,10 +2,13 @@
 
 The paper's profile (section 4 of [1]) minimises the friction loss and runs at the largest α the
 torque allows. On servo drives the copper loss dominates and falls with α, so for the objective
-``electrical`` the FDSMC is designed twice — at the torque limit's α and at the α that minimises the
-profile's friction + copper (``alpha_max_rule = min_energy``) — and the clean design that draws the
-least net electrical energy in its verification run is kept. ``friction`` is the paper's choice
-(``torque_limit``), unchanged.
+``electrical`` (and ``in_position_by_T_m``) the FDSMC is designed twice — at the torque limit's α
+and at the α that minimises the profile's friction + copper (``alpha_max_rule = min_energy``) — and
+the clean design that draws the least net electrical energy in its verification run is kept.
+``friction`` is the paper's choice (``torque_limit``), unchanged. ``in_position_by_T_m`` reads the
+requested T_m as the time by which the axis must be in position (cycle time): the move ends early
+enough that the verified run is inside the window by then
+(:func:`sim.fdsmc.design_search.in_position_by`), least energy kept.
 
 Either way the design's case is then simulated with every comparator (conventional, the tracked
 minimum-energy optimum, the stock drive's trapezoid) on the same plant and sensors, and
@@ -25,7 +28,7 @@ from sim.fdsmc.engine import COMPARATORS, Comparison, compare
 from sim.fdsmc.recommend import Recommendation, recommend
 
 #: Design objectives: the first is the default.
-OBJECTIVES = ("electrical", "friction")
+OBJECTIVES = ("electrical", "friction", "in_position_by_T_m")
 
 
 @dataclass(frozen=True)
@@ -34,7 +37,7 @@ class ObjectiveDesign:
 
     Attributes
     ----------
-    objective : str                 ``electrical`` or ``friction``.
+    objective : str                 ``electrical``, ``friction`` or ``in_position_by_T_m``.
     design : DriveDesign            The FDSMC design kept.
     rejected : DriveDesign or None  The other α rule's design (objective ``electrical``), for the record.
     comparison : Comparison or None The design's case with every comparator (None when not simulated).
@@ -54,15 +57,21 @@ def _net(dd: DriveDesign) -> float:
     return e if e is not None else float("inf")
 
 
+def _rank(dd: DriveDesign) -> int:
+    """Return 2 for a clean design, 1 for one clean only not as asked, 0 for one not clean."""
+    return {"clean": 2, "not as asked": 1, "not clean": 0}[dd.verdict]
+
+
 def design_for(params: DriveParams, objective: str = OBJECTIVES[0]) -> ObjectiveDesign:
     """Design the FDSMC for ``objective`` and compare every controller on the design (see the module doc)."""
     if objective not in OBJECTIVES:
         raise ParameterError(f"objective = {objective!r} is not allowed: one of {', '.join(OBJECTIVES)}")
-    paper = design_drive(params, "torque_limit")
+    cycle = objective == "in_position_by_T_m"
+    paper = design_drive(params, "torque_limit", cycle)
     kept, rejected = paper, None
-    if objective == "electrical":
-        lean = design_drive(params, "min_energy")
-        if (lean.clean, -_net(lean)) > (paper.clean, -_net(paper)):
+    if objective != "friction":
+        lean = design_drive(params, "min_energy", cycle)
+        if (_rank(lean), -_net(lean)) > (_rank(paper), -_net(paper)):
             kept, rejected = lean, paper
         else:
             rejected = lean
