@@ -2,7 +2,8 @@
 
 Uses Debian's ``gcc-arm-none-eabi`` (installed by ``scripts/ensure_cc.sh``). The float32 build is
 compiled with :data:`ARM_FLAGS`; :func:`double_symbols` lists every soft-float double helper
-(``__aeabi_d*``, ``__*df*``) the object needs — none when the build is float-only.
+(``__aeabi_d*``, ``__*df*``) the object needs — none when the build is float-only — and
+:func:`helper_symbols` adds the 64-bit integer helpers (``__aeabi_ldivmod``, ``__aeabi_uldivmod`` …).
 :func:`count_instructions` links the module with a tiny bench program (Linux ``exit`` syscall, no C
 library) that replays the golden vectors, runs it under ``qemu-arm`` (``qemu-user``) with one
 instruction per translation block and ``-d exec``, and counts the instructions executed between
@@ -26,6 +27,9 @@ ARM_FLAGS = ("-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=har
              "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wdouble-promotion", "-DFDSMC_USE_FLOAT")
 #: Soft-float double helpers of the ARM EABI and libgcc.
 DOUBLE_SYMBOL = re.compile(r"__aeabi_(d|l2d|ul2d|i2d|ui2d|f2d)\w*|__\w*df\w*")
+#: 64-bit integer helpers of the ARM EABI and libgcc (division, modulo, shifts, compares, conversions).
+LONG_SYMBOL = re.compile(r"__aeabi_(u?ldivmod|lmul|llsl|llsr|lasr|u?lcmp|[fd]2u?lz|u?l2[fd])"
+                         r"|__(u?(div|mod)di3|u?divmoddi4|(ash|lsh)[lr]di3|u?cmpdi2|fixu?n?[sd]fdi|floatu?n?di[sd]f)")
 
 START_C = """\
 int main(void);
@@ -102,6 +106,11 @@ def symbols(obj: Path, kind: str = "U") -> list[str]:
 def double_symbols(obj: Path) -> list[str]:
     """Soft-float double helpers an ARM object calls (empty for a float-only build)."""
     return [s for s in symbols(obj) if DOUBLE_SYMBOL.fullmatch(s)]
+
+
+def helper_symbols(obj: Path) -> list[str]:
+    """Double and 64-bit integer helpers an ARM object calls (empty for the float build, any counts/rev)."""
+    return [s for s in symbols(obj) if DOUBLE_SYMBOL.fullmatch(s) or LONG_SYMBOL.fullmatch(s)]
 
 
 def code_size(obj: Path) -> dict[str, int]:
