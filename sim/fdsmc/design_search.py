@@ -30,6 +30,10 @@ TIMING_CHECKS = frozenset({"speed", "voltage", "current", "torque", "saturation"
                            "in_position", "stable", "T_m"})
 #: Most move-time reductions while looking for a move in position by the requested time [-].
 MAX_EARLIER = 6
+#: First guess of the in-position time over the move time (the approach takes 15–25 % of T_m) [-].
+CYCLE_LEAD = 1.2
+#: Extra shortening per step of the move time when the run is in position too late [-].
+EARLIER_MARGIN = 0.99
 
 Evaluate = Callable[[DriveParams, DriveParams], DriveDesign]
 
@@ -92,31 +96,39 @@ def in_position_by(p: DriveParams, asked: DriveParams,
                    evaluate: Evaluate = verify_at) -> tuple[DriveDesign, DriveDesign | None]:
     """Return the design whose verified run is in position by the requested T_m, ending the move early.
 
-    The longest move (least energy) found whose run passes every check and is inside the window by
-    ``asked.manoeuvre.T_m`` [s]; where none is, the passing design that is in position earliest,
-    marked not as asked. Also returns the last failing design tried (None if none).
+    The search starts at the move time T_m/CYCLE_LEAD (not below the closed-form shortest move),
+    takes the shortest passing move from there (:func:`shortest_clean`), ends it earlier while its run
+    is in position too late (scaled by T_m/in-position time) and bisects towards the longest move
+    (least energy) still in position by ``asked.manoeuvre.T_m`` [s]. Where none is, the passing design
+    in position earliest, marked not as asked. Also returns the last failing design tried (None if none).
     """
     T_cycle = asked.manoeuvre.T_m
-    best, fail = shortest_clean(p, asked, evaluate)
-    if not passes(best) or best.params.manoeuvre.T_m > T_cycle:
+    fastest = planned(with_field(p, "manoeuvre", T_m=1e-3))  # the closed-form shortest move
+    T_min = fastest.manoeuvre.T_m if fastest is not None else 0.0
+    start = with_field(p, "manoeuvre", T_m=max(T_min, round_down(T_cycle / CYCLE_LEAD)))
+    best, fail = shortest_clean(start, asked, evaluate)
+    if not passes(best):
         return _cycle(best, T_cycle), fail
-    fastest = planned(with_field(p, "manoeuvre", T_m=1e-6))  # the closed-form shortest move
-    late, early, T_min = best, None, fastest.manoeuvre.T_m if fastest is not None else 0.0
+    late, early, T = best, None, best.params.manoeuvre.T_m
     for _ in range(MAX_EARLIER):
-        t_in, T = late.in_position_s, late.params.manoeuvre.T_m
+        t_in = late.in_position_s
         if t_in is not None and t_in <= T_cycle:
             early = late
             break
-        T_new = max(round_down(T * T_cycle / (t_in or 1.3 * T)), T_min)
+        T_new = max(round_down(EARLIER_MARGIN * T * T_cycle / (t_in or 1.3 * T)), T_min)
         if T_new >= T:
             break
-        cand = _at(p, T_new, asked, evaluate)
-        if not passes(cand):
+        T, cand = T_new, _at(p, T_new, asked, evaluate)
+        if passes(cand):
+            late = cand
+        else:  # the verdict is not monotonic in T_m: keep the passing one, try a shorter move still
             fail = cand
-            break
-        late = cand
     if early is None:
         return _cycle(late, T_cycle), fail
+    if early is best and T_cycle > best.params.manoeuvre.T_m:  # in time at the start: try a longer move
+        late = _at(p, round_down(T_cycle), asked, evaluate)
+        if passes(late) and late.in_position_s is not None and late.in_position_s <= T_cycle:
+            return _cycle(late, T_cycle), fail
     return _cycle(_longest_in_time(p, asked, early, late, T_cycle, evaluate), T_cycle), fail
 
 
