@@ -28,7 +28,7 @@ from app.ui.log import LogPanel
 from app.ui.props import assign
 from app.ui.results import ResultsPanel
 from app.ui.studies import OptimumToggle
-from app.ui.text import derived_markdown, design_markdown, md_text
+from app.ui.text import derived_markdown, design_markdown, md_text, stale_results_html
 from app.ui.tuning import PLANT_J_L, LiveTuning, TuneRunner
 from app.ui.verdict_panel import VerdictPanel
 from app.ui.worker import Cancelled, Worker
@@ -222,8 +222,11 @@ class PositionTab:
                                                                      "Design objective"))]
         dd = design_for(params, objective).design
         self.design_note.content = design_markdown(dd)
-        if dd.refused:  # nothing designed or simulated: the inputs, the plant and the results stay
+        if dd.refused:  # nothing designed or simulated: the inputs and plant stay, the results are marked stale
             self.status.content = "Design refused before any run — see the design note."
+            self.verdicts.design_failed(dd)
+            if self.results is not None:
+                assign(self.results.key_numbers, content=stale_results_html(dd))
             return
         shown = dd.params
         self.inputs.populate(shown)
@@ -235,6 +238,8 @@ class PositionTab:
         if comparison.fdsmc is not None:
             self._results().show(comparison)
         self.show_text()
+        if dd.verdict != "clean":  # the design's diagnosis stays in the warnings box, never "No warnings"
+            self.verdicts.design_failed(dd, comparison)
 
     def _run_latest(self) -> bool:
         """Simulate the inputs panel's values, overview only (a slider moves); False on an input error."""

@@ -164,4 +164,24 @@ def _verified_figures(dd: Any) -> str:
             f"standstill ripple {m.hold_i_q_rms_A:.2g} A rms (≤ {crit.hold_i_rms:.2g})")
 
 
-__all__ = ["derived_markdown", "design_markdown", "html_text", "key_numbers_html", "md_text", "warnings_html"]
+def design_failure_items(dd: Any) -> list[str]:
+    """Return the warnings of a design that is not clean: its verdict, the constraints and the verified alternatives."""
+    head = ("Design refused before any run — nothing designed or simulated" if dd.refused else
+            f"Design: {dd.verdict.upper()}")
+    named = ("T_m", "current", "in_position_by_T_m")
+    items = [f"{head}: {c.text}" for c in dd.limiting if c.violated or c.name in named]
+    if not items:
+        items = [f"{head}."]
+    return items + [f"Alternative: {a.text}" for a in dd.alternatives]
+
+
+def stale_results_html(dd: Any) -> str:
+    """Return the banner that replaces the key numbers when a design fails: the figures below are not current."""
+    why = next((c.text for c in dd.limiting if c.violated), dd.verdict)
+    return ('<div data-role="stale-results" style="padding:6px 10px;border-radius:6px;background:#fff4e6;'
+            f'color:#a33b00;font-weight:600">⚠ Stale results: the figures below are of the previous run, not of '
+            f'these inputs — the design failed: {html_text(why)}</div>')
+
+
+__all__ = ["derived_markdown", "design_failure_items", "design_markdown", "html_text", "key_numbers_html", "md_text",
+           "stale_results_html", "warnings_html"]

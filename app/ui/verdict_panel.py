@@ -9,11 +9,12 @@ analysis has a remedy.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import viser
 
 from app.ui.props import assign
-from app.ui.text import warnings_html
+from app.ui.text import design_failure_items, warnings_html
 from sim.fdsmc.engine import Comparison
 from sim.fdsmc.verdicts import K_advice, T_c_advice, comparator_notes, run_warnings
 
@@ -46,6 +47,14 @@ class VerdictPanel:
     def reject(self, message: str) -> None:
         """Show an input error: nothing was simulated."""
         self.render(([], message, []))
+
+    def design_failed(self, dd: Any, comparison: Comparison | None = None) -> None:
+        """Show why a design (:class:`sim.fdsmc.design.DriveDesign`) is not clean, above the run's own warnings."""
+        items = design_failure_items(dd)
+        if comparison is not None:
+            d = comparison.derived
+            items += list(d.warnings) + run_warnings(comparison)
+        self.render((items, None, comparator_notes(comparison) if comparison is not None else []))
 
     def show(self, comparison: Comparison, error: str | None, extra: list[str]) -> None:
         """Show the verdicts of ``comparison`` and its remedies (:func:`~sim.fdsmc.verdicts.K_advice`, T_c)."""
