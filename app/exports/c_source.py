@@ -23,14 +23,14 @@ from string import Template
 C_DIR = Path(__file__).resolve().parent / "c"
 
 
-def _c_text(name: str) -> str:
+def c_text(name: str) -> str:
     """Return the text of the C file ``name`` beside this module."""
     return (C_DIR / name).read_text(encoding="utf-8")
 
 
 #: The controller's source, ``$``-placeholders filled by :mod:`app.exports.c_module`.
-SOURCE = Template(_c_text("fdsmc_controller.c.in"))
+SOURCE = Template(c_text("fdsmc_controller.c.in"))
 #: The inverter limits of :func:`control.fdsmc.inverter.limit_voltage`, mirrored.
-LIMIT_CODE = _c_text("limit_voltage.c.in")
+LIMIT_CODE = c_text("limit_voltage.c.in")
 #: fdsmc_set_move of the FDSMC module: the profile of eqs. (59)-(60) computed on the target.
-FDSMC_MOVE = _c_text("fdsmc_set_move.c.in")
+FDSMC_MOVE = c_text("fdsmc_set_move.c.in")

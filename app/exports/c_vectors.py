@@ -1,19 +1,21 @@
 """Golden test vectors and the host test program of the C module, and the export's C file set.
 
-:func:`vector_header` runs the simulator's digital mode on the design (demand rounded to a whole
-encoder count, as the firmware receives it) and writes, for the first :data:`VECTOR_SAMPLES` samples,
-the inputs its controller saw (θ_r as encoder counts, i_d, i_q) and the voltages it applied (u_d, u_q)
-as ``fdsmc_vectors.h``. ``fdsmc_test.c`` (:data:`TEST_PROGRAM`) replays them through ``fdsmc_step`` and
-exits 0 when every voltage agrees within 1e-6 (double) or 1e-4 (float32) of the peak |u|.
-:func:`c_files` is the whole C export of one simulated case, the verdict gate included.
+:func:`vector_header` writes the segments of :func:`app.exports.c_golden.segments` -- the designed move
+and hold, the limits acting, injected faults -- as ``fdsmc_vectors.h``: per sample the inputs the
+simulator's controller saw (θ_r as encoder counts, i_d, i_q) and the voltages it applied (u_d, u_q).
+``fdsmc_test.c`` (:data:`TEST_PROGRAM`) replays each segment through ``fdsmc_step`` and exits 0 when
+every voltage agrees within 1e-6 (double) or 1e-4 (float32) of the peak |u| and every fault is latched
+as recorded. :func:`c_files` is the whole C export of one simulated case, the verdict gate included.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 
+from app.exports.c_golden import Segment, segments
 from app.exports.c_module import (
     CONTINUOUS_REFUSED,
     HEADER_NAME,
@@ -23,105 +25,80 @@ from app.exports.c_module import (
     parameter_hash,
     verdict_of,
 )
+from app.exports.c_source import c_text
 from app.exports.c_text import c_string
-from app.exports.c_verify import count_params, readings
+from app.exports.c_verify import count_params
 from app.io.presets import SCHEMA
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
-from sim.common import sensors
-from sim.fdsmc.engine import Comparison, simulate
-from sim.fdsmc.grid import time_grid
+from sim.fdsmc.engine import Comparison
 
-#: Most samples in the golden vectors [-] (from t = 0: the start of the move).
-VECTOR_SAMPLES = 2000
 VECTORS_NAME, TEST_NAME = "fdsmc_vectors.h", "fdsmc_test.c"
 
-TEST_PROGRAM = """\
-/* fdsmc_test.c -- replays the golden vectors of fdsmc_vectors.h through fdsmc_step() and compares the
- * voltages with the simulator's. Build and run on the host (add -DFDSMC_USE_FLOAT for float32, and
- * -DFDSMC_ACCEPT_UNCLEAN=<FDSMC_PARAM_HASH> for a design that is not clean):
- *   cc -std=c99 -Wall -Wextra -Werror -O2 fdsmc_test.c fdsmc_controller.c -lm -o fdsmc_test && ./fdsmc_test
- * Exit status 0: every sample within FDSMC_TEST_TOL of the peak |u|; 1: a sample is not; 2: refused. */
-#include <math.h>
-#include <stdio.h>
-#include "fdsmc_controller.h"
-#include "fdsmc_vectors.h"
+#: The host test program (``c/fdsmc_test.c.in``, read as C).
+TEST_PROGRAM = c_text("fdsmc_test.c.in")
 
-#ifdef FDSMC_USE_FLOAT
-#define FDSMC_TEST_TOL 1e-4
-#else
-#define FDSMC_TEST_TOL 1e-6
-#endif
 
-int main(void)
-{
-    fdsmc_state s;
-    fdsmc_output out;
-    double worst = 0.0;
-    int k, worst_k = 0;
-    int32_t rc;
-    if (FDSMC_VEC_HASH != FDSMC_PARAM_HASH) {
-        printf("fdsmc_test: the vectors belong to another design\\n");
-        return 2;
-    }
-    fdsmc_init(&s, &FDSMC_DESIGN, 0);
-    rc = fdsmc_set_move(&s, FDSMC_VEC_THETA_DEM, (fdsmc_real)FDSMC_VEC_T_M);
-    if (rc != FDSMC_OK) {
-        printf("fdsmc_test: fdsmc_set_move refused the designed move (status %d)\\n", (int)rc);
-        return 2;
-    }
-    for (k = 0; k < FDSMC_VEC_N; ++k) {
-        double e_d, e_q;
-        fdsmc_step(&s, fdsmc_vec_theta[k], fdsmc_vec_in[k][0], fdsmc_vec_in[k][1], &out);
-        e_d = fabs((double)out.u_d - (double)fdsmc_vec_u[k][0]);
-        e_q = fabs((double)out.u_q - (double)fdsmc_vec_u[k][1]);
-        if (e_d > worst || e_q > worst) {
-            worst = e_d > e_q ? e_d : e_q;
-            worst_k = k;
-        }
-    }
-    worst /= FDSMC_VEC_U_PEAK;
-    printf("fdsmc_test: %d samples, max |u - u_sim| / peak |u| = %.3g at sample %d (tolerance %g), faults 0x%x\\n",
-           FDSMC_VEC_N, worst, worst_k, FDSMC_TEST_TOL, (unsigned)s.status.fault);
-    return worst <= FDSMC_TEST_TOL && s.status.fault == 0u ? 0 : 1;
-}
-"""
+def _real(x: float) -> str:
+    return "V_(NAN)" if math.isnan(x) else f"V_({c_literal(x)})"
 
 
 def _rows(values: np.ndarray) -> str:
-    return ",\n".join("    {" + ", ".join(f"V_({c_literal(v)})" for v in row) + "}" for row in values)
+    return ",\n".join("    {" + ", ".join(_real(float(v)) for v in row) + "}" for row in values)
+
+
+def _segment_table(segs: list[Segment]) -> str:
+    """Return the ``fdsmc_vec_seg`` initializer: where each segment starts in the arrays, its move and fault."""
+    rows, start = [], 0
+    for s in segs:
+        rows.append(f"    {{{c_string(s.name)}, {start}, {s.theta.size}, {s.theta_dem}, {c_literal(s.T_m)}, "
+                    f"{s.fault}u, {s.fault_at}}}")
+        start += s.theta.size
+    return ",\n".join(rows)
+
+
+#: The segment descriptor of fdsmc_vectors.h.
+SEGMENT_TYPE = """\
+typedef struct {
+    const char *name;
+    int32_t start, n;      /* first sample in the arrays, samples [-] */
+    fdsmc_count theta_dem; /* the move set after fdsmc_init(&s, &FDSMC_DESIGN, 0) [counts] */
+    double t_m;            /* its T_m [s] */
+    uint32_t fault;        /* fault bits latched at the end (0: none) */
+    int32_t fault_at;      /* the sample that latches it (-1: none) */
+} fdsmc_vec_segment;
+"""
 
 
 def vector_header(params: DriveParams, controller: str = "fdsmc") -> str:
-    """Text of ``fdsmc_vectors.h``: the simulator's controller inputs and outputs of the first samples.
+    """Return the text of ``fdsmc_vectors.h``: the simulator's controller inputs and outputs per segment.
 
-    ``controller``: the module's outer law (``"fdsmc"`` or ``"optimum"``), whose run is recorded.
+    The segments are :func:`app.exports.c_golden.segments` (at most
+    :data:`app.exports.c_golden.MAX_SAMPLES` samples); ``controller``: the module's outer law
+    (``"fdsmc"`` or ``"optimum"``), whose runs are recorded.
 
     Raises
     ------
     ParameterError
-        When the simulated run is unstable before :data:`VECTOR_SAMPLES` samples or infeasible.
+        When the simulated run is unstable or infeasible.
     """
-    sim_params, count = count_params(params)
-    n = min(VECTOR_SAMPLES, time_grid(sim_params, 1, 0.0, 1).n_steps)
-    trace = simulate(sim_params, controller, max_points=time_grid(sim_params, 1, 0.0, 1).n_steps + 1).trace
-    if trace.t.size < n:
-        raise ParameterError(f"the simulated run stops after {trace.t.size} samples: no test vectors")
-    noise = sensors.noise_table(sim_params.sensors)
-    read = np.array([readings(sim_params, k, trace.theta_r[k], trace.i_d[k], trace.i_q[k], noise) for k in range(n)])
-    theta, u = read[:, 0].astype(np.int64), np.column_stack([trace.u_d[:n], trace.u_q[:n]])
+    segs = segments(params, controller)
+    theta = np.concatenate([s.theta for s in segs])
+    i_dq, u = np.concatenate([s.i_dq for s in segs]), np.concatenate([s.u_dq for s in segs])
+    n, names = theta.size, ", ".join(f"{s.name} ({s.theta.size})" for s in segs)
     counts = ",\n".join("    " + ", ".join(str(int(c)) for c in theta[j:j + 8]) for j in range(0, n, 8))
-    return (f"/* fdsmc_vectors.h -- golden vectors of {c_string(params.name)}: the first {n} samples of the\n"
-            " * simulator's digital mode (demand rounded to a count): theta_r [counts], i_d, i_q [A] the\n"
-            " * controller saw and the voltages u_d, u_q [V] it applied. Replayed by fdsmc_test.c. */\n"
-            "#ifndef FDSMC_VECTORS_H\n#define FDSMC_VECTORS_H\n#define V_(x) ((fdsmc_real)(x))\n"
+    return (f"/* fdsmc_vectors.h -- golden vectors of {c_string(params.name)}: {n} samples of the simulator's\n"
+            f" * digital mode (demand rounded to a count) in {len(segs)} segments, {c_string(names)}:\n"
+            " * theta_r [counts], i_d, i_q [A] the controller saw and the voltages u_d, u_q [V] it applied.\n"
+            " * Replayed by fdsmc_test.c. */\n"
+            "#ifndef FDSMC_VECTORS_H\n#define FDSMC_VECTORS_H\n#include <math.h>\n#define V_(x) ((fdsmc_real)(x))\n"
             f"#define FDSMC_VEC_HASH 0x{parameter_hash(params)}u\n#define FDSMC_VEC_N {n}\n"
-            f"#define FDSMC_VEC_THETA_DEM {count}\n#define FDSMC_VEC_T_M {c_literal(params.manoeuvre.T_m)}\n"
-            f"#define FDSMC_VEC_U_PEAK {c_literal(float(np.max(np.abs(u))) or 1.0)}\n"
+            f"#define FDSMC_VEC_SEGMENTS {len(segs)}\n"
+            f"#define FDSMC_VEC_U_PEAK {c_literal(float(np.max(np.abs(u))) or 1.0)}\n{SEGMENT_TYPE}"
+            f"static const fdsmc_vec_segment fdsmc_vec_seg[{len(segs)}] = {{\n{_segment_table(segs)}\n}};\n"
             f"static const fdsmc_count fdsmc_vec_theta[{n}] = {{\n{counts}\n}};\n"
-            f"static const fdsmc_real fdsmc_vec_in[{n}][2] = {{\n"
-            f"{_rows(read[:, 1:])}\n}};\n"
+            f"static const fdsmc_real fdsmc_vec_in[{n}][2] = {{\n{_rows(i_dq)}\n}};\n"
             f"static const fdsmc_real fdsmc_vec_u[{n}][2] = {{\n{_rows(u)}\n}};\n#endif\n")
 
 
