@@ -1,0 +1,102 @@
+"""The golden vectors kill mutants of the generated C: each mutation of the controller's source must
+make the export's host test program (fdsmc_test.c) fail, in the double and the float32 build.
+
+The vectors (app/exports/c_golden.py) cover the designed move and hold, the limits acting and two
+injected faults, so a wrong gain on the sloped segment, a sign error in the q-axis current limit, an
+innovation threshold 100 times too large and a sign flip of a gain are all caught.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from app.exports.c_vectors import c_files
+from app.exports.c_verify import CFLAGS, accept_flag, compiler
+from app.io.presets import load_preset
+from sim.fdsmc.design import run_checks
+from sim.fdsmc.engine import compare
+
+PRESET = "yaskawa_sgm7j_04a"
+BUILDS = {"double": (), "float": ("-DFDSMC_USE_FLOAT",)}
+
+
+def _flip(field: str):
+    """Mutation: the sign of the design constant ``field`` (its first element for an array) flipped."""
+    def mutate(text: str) -> str:
+        out, n = re.subn(rf"(\.{field} = \{{?R_\()(-?)", lambda m: m.group(1) + ("" if m.group(2) else "-"), text)
+        assert n >= 1, field
+        return out
+    return mutate
+
+
+def _replace(old: str, new: str):
+    def mutate(text: str) -> str:
+        assert text.count(old) == 1, old
+        return text.replace(old, new)
+    return mutate
+
+
+MUTANTS = {
+    "sloped segment gain x1.5": _replace("*S = omega_hat + FDSMC_DIV(theta_re, s->t_c, s->inv_t_c);",
+                                         "*S = omega_hat + R_(1.5) * FDSMC_DIV(theta_re, s->t_c, s->inv_t_c);"),
+    "q-limit sign": _replace("(i_q1 > R_(0) ? room : -room)", "(i_q1 > R_(0) ? -room : room)"),
+    "innovation threshold x100": _replace("!below(e_abs, p->e_o_max_counts)",
+                                          "!below(e_abs, R_(100) * p->e_o_max_counts)"),
+    "NaN passes the current check": _replace("!below(i_d * i_d + i_q * i_q, p->i_fault2)",
+                                             "i_d * i_d + i_q * i_q > p->i_fault2"),
+    **{f"sign of {f}": _flip(f) for f in ("k_bl", "alpha_max", "three_inv_t_si", "three_inv_t_salpha", "l")},
+}
+
+
+@pytest.fixture(scope="module")
+def export(tmp_path_factory) -> Path:
+    """The preset's export with the test program's object compiled once per build (the vectors are large)."""
+    if compiler() is None:
+        if os.environ.get("CI") == "true":
+            pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
+        pytest.skip("no C compiler (run scripts/ensure_cc.sh)")
+    folder = tmp_path_factory.mktemp("mutants")
+    params = load_preset(PRESET)
+    cmp = compare(params)
+    for name, text in c_files(cmp, run_checks(params, cmp.fdsmc), force=True).items():
+        (folder / name).write_text(text, encoding="utf-8")
+    for build, defines in BUILDS.items():
+        _cc(folder, *defines, "-c", "fdsmc_test.c", "-o", f"test_{build}.o")
+    return folder
+
+
+def _cc(folder: Path, *args: str) -> None:
+    run = subprocess.run([compiler() or "cc", *CFLAGS, accept_flag(folder), "-O2", *args], cwd=folder,
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+
+
+def _test_program(folder: Path, build: str) -> subprocess.CompletedProcess:
+    _cc(folder, *BUILDS[build], "-c", "fdsmc_controller.c", "-o", f"ctl_{build}.o")
+    _cc(folder, f"test_{build}.o", f"ctl_{build}.o", "-lm", "-o", f"fdsmc_test_{build}")
+    return subprocess.run([f"./fdsmc_test_{build}"], cwd=folder, capture_output=True, text=True)
+
+
+def test_the_unmutated_module_passes(export):
+    for build in BUILDS:
+        run = _test_program(export, build)
+        assert run.returncode == 0, run.stdout
+        assert "limits" in run.stdout and "fault_innovation" in run.stdout
+
+
+@pytest.mark.parametrize("name", MUTANTS)
+def test_each_mutant_fails_the_golden_test_in_both_builds(export, tmp_path, name):
+    for item in export.iterdir():
+        if item.is_file():
+            shutil.copy(item, tmp_path / item.name)
+    src = tmp_path / "fdsmc_controller.c"
+    src.write_text(MUTANTS[name](src.read_text(encoding="utf-8")), encoding="utf-8")
+    for build in BUILDS:
+        run = _test_program(tmp_path, build)
+        assert run.returncode == 1, (name, build, run.stdout)
