@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from app.exports.c_arm import arm_compiler, double_symbols
 from app.exports.c_module import HEADER_NAME
 from app.exports.c_verify import (
     CFLAGS,
@@ -142,3 +143,25 @@ def _two_samples_late(lib: ctypes.CDLL, params, count: int) -> np.ndarray:
         plant.step(*shadow)
         shadow = (out.u_d, out.u_q)
     return rows
+
+
+def test_accepting_by_the_macros_own_name_is_refused(tmp_path):
+    """-DFDSMC_ACCEPT_UNCLEAN=FDSMC_PARAM_HASH does not bypass the gate: only the literal hash does."""
+    _module(tmp_path)
+    run = subprocess.run([compiler() or "cc", *CFLAGS, "-DFDSMC_ACCEPT_UNCLEAN=FDSMC_PARAM_HASH", "-c",
+                          "fdsmc_controller.c"], cwd=tmp_path, capture_output=True, text=True)
+    assert run.returncode != 0 and "does not equal" in run.stderr
+
+
+def test_float32_is_the_default_on_a_single_precision_fpu(tmp_path):
+    """Cortex-M4F without -DFDSMC_USE_FLOAT: the float build (no double helper); -DFDSMC_USE_DOUBLE opts out."""
+    if arm_compiler() is None:
+        if CI:
+            pytest.fail("arm-none-eabi-gcc missing: scripts/ensure_cc.sh installs it (CI needs it)")
+        pytest.skip("arm-none-eabi-gcc missing (run scripts/ensure_cc.sh)")
+    _module(tmp_path)
+    base = ["arm-none-eabi-gcc", "-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard", "-O2",
+            "-std=c99", accept_flag(tmp_path), "-c", "fdsmc_controller.c"]
+    subprocess.run([*base, "-o", "f.o"], cwd=tmp_path, check=True, capture_output=True)
+    subprocess.run([*base, "-DFDSMC_USE_DOUBLE", "-o", "d.o"], cwd=tmp_path, check=True, capture_output=True)
+    assert double_symbols(tmp_path / "f.o") == [] and double_symbols(tmp_path / "d.o") != []

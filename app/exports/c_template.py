@@ -70,7 +70,8 @@ $checks *
  *   FDSMC_FAULT_* bit in s.status.fault and give u_d = u_q = 0 from then on: on a fault, open the
  *   inverter (all switches off: zero torque; zero voltage would brake a spinning rotor). Log
  *   s.status (fdsmc_status); recover with fdsmc_init().
- * Build. Double by default (host); -DFDSMC_USE_FLOAT for float32 (Cortex-M4F: -mcpu=cortex-m4
+ * Build. Double by default on the host; -DFDSMC_USE_FLOAT for float32, the default on an ARM FPU
+ *   without double precision (-DFDSMC_USE_DOUBLE to build double there) (Cortex-M4F: -mcpu=cortex-m4
  *   -mfpu=fpv4-sp-d16 -mfloat-abi=hard -O2 -fno-math-errno -ffp-contract=fast: no double operation,
  *   sqrtf is one VSQRT, multiply-adds fuse to VFMA; the double build is the simulator's arithmetic).
  *   -ffast-math, -Ofast and -ffinite-math-only stop the build (#error): add -fno-finite-math-only.
@@ -99,7 +100,6 @@ extern "C" {
 /* ---- verdict gate: an unverified or not clean design does not compile unless accepted ---- */
 #define FDSMC_DRIVE_NAME $name /* the preset's name and source, for logs */
 #define FDSMC_DRIVE_SOURCE $source
-#define FDSMC_PARAM_HASH $hash_value
 #define FDSMC_PARAM_HASH_TEXT "$hash_text"
 #define FDSMC_VERIFIED $verified /* 1: the tool simulated this design */
 #define FDSMC_CLEAN $clean /* 1: the simulated FDSMC run violated none of the drive's checks */
@@ -107,9 +107,16 @@ extern "C" {
 #if !(FDSMC_VERIFIED && FDSMC_CLEAN)
 #ifndef FDSMC_ACCEPT_UNCLEAN
 #error $error_text
-#elif FDSMC_ACCEPT_UNCLEAN != FDSMC_PARAM_HASH
+#elif FDSMC_ACCEPT_UNCLEAN != $hash_value /* the literal: FDSMC_PARAM_HASH is defined only below */
 #error "FDSMC_ACCEPT_UNCLEAN does not equal this design's FDSMC_PARAM_HASH"
 #endif
+#endif
+#define FDSMC_PARAM_HASH $hash_value
+
+/* An ARM FPU without double precision (e.g. Cortex-M4F): float32 unless the double build is asked for
+ * (-DFDSMC_USE_DOUBLE: soft-float, ~40 times the instructions). */
+#if !defined(FDSMC_USE_FLOAT) && !defined(FDSMC_USE_DOUBLE) && defined(__ARM_FP) && !(__ARM_FP & 8)
+#define FDSMC_USE_FLOAT
 #endif
 
 #ifdef FDSMC_USE_FLOAT
