@@ -13,6 +13,7 @@ from app.cli.main import main
 from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
 from app.exports.model import FORMATS, export_download, export_files
 from app.exports.provenance import ExportRefusedError, failed_checks, parameter_hash
+from app.exports.stock_route import file_verdict
 from app.io.presets import load_preset
 from sim.fdsmc.design import run_checks
 
@@ -54,7 +55,7 @@ def test_clean_verdict_is_exactly_run_checks(paper_case, clean_case):
     assert failed_checks(clean_case) == []
 
 
-@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("fmt", [f for f in FORMATS if f not in DRIVE_FORMATS])
 def test_every_format_is_refused_for_a_design_that_is_not_clean(paper_case, fmt):
     with pytest.raises(ExportRefusedError, match=rf"export --format {fmt} refused: .* not clean — .*chatter: 1000 "
                                                  r"s/rad.*--force"):
@@ -63,12 +64,21 @@ def test_every_format_is_refused_for_a_design_that_is_not_clean(paper_case, fmt)
         export_download(fmt, paper_case)  # the page's path
 
 
+@pytest.mark.parametrize("fmt", DRIVE_FORMATS)
+def test_drive_files_are_refused_on_their_own_stock_route(paper_case, fmt):
+    """A drive file is gated on the route its drive runs, simulated from the file (not on the FDSMC's chatter)."""
+    with pytest.raises(ExportRefusedError, match=rf"export --format {fmt} refused: the stock route .* not clean — "
+                                                 r".*saturation: .*--force") as exc:
+        export_download(fmt, paper_case)  # the page's path
+    assert "chatter" not in str(exc.value)
+
+
 def test_cli_refuses_with_exit_2_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "p.odrive.json"
     assert main(["export", "paper_12kw_pmsm", "--format", "odrive", "-o", str(out)]) == 2
     err = capsys.readouterr().err
     # one line (≤ 300 characters: the first failed checks, the paper's torque first)
-    assert err.startswith("error: export --format odrive refused") and "torque" in err and err[-1] == "\n"
+    assert err.startswith("error: export --format odrive refused: the stock route") and err[-1] == "\n"
     assert not out.exists()
     assert main(["export", "paper_12kw_pmsm", "--format", "c", "-o", str(tmp_path / "c")]) == 2  # C too
     assert not (tmp_path / "c").exists()
@@ -82,9 +92,10 @@ def test_forced_files_carry_the_failed_checks_inside(paper_case):
     assert texts["c"].startswith("/* verdict: NOT CLEAN — written with --force")
     assert texts["csv"].startswith("# verdict: NOT CLEAN") and "\ncontroller,t [s]," in texts["csv"]
     assert '<body><div class="not-clean"><p>verdict: NOT CLEAN' in texts["html"]
-    assert "NOT CLEAN" in json.loads(texts["odrive"])["_comment"][3]
+    assert json.loads(texts["odrive"])["_comment"][3].startswith("verdict: NOT CLEAN — stock route")
     for fmt in ("moteus", "vesc", "setpoints"):  # (an XML comment cannot hold "--": VESC's reads "- -force")
-        assert "verdict: NOT CLEAN — written with " in texts[fmt] and "chatter: 1000 s/rad" in texts[fmt]
+        assert "verdict: NOT CLEAN — stock route" in texts[fmt] and "saturation: " in texts[fmt]
+        assert "FDSMC design (C module, not this file): NOT CLEAN" in texts[fmt]
 
 
 def test_clean_files_say_clean_and_carry_preset_version_hash_and_energies(clean_case):
@@ -97,8 +108,9 @@ def test_clean_files_say_clean_and_carry_preset_version_hash_and_energies(clean_
     energies = [c for c in comment if c.startswith("simulated whole-run energy")]
     assert [e.split(":")[0].rsplit(", ", 1)[1] for e in energies] == ["FDSMC", "tracked optimum",
                                                                          "stock route (this file)"]
-    stock = clean_case.stock.metrics.electrical_in_total_J
-    assert f"net electrical {stock:.5g} J" in energies[2]
+    text = export_files("odrive", clean_case)["yaskawa_sgm7j_04a.odrive.json"].decode()
+    stock = file_verdict("odrive", text, p, clean_case.derived).run.metrics.electrical_in_total_J
+    assert f"net electrical {stock:.5g} J" in energies[2]  # the route this file runs
     y = yaml.safe_load(export_files("yaml", clean_case)["yaskawa_sgm7j_04a.yaml"])
     assert y["verdicts"]["failed_checks"] == []
 

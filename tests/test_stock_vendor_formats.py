@@ -33,7 +33,8 @@ F32 = 2e-7
 ODRIVE_KEYS = {
     "axis0.motor.config.pole_pairs": "-", "axis0.motor.config.phase_resistance": "Ohm",
     "axis0.motor.config.phase_inductance": "H", "axis0.motor.config.torque_constant": "Nm/A",
-    "axis0.motor.config.current_lim": "A", "axis0.controller.config.control_mode": "-",
+    "axis0.motor.config.current_lim": "A", "axis0.motor.config.current_control_bandwidth": "rad/s",
+    "axis0.encoder.config.bandwidth": "rad/s", "axis0.controller.config.control_mode": "-",
     "axis0.controller.config.input_mode": "-", "axis0.controller.config.pos_gain": "(turn/s) / turn",
     "axis0.controller.config.vel_gain": "Nm/(turn/s)", "axis0.controller.config.vel_integrator_gain": "Nm/(turn/s * s)",
     "axis0.controller.config.vel_limit": "turn/s", "axis0.controller.config.inertia": "Nm/(turn/s^2)",
@@ -44,12 +45,13 @@ MOTEUS_KEYS = {
     "motor.poles": "-", "motor.resistance_ohm": "Ohm", "servo.max_current_A": "A", "servo.pid_position.kp": "Nm/rev",
     "servo.pid_position.ki": "Nm/s/rev", "servo.pid_position.kd": "Nm/(rev/s)", "servo.pid_position.ilimit": "Nm",
     "servo.default_velocity_limit": "rev/s", "servo.default_accel_limit": "rev/s^2",
-    "servo.inertia_feedforward": "kg*m^2", "motor_position.rotor_to_output_ratio": "-",
+    "servo.inertia_feedforward": "kg*m^2", "motor_position.rotor_to_output_ratio": "-", "servo.pid_dq.kp": "V/A",
+    "servo.pid_dq.ki": "V/A/s", "motor_position.sources.0.pll_filter_hz": "Hz", "servo.pwm_rate_hz": "Hz",
 }
 VESC_KEYS = {
     "motor_type": "-", "l_current_max": "A", "l_current_min": "A", "foc_motor_r": "Ohm", "foc_motor_l": "H",
     "foc_motor_ld_lq_diff": "H", "foc_motor_flux_linkage": "Wb", "si_motor_poles": "-", "foc_current_kp": "V/A",
-    "foc_current_ki": "V/(A*s)",
+    "foc_current_ki": "V/(A*s)", "foc_f_zv": "Hz",
 }
 
 
@@ -73,7 +75,7 @@ def test_every_key_written_is_documented_with_the_vendors_unit():
 
 
 def test_odrive_round_trip_and_units(real_case):
-    s = stock_settings(real_case)
+    s = stock_settings(real_case, "odrive")
     text = _text("odrive", real_case)
     parsed = odrive.parse_odrive(text)
     assert set(dict(parsed.values)) == set(ODRIVE_KEYS) and parsed.unknown == ()
@@ -82,10 +84,11 @@ def test_odrive_round_trip_and_units(real_case):
         assert parsed.get(key) == pytest.approx(want, rel=F32)
     p = real_case.derived.params
     assert parsed.get("axis0.trap_traj.config.accel_limit") == pytest.approx(
-        real_case.derived.alpha.alpha_max / TURN_RAD, rel=F32)  # rad/s² → turn/s²
-    g1, g2 = real_case.derived.conventional.g1, real_case.derived.conventional.g2
-    assert parsed.get("axis0.controller.config.vel_gain") == pytest.approx(g2 * p.J_total * TURN_RAD, rel=F32)
-    assert parsed.get("axis0.controller.config.pos_gain") == pytest.approx(g1 / g2, rel=F32)
+        s.tuning.accel_fraction * real_case.derived.alpha.alpha_max / TURN_RAD, rel=F32)  # rad/s² → turn/s²
+    w_v = s.tuning.omega_v  # the tuned speed loop: vel_gain = J·ω_v, pos_gain = ω_v/4 (sim.stock.tuning)
+    assert parsed.get("axis0.controller.config.vel_gain") == pytest.approx(w_v * p.J_total * TURN_RAD, rel=F32)
+    assert parsed.get("axis0.controller.config.pos_gain") == pytest.approx(w_v / 4.0, rel=F32)
+    assert parsed.get("axis0.motor.config.current_control_bandwidth") == pytest.approx(3.0 / p.controller.T_si)
     assert parsed.get("axis0.motor.config.torque_constant") == pytest.approx(1.5 * p.motor.p * p.motor.psi_pm, rel=F32)
     assert parsed.get("axis0.controller.config.input_mode") == 5  # TRAP_TRAJ
     assert parsed.get("axis0.motor.config.pole_pairs") == p.motor.p
@@ -95,22 +98,23 @@ def test_odrive_round_trip_and_units(real_case):
 
 
 def test_moteus_round_trip_and_units(real_case):
-    s = stock_settings(real_case)
+    s = stock_settings(real_case, "moteus")
     parsed = moteus.parse_moteus(_text("moteus", real_case))
     assert set(dict(parsed.values)) == set(MOTEUS_KEYS) and parsed.unknown == ()
     for key, want in moteus.moteus_values(s).items():
         assert parsed.get(key) == pytest.approx(want, rel=F32)
     p = real_case.derived.params
     assert parsed.get("motor.poles") == 2 * p.motor.p  # poles, not pole pairs
-    kp = real_case.derived.conventional.g1 * p.J_total * TURN_RAD  # N·m per revolution
+    kp = s.tuning.omega_v ** 2 / 4.0 * p.J_total * TURN_RAD  # N·m per revolution
     assert parsed.get("servo.pid_position.kp") == pytest.approx(kp, rel=F32)
-    assert parsed.get("servo.default_accel_limit") == pytest.approx(real_case.derived.alpha.alpha_max / TURN_RAD,
-                                                                    rel=F32)
+    assert parsed.get("servo.pid_position.ki") == 0.0  # no integrator for a high torque bandwidth
+    assert parsed.get("servo.default_accel_limit") == pytest.approx(
+        s.tuning.accel_fraction * real_case.derived.alpha.alpha_max / TURN_RAD, rel=F32)
     assert parsed.get("servo.inertia_feedforward") == pytest.approx(p.J_total, rel=F32)
 
 
 def test_vesc_round_trip_and_units(real_case):
-    s = stock_settings(real_case)
+    s = stock_settings(real_case, "vesc")
     parsed = vesc.parse_vesc(_text("vesc", real_case))
     assert set(dict(parsed.values)) == set(VESC_KEYS) and parsed.unknown == ()
     for key, want in vesc.vesc_values(s).items():
@@ -126,14 +130,14 @@ def test_vesc_round_trip_and_units(real_case):
 @pytest.mark.parametrize("unit", ["rad", "deg", "rev"])
 def test_setpoints_at_the_drive_cycle_in_the_users_unit(unit):
     cmp = case(load_preset("yaskawa_sgm7j_04a"), "setpoints")
-    s = stock_settings(cmp)
+    s = stock_settings(cmp, "setpoints")
     files = export_files("setpoints", cmp, ExportOptions(force=True, angle_unit=unit, cycle_s=1e-3))
     table = setpoints.parse_setpoints(next(iter(files.values())).decode())
     scale = {"rad": 1.0, "deg": 180.0 / math.pi, "rev": 1.0 / TURN_RAD}[unit]
     assert table.unit == unit and np.allclose(np.diff(table.t), 1e-3)
     assert table.t[-1] == pytest.approx(s.trapezoid.T_m) and table.omega[-1] == 0.0
     assert table.theta[-1] == pytest.approx(cmp.derived.params.manoeuvre.theta_dem * scale, rel=F32)
-    assert np.max(np.abs(table.alpha)) == pytest.approx(cmp.derived.alpha.alpha_max * scale, rel=F32)
+    assert np.max(np.abs(table.alpha)) == pytest.approx(s.trapezoid.alpha * scale, rel=F32)
     default = setpoints.parse_setpoints(_text("setpoints", cmp))  # default: the drive's 1/f_s, rad
     assert np.diff(default.t)[0] == pytest.approx(1.0 / 16000.0) and default.unit == "rad"
 

@@ -123,7 +123,7 @@ def moteus_motor(f: VendorFile) -> tuple[float, float | None, float | None, floa
 
 
 def moteus_loop(f: VendorFile, params: DriveParams) -> StockLoop:
-    """The stock route of a parsed configuration: moteus' PID, current PI and PLL at its PWM rate (SI).
+    """Return the stock route of a parsed configuration: moteus' PID, current PI and PLL at its PWM rate (SI).
 
     The torque constant is the case's (moteus calibrates Kv on the motor itself; the file leaves it
     out); the move is the trajectory from the file's limits over the case's θ_dem.

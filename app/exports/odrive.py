@@ -66,7 +66,8 @@ def odrive_values(s: StockSettings) -> dict[str, float]:
     tr, g = s.trapezoid, s.gains
     accel = rad_to_turn(tr.alpha)
     values = [s.p, s.R_s, 0.5 * (s.L_d + s.L_q), torque_constant(s.psi_pm, s.p), s.current_limit,
-              s.current_bandwidth, s.pll_bandwidth, CONTROL_MODE_POSITION_CONTROL, INPUT_MODE_TRAP_TRAJ, g.pos_gain, per_rad_to_per_turn(g.vel_gain),
+              s.current_bandwidth, s.pll_bandwidth, CONTROL_MODE_POSITION_CONTROL, INPUT_MODE_TRAP_TRAJ, g.pos_gain,
+              per_rad_to_per_turn(g.vel_gain),
               per_rad_to_per_turn(g.vel_integrator_gain), rad_to_turn(s.speed_limit), per_rad_to_per_turn(g.inertia),
               rad_to_turn(abs(tr.omega_c)), accel, accel]
     return dict(zip(KEYS, values, strict=True))
@@ -153,7 +154,7 @@ def _key(f: VendorFile, leaf: str, what: str) -> float:
 
 
 def odrive_loop(f: VendorFile, params: DriveParams) -> StockLoop:
-    """The stock route of a parsed backup: ODrive fw 0.5.x's loops at 8 kHz with the file's settings (SI).
+    """Return the stock route of a parsed backup: ODrive fw 0.5.x's loops at 8 kHz with the file's settings (SI).
 
     The move is the planner's trapezoid from the file's limits over the case's θ_dem.
 

@@ -95,7 +95,7 @@ def _energy(run: RunResult | None) -> str:
 
 
 def route_verdict_lines(route: str, failed: Sequence[Constraint], in_position_s: float | None) -> list[str]:
-    """The stock route's verdict lines: what was simulated, clean or NOT CLEAN and each failed check."""
+    """Return the stock route's verdict lines: what was simulated, clean or NOT CLEAN and each failed check."""
     where = f"{route}, simulated from this file's own numbers with the case's sensors and limits"
     settled = "never" if in_position_s is None else f"at {in_position_s:.4g} s"
     if not failed:

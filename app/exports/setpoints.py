@@ -58,7 +58,7 @@ CASCADE_KEYS = tuple(k for k in CASCADE_UNITS if k not in ("vel_limit", "accel_l
 
 
 def cascade_values(s: StockSettings) -> dict[str, float]:
-    """The loops (SI) a setpoint table carries as comment lines: cascade, PLL, rate, current loop, motor."""
+    """Return the loops (SI) a setpoint table carries as comment lines: cascade, PLL, rate, current loop, motor."""
     g, L = s.gains, 0.5 * (s.L_d + s.L_q)
     return dict(zip(CASCADE_KEYS, (g.pos_gain, g.vel_gain, g.vel_integrator_gain, g.inertia, s.pll_bandwidth,
                                    s.f_loop, s.current_bandwidth, 1.5 * s.p * s.psi_pm, s.current_limit, s.R_s, L),
@@ -114,7 +114,7 @@ def parse_setpoints(text: str) -> SetpointTable:
 
 
 def setpoints_loop(text: str) -> StockLoop:
-    """The stock route of a setpoint table: its rows (in rad) held a cycle each, run by its ``cascade.*`` loops.
+    """Return the stock route of a setpoint table: its rows (rad) interpolated, run by its ``cascade.*`` loops.
 
     Raises
     ------
@@ -124,7 +124,8 @@ def setpoints_loop(text: str) -> StockLoop:
     table = parse_setpoints(text)
     c = parse_cascade((ln.lstrip("#").strip() for ln in text.splitlines() if ln.startswith("#")), CASCADE_KEYS)
     dt = float(table.t[1] - table.t[0]) if table.t.size > 1 else 1.0 / c["loop_rate"]
-    if table.t[0] != 0.0 or not np.allclose(np.diff(table.t), dt, rtol=1e-6, atol=0.0):
+    k = np.arange(table.t.size)
+    if not (dt > 0.0 and np.allclose(table.t, k * dt, rtol=1e-8, atol=1e-6 * dt)):  # 9-digit times
         raise ParameterError("setpoint times are not allowed: equally spaced rows from t = 0 s (one per cycle)")
     to_rad = 1.0 / rad_to_angle_unit(1.0, table.unit)
     rows = np.ascontiguousarray(np.vstack((table.theta, table.omega, table.alpha)) * to_rad)

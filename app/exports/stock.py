@@ -69,7 +69,7 @@ class StockSettings:
 
 
 def loop_gains(loop: StockLoop) -> CascadeGains:
-    """The loop's gains in both forms: the cascade's (pos_gain, vel_gain, k_i) and the parallel PID's."""
+    """Return the loop's gains in both forms: the cascade's (pos_gain, vel_gain, k_i) and the parallel PID's."""
     if loop.law == "pid":
         return CascadeGains(loop.kp / loop.kd, loop.kd, 0.0, loop.J_ff, loop.kp, loop.kd, loop.ki)
     return CascadeGains(loop.kp, loop.kd, loop.ki, loop.J_ff, loop.kp * loop.kd, loop.kd, loop.kp * loop.ki)

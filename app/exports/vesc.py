@@ -65,7 +65,7 @@ CASCADE_KEYS = ("pos_gain", "vel_gain", "vel_integrator_gain", "inertia", "pll_b
 
 
 def cascade_values(s: StockSettings) -> dict[str, float]:
-    """The stock route's cascade and trapezoid (SI) that a VESC file carries as comment lines."""
+    """Return the stock route's cascade and trapezoid (SI) that a VESC file carries as comment lines."""
     g = s.gains
     return dict(zip(CASCADE_KEYS, (g.pos_gain, g.vel_gain, g.vel_integrator_gain, g.inertia, s.pll_bandwidth,
                                    abs(s.trapezoid.omega_c), s.trapezoid.alpha), strict=True))
@@ -75,8 +75,8 @@ def vesc_xml(s: StockSettings, header: list[str]) -> str:
     """Return the mcconf XML: declaration, the header as an XML comment, ``<MCConfiguration>`` with the motor part."""
     note = header + ["VESC: motor part (VESC has no position trajectory planner); load it in VESC Tool "
                      "(Motor Settings, Load XML) or with vesc_tool's setMcConf option, see docs/drives/vesc.md",
-                     "the move's trapezoid and the position/speed cascade a VESC app or the host runs each current-loop "
-                     "cycle (SI units):"] + cascade_lines(cascade_values(s))
+                     "the move's trapezoid and the position/speed cascade a VESC app or the host runs each "
+                     "current-loop cycle (SI units):"] + cascade_lines(cascade_values(s))
     body = "\n".join(f"    {escape(line).replace('--', '- -')}" for line in note)
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', f"<!--\n{body}\n-->", f"<{ROOT}>",
              f"    <{VERSION_TAG}>{CONFIG_VERSION}</{VERSION_TAG}>"]
@@ -138,7 +138,7 @@ def vesc_motor(f: VendorFile) -> tuple[float, float, float, float, int, float]:
 
 
 def vesc_loop(f: VendorFile, params: DriveParams) -> StockLoop:
-    """The stock route of a parsed mcconf: VESC's current PI once per switching period, fed by the file's cascade.
+    """Return the stock route of a parsed mcconf: VESC's current PI each switching period, the file's cascade.
 
     Raises
     ------

@@ -1,24 +1,17 @@
-"""The same move for a stock drive: a symmetric trapezoid and the comparator's gains as a P–PI cascade.
+"""The same move for a stock drive: a symmetric trapezoid, from its timing or from a planner's limits.
 
 A stock drive (ODrive, moteus, an industrial servo) plans a trapezoidal speed profile and tracks it
-with a cascaded position (P) / speed (PI) loop. This module gives both for the manoeuvre of [1]:
+with its own loops (:mod:`control.stock.loops`). This module gives the trapezoid:
 
-* the symmetric trapezoid at the designed acceleration α whose cruise ends the move at T_m
+* the symmetric trapezoid at acceleration α whose cruise ends the move at T_m
   (:func:`trapezoid_timing`, :func:`trapezoid_samples`):
 
       T_a = (T_m − √(T_m² − 4·|Δθ|/α)) / 2,   ω_c = α·T_a,   |Δθ| = ω_c·(T_m − T_a);
 
+* the move a drive's planner makes from its speed and acceleration limits (:func:`trapezoid_from_limits`);
 * its ideal-tracking friction integral ∫ω² dt = ω_c²·(T_m − 4·T_a/3) (:func:`trapezoid_omega_square_integral`);
-* the comparator's gains g1, g2 of eq. (61) in [1] as a P–PI cascade (:func:`cascade_gains`):
-  pos_gain = g1/g2 [1/s], vel_gain = g2·J [N·m·s/rad]. Without the speed integrator the cascade
-  with inertia feed-forward J·α_ref is exactly the tracking law α_ref + g1·(θ_ref − θ) + g2·(ω_ref − ω)
-  (:func:`control.fdsmc.conventional.tracking_demand`), which the simulator runs as the "stock" comparator.
-
-The speed integrator is a documented choice, not part of eq. (61): its zero is placed at
-``INTEGRATOR_ZERO_FRACTION`` of the double pole a = g2/2, a decade below the position loop, so that
-it removes a steady load torque slowly without changing the move (it is not simulated).
-
-[1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
+* :class:`CascadeGains`, a P–PI position/speed cascade with inertia feed-forward and the parallel PID
+  of the same law, the form the drive files carry.
 """
 
 from __future__ import annotations
@@ -29,11 +22,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.common.checks import ParameterError
-
-#: Integrator zero of the stock speed PI as a fraction of the comparator's double pole a = g2/2 [-].
-INTEGRATOR_ZERO_FRACTION = 0.1
-#: Nodes of the reference the simulator tracks (equally spaced over [0, T_m]) [-].
-REFERENCE_NODES = 4001
 
 
 @dataclass(frozen=True)
@@ -115,28 +103,9 @@ def trapezoid_samples(tr: TrapezoidTiming, t: np.ndarray) -> tuple[np.ndarray, n
     return theta, omega, alpha
 
 
-def trapezoid_reference(tr: TrapezoidTiming, n: int = REFERENCE_NODES) -> np.ndarray:
-    """Return the 3 × n rows (θ_ref, ω_ref, α_ref) on equal nodes over [0, T_m] (the simulator's reference)."""
-    return np.vstack(trapezoid_samples(tr, np.linspace(0.0, tr.T_m, int(n))))
-
-
 def trapezoid_omega_square_integral(tr: TrapezoidTiming) -> float:
     """∫ω² dt over the move [rad²/s]: ω_c²·(T_m − 4·T_a/3) (ideal tracking; friction = F_v times this)."""
     return tr.omega_c ** 2 * (tr.T_m - 4.0 * tr.T_a / 3.0)
-
-
-def cascade_gains(g1: float, g2: float, J: float) -> CascadeGains:
-    """Return the comparator's gains of eq. (61) in [1] as a P–PI cascade for inertia ``J`` [kg·m²].
-
-    pos_gain = g1/g2 [1/s], vel_gain = g2·J [N·m·s/rad], inertia feed-forward J; the speed
-    integrator's zero at ``INTEGRATOR_ZERO_FRACTION``·g2/2: vel_integrator_gain = vel_gain·zero
-    [N·m/rad]. The parallel PID of the same law: kp = g1·J, kd = g2·J, ki = kp·zero.
-    """
-    if not (g1 > 0.0 and g2 > 0.0 and J > 0.0):
-        raise ParameterError(f"cascade gains need g1, g2, J > 0: got g1 = {g1!r}, g2 = {g2!r}, J = {J!r}")
-    zero = INTEGRATOR_ZERO_FRACTION * 0.5 * g2
-    vel_gain, kp = g2 * J, g1 * J
-    return CascadeGains(g1 / g2, vel_gain, vel_gain * zero, J, kp, vel_gain, kp * zero)
 
 
 def trapezoid_from_limits(delta_theta: float, v_max: float, a_max: float) -> TrapezoidTiming:

@@ -62,9 +62,9 @@ CONTROLLERS = ("fdsmc", "conventional")
 COMPARATORS = CONTROLLERS + ("optimum", "stock")
 #: The name each simulated outer loop goes by in messages, tables and figures.
 LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum", "stock": "Stock trapezoid"}
-#: The kernel's outer law (P_CTRL) of each comparator: the stock drive (a trapezoid tracked by the
-#: P–PI cascade without its integrator, :mod:`control.fdsmc.trapezoid`) is the reference-tracking law.
-KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "stock": 2.0, "optimum": 3.0}
+#: The kernel's outer law (P_CTRL) of each comparator on the FDC inner loops; the stock drive runs its own
+#: loops instead (P_CTRL = 4, :mod:`sim.stock.route`).
+KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 3.0}
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.
@@ -193,12 +193,7 @@ def _observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _reference(d: Derived, controller: str) -> np.ndarray:
-    """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum or trapezoid, else zeros."""
-    if controller == "stock":
-        from control.fdsmc.trapezoid import trapezoid_reference, trapezoid_timing
-
-        tr = trapezoid_timing(d.params.manoeuvre.theta_dem, d.alpha.alpha_max, d.params.manoeuvre.T_m)
-        return np.ascontiguousarray(trapezoid_reference(tr))
+    """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum's, else zeros."""
     if controller != "optimum":
         return np.zeros((3, 2))
     from control.fdsmc.optimum import tracked_move  # imports cvxpy only when limits are active

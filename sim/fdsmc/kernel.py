@@ -16,11 +16,11 @@ agree. Formulas (see [1], the FDSMC paper):
   ZOH-exact prediction form x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·e_o[k];
 * outer loop: eqs. (41)–(46) (FDSMC), eq. (62) sign-corrected (conventional), or tracking of a
   reference move (θ_ref, ω_ref, α_ref) by α_ref fed forward plus gains on the tracking error — the
-  stock cascade's trapezoid (``P_CTRL`` = 2), or the minimum-energy optimum ending on the FDSMC's
-  terminal slide (``P_CTRL`` = 3, :mod:`control.fdsmc.terminal_slide`);
+  minimum-energy optimum ending on the FDSMC's terminal slide (``P_CTRL`` = 3,
+  :mod:`control.fdsmc.terminal_slide`);
 * or, instead of all of the above but the plant and sensors, a stock drive's own loops (``P_CTRL`` = 4,
-  :mod:`control.stock.loops`): encoder PLL, position/speed law on a setpoint table held between its
-  rows, dq current PI;
+  :mod:`control.stock.loops`): encoder PLL, position/speed law on a setpoint table interpolated between
+  its rows, dq current PI;
 * the FDC's u_q corrected by the q-axis voltage-mismatch estimate where ``P_BDV`` > 0 (not in [1],
   :func:`control.fdsmc.fdc.voltage_mismatch`);
 * energies as extra states of the same RK4 integration, so that the balance closes.
@@ -131,15 +131,12 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
               ref: np.ndarray) -> tuple[float, float]:
     """Return the outer loop's demanded acceleration [rad/s²] and S [rad/s].
 
-    Eqs. (44)–(46), (62), the reference tracking law :func:`control.fdsmc.conventional.tracking_demand`
-    (``P_CTRL`` = 2) or the tracked optimum's :func:`control.fdsmc.terminal_slide.slide_in_demand`
+    Eqs. (44)–(46), (62) or the tracked optimum's :func:`control.fdsmc.terminal_slide.slide_in_demand`
     (``P_CTRL`` = 3), all of :mod:`control`.
     """
-    if prm[P_CTRL] >= 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
+    if prm[P_CTRL] == 3.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
         th_r, w_r, _ = reference_at(t, ref, prm[P_TM])
         a_r = reference_at(t + prm[P_LEAD], ref, prm[P_TM])[2]
-        if prm[P_CTRL] == 2.0:
-            return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
         return terminal_slide.slide_in_demand(th_r, w_r, a_r, ref[0, 0], theta_hat, omega_hat, prm[P_G1], prm[P_G2],
                                               prm[P_THDEM], prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
     if prm[P_CTRL] == 1.0:
@@ -338,12 +335,19 @@ def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: b
 
 @inlined
 def table_at(t: float, ref: np.ndarray, dt: float) -> tuple[float, float, float]:
-    """Return the setpoint table's row (θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²]) in force at t [s].
+    """Return the setpoint table at t [s]: θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²].
 
-    The rows are k·dt apart from t = 0; each holds until the next (the last one ever after).
+    The rows are k·dt apart from t = 0; between two rows each value is interpolated linearly (a drive's
+    interpolated position mode, CiA 402), after the last row the last row holds.
     """
-    j = min(int(t / dt + 1e-9), ref.shape[1] - 1)
-    return ref[0, j], ref[1, j], ref[2, j]
+    x = t / dt + 1e-9
+    j = int(x)
+    n = ref.shape[1]
+    if j >= n - 1:
+        return ref[0, n - 1], ref[1, n - 1], ref[2, n - 1]
+    f = min(x - j, 1.0)
+    return (ref[0, j] + f * (ref[0, j + 1] - ref[0, j]), ref[1, j] + f * (ref[1, j + 1] - ref[1, j]),
+            ref[2, j] + f * (ref[2, j + 1] - ref[2, j]))
 
 
 @inlined

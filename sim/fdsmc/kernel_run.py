@@ -125,8 +125,9 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
                k_win: np.ndarray, win: np.ndarray, ref: np.ndarray, noise: np.ndarray) -> None:
     """Integrate one run from rest; fills ``out`` (N_CH × samples) and ``info`` (I_* indices).
 
-    ``ref`` (3 × n: θ_ref, ω_ref, α_ref on equally spaced nodes over [0, T_m]) is read only by the
-    reference-tracking outer laws (``prm[P_CTRL]`` = 2, 3); pass a 3 × 2 array of zeros otherwise.
+    ``ref`` (3 × n: θ_ref, ω_ref, α_ref) is read only by the tracked optimum (``prm[P_CTRL]`` = 3: equally
+    spaced nodes over [0, T_m]) and a stock drive's own loops (= 4: its setpoint table, one row per
+    ``prm[P_DREFDT]``); pass a 3 × 2 array of zeros otherwise.
 
     For each window j, rows WIN_ROWS·j … WIN_ROWS·j + 3 of ``win`` receive α_dem, ω_r, i_q and the
     applied u_q of every step k_win[j] … k_win[j] + n − 1 at full resolution (the chatter and

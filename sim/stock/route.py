@@ -58,7 +58,7 @@ class StockLoop:
     current_kp : float     Current PI proportional gain [V/A].
     current_ki : float     Current PI integral gain [V/(A·s)].
     table : numpy.ndarray  Setpoints, 3 × n: θ_ref [rad], ω_ref [rad/s], α_ref [rad/s²] …
-    table_dt : float       … one row per table_dt [s] from t = 0, each held until the next.
+    table_dt : float       … one row per table_dt [s] from t = 0, interpolated linearly between rows.
     """
 
     drive: str
@@ -80,6 +80,7 @@ class StockLoop:
     table_dt: float = 1e-3
 
     def __post_init__(self) -> None:
+        """Refuse a law or a setting outside its range, naming it."""
         if self.law not in LAWS:
             raise ParameterError(f"stock law = {self.law!r} is not allowed: one of {', '.join(LAWS)}")
         for name in ("f_loop", "K_t", "current_limit", "omega_e", "current_kp", "table_dt"):
@@ -131,7 +132,7 @@ def simulate_stock(params: DriveParams, loop: StockLoop, derived: Derived | None
     d = derive(params) if derived is None else derived
     g = time_grid(p, 1, 0.0, 20000)
     T_step = g.h * g.n_sub
-    prm = pack_parameters(params, d, "stock", plant, T_step)
+    prm = pack_parameters(params, d, "fdsmc", plant, T_step)  # the plant, sensors and limits
     V_dc = params.controller.V_dc  # 0: no voltage limit
     pack_loop(prm, loop, V_dc / math.sqrt(3.0) if V_dc > 0.0 else math.inf, params.sensors.encoder_step)
     step_t, step_v = load_steps(params if plant is None else plant)
@@ -147,7 +148,7 @@ def simulate_stock(params: DriveParams, loop: StockLoop, derived: Derived | None
 
 
 def _result(params, d, out, info, windows, steps, win, plant, T_step) -> RunResult:
-    """The run's trace and metrics from the kernel's buffers (as :func:`sim.fdsmc.engine.simulate`)."""
+    """Return the run's trace and metrics from the kernel's buffers (as :func:`sim.fdsmc.engine.simulate`)."""
     from sim.fdsmc.engine import _trace
 
     summary = decode_info(info)

@@ -121,7 +121,7 @@ class StockTuning:
 
 
 def loop_rate(spec: DriveSpec, params: DriveParams) -> float:
-    """The drive's cycle rate [Hz] (the case's f_s for a setpoint-table drive; 1 kHz if continuous)."""
+    """Return the drive's cycle rate [Hz] (the case's f_s for a setpoint-table drive; 1 kHz if continuous)."""
     if spec.f_loop is not None:
         return spec.f_loop
     f_s = params.controller.f_s
@@ -129,7 +129,7 @@ def loop_rate(spec: DriveSpec, params: DriveParams) -> float:
 
 
 def setpoint_table(tr: TrapezoidTiming, dt: float) -> np.ndarray:
-    """The trapezoid sampled every ``dt`` [s] from 0 to just past T_m: 3 × n rows θ, ω, α (SI)."""
+    """Return the trapezoid sampled every ``dt`` [s] from 0 to just past T_m: 3 × n rows θ, ω, α (SI)."""
     n = int(math.ceil(tr.T_m / dt - 1e-9)) + 2
     return np.ascontiguousarray(np.vstack(trapezoid_samples(tr, np.arange(n) * dt)))
 
@@ -163,7 +163,7 @@ def with_load_inertia(params: DriveParams, factor: float) -> DriveParams:
 
 
 def robust(params: DriveParams, loop: StockLoop, d: Derived) -> bool:
-    """True when the route stays stable, within limits and settles with J_L at every ROBUST_J_L factor."""
+    """Return True when the route stays stable, within limits and settles with J_L at every ROBUST_J_L factor."""
     for factor in ROBUST_J_L:
         run = simulate_stock(params, loop, d, plant=with_load_inertia(params, factor))
         if any(c.name not in ROBUST_EXEMPT for c in run_checks(params, run)):
@@ -172,7 +172,7 @@ def robust(params: DriveParams, loop: StockLoop, d: Derived) -> bool:
 
 
 def trapezoids(params: DriveParams, d: Derived) -> list[tuple[float, TrapezoidTiming]]:
-    """The feasible planner moves (α fraction, trapezoid) within the speed limit, fastest α first."""
+    """Return the feasible planner moves (α fraction, trapezoid) within the speed limit, fastest α first."""
     out = []
     for frac in ACCEL_FRACTIONS:
         disc = params.manoeuvre.T_m ** 2 - 4.0 * abs(params.manoeuvre.theta_dem) / (frac * d.alpha.alpha_max)
