@@ -12,6 +12,7 @@ from app.io.derived_view import derived_json
 from app.io.json_data import to_json
 from app.io.numbers import format_metric
 from app.io.plant_overrides import load_model_and_plant
+from app.io.stock_view import stock_json, stock_lines
 from control.common.checks import ParameterError
 from sim.fdsmc.engine import COMPARATORS, LABELS, Comparison, compare
 from sim.fdsmc.optimum_gap import saving_vs_optimum
@@ -79,6 +80,8 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["run_warnings"] = run_warnings(cmp)
     out["comparator_notes"] = comparator_notes(cmp)
+    if cmp.stock is not None:
+        out["stock"].update(stock_json(cmp))
     return to_json(out)
 
 
@@ -117,6 +120,8 @@ def print_summary(cmp: Comparison) -> None:
         if run is not None and gap is not None:
             print(f"The tracked minimum-energy optimum would save {gap:.2f} % of the {run.controller}'s "
                   "net electrical input (whole run)")
+    if cmp.stock is not None:
+        print("\n" + "\n".join(stock_lines(cmp)))
     for w in run_warnings(cmp) + list(cmp.derived.warnings) + comparator_notes(cmp):
         print(f"  ! {w}")
 

@@ -44,7 +44,7 @@ OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")
 
 
 def comparison_or_derived(params: DriveParams, optimum: bool = False, plant_J_L: float | None = None) -> Comparison:
-    """Simulate both controllers (and the tracked optimum if ``optimum``) on a plant with ``plant_J_L`` [kg·m²].
+    """Simulate both controllers, the stock route (and the tracked optimum if ``optimum``) on ``plant_J_L`` [kg·m²].
 
     The controllers' model stays ``params`` (``plant_J_L`` None: the plant is the model). For an
     infeasible case, return the derivations alone (no runs).
@@ -53,7 +53,7 @@ def comparison_or_derived(params: DriveParams, optimum: bool = False, plant_J_L:
     if not d.profile.feasible:
         return Comparison(d, None, None, None, None)
     plant = None if plant_J_L is None else with_plant_J_L(params, plant_J_L)
-    return compare(params, COMPARATORS if optimum else CONTROLLERS, derived=d, plant=plant)
+    return compare(params, COMPARATORS if optimum else CONTROLLERS + ("stock",), derived=d, plant=plant)
 
 
 class PositionTab:

@@ -18,6 +18,7 @@ import viser
 from app.figures.fdsmc_comparison import runs
 from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
 from app.figures.plain import figure_json
+from app.figures.stock_route import stock_route_spec
 from app.io.numbers import parse_T_m_list
 from app.ui.layout import PanelLayout
 from app.ui.paper_text import errata_html, table1_html
@@ -25,12 +26,12 @@ from app.ui.props import assign
 from app.ui.replay import Replay, overview_json, time_plots_json
 from app.ui.savings import annual_savings, savings_markdown
 from app.ui.scene import RotorScene
-from app.ui.text import key_numbers_html
+from app.ui.text import key_numbers_html, stock_html
 from app.ui.viser_adapter import add_figure, set_figure_json
 from sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M
 
 #: Plot height / width per figure [-].
-ASPECT_PHASE, ASPECT_TIME, ASPECT_SMALL = 0.72, 1.45, 0.55
+ASPECT_PHASE, ASPECT_TIME, ASPECT_SMALL, ASPECT_STOCK = 0.72, 1.45, 0.55, 0.95
 
 
 @functools.cache
@@ -75,6 +76,10 @@ class ResultsPanel:
             self.bars = add_figure(gui, figure_json(energy_bars_spec(comparison)) if simulated else None,
                                    ASPECT_SMALL)
             self._build_savings(gui)
+        with self.panel.add_tab("Stock drive", viser.Icon.ROUTE):
+            self.stock_text = gui.add_html(stock_html(comparison) if simulated else "")
+            self.stock = add_figure(gui, figure_json(stock_route_spec(comparison)) if simulated else None,
+                                    ASPECT_STOCK)
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
             self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
@@ -128,6 +133,8 @@ class ResultsPanel:
         self._rest_pending = False
         set_figure_json(self.energy, figure_json(energy_spec(comparison)))
         set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))
+        assign(self.stock_text, content=stock_html(comparison))
+        set_figure_json(self.stock, figure_json(stock_route_spec(comparison)))
         self._update_savings()
 
     def show_derived_only(self, comparison: Any) -> None:

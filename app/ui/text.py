@@ -185,3 +185,18 @@ def stale_results_html(dd: Any) -> str:
 
 __all__ = ["derived_markdown", "design_failure_items", "design_markdown", "html_text", "key_numbers_html", "md_text",
            "stale_results_html", "warnings_html"]
+
+
+def stock_html(comparison: Any) -> str:
+    """The stock routes' verdicts, one line per drive (ODrive, moteus, VESC, setpoint table), green or red."""
+    from app.io.stock_view import stock_lines  # tunes the vendor routes (cached per case)
+
+    if getattr(comparison, "stock", None) is None:
+        return "<p>Stock route: not simulated for this case.</p>"
+    items = []
+    for line in stock_lines(comparison):
+        colour = GOOD_COLOUR if ": CLEAN," in line else BAD_COLOUR
+        items.append(f'<li style="color:{colour}">{html_text(line)}</li>')
+    return ('<div class="stock-verdicts" style="font-size:14px"><p>Each drive file runs its own loops, '
+            "tuned and simulated with this case's sensors, limits and pass criteria; the export gate uses "
+            "that verdict.</p><ul>" + "".join(items) + "</ul></div>")
