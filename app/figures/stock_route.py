@@ -54,7 +54,7 @@ def stock_title(comparison: Comparison) -> tuple[str, bool]:
 
 
 def stock_route_spec(comparison: Comparison) -> dict[str, Any]:
-    """The stock route's figure as a plain dict (see the module doc); an empty figure without a stock run."""
+    """Return the stock route's figure as a plain dict (see the module doc); only the FDSMC without a stock run."""
     p = comparison.derived.params
     title, clean = stock_title(comparison)
     data: list[dict[str, Any]] = []

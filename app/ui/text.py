@@ -188,7 +188,7 @@ __all__ = ["derived_markdown", "design_failure_items", "design_markdown", "html_
 
 
 def stock_html(comparison: Any) -> str:
-    """The stock routes' verdicts, one line per drive (ODrive, moteus, VESC, setpoint table), green or red."""
+    """Return the stock routes' verdicts, one line per drive (ODrive, moteus, VESC, setpoint table), green or red."""
     from app.io.stock_view import stock_lines  # tunes the vendor routes (cached per case)
 
     if getattr(comparison, "stock", None) is None:
