@@ -18,6 +18,7 @@ from app.exports.odrive import odrive_motor, parse_odrive
 from app.exports.vendor_keys import VendorFile
 from app.exports.vesc import parse_vesc, vesc_motor
 from app.io.units import spec_of
+from app.io.user_text import escaped
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 
@@ -51,7 +52,8 @@ class DriveImport:
     params : DriveParams       The base preset with the file's motor data.
     imported : tuple of str    ``field = value (from vendor key)`` for each imported value (SI).
     kept : tuple of str        Preset fields the file does not give (kept from the base).
-    not_imported : tuple of str  Every key of the file that was not imported.
+    not_imported : tuple of str  Every key of the file that was not imported, escaped
+        (:func:`app.io.user_text.escaped`: a key never carries a line break or a control character).
     """
 
     params: DriveParams
@@ -106,5 +108,5 @@ def import_drive(text: str, fmt: str, base: DriveParams, origin: str = "<drive f
     used = {SOURCES[fmt][k][0] for k in given} | set(ALSO_USED.get(fmt, ()))
     imported = tuple(f"{k} = {v!r} (from {SOURCES[fmt][k][0]})" for k, v in given.items())
     kept = tuple(f"{k} (not in the file; {SOURCES[fmt][k][0]} absent)" for k in values if k not in given)
-    not_imported = tuple(k for k, _ in f.values if k not in used) + f.unknown
+    not_imported = tuple(escaped(k) for k in tuple(k for k, _ in f.values if k not in used) + f.unknown)
     return DriveImport(params, imported, kept, not_imported)

@@ -32,6 +32,7 @@ from app.exports.drive_units import (
 )
 from app.exports.stock import StockSettings
 from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from app.io.user_text import escaped
 from control.common.checks import ParameterError
 from control.fdsmc.model import torque_constant
 from control.fdsmc.params import DriveParams
@@ -79,8 +80,12 @@ def moteus_values(s: StockSettings) -> dict[str, float]:
 
 
 def moteus_text(s: StockSettings, header: list[str]) -> str:
-    """Return the configuration text: ``# `` header lines, then one ``key value`` per line."""
-    lines = [f"# {h}" for h in header]
+    """Return the configuration text: ``# `` header lines, then one ``key value`` per line.
+
+    Every header line is escaped (:func:`app.io.user_text.escaped`): no line break of any kind, so a
+    name or source can never add a ``key value`` line.
+    """
+    lines = [f"# {escaped(h)}" for h in header]
     lines.append("# moteus: grep -v '^#' THIS_FILE > restore.cfg && moteus_tool -t 1 --restore-config restore.cfg")
     for key, v in moteus_values(s).items():
         lines.append(f"{key} {int(v) if KEYS[key].kind != 'float' else fmt_float(v)}")

@@ -28,6 +28,7 @@ from app.exports.drive_units import (
 )
 from app.exports.stock import StockSettings
 from app.exports.vendor_keys import VendorFile, VendorKey, vendor_file
+from app.io.user_text import escaped
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 from control.fdsmc.trapezoid import trapezoid_from_limits
@@ -85,19 +86,30 @@ def _nest(flat: dict[str, Any]) -> dict[str, Any]:
 
 
 def odrive_json(s: StockSettings, header: list[str]) -> str:
-    """Return the backup JSON (``_comment`` first, then the ``axis0`` tree), floats to 9 significant digits."""
+    """Return the backup JSON (``_comment`` first, then the ``axis0`` tree), floats to 9 significant digits.
+
+    The keys are this module's constants; the header lines are escaped (:func:`app.io.user_text.escaped`).
+    """
     flat = {k: (int(v) if KEYS[k].kind != "float" else float(f"{v:.9g}")) for k, v in odrive_values(s).items()}
-    data = {"_comment": header + ["ODrive fw 0.5.x: odrivetool restore-config THIS_FILE (units: turn, turn/s, "
-                                  "turn/s², N·m; the motor must still be calibrated)"]}
+    note = ("ODrive fw 0.5.x: odrivetool restore-config THIS_FILE (units: turn, turn/s, turn/s², N·m; the motor "
+            "must still be calibrated)")
+    data = {"_comment": [escaped(h) for h in header] + [note]}
     data.update(_nest(flat))
     return json.dumps(data, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
 
 
-def _leaves(node: Any, prefix: str = "") -> list[tuple[str, Any]]:
+#: Deepest nesting of an ODrive backup read [levels] (odrivetool writes ≈ 5).
+MAX_DEPTH = 32
+
+
+def _leaves(node: Any, prefix: str = "", depth: int = 0) -> list[tuple[str, Any]]:
+    if depth > MAX_DEPTH:
+        raise ParameterError(f"ODrive JSON {escaped(prefix)[:80]!r} is nested deeper than {MAX_DEPTH} levels: "
+                             f"allowed ≤ {MAX_DEPTH}")
     if isinstance(node, dict):
         out: list[tuple[str, Any]] = []
         for k, v in node.items():
-            out += _leaves(v, f"{prefix}.{k}" if prefix else str(k))
+            out += _leaves(v, f"{prefix}.{k}" if prefix else str(k), depth + 1)
         return out
     return [(prefix, node)]
 
@@ -125,6 +137,8 @@ def parse_odrive(text: str, origin: str = "<odrive>") -> VendorFile:
         data = json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=lambda c: float(c))
     except json.JSONDecodeError as exc:
         raise ParameterError(f"{origin} is not valid JSON at line {exc.lineno}: {exc.msg}") from None
+    except RecursionError:
+        raise ParameterError(f"{origin} is nested too deeply: allowed ≤ {MAX_DEPTH} levels") from None
     if not isinstance(data, dict) or "axis0" not in data:
         raise ParameterError(f"{origin} is not an ODrive backup: allowed a JSON object with an 'axis0' object")
     comment = data.pop("_comment", [])

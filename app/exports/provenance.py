@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from app.exports.c_module import TOOL
 from app.io.json_data import to_json
 from app.io.presets import to_raw
+from app.io.user_text import escaped
 from control.common.checks import ParameterError
 from sim.fdsmc.design import Constraint, run_checks
 from sim.fdsmc.engine import Comparison, RunResult
@@ -112,7 +113,7 @@ def header_lines(cmp: Comparison, failed: Sequence[Constraint], route: tuple[str
     the file's own verdict; None while the file is being drafted. ``failed`` are the FDSMC design's.
     """
     p = cmp.derived.params
-    lines = [f"preset: {p.name} — {p.source}", f"written by: {tool_version()}",
+    lines = [f"preset: {escaped(p.name)} — {escaped(p.source)}", f"written by: {tool_version()}",
              f"parameter hash: {parameter_hash(p)} (SHA-256 of the inputs' canonical JSON)"]
     if route is not None:
         run = route[1]

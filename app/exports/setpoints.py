@@ -18,6 +18,7 @@ import numpy as np
 from app.exports.drive_units import ANGLE_UNITS, rad_to_angle_unit
 from app.exports.stock import StockSettings
 from app.exports.stock_lines import CASCADE_UNITS, cascade_lines, parse_cascade
+from app.io.user_text import csv_comment
 from control.common.checks import ParameterError
 from control.fdsmc.trapezoid import trapezoid_samples
 from sim.stock.route import StockLoop
@@ -66,7 +67,11 @@ def cascade_values(s: StockSettings) -> dict[str, float]:
 
 
 def setpoints_csv(s: StockSettings, header: list[str], unit: str = "rad", cycle_s: float | None = None) -> str:
-    """Return the setpoint table of the stock trapezoid (see the module doc)."""
+    """Return the setpoint table of the stock trapezoid (see the module doc).
+
+    The ``#`` lines go through :func:`app.io.user_text.csv_comment`: no added row, no cell a
+    spreadsheet reads as a formula.
+    """
     if unit not in ANGLE_UNITS:
         raise ParameterError(f"angle unit = {unit!r} is not allowed: one of {', '.join(ANGLE_UNITS)}")
     cycle = s.cycle_s if cycle_s is None else cycle_s
@@ -77,7 +82,7 @@ def setpoints_csv(s: StockSettings, header: list[str], unit: str = "rad", cycle_
              "trapezoid's jerk is unbounded)", "the drive's position/speed cascade and current loop this table was "
              "verified with (SI units):"] + cascade_lines(cascade_values(s))
     for line in header + notes:
-        out.write(f"# {line}\n")
+        out.write(f"# {csv_comment(line)}\n")
     out.write(",".join(columns(unit)) + "\n")
     np.savetxt(out, np.column_stack((t, theta, omega, alpha)), fmt="%.9g", delimiter=",")
     return out.getvalue()

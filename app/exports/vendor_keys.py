@@ -12,6 +12,7 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from app.io.numbers import NumberFormatError, parse_number
 from control.common.checks import ParameterError
 
 #: Value kinds of a vendor key.
@@ -58,15 +59,29 @@ class VendorFile:
         return v
 
 
+def _from_text(vk: VendorKey, raw: str, allowed: str) -> float:
+    """Parse a vendor file's text value with the one number grammar (:func:`app.io.numbers.parse_number`)."""
+    if raw.strip().lower() == "nan":
+        return math.nan  # allowed only where the vendor documents it as "not set" (checked by the caller)
+    try:
+        return parse_number(raw, vk.key)
+    except NumberFormatError as exc:
+        if "underflows" in str(exc):
+            raise ParameterError(str(exc)) from None
+        raise ParameterError(f"{vk.key} = {raw[:80]!r} is not allowed: {allowed} (ASCII digits, decimal or "
+                             "scientific notation)") from None
+
+
 def typed_value(vk: VendorKey, raw: object) -> float:
-    """Check a raw value against its key's kind; ParameterError naming the key, the value and what is allowed."""
+    """Check a raw value against its key's kind; ParameterError naming the key, the value and what is allowed.
+
+    Text goes through the one number grammar (ASCII digits; ``1_0``, full-width or Arabic-Indic
+    digits are refused); ``nan`` only for a key whose vendor documents it as "not set".
+    """
     allowed = {"float": f"a finite number in {vk.unit}", "int": "an integer",
                "enum": "an integer code"}[vk.kind]
     if isinstance(raw, str):
-        try:
-            raw = int(raw) if vk.kind != "float" else float(raw)
-        except ValueError:
-            raise ParameterError(f"{vk.key} = {raw!r} is not allowed: {allowed}") from None
+        raw = _from_text(vk, raw, allowed)
     if isinstance(raw, bool) or not isinstance(raw, int | float):
         raise ParameterError(f"{vk.key} = {raw!r} is not allowed: {allowed}")
     if vk.nan_unset and isinstance(raw, float) and math.isnan(raw):

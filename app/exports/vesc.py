@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from xml.sax.saxutils import escape
 
 from app.exports.drive_units import pole_pairs_to_poles, poles_to_pole_pairs
 from app.exports.stock import StockSettings
 from app.exports.stock_lines import cascade_lines, parse_cascade
 from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from app.io.user_text import xml_comment
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 from control.fdsmc.trapezoid import trapezoid_from_limits
@@ -72,12 +72,16 @@ def cascade_values(s: StockSettings) -> dict[str, float]:
 
 
 def vesc_xml(s: StockSettings, header: list[str]) -> str:
-    """Return the mcconf XML: declaration, the header as an XML comment, ``<MCConfiguration>`` with the motor part."""
+    """Return the mcconf XML: declaration, the header as an XML comment, ``<MCConfiguration>`` with the motor part.
+
+    Each comment line goes through :func:`app.io.user_text.xml_comment` (escaped, never ``--``): the
+    XML stays well-formed and :func:`parse_vesc` reads the comment back line by line.
+    """
     note = header + ["VESC: motor part (VESC has no position trajectory planner); load it in VESC Tool "
                      "(Motor Settings, Load XML) or with vesc_tool's setMcConf option, see docs/drives/vesc.md",
                      "the move's trapezoid and the position/speed cascade a VESC app or the host runs each "
                      "current-loop cycle (SI units):"] + cascade_lines(cascade_values(s))
-    body = "\n".join(f"    {escape(line).replace('--', '- -')}" for line in note)
+    body = "\n".join(f"    {xml_comment(line)}" for line in note)
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', f"<!--\n{body}\n-->", f"<{ROOT}>",
              f"    <{VERSION_TAG}>{CONFIG_VERSION}</{VERSION_TAG}>"]
     for key, v in vesc_values(s).items():

@@ -19,6 +19,8 @@ import math
 import re
 from collections.abc import Callable
 
+from app.io.user_text import escaped
+
 _GROUPED = r"[0-9]{1,3}(?:[ \u2009\u202f][0-9]{3})+"
 _NUMBER = re.compile(rf"[+-]?(?:(?:{_GROUPED}|[0-9]+)(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 #: Longest value quoted in a message [characters]; longer ones are shortened with "…".
@@ -47,10 +49,11 @@ MESSAGE_MAX = 300
 def one_line(message: object, limit: int = MESSAGE_MAX) -> str:
     """Return a refusal as one line of at most ``limit`` characters.
 
-    Line breaks become spaces; an overlong message keeps its start (the field and value) and its
-    end (what is allowed), joined by "…".
+    Line breaks become spaces, every other control, escape or bidi character is shown escaped
+    (:func:`app.io.user_text.escaped`: nothing reaches a terminal raw); an overlong message keeps its
+    start (the field and value) and its end (what is allowed), joined by "…".
     """
-    flat = " ".join(str(message).split())
+    flat = escaped(" ".join(str(message).split()))
     if len(flat) <= limit:
         return flat
     tail = (limit - 3) * 2 // 5
@@ -81,7 +84,8 @@ def parse_number(text: str, field: str) -> float:
     Raises
     ------
     NumberFormatError
-        When ``text`` is not decimal or scientific notation, or overflows a double.
+        When ``text`` is not decimal or scientific notation, overflows a double or underflows to 0
+        (``1e-400``: a non-zero number typed must not silently become 0).
     """
     if isinstance(text, QuotedText):
         raise NumberFormatError(f"{field} = {shown(text)} is quoted text: allowed a number written without "
@@ -92,6 +96,8 @@ def parse_number(text: str, field: str) -> float:
     value = float(re.sub(r"[ \u2009\u202f]", "", stripped))
     if not math.isfinite(value):
         raise NumberFormatError(f"{field} = {shown(text)} is too large: allowed |value| < 1.8e308")
+    if value == 0.0 and re.search(r"[1-9]", re.split(r"[eE]", stripped)[0]):
+        raise NumberFormatError(f"{field} = {shown(text)} underflows to 0: allowed 0 or |value| ≥ 5e-324")
     return value
 
 
