@@ -24,6 +24,7 @@ from app.exports.model import FORMATS, c_law, export_files
 from app.io import atomic
 from app.io.numbers import parse_number
 from app.io.presets import load, load_with_plant
+from app.io.user_text import check_label, escaped
 from control.common.checks import ParameterError
 from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
@@ -93,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("plant: export writes the controller's model (motor, load, controller); a plant "
                              "section or --set plant.* (the drive's true values) is not exported: allowed none — "
                              "simulate it with `python -m app simulate`, or move the values into motor/load")
-    renamed = {k: v for k, v in (("name", args.name), ("source", args.source)) if v is not None}
+    renamed = {k: check_label(v, f"--{k}") for k, v in (("name", args.name), ("source", args.source))
+               if v is not None}
     params = dataclasses.replace(params, **renamed)
     c_law(args.format, args.controller)  # before the simulation: a wrong combination is refused at once
     options = ExportOptions(args.force, args.angle_unit, cycle_seconds(args.cycle_ms), args.controller)
@@ -109,5 +111,5 @@ def run(args: argparse.Namespace) -> int:
         targets = {Path(args.output or name): content}
     for path, content in targets.items():
         write_atomic(path, content)
-        sys.stdout.write(f"wrote {path} ({len(content)} bytes)\n")
+        sys.stdout.write(f"wrote {escaped(path)} ({len(content)} bytes)\n")
     return 0

@@ -4,6 +4,10 @@ Reads a stock drive's own file (ODrive backup JSON, moteus configuration dump, V
 writes a preset: the base preset with the file's motor data (:func:`app.exports.drive_import.import_drive`).
 Every key of the file that is not imported is listed (on the terminal and in the preset's header
 comment). The preset is written whole (a temporary file, then ``os.replace``).
+
+Text from the file (its keys) and its name reaches the written preset and the terminal only escaped
+(:func:`app.io.user_text.escaped`): a key or a file name with a line break cannot add a YAML line;
+``--name`` with one is refused (:func:`app.io.user_text.check_label`).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from app.cli.export import write_atomic
 from app.cli.main import check_writable
 from app.exports.drive_import import IMPORT_FORMATS, import_drive
 from app.io.presets import MAX_BYTES, dumps, load, to_raw
+from app.io.user_text import check_label, escaped
 from control.common.checks import ParameterError
 
 
@@ -47,16 +52,18 @@ def read_text(path: str) -> str:
 def run(args: argparse.Namespace) -> int:
     """Import, write the preset, list what was imported, kept and not imported."""
     check_writable(args.output, "-o")
+    name = check_label(args.name, "--name") if args.name is not None else escaped(Path(args.file).stem)
     base = load(args.base, (), mode="position")
-    result = import_drive(read_text(args.file), args.format, base, args.file)
-    name = args.name or Path(args.file).stem
-    params = dataclasses.replace(result.params, name=name,
-                                 source=f"motor data imported from {args.format} file {Path(args.file).name} "
-                                        f"onto preset {base.name}")
-    notes = ([f"imported: {x}" for x in result.imported] + [f"kept from {base.name}: {x}" for x in result.kept]
-             + [f"not imported ({len(result.not_imported)} keys): " + ", ".join(result.not_imported)])
-    head = "".join(f"# {line}\n" for line in [f"python -m app import-drive {args.file} --format {args.format} "
-                                              f"--base {args.base}"] + notes)
+    result = import_drive(read_text(args.file), args.format, base, escaped(args.file))
+    params = dataclasses.replace(result.params, name=name[:400],
+                                 source=f"motor data imported from {args.format} file "
+                                        f"{escaped(Path(args.file).name)[:200]} onto preset {escaped(base.name)}")
+    notes = [escaped(n) for n in ([f"imported: {x}" for x in result.imported]
+                                  + [f"kept from {base.name}: {x}" for x in result.kept]
+                                  + [f"not imported ({len(result.not_imported)} keys): "
+                                     + ", ".join(result.not_imported)])]
+    command = escaped(f"python -m app import-drive {args.file} --format {args.format} --base {args.base}")
+    head = "".join(f"# {line}\n" for line in [command] + notes)
     write_atomic(Path(args.output), (head + dumps(to_raw(params))).encode("utf-8"))
-    sys.stdout.write("\n".join(notes) + f"\nwrote {args.output}\n")
+    sys.stdout.write("\n".join(notes) + f"\nwrote {escaped(args.output)}\n")
     return 0

@@ -17,6 +17,11 @@ import yaml
 from app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
 from app.io.numbers import QuotedText, shorten
 from app.io.preset_schema import PresetError
+from app.io.user_text import check_label, escaped, forbidden
+from control.common.checks import ParameterError
+
+#: Keys whose text is written into files (a preset's name and source): one printable line.
+LABEL_KEYS = ("name", "source")
 
 #: Most YAML nodes (scalars, keys and collections) one text may hold [-]: a preset needs ≈ 200, one
 #: with a measured back-EMF table ≈ 4 300. Counted as the text is parsed, it bounds the pure-Python
@@ -142,12 +147,25 @@ def _unique_mapping(loader: _TextLoader, node: yaml.MappingNode) -> dict[Any, An
         if not isinstance(key, str):
             raise PresetError(f"key at {_mark(key_node)} is not a name: allowed text keys only")
         key = str(key)
+        if any(forbidden(ch) for ch in key):
+            raise PresetError(f"key '{escaped(shorten(key))}' at {_mark(key_node)} holds a control, line-break or "
+                              "bidi character: allowed printable keys")
         if key in out:
             raise PresetError(f"duplicate key {shorten(key)!r} at {_mark(key_node)} (first at {first[key]}): "
                               "allowed each key once per mapping")
         first[key] = _mark(key_node)
-        out[key] = loader.construct_object(value_node, deep=True)
+        out[key] = _label(key, loader.construct_object(value_node, deep=True))
     return out
+
+
+def _label(key: str, value: Any) -> Any:
+    """``value``, refused (PresetError) when it is a name or source that is not one printable line."""
+    if key in LABEL_KEYS and isinstance(value, str):
+        try:
+            check_label(value, key)
+        except ParameterError as exc:
+            raise PresetError(str(exc)) from None
+    return value
 
 
 for _cls in filter(None, (_TextLoader, _CLoader)):
@@ -186,22 +204,42 @@ def plain_scalar(text: str, where: str) -> Any:
     differ from what was typed; those are refused, naming ``where``.
     """
     value = loads_raw(text, where)
-    if isinstance(value, str) and not isinstance(value, QuotedText) and value != text.strip(" \t"):
+    hidden = (isinstance(value, str) and not isinstance(value, QuotedText) and value != text.strip(" \t")) \
+        or _uncovered(text)
+    if hidden:
         raise PresetError(f"{where} = {shorten(text)!r} is not a plain value: allowed the value alone "
                           "(no comment, byte-order mark, line break or YAML block syntax)")
     return value
 
 
+def _uncovered(text: str) -> bool:
+    """Return True when some typed character is in no YAML token (a ``# …`` comment, even inside ``[…]``)."""
+    covered = bytearray(len(text))
+    for tok in yaml.scan(text, Loader=yaml.SafeLoader):
+        covered[tok.start_mark.index: tok.end_mark.index] = b"\x01" * (tok.end_mark.index - tok.start_mark.index)
+    return any(not covered[i] and not ch.isspace() for i, ch in enumerate(text))
+
+
 def loads_any_raw(text: str, origin: str = "<text>") -> Any:
     """JSON (``*.json``, or text starting with ``{``) or YAML text → plain Python data."""
     if origin.lower().endswith(".json"):
-        return loads_json_raw(text, origin)
+        return _json_labels(loads_json_raw(text, origin))
     if text.lstrip().startswith("{"):  # JSON text; a YAML flow mapping falls back to YAML
         try:
-            return loads_json_raw(text, origin)
+            data = loads_json_raw(text, origin)
         except PresetError:
             pass
+        else:
+            return _json_labels(data)
     return loads_raw(text, origin)
+
+
+def _json_labels(data: Any) -> Any:
+    """JSON data with its top-level name and source checked as YAML's are (:func:`_label`)."""
+    if isinstance(data, dict):
+        for key in LABEL_KEYS:
+            _label(key, data.get(key))
+    return data
 
 
 class _Dumper(yaml.SafeDumper):

@@ -24,6 +24,7 @@ from app.exports.model import export_download, safe_stem
 from app.io.modes import REGISTRY
 from app.io.preset_schema import PresetError
 from app.io.presets import MAX_BYTES, loads_preset, to_raw
+from app.io.user_text import check_label
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 from sim.fdsmc.engine import Comparison
@@ -104,6 +105,10 @@ def renamed(cmp: Comparison, name: str, source: str) -> Comparison:
         if not text.strip():
             raise ExportRefusedError(f"Export › {field} = {text!r} is empty: allowed any non-blank text "
                                      "(the file name and the file's header come from it)")
+        try:
+            check_label(text, f"Export › {field}")
+        except ParameterError as exc:
+            raise ExportRefusedError(str(exc)) from None
     params = dataclasses.replace(cmp.derived.params, name=name.strip(), source=source.strip())
     return dataclasses.replace(cmp, derived=dataclasses.replace(cmp.derived, params=params))
 
