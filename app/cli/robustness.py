@@ -23,6 +23,7 @@ from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
 from app.io.json_data import to_json
+from app.io.numbers import integer_option, number_option
 from app.io.plant_overrides import load_model_and_plant
 from app.io.sample_table import write_csv, write_parquet
 from app.io.study_inputs import parse_spreads
@@ -44,16 +45,17 @@ MAX_SAMPLES = 1_000_000
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``robustness``."""
     add_preset_arguments(p)
-    p.add_argument("--samples", type=int, default=100, help="number of sampled plants (default 100)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the sampling (default 0)")
+    p.add_argument("--samples", type=integer_option("--samples"), default=100,
+                   help="number of sampled plants (default 100)")
+    p.add_argument("--seed", type=integer_option("--seed"), default=0, help="seed of the sampling (default 0)")
     p.add_argument("--spread", action="append", default=[], metavar="plant.FIELD=DIST[,…]",
                    help="plant.J_L=0:0.3 (uniform), plant.R_s=±20%% (uniform relative), "
                         "plant.psi_pm=~5%% (normal, relative σ)")
-    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+    p.add_argument("--workers", type=integer_option("--workers"), default=os.cpu_count() or 1,
                    help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=os.environ.get(SCHEDULER_ENV),
                    help=f"Dask scheduler address tcp://HOST:PORT (or ${SCHEDULER_ENV})")
-    p.add_argument("--cluster-timeout", type=float, default=60.0, metavar="S",
+    p.add_argument("--cluster-timeout", type=number_option("--cluster-timeout"), default=60.0, metavar="S",
                    help="seconds the Dask cluster may have no worker before the run stops (default 60)")
     p.add_argument("--controllers", default=",".join(CONTROLLERS), metavar="NAME[,NAME…]",
                    help=f"controllers run on every sample, of {', '.join(STUDY_CONTROLLERS)} "
@@ -88,8 +90,10 @@ def _print_table(summary: dict[str, Any]) -> None:
 def _check(args: argparse.Namespace) -> None:
     if not 1 <= args.samples <= MAX_SAMPLES:
         raise ParameterError(f"--samples = {args.samples} is not allowed: 1 … {MAX_SAMPLES}")
-    if args.workers < 1:
-        raise ParameterError(f"--workers = {args.workers} is not allowed: ≥ 1")
+    if not 1 <= args.workers <= 1024:
+        raise ParameterError(f"--workers = {args.workers} is not allowed: 1 … 1024")
+    if not 0 <= args.seed < 2**63:
+        raise ParameterError(f"--seed = {args.seed} is not allowed: 0 … 2^63 − 1")
     if not 1.0 <= args.cluster_timeout <= 86400.0:
         raise ParameterError(f"--cluster-timeout = {args.cluster_timeout:g} s is not allowed: 1 … 86400 s")
     for opt, path in (("--csv", args.csv), ("--parquet", args.parquet)):
@@ -127,11 +131,17 @@ def _compute(args: argparse.Namespace) -> RobustnessResult:
 
 
 def _atomic(path: str, write: Callable[[str], None]) -> None:
-    """Write through a temporary file in the same folder, then rename it over ``path``."""
+    """Write through a temporary file in the same folder, then rename it over ``path``.
+
+    A write error (disk full, quota, a folder gone) is one line naming the file; the old file, if
+    any, is left as it was and no temporary file remains.
+    """
     tmp = f"{path}.tmp-{os.getpid()}"
     try:
         write(tmp)
         os.replace(tmp, path)
+    except OSError as exc:
+        raise ParameterError(f"cannot write {path!r}: {exc.strerror or exc}; nothing was written there") from None
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from app.io.numbers import NumberFormatError, parse_number
 from app.io.plant_overrides import plant_section
 from app.io.presets import load_preset
 from control.common.checks import ParameterError
@@ -23,13 +24,11 @@ MAX_AXES = 16
 
 
 def _number(text: str, item: str) -> float:
+    """Return a number of a ``--spread`` item, parsed by the one grammar (:func:`app.io.numbers.parse_number`)."""
     try:
-        v = float(text)
-    except ValueError:
-        raise ParameterError(f"--spread {item!r}: {text!r} is not a number") from None
-    if v != v or v in (float("inf"), float("-inf")):
-        raise ParameterError(f"--spread {item!r}: {text!r} is not a finite number")
-    return v
+        return parse_number(text, f"--spread {item!r}")
+    except NumberFormatError as exc:
+        raise ParameterError(str(exc)) from None
 
 
 def parse_spread(item: str) -> Spread:

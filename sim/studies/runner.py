@@ -7,18 +7,21 @@ the pool is then replaced by a new one and every chunk not finished is submitted
 chunk that the pool loses a second time raises :class:`ExecutorError` (one line: which chunk, what
 happened, what is allowed). Workers are started with ``spawn`` (no fork of a threaded parent) and
 each runs its chunks on one numba thread: the processes are the parallelism. ``nice`` lowers the
-workers' scheduling priority (so that a server's interactive work comes first).
+workers' scheduling priority (so that a server's interactive work comes first). Workers start
+with SIGINT blocked (:class:`_QuietSpawn`): a Ctrl-C typed as the pool starts reaches the whole
+process group, and the parent alone answers it (ending the workers), so no worker prints a traceback.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import threading
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
-from multiprocessing import get_context
+from multiprocessing.context import SpawnContext, SpawnProcess
 from typing import Any
 
 #: How often a chunk may be submitted again after its worker was lost [-].
@@ -27,6 +30,24 @@ RETRIES = 1
 #: signal to any of its threads; Python's handler then only sets a flag, which the main thread reads when it
 #: wakes: a wait in slices keeps Ctrl-C and SIGTERM prompt however long the chunk runs.
 WAIT_SLICE_S = 0.2
+
+
+class _QuietProcess(SpawnProcess):
+    """A spawned process that inherits SIGINT blocked (the mask survives fork and exec)."""
+
+    def start(self) -> None:
+        """Start the process with SIGINT blocked in this thread meanwhile (a pending one is then delivered)."""
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            super().start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+class _QuietSpawn(SpawnContext):
+    """The ``spawn`` start method whose processes never see Ctrl-C (their parent ends them)."""
+
+    Process = _QuietProcess
 
 
 class ExecutorError(RuntimeError):
@@ -107,7 +128,7 @@ class RetryingPool:
         self._futures: list[RetryingFuture] = []
 
     def _new_pool(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(self.workers, mp_context=get_context("spawn"), initializer=lower_priority,
+        return ProcessPoolExecutor(self.workers, mp_context=_QuietSpawn(), initializer=lower_priority,
                                    initargs=(self.nice,))
 
     def raw_submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
