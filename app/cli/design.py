@@ -9,13 +9,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-from pathlib import Path
 from typing import Any
 
-from app.cli.main import add_preset_arguments
+from app.cli.main import add_preset_arguments, check_writable
 from app.io.atomic import write_atomic_text
 from app.io.json_data import to_json
 from app.io.presets import dumps, load_preset, to_raw
+from app.io.user_text import check_label
 from sim.fdsmc.checks import run_checks
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import LABELS
@@ -90,10 +90,11 @@ def design_json(od: ObjectiveDesign) -> dict[str, Any]:
 def run(args: argparse.Namespace) -> int:
     """Design, verify and print (table or JSON); optionally write the designed preset."""
     params = load_preset(args.preset, args.overrides)
-    renamed = {k: v for k, v in (("name", args.name), ("source", args.source)) if v is not None}
+    renamed = {k: check_label(v, f"--{k}") for k, v in (("name", args.name), ("source", args.source))
+               if v is not None}
     params = dataclasses.replace(params, **renamed)
-    if args.output and not Path(args.output).resolve().parent.is_dir():  # checked before the work
-        raise ValueError(f"-o {args.output}: the folder does not exist")
+    if args.output:  # checked before the work: a device, read-only file, link loop … is refused as export does
+        check_writable(args.output, "-o")
     od = design_for(params, args.objective)
     dd = od.design
     out = design_json(od)

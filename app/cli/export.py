@@ -6,7 +6,11 @@ the tracked optimum with its designed move's reference table); otherwise PATH is
 (default: ``<name>.<format>`` here; the stock-drive formats ``<name>.odrive.json``,
 ``<name>.moteus.cfg``, ``<name>.vesc.xml``, ``<name>.setpoints.csv``). Every format is refused,
 naming the failed checks, when the simulated design is not clean; ``--force`` writes it with the
-failed checks inside. Files are written whole (a temporary file, then ``os.replace``).
+failed checks inside. Files are written whole (a temporary file, then ``os.replace``); the C
+module's files are all written to temporary files first and renamed only when every one is complete
+(:func:`app.io.atomic.write_all`: a full disk leaves the old files). ``-o`` a device node, FIFO,
+folder, read-only file or symbolic-link loop is refused before any simulation
+(:func:`app.io.atomic.target_problem`).
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from app.cli.main import add_preset_arguments
+from app.cli.main import add_preset_arguments, check_writable
 from app.exports.c_module import LAWS
 from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
 from app.exports.drive_units import ANGLE_UNITS
@@ -80,10 +84,16 @@ def write_atomic(path: Path, content: bytes) -> None:
     A temporary file in the same folder, then ``os.replace`` (removed on Ctrl-C too); a write
     error is a one-line ParameterError.
     """
+    write_files({path: content})
+
+
+def write_files(targets: dict[Path, bytes]) -> None:
+    """Write files that belong together through :func:`app.io.atomic.write_all`; one-line ParameterError."""
     try:
-        atomic.write_atomic(path, content)
+        atomic.write_all(targets)
     except OSError as exc:
-        raise ParameterError(f"cannot write {str(path)!r}: {exc.strerror or exc}") from None
+        where = exc.filename if exc.filename is not None else ", ".join(str(p) for p in targets)
+        raise ParameterError(f"cannot write {str(where)!r}: {exc.strerror or exc}; no file was changed") from None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -98,6 +108,8 @@ def run(args: argparse.Namespace) -> int:
                if v is not None}
     params = dataclasses.replace(params, **renamed)
     c_law(args.format, args.controller)  # before the simulation: a wrong combination is refused at once
+    if args.output and args.format != "c":
+        check_writable(args.output, "-o")
     options = ExportOptions(args.force, args.angle_unit, cycle_seconds(args.cycle_ms), args.controller)
     files = export_files(args.format, case(params, args.format, args.controller), options)
     if args.format == "c":
@@ -109,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         ((name, content),) = files.items()
         targets = {Path(args.output or name): content}
+    write_files(targets)
     for path, content in targets.items():
-        write_atomic(path, content)
         sys.stdout.write(f"wrote {escaped(path)} ({len(content)} bytes)\n")
     return 0

@@ -78,18 +78,20 @@ def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None)
 
 def check_writable(path: str, option: str) -> None:
     """Raise ValueError unless ``path`` can be written (checked before any simulation runs)."""
+    from app.io.atomic import target_problem
+
     target = Path(path)
     try:
-        parent = target.parent if str(target.parent) else Path(".")
+        problem = target_problem(target)  # a device, FIFO, folder, read-only file, link loop
+        parent = Path(os.path.realpath(target)).parent if problem is None else target.parent
         ok_dir = parent.is_dir() and os.access(parent, os.W_OK)
-        ok_file = not target.exists() or (target.is_file() and os.access(target, os.W_OK))
     except (OSError, ValueError) as exc:  # name too long, NUL byte …
         raise ValueError(f"{option} {path!r} cannot be written: {exc}") from None
+    if problem is not None:
+        raise ValueError(f"{option} {path!r} {problem}")
     if not ok_dir:
         raise ValueError(f"{option} {path!r}: the folder {str(parent)!r} does not exist or is not writable: "
                          "allowed a file in an existing, writable folder")
-    if not ok_file:
-        raise ValueError(f"{option} {path!r} is not a writable file: allowed a new or writable file")
 
 
 #: Commands run in a worker thread while the main thread only waits, so that Ctrl-C or SIGTERM is
@@ -101,8 +103,43 @@ THREADED = frozenset({"derive", "design", "simulate", "export", "import-drive", 
 INTERRUPTED = 130
 
 
+#: True while :func:`main` runs as the process itself (``python -m app``, the console script).
+_AS_PROCESS = False
+
+
 def _raise_interrupt(signum: int, frame: Any) -> None:
+    """Raise KeyboardInterrupt; while numba compiles on this thread, end the process at once instead.
+
+    LLVM hands each compiled module to numba through a ctypes callback, the first Python code to
+    run after a long code-generation step, so a signal that arrives then is handled inside that
+    callback, and ctypes prints and drops what it raises ("Exception ignored on calling ctypes
+    callback"): the run went on to its end with exit 0.
+    """
+    if _AS_PROCESS and _compiling_here():
+        _end_child_processes()
+        _stop_interrupted()
     raise KeyboardInterrupt
+
+
+def _compiling_here() -> bool:
+    """Return True when the calling thread holds numba's compiler lock (a kernel is being compiled)."""
+    lock_module = sys.modules.get("numba.core.compiler_lock")
+    return lock_module is not None and bool(lock_module.global_compiler_lock.is_locked())
+
+
+def _end_child_processes() -> None:
+    """Terminate this process's multiprocessing children (a pool's workers), which would outlive it."""
+    mp = sys.modules.get("multiprocessing")
+    for child in mp.active_children() if mp is not None else []:
+        child.terminate()
+
+
+def _install_handlers() -> dict[int, Any]:
+    """Route SIGTERM, and SIGINT unless it is ignored (a background job), to :func:`_raise_interrupt`."""
+    previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _raise_interrupt)}
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, _raise_interrupt)
+    return previous
 
 
 def _run_in_thread(args: argparse.Namespace) -> int:
@@ -140,8 +177,10 @@ def _stop_interrupted() -> NoReturn:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the process exit code (130 at once on Ctrl-C or SIGTERM, from a real process)."""
+    global _AS_PROCESS
     in_main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt) if in_main else None
+    previous = _install_handlers() if in_main else {}
+    _AS_PROCESS = in_main and argv is None
     try:
         return _main(sys.argv[1:] if argv is None else argv)
     except KeyboardInterrupt:
@@ -149,8 +188,9 @@ def main(argv: list[str] | None = None) -> int:
             _stop_interrupted()
         return INTERRUPTED
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        _AS_PROCESS = False
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _main(argv: list[str]) -> int:
