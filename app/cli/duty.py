@@ -16,7 +16,7 @@ from typing import Any
 from app.cli.main import add_preset_arguments
 from app.io.json_data import to_json
 from app.io.numbers import number_option, parse_number
-from app.io.presets import load_preset, loads_raw
+from app.io.presets import MAX_BYTES, load_preset, loads_raw
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
 from sim.studies.duty import Move, duty_cycle
@@ -45,6 +45,27 @@ def _field(item: dict[str, Any], key: str, where: str, default: float | None = N
     return float(v)
 
 
+#: Longest move and dwell of a duty cycle [s] (a dwell of a day; the step budget bounds the rest).
+MAX_T_M_S, MAX_DWELL_S = 1e4, 86400.0
+
+
+def read_moves(path: str) -> str:
+    """Return the moves file's UTF-8 text; one line naming the file when it cannot be read."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as exc:
+        raise ParameterError(f"FILE = {path!r} cannot be read: {exc.strerror or exc}: allowed a readable "
+                             "YAML file") from None
+    if len(data) > MAX_BYTES:
+        raise ParameterError(f"FILE = {path!r} is larger than {MAX_BYTES // 1024} KiB: allowed ≤ "
+                             f"{MAX_BYTES // 1024} KiB")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ParameterError(f"FILE = {path!r} is not UTF-8 text: allowed a YAML file") from None
+
+
 def parse_moves(raw: Any, origin: str) -> list[Move]:
     """Parse the YAML list into moves, with a clear message for a bad entry."""
     if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_MOVES:
@@ -55,8 +76,9 @@ def parse_moves(raw: Any, origin: str) -> list[Move]:
         if not isinstance(item, dict) or set(item) - {"theta_dem", "T_m", "dwell"}:
             raise ParameterError(f"{where}: expected a mapping with theta_dem, T_m and optional dwell only")
         mv = Move(_field(item, "theta_dem", where), _field(item, "T_m", where), _field(item, "dwell", where, 0.0))
-        if mv.T_m <= 0.0 or mv.dwell < 0.0:
-            raise ParameterError(f"{where}: T_m = {mv.T_m:g} s, dwell = {mv.dwell:g} s not allowed: T_m > 0, dwell ≥ 0")
+        if not (0.0 < mv.T_m <= MAX_T_M_S and 0.0 <= mv.dwell <= MAX_DWELL_S):
+            raise ParameterError(f"{where}: T_m = {mv.T_m:g} s, dwell = {mv.dwell:g} s not allowed: "
+                                 f"0 < T_m ≤ {MAX_T_M_S:g} s, 0 ≤ dwell ≤ {MAX_DWELL_S:g} s")
         moves.append(mv)
     return moves
 
@@ -75,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     path = Path(args.file)
     if not path.is_file():
         raise ParameterError(f"FILE = {args.file!r} is not a readable file")
-    res = duty_cycle(params, parse_moves(loads_raw(path.read_text(encoding="utf-8"), str(path)), str(path)))
+    res = duty_cycle(params, parse_moves(loads_raw(read_moves(str(path)), str(path)), str(path)))
     year = res.per_year(args.cycles_per_hour, args.hours_per_year, args.price)
     out = {"cycle_s": res.cycle_s, "cycle_J": res.cycle_J, "moves_J": list(res.moves),
            "kWh_per_year": {c: (v[0] if v else None) for c, v in year.items()},
