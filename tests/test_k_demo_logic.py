@@ -95,3 +95,44 @@ def test_readout_says_K_in_red_at_or_above_the_limit():
     assert "K = 5000 s/rad" in above and BAD_COLOUR in above and BAD_COLOUR not in below
     assert "lim 0.605" in below and "rec 0.302" in below
     assert 'id="abc"' in hide_box_css("abc")
+
+
+def test_verdict_says_K_limit_is_the_models_when_the_plant_differs():
+    c = _comparison(0.5, 0.605, chatter=True, freq=162.0)
+    c.derived.params.load = SimpleNamespace(J_L=2.0e-3)
+    assert chatter_verdict(c, plant_J_L=6.0e-3).text == "CHATTER 162 Hz (K < K_limit = 0.605, the model's (plant J_L ×3))"
+    assert chatter_verdict(c, plant_J_L=2.0e-3).detail == "K < K_limit = 0.605"  # the plant is the model
+
+
+def test_k_grid_holds_the_marked_gains_and_spans_the_slider():
+    from app.figures.k_sweep import N_LOG, k_grid
+    grid = k_grid(-2.0, 4.0, 1000.0, 0.6048, 0.3024)
+    assert grid == tuple(sorted(grid)) and grid[0] == 0.01 and grid[-1] == 1e4
+    for K in (1000.0, 0.3024, 0.9 * 0.6048 * 1.1, 0.99 * 0.6048, 1.01 * 0.6048):
+        if K != 0.9 * 0.6048 * 1.1:
+            assert any(abs(g / K - 1.0) < 0.005 for g in grid), K
+    assert N_LOG <= len(grid) <= N_LOG + 5
+    assert any(g < 0.6048 for g in grid if g > 0.59) and any(0.6048 < g < 0.62 for g in grid)  # either side of lim
+
+
+def test_k_sweep_frames_carry_each_runs_own_verdict():
+    import json
+
+    from app.figures.k_sweep import DYNAMIC, k_sweep_spec
+    from app.figures.plain import figure_json
+    from app.io.presets import PAPER_PRESET, load_preset
+    from app.ui.k_sweep import sweep_points
+    from sim.fdsmc.engine import compare
+
+    params = load_preset(PAPER_PRESET)
+    points = sweep_points(compare(params, ("fdsmc",)), None)
+    spec, raw = k_sweep_spec(points, 1000.0, {"lim": points[0].derived.gain.K_limit})
+    fig = json.loads(figure_json(spec, raw))
+    steps = fig["layout"]["sliders"][0]["steps"]
+    assert len(steps) == len(points) and fig["layout"]["sliders"][0]["active"] == fig["layout"]["meta"]["K"].index(1000)
+    for step, c in zip(steps, points, strict=True):
+        frame = step["args"][0][0]
+        assert frame["traces"] == list(DYNAMIC) and step["args"][1]["frame"]["redraw"] is False
+        text = frame["data"][-1]["text"][0]
+        assert ("CHATTER" in text) == c.fdsmc.metrics.chatter and f"K = {c.derived.params.controller.K:.3g}" in text
+    assert sum(len(s["args"][0][0]["data"][1]["x"]) for s in steps) / len(steps) <= 410  # bounded per frame

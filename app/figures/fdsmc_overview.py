@@ -164,7 +164,7 @@ def _add_zoom(comparison: Any, data: list[dict[str, Any]], layout: dict[str, Any
         layout["annotations"] += notes
 
 
-def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]:
+def overview_spec(comparison: Any, pins: tuple[Pin, ...] = (), plant_J_L: float | None = None) -> dict[str, Any]:
     """Build the phase plane (left) and the compact time plot (right) as one plain-dict figure.
 
     ``layout.meta.id`` stays ``"phase_plane"`` (the page and its tests find the figure by it);
@@ -177,6 +177,8 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
     comparison : sim.fdsmc.engine.Comparison
     pins : tuple of Pin
         Pinned runs, drawn first as grey ghosts (:func:`app.figures.fdsmc_pins.ghost_traces`).
+    plant_J_L : float or None
+        The plant's load inertia [kg·m²] of the runs where it is not the model's (the verdict says so).
 
     Returns
     -------
@@ -196,7 +198,7 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = ()) -> dict[str, Any]
     spec["data"] = _with_trail(comparison, spec["data"])
     traces, ranges, t_end = _row_traces(comparison)
     phase_notes = list(layout.get("annotations", []))
-    verdict = chatter_verdict(comparison)
+    verdict = chatter_verdict(comparison, plant_J_L)
     if verdict is not None:
         phase_notes.append(verdict_annotation(verdict, PHASE_X[1]))
     layout.update(_time_layout(comparison, t_end, ranges))

@@ -44,13 +44,28 @@ def _k_vs_limit(K: float, K_limit: float, K_noise: float = math.inf) -> str:
     return f"K {'<' if K_limit > K else '≥'} K_limit = {K_limit:.3g}"
 
 
-def chatter_verdict(comparison: Any) -> Verdict | None:
+def _plant_note(d: Any, plant_J_L: float | None) -> str:
+    """Say that K_limit is the model's where the plant's load inertia [kg·m²] differs from it."""
+    if plant_J_L is None:
+        return ""
+    model = d.params.load.J_L
+    if abs(plant_J_L - model) <= 1e-9 * max(abs(model), 1e-30):
+        return ""
+    ratio = f"×{plant_J_L / model:.3g}" if model > 0.0 else f"= {plant_J_L:.3g} kg·m²"
+    return f", the model's (plant J_L {ratio})"
+
+
+def chatter_verdict(comparison: Any, plant_J_L: float | None = None) -> Verdict | None:
     """Verdict of the FDSMC run of ``comparison`` (:class:`sim.fdsmc.engine.Comparison`), None if not run.
 
     Parameters
     ----------
     comparison : sim.fdsmc.engine.Comparison
         The derivations and the runs; the run's metrics decide, K_limit (the loop analysis) explains.
+    plant_J_L : float or None
+        The plant's load inertia [kg·m²] the run had (None: the model's). Where it differs from the
+        controller's J_L, K_limit is still computed for the model's: the detail says so
+        (``K < K_limit = 0.605, the model's (plant J_L ×3)``).
 
     Returns
     -------
@@ -62,7 +77,7 @@ def chatter_verdict(comparison: Any) -> Verdict | None:
     if run is None:
         return None
     m, d = run.metrics, comparison.derived
-    where = _k_vs_limit(d.params.controller.K, d.gain.K_limit, d.gain.K_noise_binding)
+    where = _k_vs_limit(d.params.controller.K, d.gain.K_limit, d.gain.K_noise_binding) + _plant_note(d, plant_J_L)
     if not m.stable:
         return Verdict("UNSTABLE", where, True)
     if m.chatter:

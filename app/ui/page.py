@@ -36,9 +36,10 @@ from app.ui.layout import (
 )
 from app.ui.log import LogPanel
 from app.ui.plotly_js import use_basic_plotly
-from app.ui.position_tab import PositionTab, comparison_or_derived
+from app.ui.position_tab import PositionTab
 from app.ui.replay import prebuild_figures
 from app.ui.results import ResultsPanel, empty_table1_json
+from app.ui.runs import comparison_or_derived
 from app.ui.scene import RotorScene, aim_camera
 from app.ui.studies import StudiesSection
 from app.ui.studies_queue import StudySlots

@@ -17,7 +17,6 @@ from typing import Any
 
 import viser
 
-from app.io.plant_overrides import with_plant_J_L
 from app.io.presets import list_presets_of, load, require_mode
 from app.ui.case import Case, CaseState
 from app.ui.choices import checked_choice
@@ -27,33 +26,16 @@ from app.ui.lecture import DemoStateFiles, LecturePins
 from app.ui.log import LogPanel
 from app.ui.props import assign
 from app.ui.results import ResultsPanel
+from app.ui.runs import OBJECTIVE_LABELS, comparison_or_derived, table1_job
 from app.ui.studies import OptimumToggle
 from app.ui.text import derived_markdown, design_markdown, md_text, stale_results_html
 from app.ui.tuning import PLANT_J_L, LiveTuning, TuneRunner
 from app.ui.verdict_panel import VerdictPanel
 from app.ui.worker import Cancelled, Worker
-from control.fdsmc.derivations import derive
 from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Comparison, compare
+from sim.fdsmc.engine import Comparison
 from sim.fdsmc.objective import OBJECTIVES, design_for
-from sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
 from sim.fdsmc.verdicts import T_c_advice, recommended_K
-
-#: The page's words for the design objectives (same order as :data:`sim.fdsmc.objective.OBJECTIVES`).
-OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")
-
-
-def comparison_or_derived(params: DriveParams, optimum: bool = False, plant_J_L: float | None = None) -> Comparison:
-    """Simulate both controllers, the stock route (and the tracked optimum if ``optimum``) on ``plant_J_L`` [kg·m²].
-
-    The controllers' model stays ``params`` (``plant_J_L`` None: the plant is the model). For an
-    infeasible case, return the derivations alone (no runs).
-    """
-    d = derive(params)  # a ParameterError here is an input error for the caller
-    if not d.profile.feasible:
-        return Comparison(d, None, None, None, None)
-    plant = None if plant_J_L is None else with_plant_J_L(params, plant_J_L)
-    return compare(params, COMPARATORS if optimum else CONTROLLERS + ("stock",), derived=d, plant=plant)
 
 
 class PositionTab:
@@ -139,7 +121,7 @@ class PositionTab:
         self._worker.checkpoint()
         self._state.ran(params, comparison, plant_J_L)
         if comparison.fdsmc is not None:
-            self._results().show(comparison, autoplay=autoplay, overview_only=overview_only)
+            self._results().show(comparison, autoplay=autoplay, overview_only=overview_only, plant_J_L=plant_J_L)
         else:
             self._results().show_derived_only(comparison)
         self.show_text(status=not overview_only)
@@ -268,19 +250,7 @@ class PositionTab:
 
     def sweep(self, T_m_values: list[float]) -> None:
         """Run the Table-1 sweep over ``T_m_values`` [s] on the worker with a progress bar."""
-        params = self.case.params
-
-        def progress(done: int, total: int) -> None:
-            self._worker.checkpoint()
-            self._results().set_progress(done, total)
-
-        def job() -> None:
-            progress(0, len(T_m_values))
-            rows = table1_sweep(params, T_m_values, progress=progress)
-            self._results().show_table1(rows, PAPER_TABLE1)
-            self.status.content = f"Ready — Table 1: {len(rows)} manoeuvre time(s) simulated."
-
-        self.submit(job)
+        self.submit(table1_job(self, self._results(), T_m_values))
 
     def _preset_chosen(self, event: viser.GuiEvent) -> None:
         if event.client is None:
@@ -343,6 +313,9 @@ class PositionTab:
         if status:  # not during a drag: the sliders stand where the user's pointer holds them
             self.tuning.show(d, case.plant_J_L, recentre=self._recentre)
             self._recentre = False
+            if self.results is not None:  # the K sweep of this run, after it (yields to the next job)
+                self.results.k_sweep.schedule(self._worker.submit_tail, self._worker.tail_checkpoint,
+                                              case.comparison, case.plant_J_L)
         nameplate = self.inputs.nameplate_warnings(case.params.motor)
         self.verdicts.show(case.comparison, case.error, nameplate)
         if status:

@@ -51,7 +51,7 @@ def _last_or_build(kind: str, comparison: Any, build: Callable[[], Any]) -> Any:
 
 
 def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = (),
-                  static: bool = True) -> tuple[str, ScrubTargets]:
+                  static: bool = True, plant_J_L: float | None = None) -> tuple[str, ScrubTargets]:
     """JSON of the overview figure (phase plane + compact time plot, ``pins`` as ghosts) and the traces a scrub moves.
 
     With ``replay`` the figure carries its in-browser replay (play buttons and key frames); without
@@ -59,17 +59,18 @@ def overview_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = 
     both come back when the drag stops (``static`` False: the same light figure with Plotly's
     default config, drawn first after a Simulate; a change of config makes Plotly draw the next
     figure from scratch, at twice the cost). The page fits the figure's height to the window
-    (``layout.meta.fit_height``, :data:`app.ui.plotly_js.REACT_JS`).
+    (``layout.meta.fit_height``, :data:`app.ui.plotly_js.REACT_JS`). ``plant_J_L`` [kg·m²]: the
+    plant's load inertia where it is not the model's (the verdict then says K_limit is the model's).
     """
-    if pins:
-        return _overview_json(comparison, replay, pins, static)
+    if pins or plant_J_L is not None:
+        return _overview_json(comparison, replay, pins, static, plant_J_L)
     return _last_or_build(f"overview {replay} {static}", comparison,
                           lambda: _overview_json(comparison, replay, (), static))
 
 
 def _overview_json(comparison: Any, replay: bool, pins: tuple[Pin, ...],
-                   static: bool) -> tuple[str, ScrubTargets]:
-    spec = overview_spec(comparison, pins)
+                   static: bool, plant_J_L: float | None = None) -> tuple[str, ScrubTargets]:
+    spec = overview_spec(comparison, pins, plant_J_L)
     spec["layout"]["meta"] = {**spec["layout"]["meta"], "fit_height": [CHROME_HEIGHT, ASPECT_MIN, ASPECT_MAX]}
     if not replay:
         drag = _drag_figure(spec, {"staticPlot": True} if static else {})
@@ -108,9 +109,10 @@ def _drag_trace(tr: dict[str, Any]) -> dict[str, Any]:
     return {**tr, "opacity": 1.0} if str(tr.get("name", "")).endswith(" trajectory") else tr
 
 
-def phase_plane_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = ()) -> str:
+def phase_plane_json(comparison: Any, replay: bool = True, pins: tuple[Pin, ...] = (),
+                     plant_J_L: float | None = None) -> str:
     """JSON of the overview figure, with its in-browser replay if ``replay`` (see :func:`overview_json`)."""
-    return overview_json(comparison, replay, pins)[0]
+    return overview_json(comparison, replay, pins, plant_J_L=plant_J_L)[0]
 
 
 #: Script run in the page for a scrub: stop the overview's replay, then restyle its moved traces.
@@ -166,6 +168,7 @@ class Replay:
         self._thread: threading.Thread | None = None
         self._gui = gui
         self.pins: tuple[Pin, ...] = ()  # pinned runs, drawn as ghosts in every overview sent
+        self.plant_J_L: float | None = None  # the plant's J_L of the runs shown [kg·m²] (None: the model's)
         self._comparison, self._targets = shown if shown is not None else (None, ScrubTargets((), (), ()))
         self._t_end = self._t_now = end_time(self._comparison) if self._comparison is not None else 1.0
         self.slider = gui.add_slider("Replay t [s]", min=0.0, max=self._t_end, step=self._t_end / 1000.0,
@@ -203,9 +206,10 @@ class Replay:
         self.pause()
         with self._sending:
             if not light:
-                set_figure_json(self._phase, overview_json(comparison, replay=False, pins=self.pins, static=False)[0])
+                set_figure_json(self._phase, overview_json(comparison, replay=False, pins=self.pins, static=False,
+                                                                   plant_J_L=self.plant_J_L)[0])
                 self._flush()
-            figure, targets = overview_json(comparison, replay=not light, pins=self.pins)
+            figure, targets = overview_json(comparison, replay=not light, pins=self.pins, plant_J_L=self.plant_J_L)
             set_figure_json(self._phase, figure)
             self._flush()  # the phase plane goes out before the larger figure is even built
             if not light:
@@ -224,7 +228,7 @@ class Replay:
     def complete(self, comparison: Any) -> None:
         """Send what a light :meth:`load` left out: the overview's replay and the time plots."""
         with self._sending:
-            set_figure_json(self._phase, phase_plane_json(comparison, pins=self.pins))
+            set_figure_json(self._phase, phase_plane_json(comparison, pins=self.pins, plant_J_L=self.plant_J_L))
             self.show_time_plots(comparison)
 
     def show_pins(self, pins: tuple[Pin, ...]) -> None:
@@ -233,7 +237,7 @@ class Replay:
             with self._lock:
                 self.pins, comparison = pins, self._comparison
             if comparison is not None:
-                figure, targets = overview_json(comparison, pins=pins)
+                figure, targets = overview_json(comparison, pins=pins, plant_J_L=self.plant_J_L)
                 set_figure_json(self._phase, figure)
                 with self._lock:
                     self._targets = targets

@@ -20,6 +20,7 @@ from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_
 from app.figures.plain import figure_json
 from app.figures.stock_route import stock_route_spec
 from app.io.numbers import parse_T_m_list
+from app.ui.k_sweep import KSweepView
 from app.ui.layout import PanelLayout
 from app.ui.paper_text import errata_html, table1_html
 from app.ui.props import assign
@@ -61,6 +62,8 @@ class ResultsPanel:
         with phase_tab:
             self.key_numbers = gui.add_html(key_numbers_html(comparison))
             self.phase = add_figure(gui, overview, ASPECT_PHASE)
+        with self.panel.add_tab("K sweep", viser.Icon.CHART_DOTS):
+            self.k_sweep = KSweepView(gui)
         with time_tab:
             self.time_plots = add_figure(gui, time_plots_json(comparison), ASPECT_TIME)
         with phase_tab:
@@ -111,7 +114,8 @@ class ResultsPanel:
         """Size the overview plot for the window; the page's CSS sizes the panel (:mod:`app.ui.layout`)."""
         self.phase.aspect = layout.plot_aspect
 
-    def show(self, comparison: Any, autoplay: bool = True, overview_only: bool = False) -> None:
+    def show(self, comparison: Any, autoplay: bool = True, overview_only: bool = False,
+             plant_J_L: float | None = None) -> None:
         """Draw a new comparison: key numbers and overview first (what the user waits for), then the rest.
 
         With ``overview_only`` (a slider being dragged) the other tabs keep their figures and the
@@ -120,6 +124,7 @@ class ResultsPanel:
         """
         self._comparison = comparison
         assign(self.key_numbers, content=key_numbers_html(comparison))
+        self.replay.plant_J_L = plant_J_L
         self.replay.load(comparison, autoplay=autoplay, light=overview_only)
         self._rest_pending = overview_only
         if not overview_only:

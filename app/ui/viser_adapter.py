@@ -143,7 +143,7 @@ def resolve_client(gui: Any, client_id: Any) -> Any | None:
 
 #: Every icon the page shows (a test checks the UI modules use no other).
 PAGE_ICONS = ("ARROWS_MAXIMIZE", "BOLT", "CHART_DOTS", "CHART_HISTOGRAM", "CHART_LINE", "DOWNLOAD", "ENGINE", "FILE",
-              "FLASK", "PHOTO", "PLAYER_PLAY", "PLAYER_STOP", "PLUS", "SHARE", "TABLE", "UPLOAD", "WAND")
+              "FLASK", "PHOTO", "PLAYER_PLAY", "PLAYER_STOP", "PLUS", "ROUTE", "SHARE", "TABLE", "UPLOAD", "WAND")
 
 
 def warm_icons(names: tuple[str, ...] = PAGE_ICONS) -> None:

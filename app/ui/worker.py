@@ -63,6 +63,7 @@ class Worker:
         self._on_error = on_error
         self._slots, self._on_queued = slots, on_queued or (lambda label, ahead: None)
         self._study: str | None = None
+        self._tail_cancel = threading.Event()
 
     @property
     def busy(self) -> bool:
@@ -80,11 +81,39 @@ class Worker:
                 return None
             self._busy = True
             self._cancel.clear()
+            self._tail_cancel.set()  # a tail still running yields to the new job
         self._safe_busy(True)
         if label is not None and self._slots is not None:
             slots, job = self._slots, fn
             fn = lambda: slots.run(label, job, self._on_queued, self._cancel.is_set)  # noqa: E731
         return self._pool.submit(self._run, fn)
+
+    def submit_tail(self, fn: Callable[[], None]) -> None:
+        """Queue ``fn`` after the running job as background work: not busy, and yielding to any new job.
+
+        A tail (e.g. the K sweep after a run) leaves the buttons enabled; the next :meth:`submit`
+        makes its next :meth:`tail_checkpoint` raise :class:`Cancelled` (its result is discarded),
+        and the new job runs once it has stopped. A cancelled tail is not an error.
+        """
+        with self._lock:
+            if self._closed:
+                return
+            self._tail_cancel.clear()
+        self._pool.submit(self._run_tail, fn)
+
+    def tail_checkpoint(self) -> None:
+        """Raise :class:`Cancelled` in a tail once a new job was submitted (or the page closed)."""
+        if self._tail_cancel.is_set():
+            raise Cancelled("a new job came")
+
+    def _run_tail(self, fn: Callable[[], None]) -> None:
+        try:
+            self.tail_checkpoint()
+            fn()
+        except Cancelled:
+            pass
+        except Exception as exc:  # shown to the user by on_error, never lost
+            self._on_error(exc)
 
     @contextlib.contextmanager
     def as_study(self, label: str) -> Iterator[None]:
@@ -160,5 +189,6 @@ class Worker:
         with self._lock:
             self._closed = True
             self._cancel.set()
+            self._tail_cancel.set()
         self._run_hooks()
         self._pool.shutdown(wait=False, cancel_futures=True)
