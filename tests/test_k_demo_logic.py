@@ -100,7 +100,8 @@ def test_readout_says_K_in_red_at_or_above_the_limit():
 def test_verdict_says_K_limit_is_the_models_when_the_plant_differs():
     c = _comparison(0.5, 0.605, chatter=True, freq=162.0)
     c.derived.params.load = SimpleNamespace(J_L=2.0e-3)
-    assert chatter_verdict(c, plant_J_L=6.0e-3).text == "CHATTER 162 Hz (K < K_limit = 0.605, the model's (plant J_L ×3))"
+    want = "CHATTER 162 Hz (K < K_limit = 0.605, the model's (plant J_L ×3))"
+    assert chatter_verdict(c, plant_J_L=6.0e-3).text == want
     assert chatter_verdict(c, plant_J_L=2.0e-3).detail == "K < K_limit = 0.605"  # the plant is the model
 
 

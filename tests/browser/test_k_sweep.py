@@ -9,8 +9,10 @@ STATE_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout && e.layout.meta
                                                                       && e.layout.meta.id === 'k_sweep');
   if (!el || !el._fullData) return null;
-  const v = el._fullData.find(t => t.name === 'verdict'), tr = el._fullData.find(t => t.name === 'FDSMC trajectory');
-  return {frames: window.__appKSweepFrames, verdict: v.text[0], n: tr.x.length, y0: Array.from(tr.y).reduce((a, b) => a + b, 0),
+  const v = el._fullData.find(t => t.name === 'verdict');
+  const tr = el._fullData.find(t => t.name === 'FDSMC trajectory');
+  return {frames: window.__appKSweepFrames, verdict: v.text[0], n: tr.x.length,
+          y0: Array.from(tr.y).reduce((a, b) => a + b, 0),
           active: el._fullLayout.sliders[0].active, steps: el._fullLayout.sliders[0].steps.length};
 }"""
 #: Counts websocket frames the server sends from now on.
