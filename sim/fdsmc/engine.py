@@ -42,6 +42,7 @@ from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.grid import (
     CONTINUOUS_STEP_S,
     MAX_POINTS,
+    TimeGrid,
     check_budget,
     continuous_step,
     load_steps,
@@ -274,19 +275,29 @@ def _simulate_checked(
         tu = tuned(DRIVES["setpoints"], params, d)
         return tu.run if plant is None else simulate_stock(params, tu.loop, d, plant)
     g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
+    prm = pack_parameters(params, d, controller, plant, g.h * g.n_sub)
+    return run_packed(params, d, controller, g, prm, _reference(d, controller), _observer_arrays(d), plant)
+
+
+def run_packed(params: DriveParams, d: Derived, controller: str, g: TimeGrid, prm: np.ndarray, ref: np.ndarray,
+               observer: tuple[np.ndarray, np.ndarray, np.ndarray], plant: DriveParams | None) -> RunResult:
+    """Run the kernel on the grid ``g`` with the packed ``prm`` and return the run's trace and metrics.
+
+    ``ref`` is the kernel's reference or setpoint table, ``observer`` its discrete (Φ, Γ, L); the
+    sensors' noise, the load steps (of ``plant`` when given), the chatter windows and the metrics are
+    those of :func:`simulate`.
+    """
     T_step = g.h * g.n_sub
-    prm = pack_parameters(params, d, controller, plant, T_step)
     step_t, step_v = load_steps(params if plant is None else plant)
-    Phi, Gam, Lo = _observer_arrays(d)
     out = np.zeros((kn.N_CH, g.n_out))
     info = np.zeros(kn.N_INFO)
     windows = chatter_windows(params, d, controller, g.n_steps * T_step)
     steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
     win = np.zeros((kn.WIN_ROWS * len(steps), max(n for _, n in steps)))
-    kernel_run.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, g.continuous, g.h, g.n_steps, g.n_sub,
-                          params.controller.delay_samples, g.decim, out, info, k_win, win,
-                          _reference(d, controller), sensors.noise_table(params.sensors))
+    kernel_run.run_kernel(prm, step_t, step_v, *observer, g.continuous, g.h, g.n_steps, g.n_sub,
+                          params.controller.delay_samples, g.decim, out, info, k_win, win, ref,
+                          sensors.noise_table(params.sensors))
     summary = decode_info(info)
     trace = _trace(out[:, : summary.n_out])
     rows = kn.WIN_ROWS

@@ -24,13 +24,9 @@ from control.common.checks import ParameterError
 from control.fdsmc.derivations import Derived, derive
 from control.fdsmc.params import DriveParams
 from control.stock.loops import LAW_CASCADE, LAW_PID
-from sim.common import sensors
 from sim.fdsmc import kernel as kn
-from sim.fdsmc import kernel_run
-from sim.fdsmc.engine import RunResult, pack_parameters
-from sim.fdsmc.grid import check_budget, load_steps, time_grid
-from sim.fdsmc.metrics import WindowSamples, chatter_window_steps, chatter_windows, run_metrics
-from sim.fdsmc.summary import decode_info
+from sim.fdsmc.engine import RunResult, pack_parameters, run_packed
+from sim.fdsmc.grid import MAX_POINTS, check_budget, time_grid
 
 #: Position/speed laws by name.
 LAWS = {"cascade": LAW_CASCADE, "pid": LAW_PID}
@@ -127,34 +123,12 @@ def simulate_stock(params: DriveParams, loop: StockLoop, derived: Derived | None
     RunResult
         Controller ``"stock"``; never raises for an unstable run (``metrics.stable`` False).
     """
-    p = at_loop_rate(params, loop.f_loop)
+    p = at_loop_rate(params, loop.f_loop)  # its delay_samples = 1: the drive's one cycle of delay
     check_budget(p, 1)
     d = derive(params) if derived is None else derived
-    g = time_grid(p, 1, 0.0, 20000)
-    T_step = g.h * g.n_sub
-    prm = pack_parameters(params, d, "fdsmc", plant, T_step)  # the plant, sensors and limits
+    g = time_grid(p, 1, 0.0, MAX_POINTS)
+    prm = pack_parameters(params, d, "fdsmc", plant, g.h * g.n_sub)  # the plant, sensors and limits
     V_dc = params.controller.V_dc  # 0: no voltage limit
     pack_loop(prm, loop, V_dc / math.sqrt(3.0) if V_dc > 0.0 else math.inf, params.sensors.encoder_step)
-    step_t, step_v = load_steps(params if plant is None else plant)
-    out, info = np.zeros((kn.N_CH, g.n_out)), np.zeros(kn.N_INFO)
-    windows = chatter_windows(p, d, "stock", g.n_steps * T_step)
-    steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
-    k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
-    win = np.zeros((kn.WIN_ROWS * len(steps), max(n for _, n in steps)))
-    kernel_run.run_kernel(prm, step_t, step_v, np.zeros((4, 4)), np.zeros(4), np.zeros(4), False, g.h, g.n_steps,
-                          g.n_sub, 1, g.decim, out, info, k_win, win, np.ascontiguousarray(loop.table),
-                          sensors.noise_table(params.sensors))
-    return _result(params, d, out, info, windows, steps, win, plant, T_step)
-
-
-def _result(params, d, out, info, windows, steps, win, plant, T_step) -> RunResult:
-    """Return the run's trace and metrics from the kernel's buffers (as :func:`sim.fdsmc.engine.simulate`)."""
-    from sim.fdsmc.engine import _trace
-
-    summary = decode_info(info)
-    trace = _trace(out[:, : summary.n_out])
-    rows = kn.WIN_ROWS
-    samples = {name: WindowSamples(w, (k0 + np.arange(n)) * T_step, *win[rows * j: rows * (j + 1), :n])
-               for j, ((name, w), (k0, n)) in enumerate(zip(windows.items(), steps, strict=True))}
-    met = run_metrics(params, d, "stock", trace.t, trace.theta_r, samples, summary, plant, T_step=T_step)
-    return RunResult("stock", trace, met)
+    no_observer = (np.zeros((4, 4)), np.zeros(4), np.zeros(4))
+    return run_packed(p, d, "stock", g, prm, np.ascontiguousarray(loop.table), no_observer, plant)

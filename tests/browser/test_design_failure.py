@@ -13,29 +13,22 @@ from typing import Any
 
 import pytest
 
-from tests.browser.conftest import UiServer, open_page, set_number
-from tests.net import free_port
+from tests.browser.conftest import UiServer, set_number
+from tests.browser.preset_server import preset_page, preset_server
 
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[UiServer]:
-    from app.io.presets import DEFAULT_PRESET, load_preset
-    from app.ui.page import create_server
+    from app.io.presets import DEFAULT_PRESET
 
-    srv, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(), scene_3d=False)
-    try:
-        yield UiServer(f"http://127.0.0.1:{srv.get_port()}", srv, config)
-    finally:
-        srv.stop()
+    with preset_server(DEFAULT_PRESET) as srv:
+        yield srv
 
 
 @pytest.fixture
 def page(browser: Any, server: UiServer) -> Iterator[Any]:
-    context, pg = open_page(browser, server)
-    try:
+    with preset_page(browser, server) as pg:
         yield pg
-    finally:
-        context.close()
 
 
 def test_failing_design_after_a_good_run_marks_results_stale_and_shows_the_diagnosis(page):

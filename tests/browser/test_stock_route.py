@@ -7,8 +7,8 @@ from typing import Any
 
 import pytest
 
-from tests.browser.conftest import UiServer, click_tab, figure, open_page
-from tests.net import free_port
+from tests.browser.conftest import UiServer, click_tab, figure
+from tests.browser.preset_server import preset_page, preset_server
 
 STOCK_FIGURE_DRAWN = ("() => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta "
                       "&& e.layout.meta.id === 'stock_route' && e._fullData && e._fullData.length >= 6)")
@@ -16,24 +16,14 @@ STOCK_FIGURE_DRAWN = ("() => [...document.querySelectorAll('.js-plotly-plot')].s
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[UiServer]:
-    from app.io.presets import load_preset
-    from app.ui.page import create_server
-
-    srv, config = create_server(load_preset("yaskawa_sgm7j_04a"), "yaskawa_sgm7j_04a", port=free_port(),
-                                scene_3d=False)
-    try:
-        yield UiServer(f"http://127.0.0.1:{srv.get_port()}", srv, config)
-    finally:
-        srv.stop()
+    with preset_server("yaskawa_sgm7j_04a") as srv:
+        yield srv
 
 
 @pytest.fixture
 def page(browser: Any, server: UiServer) -> Iterator[Any]:
-    context, pg = open_page(browser, server)
-    try:
+    with preset_page(browser, server) as pg:
         yield pg
-    finally:
-        context.close()
 
 
 def test_stock_drive_tab_draws_the_route_and_its_verdicts(page):
