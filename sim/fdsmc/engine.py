@@ -62,7 +62,7 @@ CONTROLLERS = ("fdsmc", "conventional")
 #: (:mod:`control.fdsmc.optimum`); the kernel's P_CTRL is the index in this tuple.
 COMPARATORS = CONTROLLERS + ("optimum", "stock")
 #: The name each simulated outer loop goes by in messages, tables and figures.
-LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum", "stock": "Stock trapezoid"}
+LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum", "stock": "Stock drive"}
 #: The kernel's outer law (P_CTRL) of each comparator on the FDC inner loops; the stock drive runs its own
 #: loops instead (P_CTRL = 4, :mod:`sim.stock.route`).
 KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 3.0}
