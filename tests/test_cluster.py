@@ -11,12 +11,14 @@ import contextlib
 import json
 import os
 import pathlib
+import re
 import shutil
 import signal
 import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterator
 
 import psutil
 import pytest
@@ -27,6 +29,7 @@ from app.io.sample_table import read_parquet
 from app.io.study_inputs import parse_spreads
 from control.fdsmc.derivations import derive
 from sim.studies.robustness import METRICS, draw, simulate_chunk
+from tests.child_signals import default_signals
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PRESET = "paper_12kw_pmsm"
@@ -34,35 +37,61 @@ SPREAD = "plant.J_L=0:0.3,plant.R_s=±20%,plant.psi_pm=±10%"
 START_S = 120.0
 
 
-class Cluster:
-    """A scheduler and its workers as subprocesses; every process is ended by ``close``."""
+#: ``python -m dask scheduler …`` on loopback, writing its address to ``{file}``.
+SCHEDULER = ["-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard", "--scheduler-file",
+             "{file}"]
 
-    def __init__(self, tmp: pathlib.Path, pythonpath: pathlib.Path = ROOT) -> None:
-        self.tmp, self.procs, self.workers = tmp, [], []
+
+def read_scheduler_file(file: pathlib.Path, proc: subprocess.Popen, timeout_s: float) -> str:
+    """Poll until the scheduler file parses and holds an address (the scheduler writes it in pieces:
+    a missing or half-written file means "not yet"); fail when the scheduler exited or time is up.
+    """
+    deadline = time.monotonic() + timeout_s
+    while True:
+        with contextlib.suppress(OSError, ValueError, KeyError, TypeError):  # JSONDecodeError is a ValueError
+            return str(json.loads(file.read_text(encoding="utf-8"))["address"])
+        assert proc.poll() is None, f"the scheduler exited ({proc.returncode}) before writing {file.name}"
+        assert time.monotonic() < deadline, f"{file.name} not complete within {timeout_s:g} s"
+        time.sleep(0.1)  # poll again (a positive condition)
+
+
+class Cluster:
+    """A scheduler and its workers as subprocesses; every process is ended by ``close``.
+
+    ``scheduler`` is the scheduler's command after the interpreter (``{file}``: the scheduler file).
+    Use :func:`running_cluster`, which ends everything it started whatever fails.
+    """
+
+    def __init__(self, tmp: pathlib.Path, scheduler: list[str] | None = None, start_s: float = START_S) -> None:
+        self.tmp, self.procs, self.workers, self.address, self.start_s = tmp, [], [], "", start_s
         self.env = {**os.environ, "PYTHONPATH": str(ROOT),
                     "NUMBA_CACHE_DIR": os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache"))}
         self.file = tmp / "scheduler.json"
-        self._spawn("scheduler", ["scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                                  "--scheduler-file", str(self.file)], self.env)
-        deadline = time.monotonic() + START_S
-        while not self.file.exists() and time.monotonic() < deadline:
-            time.sleep(0.2)
-        self.address = json.loads(self.file.read_text(encoding="utf-8"))["address"]
+        self.scheduler = [a.replace("{file}", str(self.file)) for a in (scheduler or SCHEDULER)]
+        self.logs: list = []
+
+    def start(self) -> None:
+        """Start the scheduler and wait for its complete scheduler file."""
+        proc = self._spawn("scheduler", self.scheduler, self.env)
+        self.address = read_scheduler_file(self.file, proc, self.start_s)
 
     def _spawn(self, name: str, args: list[str], env: dict[str, str]) -> subprocess.Popen:
-        log = open(self.tmp / f"{name}.log", "w", encoding="utf-8")  # noqa: SIM115 — closed with the process
-        p = subprocess.Popen([sys.executable, "-m", "dask", *args], stdout=log, stderr=log, env=env, cwd=self.tmp)
+        log = open(self.tmp / f"{name}.log", "w", encoding="utf-8")  # noqa: SIM115 — closed by close()
+        self.logs.append(log)
+        p = subprocess.Popen([sys.executable, *args], stdout=log, stderr=log, env=env, cwd=self.tmp,
+                             preexec_fn=default_signals)
         self.procs.append(p)
         return p
 
     def add_worker(self, pythonpath: pathlib.Path = ROOT) -> None:
         """Start one ``dask worker`` (a nanny and its worker process) and wait until it registered."""
         name = f"worker{len(self.workers)}"
-        self.workers.append(self._spawn(name, ["worker", "--scheduler-file", str(self.file), "--nthreads", "1",
-                                               "--no-dashboard", "--host", "127.0.0.1"],
+        self.workers.append(self._spawn(name, ["-m", "dask", "worker", "--scheduler-file", str(self.file),
+                                               "--nthreads", "1", "--no-dashboard", "--host", "127.0.0.1"],
                                         {**self.env, "PYTHONPATH": str(pythonpath)}))
         deadline = time.monotonic() + START_S
         while "Registered to" not in (self.tmp / f"{name}.log").read_text(encoding="utf-8"):
+            assert self.workers[-1].poll() is None, f"{name} exited ({self.workers[-1].returncode})"
             assert time.monotonic() < deadline, f"{name} did not start"
             time.sleep(0.2)
 
@@ -79,31 +108,94 @@ class Cluster:
             for child in kids:
                 child.send_signal(signal.SIGKILL)
 
+    def tree(self) -> list[psutil.Process]:
+        """Every process started here that still runs, with its descendants."""
+        found = []
+        for p in self.procs:
+            with contextlib.suppress(psutil.NoSuchProcess):
+                if p.poll() is None:
+                    root = psutil.Process(p.pid)
+                    found += [root, *root.children(recursive=True)]
+        return found
+
     def close(self) -> None:
         """Stop the cluster: SIGTERM, then (test clean-up, not under test) SIGKILL what is left after 2 s."""
-        tree = []
-        for p in reversed(self.procs):
-            if p.poll() is None:
-                with contextlib.suppress(psutil.NoSuchProcess):
-                    tree += psutil.Process(p.pid).children(recursive=True)
-                p.terminate()
-        _, alive = psutil.wait_procs([psutil.Process(p.pid) for p in self.procs if p.poll() is None] + tree, timeout=2)
+        tree = self.tree()
+        for q in tree:
+            with contextlib.suppress(psutil.NoSuchProcess):
+                q.terminate()
+        _, alive = psutil.wait_procs(tree, timeout=2)
         for q in alive:
             with contextlib.suppress(psutil.NoSuchProcess):
                 q.kill()
+        psutil.wait_procs(alive, timeout=5)
         for p in self.procs:
             p.wait()
+        for log in self.logs:
+            log.close()
+
+
+@contextlib.contextmanager
+def running_cluster(tmp: pathlib.Path, workers: int, pythonpath: pathlib.Path = ROOT,
+                    scheduler: list[str] | None = None, start_s: float = START_S) -> Iterator[Cluster]:
+    """A started cluster of ``workers`` workers; everything started is ended on leaving, whatever failed."""
+    c = Cluster(tmp, scheduler, start_s)
+    try:
+        c.start()
+        for _ in range(workers):
+            c.add_worker(pythonpath)
+        yield c
+    finally:
+        c.close()
 
 
 @pytest.fixture
 def cluster(tmp_path):
-    c = Cluster(tmp_path)
-    try:
-        c.add_worker()
-        c.add_worker()
+    with running_cluster(tmp_path, 2) as c:
         yield c
-    finally:
-        c.close()
+
+
+#: A scheduler that writes its file in two pieces ``argv[2]`` s apart (``argv[2]`` "exit": half, then exit 3)
+#: and otherwise runs on with a process of its own, as a slow ``dask scheduler`` start on a loaded machine
+#: does; ``pids`` beside the file names the processes.
+_SLOW_SCHEDULER = """
+import json, os, pathlib, subprocess, sys, time
+file, pids = pathlib.Path(sys.argv[1]), [os.getpid()]
+if sys.argv[2] != "exit":
+    pids.append(subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"]).pid)
+(file.parent / "pids").write_text(" ".join(map(str, pids)))
+text = json.dumps({"address": "tcp://127.0.0.1:1", "type": "Scheduler"})
+with open(file, "w", encoding="utf-8") as fh:
+    fh.write(text[:12])
+    fh.flush()
+    if sys.argv[2] == "exit":
+        sys.exit(3)
+    time.sleep(float(sys.argv[2]))
+    fh.write(text[12:])
+time.sleep(120)
+"""
+
+
+def _running(pid: int) -> bool:
+    with contextlib.suppress(psutil.NoSuchProcess):
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    return False
+
+
+@pytest.mark.parametrize(("second_half", "start_s", "error"), [
+    ("1.0", START_S, None),
+    ("exit", START_S, "the scheduler exited (3) before writing scheduler.json"),
+    ("30", 1.0, "scheduler.json not complete within 1 s"),
+], ids=["slow start", "exits half-written", "never complete"])
+def test_the_cluster_waits_for_a_complete_scheduler_file_and_always_cleans_up(tmp_path, second_half, start_s, error):
+    fake = ["-c", _SLOW_SCHEDULER, "{file}", second_half]
+    with contextlib.ExitStack() as stack:
+        if error:
+            stack.enter_context(pytest.raises(AssertionError, match=re.escape(error)))
+        c = stack.enter_context(running_cluster(tmp_path, 0, scheduler=fake, start_s=start_s))
+        assert c.address == "tcp://127.0.0.1:1" and len(c.tree()) == 2  # the scheduler and its own process
+    pids = [int(p) for p in (tmp_path / "pids").read_text().split()]
+    assert len(pids) == (1 if second_half == "exit" else 2) and not any(_running(pid) for pid in pids)
 
 
 class CliRun:
@@ -114,7 +206,7 @@ class CliRun:
         self.p = subprocess.Popen([sys.executable, "-m", "app", "robustness", PRESET, "--samples", str(samples),
                                    "--spread", SPREAD, "--seed", "9", "--scheduler", address, "--parquet",
                                    str(parquet), "--json", *extra], stdout=subprocess.PIPE,
-                                  stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
+                                  stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env, preexec_fn=default_signals)
         self.err = ""
         self._reader = threading.Thread(target=self._read, daemon=True)
         self._reader.start()
@@ -203,12 +295,8 @@ def test_a_worker_with_other_source_is_refused_by_name(tmp_path):
         shutil.copytree(ROOT / pkg, other / pkg, ignore=shutil.ignore_patterns("__pycache__"))
     with open(other / "sim" / "studies" / "batch.py", "a", encoding="utf-8") as fh:
         fh.write("# another version\n")
-    c = Cluster(tmp_path)
-    try:
-        c.add_worker(pythonpath=other)
+    with running_cluster(tmp_path, 1, pythonpath=other) as c:
         rc, out, err = CliRun(c.address, 10, tmp_path / "r.parquet").finish()
-    finally:
-        c.close()
     assert rc == 2 and out == ""
     line = err.strip().splitlines()[-1]
     assert line.startswith(f"error: the Dask cluster at {c.address} is refused: worker tcp://127.0.0.1:")
