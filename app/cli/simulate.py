@@ -7,15 +7,18 @@ import json
 from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
+from app.io.assumed import assumptions
 from app.io.atomic import write_atomic_text
+from app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
 from app.io.derived_view import derived_json
 from app.io.json_data import to_json
 from app.io.numbers import format_metric
 from app.io.plant_overrides import load_model_and_plant
+from app.io.presets import load_raw
 from app.io.stock_view import stock_json, stock_lines
 from control.common.checks import ParameterError
 from sim.fdsmc.engine import COMPARATORS, LABELS, Comparison, compare
-from sim.fdsmc.optimum_gap import saving_vs_optimum
+from sim.fdsmc.optimum_gap import DRAWN_BASIS, saving_vs_optimum
 from sim.fdsmc.recommend import recommend, runs_of
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
@@ -28,6 +31,8 @@ SUMMARY = (
     ("friction_total_J", "Friction loss, whole run", "J"),
     ("copper_total_J", "Copper loss, whole run", "J"),
     ("electrical_in_total_J", "Net electrical input, whole run", "J"),
+    ("motoring_total_J", "Drawn from the DC link, whole run", "J"),
+    ("regenerated_total_J", "Returned to the DC link, whole run", "J"),
     ("energy_balance_residual_J", "Energy-balance residual", "J"),
     ("t_2pct_first_s", "First entry into the 2 % band", "s"),
     ("t_2pct_settle_s", "2 % settling time", "s"),
@@ -71,18 +76,50 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
         for run in (cmp.fdsmc, cmp.conventional, cmp.stock):
             if run is not None:
                 out[run.controller]["saving_vs_optimum_pct"] = saving_vs_optimum(run, cmp.optimum)
+                out[run.controller]["saving_vs_optimum_drawn_pct"] = saving_vs_optimum(run, cmp.optimum, DRAWN_BASIS)
     rec = recommend(cmp.derived.params, cmp)
     for e in rec.energies:
         out[e.controller]["net_electrical_J"] = e.net_electrical_J
         out[e.controller]["checks_failed"] = list(e.failed)
+        out[e.controller]["dc_link"] = dc_link_json(e)
     out["recommended"] = {"controller": rec.controller, "why": rec.why}
+    out["energy_basis"] = ENERGY_BASIS
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
+    out["saving_electrical_drawn_pct"] = _drawn_saving(cmp)
+    if (tr := transmission_json(cmp.derived.params)) is not None:
+        out["transmission"] = tr
+        for run in runs_of(cmp):
+            out[run.controller]["at_output"] = run_at_output(run.metrics, cmp.derived.params)
     out["run_warnings"] = run_warnings(cmp)
     out["comparator_notes"] = comparator_notes(cmp)
     if cmp.stock is not None:
         out["stock"].update(stock_json(cmp))
     return to_json(out)
+
+
+#: Which energy the savings, the optimum gap and the recommendation use (said in every output).
+ENERGY_BASIS = ("net electrical input over the whole run (drawn − returned: a DC link that takes the regenerated "
+                "energy back); with a braking resistor the supply delivers dc_link.drawn_J "
+                "(*_drawn_pct savings use it)")
+
+
+def dc_link_json(e: Any) -> dict[str, float]:
+    """Return a run's energies at the DC link [J].
+
+    Drawn ∫max(p, 0) dt, returned (regenerated), net, and the supply's energy with a braking resistor
+    (= drawn: the regenerated energy is burnt).
+    """
+    return {"drawn_J": e.drawn_J, "returned_J": e.returned_J, "net_J": e.net_electrical_J,
+            "braking_resistor_supply_J": e.drawn_J}
+
+
+def _drawn_saving(cmp: Comparison) -> float | None:
+    """FDSMC's saving over the conventional comparator on the energy drawn from the DC link [%]."""
+    if cmp.saving_electrical_pct is None or cmp.fdsmc is None or cmp.conventional is None:
+        return None
+    a, b = cmp.fdsmc.metrics.motoring_total_J, cmp.conventional.metrics.motoring_total_J
+    return None if a is None or not b else 100.0 * (1.0 - a / b)
 
 
 def write_csv(path: str, cmp: Comparison) -> None:
@@ -105,6 +142,9 @@ def print_summary(cmp: Comparison) -> None:
     print("Net electrical input, whole run: " + ", ".join(
         f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J (copper {e.copper_J:.3g}, friction {e.friction_J:.3g})"
         for e in rec.energies))
+    print("Drawn from the DC link (the supply's energy with a braking resistor) / returned, whole run: " + ", ".join(
+        f"{LABELS[e.controller]} {e.drawn_J:.4g} / {e.returned_J:.4g} J" for e in rec.energies))
+    print("Savings and the recommendation use the net electrical input (regenerative DC link).")
     print(f"Recommended: {LABELS.get(rec.controller or '', 'none')}. {rec.why}\n")
     print(f"{'':40s}" + "".join(f"{r.controller:>16s}" for r in runs))
     for key, label, unit in SUMMARY:
@@ -117,9 +157,15 @@ def print_summary(cmp: Comparison) -> None:
         print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
     for run in (cmp.fdsmc, cmp.conventional):
         gap = saving_vs_optimum(run, cmp.optimum)
+        drawn = saving_vs_optimum(run, cmp.optimum, DRAWN_BASIS)
         if run is not None and gap is not None:
             print(f"The tracked minimum-energy optimum would save {gap:.2f} % of the {run.controller}'s "
-                  "net electrical input (whole run)")
+                  f"net electrical input (whole run), {format_metric(drawn)} % of the energy it draws from the DC link")
+    for line in transmission_lines(p):
+        print(line)
+    if transmission_lines(p):
+        for r in runs:
+            print("  " + run_line(r.controller, r.metrics, p))
     if cmp.stock is not None:
         print("\n" + "\n".join(stock_lines(cmp)))
     for w in run_warnings(cmp) + list(cmp.derived.warnings) + comparator_notes(cmp):
@@ -136,8 +182,12 @@ def run(args: argparse.Namespace) -> int:
     cmp = compare(params, ctrls, plant=plant)
     if args.csv:
         write_csv(args.csv, cmp)
+    assumed = assumptions(load_raw(args.preset), params, tuple(args.overrides), params.name)
     if args.json:
-        print(json.dumps(comparison_json(cmp), indent=2, ensure_ascii=False, allow_nan=False))
+        out = comparison_json(cmp) | {"assumptions": to_json(assumed.to_json())}
+        print(json.dumps(out, indent=2, ensure_ascii=False, allow_nan=False))
     else:
         print_summary(cmp)
+        for line in assumed.lines():
+            print(f"  ! {line}")
     return 0

@@ -146,18 +146,19 @@ CSV_COLUMNS = (
 
 
 def trace_csv(cmp: Comparison) -> str:
-    """Time series of both runs as one CSV table (the format of the page and ``simulate --csv``).
+    """Time series of every simulated run as one CSV table (the format of the page and ``simulate --csv``).
 
     One column per signal with its unit in the header (``theta_r [rad]``), a first ``controller``
-    column, one row per controller and sample (SI units, ``%.9g``): ``pandas.read_csv`` gives typed
-    columns directly (``df.groupby("controller")``), Excel filters on the first column.
+    column (``fdsmc``, ``conventional``, ``optimum``, ``stock``: every run the case holds), one row per
+    controller and sample (SI units, ``%.9g``): ``pandas.read_csv`` gives typed columns directly
+    (``df.groupby("controller")``), Excel filters on the first column.
 
     Raises
     ------
     ParameterError
         When there is no run (an infeasible manoeuvre).
     """
-    runs = [r for r in (cmp.fdsmc, cmp.conventional) if r is not None]
+    runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock) if r is not None]
     if not runs:
         raise ParameterError("nothing to export as CSV: there is no simulated run "
                              f"(manoeuvre.T_m = {cmp.derived.params.manoeuvre.T_m:g} s is infeasible)")

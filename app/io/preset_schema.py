@@ -16,11 +16,12 @@ import types
 import typing
 from typing import Any
 
-from app.io import units
+from app.io import motor_defaults, transmission_keys, units
 from app.io.modes import MODES as _MODES
 from app.io.numbers import NumberFormatError, parse_integer, parse_number, shorten, shown
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
+from control.fdsmc.transmission import Transmission
 
 SCHEMA = 2
 #: Schemas read: 1 (inputs only) is migrated to 2 (adds the informational export sections).
@@ -32,7 +33,7 @@ PLANT = "plant"
 PLANT_SECTIONS = ("motor", "load")
 #: Top-level keys an exported drive parameter file adds; informational, ignored on import (the
 #: gains are recomputed from the inputs).
-_EXPORT_KEYS = ("exported_by", "units", "drive_gains", "verdicts", "results")
+_EXPORT_KEYS = ("exported_by", "units", "drive_gains", "verdicts", "results", "inherited")
 
 #: Parameter dataclass per preset mode: a view of the one registry :mod:`app.io.modes`.
 MODES: dict[str, type] = dict(_MODES)
@@ -134,7 +135,7 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
                 raise PresetError(f"{section}.{key} needs a valid {section}.p (pole pairs) beside it")
             values[target] = units.FLUX_KEYS[key](ke, p)
         else:
-            raise PresetError(f"unknown key {shorten(f'{section}.{key}')}{hint(key, allowed)}")
+            raise PresetError(f"unknown key {shorten(f'{section}.{key}')}{key_hint(key, allowed)}")
         if sum(1 for k in raw if field_of(str(k), aliases, extra) == target) > 1:
             raise PresetError(f"{section}.{target} is given more than once (SI and unit-suffixed forms)")
     missing = [
@@ -145,6 +146,37 @@ def _parse_section(cls: type, raw: Any, section: str) -> Any:
     if missing:
         raise PresetError(f"missing key(s) in {section}: {', '.join(missing)}")
     return cls(**values)
+
+
+def key_hint(key: str, allowed: list[str]) -> str:
+    """Return :func:`hint`, except near a flux key: then every flux key with its unit, never one guess.
+
+    The flux keys differ by their unit only (Kt per A rms or per A peak, Ke rms or peak): pointing
+    a per-A-peak value at the rms key would make Ψ_PM √2 too small.
+    """
+    close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.5)
+    if close and close[0] in units.FLUX_KEY_MEANING:
+        keys = ", ".join(f"{k} [{m}]" for k, m in units.FLUX_KEY_MEANING.items())
+        return f" — flux keys: {keys}"
+    return hint(key, allowed)
+
+
+def position_edge(raw: dict[str, Any]) -> tuple[dict[str, Any], tuple[str, ...]]:
+    """Return (``raw`` with load-side keys reflected to the rotor, the motor fields to derive).
+
+    Load-side keys (:mod:`app.io.transmission_keys`) are converted with the preset's transmission;
+    absent or ``derived`` rated values (:mod:`app.io.motor_defaults`) get a stand-in, replaced by
+    :func:`~app.io.motor_defaults.derive_motor` once the controller section is validated.
+    """
+    fields = motor_defaults.derived_fields(raw)
+    raw = motor_defaults.with_placeholders(raw, fields)
+    if transmission_keys.output_keys_in(raw):
+        tr = _parse_section(Transmission, raw.get("transmission", {}), "transmission")
+        try:
+            raw = transmission_keys.to_motor_side(raw, tr, lambda name, v: number_of(name, v, float))
+        except ValueError as exc:
+            raise PresetError(str(exc)) from None
+    return raw, fields
 
 
 def field_of(key: str, aliases: dict[str, units.Alias], extra: list[str]) -> str:
@@ -175,6 +207,9 @@ def parse_preset(raw: Any) -> Any:
     for key in raw:
         if key not in allowed:
             raise PresetError(f"unknown top-level key {shown(key)}{hint(str(key), allowed)}")
+    derived: tuple[str, ...] = ()
+    if cls is DriveParams:
+        raw, derived = position_edge(raw)
     hints = typing.get_type_hints(cls)
     kwargs: dict[str, Any] = {}
     optional = optional_sections(cls)
@@ -189,6 +224,11 @@ def parse_preset(raw: Any) -> Any:
             raise PresetError(f"missing key {key!r}: every preset names itself and its source")
         kwargs[key] = _coerce(key, raw[key], str)
     _check_units(raw.get("units"), sections)
+    if derived:
+        try:
+            kwargs["motor"] = motor_defaults.derive_motor(kwargs["motor"], kwargs["controller"], derived)
+        except ParameterError as exc:
+            raise PresetError(str(exc)) from None
     params = cls(**kwargs)
     if cls is DriveParams:
         parse_plant(raw, params)  # validated with the rest of the file, even where only the model is used

@@ -41,6 +41,7 @@ from app.io.preset_schema import (
     plain,
     plant_raw,
 )
+from app.io.transmission_keys import as_aliases
 from app.io.yaml_text import dumps, loads_any_raw, loads_raw, plain_scalar
 from app.resources import preset_dir
 from control.common.checks import field_specs
@@ -73,7 +74,7 @@ def apply_overrides(raw: Any, overrides: typing.Iterable[str]) -> Any:
         value = plain_scalar(text, f"--set {key}") if text.strip() else None
         if value is None:
             raise PresetError(f"--set {shown(item)} has no value: allowed section.field=value, e.g. manoeuvre.T_m=1.4")
-        aliases = units.ALIASES.get(section, {}) if section != PLANT else (
+        aliases = units.ALIASES.get(section, {}) | as_aliases(section) if section != PLANT else (
             units.ALIASES["motor"] | units.ALIASES["load"])
         target = field_of(name, aliases, list(units.FLUX_KEYS))
         for other in [k for k in raw[section] if field_of(str(k), aliases, list(units.FLUX_KEYS)) == target]:

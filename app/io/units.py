@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from app.io.modes import MODE_CLASSES as _MODE_CLASSES
-from control.common.checks import FieldSpec, field_specs, range_text
+from control.common.checks import FieldSpec, ParameterError, field_specs, range_text
 
 
 def rpm_to_rad_s(n_rpm: float) -> float:
@@ -154,6 +154,8 @@ CONVERSIONS: dict[str, tuple[Callable[[float], float], Callable[[float], float]]
     "deg": (deg_to_rad, rad_to_deg),
     "rev": (rev_to_rad, rad_to_rev),
     "kg·cm²": (kgcm2_to_kgm2, kgm2_to_kgcm2),
+    "mm": (lambda x_mm: x_mm * 1e-3, lambda x: x * 1e3),
+    "µm": (lambda x_um: x_um * 1e-6, lambda x: x * 1e6),
     # a datasheet's rms current for a field that holds the amplitude (controller.i_max_Arms)
     "Arms": (arms_to_amplitude, amplitude_to_arms),
     # a field that already holds an rms value in A (sensors.i_noise_A_rms): the suffix only states it
@@ -163,7 +165,7 @@ CONVERSIONS: dict[str, tuple[Callable[[float], float], Callable[[float], float]]
     "mH LL": (lambda L_LL_mH: mH_to_H(L_LL_mH) / 2.0, lambda L: 2.0 * H_to_mH(L)),
 }
 #: Key suffix of a unit whose name is not an identifier (``J_r_kgcm2``).
-KEY_SUFFIX = {"kg·cm²": "kgcm2", "Ω LL": "LL_Ohm", "mH LL": "LL_mH"}
+KEY_SUFFIX = {"kg·cm²": "kgcm2", "Ω LL": "LL_Ohm", "mH LL": "LL_mH", "µm": "um"}
 
 
 def to_si(x: float, unit: str) -> float:
@@ -181,6 +183,25 @@ def alias_key(name: str, unit: str) -> str:
     return f"{name}_{KEY_SUFFIX.get(unit, unit)}"
 
 
+def _bandwidth(factor: float, unit: str) -> Callable[[float], float]:
+    """Return the converter current-loop bandwidth → T_si = 3/ω_c (eq. (8) of [1]: the d-current pole is 3/T_si)."""
+    def convert(x: float) -> float:
+        omega_c = x * factor
+        if not 0.3 <= omega_c <= 3e6:  # T_si's range 1e-6 … 10 s
+            raise ParameterError(f"controller.current_bandwidth_{unit.replace('/', '_')} = {x!r} {unit} is out of "
+                                 f"range: allowed {0.3 / factor:.4g} ≤ value ≤ {3e6 / factor:.4g} {unit} "
+                                 "(T_si = 3/ω_c, eq. (8))")
+        return 3.0 / omega_c
+    return convert
+
+
+#: Keys that give T_si as the drive's current-loop bandwidth ω_c (rad/s or Hz): T_si = 3/ω_c.
+BANDWIDTH_KEYS: dict[str, Alias] = {
+    "current_bandwidth_rad_s": Alias("T_si", _bandwidth(1.0, "rad/s"), "rad/s"),
+    "current_bandwidth_Hz": Alias("T_si", _bandwidth(2.0 * math.pi, "Hz"), "Hz"),
+}
+
+
 def aliases_of(cls: type) -> dict[str, Alias]:
     """Unit-suffixed keys of a parameter dataclass, from its field specs.
 
@@ -192,6 +213,8 @@ def aliases_of(cls: type) -> dict[str, Alias]:
     for name, spec in field_specs(cls).items():
         if spec.unit.isidentifier():
             table.setdefault(alias_key(name, spec.unit), Alias(name, _identity, spec.unit))
+    if "T_si" in field_specs(cls):
+        table.update(BANDWIDTH_KEYS)
     return table
 
 
@@ -271,7 +294,29 @@ FLUX_KEYS: dict[str, Callable[[float, int], float]] = {
     "Ke_ph_Vpk_krpm": lambda x, p: ke_vrms_krpm_to_psi_pm(x * math.sqrt(1.5), p),
     "Kv_rpm_per_V": lambda x, p: kv_rpm_per_v_to_psi_pm(x, p),
     "Kt_Nm_per_Arms": lambda x, p: kt_nm_per_arms_to_psi_pm(x, p),
+    # per A of phase-current amplitude, the dq amplitude-invariant scale (ODrive's torque_constant,
+    # moteus and VESC quote it so): Kt = (3/2)·p·Ψ_PM; Kt_Nm_per_A is the same, as those vendors write it
+    "Kt_Nm_per_Apeak": lambda x, p: kt_nm_per_apeak_to_psi_pm(x, p),
+    "Kt_Nm_per_A": lambda x, p: kt_nm_per_apeak_to_psi_pm(x, p),
 }
+#: What each flux key means, for the loader's hint when a flux key is misspelt (never one other key,
+#: which could be of another unit: a per-A-peak value typed under the rms key is 41 % off).
+FLUX_KEY_MEANING = {
+    "psi_pm": "Wb", KE_KEY: "V/krpm LL rms", "Ke_Vpk_krpm": "LL peak", "Ke_ph_Vrms_krpm": "phase rms",
+    "Ke_ph_Vpk_krpm": "phase peak", "Kv_rpm_per_V": "rpm/V", "Kt_Nm_per_Arms": "N·m/A rms",
+    "Kt_Nm_per_Apeak": "N·m/A peak", "Kt_Nm_per_A": "peak, as ODrive quotes it",
+}
+
+
+def kt_nm_per_apeak_to_psi_pm(Kt_Nm_Apk: float, p: int) -> float:
+    """Torque constant Kt [N·m per A of phase-current amplitude] → Ψ_PM [Wb] (amplitude-invariant dq).
+
+    Γ = (3/2)·p·Ψ_PM·i_q with i_q the phase-current amplitude (eq. (5) in [1]), so Ψ_PM = Kt/(1.5·p).
+    ODrive's torque_constant 8.27/Kv is this Kt (e.g. the D5065: 8.27/270 = 0.0306 N·m/A).
+    """
+    return Kt_Nm_Apk / (1.5 * p)
+
+
 
 def kt_nm_per_arms_to_psi_pm(Kt_Nm_Arms: float, p: int) -> float:
     """Torque constant Kt [N·m per A_rms] → Ψ_PM [Wb] (amplitude-invariant dq, i_d = 0).

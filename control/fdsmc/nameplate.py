@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from control.common.checks import ParameterError
 from control.fdsmc.model import available_voltage
 from control.fdsmc.params import Motor
 
@@ -103,4 +104,35 @@ def _rated_voltage(motor: Motor, torque: float) -> float:
     return math.hypot(motor.R_s * i_q + w_e * motor.psi_pm, w_e * motor.L_q * i_q)
 
 
-__all__ = ["NAMEPLATE_TOLERANCE", "Disagreement", "emf_at_rated_speed", "kt_from_psi", "nameplate_consistency"]
+def rated_from_inverter(motor: Motor, V_dc: float, i_max: float) -> tuple[float, float, float]:
+    """Rated values a robotics datasheet lacks, derived from the inverter: (V_0 [V], P_r [W], ω_b [rad/s]).
+
+    * V_0 = V_dc/√2: the largest line-to-line rms voltage of a space-vector modulated inverter
+      (√(2/3)·V_0 = V_dc/√3, the dq voltage limit of eqs. (1)–(2) in [1]);
+    * ω_b: the speed at which the steady voltage for the peak torque at i_d = 0,
+      |u_dq| = √((R_s·i + p·ω·Ψ_PM)² + (p·ω·L_q·i)²) from eqs. (1)–(2), reaches V_dc/√3, with
+      i = min(i_max, Γ_max/k_t) and k_t = 3·p·Ψ_PM/2 (eq. (5));
+    * P_r = Γ_lim·ω_b with Γ_lim = k_t·i (the peak-torque power at that speed; not a thermal rating).
+
+    Raises
+    ------
+    ParameterError
+        Without a DC link (V_dc = 0), or when R_s·i alone exceeds V_dc/√3.
+    """
+    if V_dc <= 0.0:
+        raise ParameterError(f"controller.V_dc = {V_dc!r} V is out of range for derived rated values: "
+                             "allowed > 0 V (or give motor.V_0, motor.P_r and motor.omega_b)")
+    k_t = 1.5 * motor.p * motor.psi_pm
+    i = min(i_max if i_max > 0.0 else math.inf, motor.Gamma_max / k_t)
+    u_max, a, b = V_dc / math.sqrt(3.0), motor.p * motor.psi_pm, motor.p * motor.L_q * i
+    drop = motor.R_s * i
+    if drop >= u_max:
+        raise ParameterError(f"motor.R_s = {motor.R_s!r} Ω drops {drop:.4g} V at {i:.4g} A: allowed < V_dc/√3 = "
+                             f"{u_max:.4g} V to derive the rated speed (or give motor.omega_b)")
+    c2 = a * a + b * b
+    omega_b = (-drop * a + math.sqrt((drop * a) ** 2 - c2 * (drop * drop - u_max * u_max))) / c2
+    return V_dc / math.sqrt(2.0), k_t * i * omega_b, omega_b
+
+
+__all__ = ["NAMEPLATE_TOLERANCE", "Disagreement", "emf_at_rated_speed", "kt_from_psi", "nameplate_consistency",
+           "rated_from_inverter"]

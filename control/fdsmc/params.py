@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 from control.common.checks import ParameterError, check_fields, spec_field
+from control.fdsmc.transmission import Transmission
 
 ALPHA_MAX_RULES = ("paper", "torque_limit", "min_energy")
 
@@ -310,14 +311,16 @@ class Limits:
 
 
 __all__ = ["ALPHA_MAX_RULES", "ENCODER_CPR_MAX", "Controller", "DriveParams", "Limits", "Load", "LoadStep",
-           "Manoeuvre", "Motor", "ParameterError", "Sensors", "T_MIN_S", "THETA_DEM_MIN"]
+           "Manoeuvre", "Motor", "ParameterError", "Sensors", "T_MIN_S", "THETA_DEM_MIN", "Transmission"]
 
 
 @dataclass(frozen=True)
 class DriveParams:
     """Everything one FDSMC commissioning case needs: motor, load, controller, manoeuvre.
 
-    ``sensors`` and ``limits`` are optional sections (ideal sensors, default pass criteria).
+    ``sensors``, ``limits`` and ``transmission`` are optional sections (ideal sensors, default pass
+    criteria, direct drive). The load and the manoeuvre are always the rotor's side (SI); the
+    transmission says how they map onto the output (:mod:`control.fdsmc.transmission`).
     """
 
     motor: Motor
@@ -328,6 +331,7 @@ class DriveParams:
     source: str = "user input"
     sensors: Sensors = Sensors()
     limits: Limits = Limits()
+    transmission: Transmission = Transmission()
 
     def __post_init__(self) -> None:
         """Sensor models need a sampled controller (measurements are taken at the sample instants)."""

@@ -12,6 +12,7 @@ limits, sensors, in-position, overshoot, ripple).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from control.fdsmc.params import DriveParams
@@ -29,6 +30,9 @@ class ControllerEnergy:
     net_electrical_J : float    Net electrical input [J].
     copper_J, friction_J : float  Its copper and friction losses [J].
     failed : tuple of str       Names of the checks the run fails (empty: clean).
+    drawn_J : float             Energy drawn from the DC link, ∫max(p_el, 0) dt [J]: what the supply
+                                delivers when a braking resistor burns the regenerated energy.
+    returned_J : float          Energy returned to the DC link (regenerated), drawn − net [J].
     """
 
     controller: str
@@ -36,6 +40,8 @@ class ControllerEnergy:
     copper_J: float
     friction_J: float
     failed: tuple[str, ...]
+    drawn_J: float = math.nan
+    returned_J: float = math.nan
 
     @property
     def clean(self) -> bool:
@@ -71,8 +77,9 @@ def controller_energies(params: DriveParams, cmp: Comparison) -> tuple[Controlle
         m = run.metrics
         if m.stable and m.electrical_in_total_J is not None:
             failed = tuple(c.name for c in run_checks(params, run))
+            drawn = m.motoring_total_J if m.motoring_total_J is not None else math.nan
             out.append(ControllerEnergy(run.controller, m.electrical_in_total_J, m.copper_total_J or 0.0,
-                                        m.friction_total_J or 0.0, failed))
+                                        m.friction_total_J or 0.0, failed, drawn, drawn - m.electrical_in_total_J))
     return tuple(out)
 
 
