@@ -19,7 +19,7 @@ from app.io.stock_view import stock_json, stock_lines
 from control.common.checks import ParameterError
 from sim.fdsmc.engine import COMPARATORS, LABELS, Comparison, compare
 from sim.fdsmc.optimum_gap import DRAWN_BASIS, saving_vs_optimum
-from sim.fdsmc.recommend import recommend, runs_of
+from sim.fdsmc.recommend import least_drawn, recommend, runs_of
 from sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
@@ -84,6 +84,8 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
         out[e.controller]["dc_link"] = dc_link_json(e)
     out["recommended"] = {"controller": rec.controller, "why": rec.why}
     out["energy_basis"] = ENERGY_BASIS
+    low = least_drawn(rec.energies)
+    out["least_drawn"] = None if low is None else {"controller": low.controller, "drawn_J": low.drawn_J}
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["saving_electrical_drawn_pct"] = _drawn_saving(cmp)
@@ -144,7 +146,10 @@ def print_summary(cmp: Comparison) -> None:
         for e in rec.energies))
     print("Drawn from the DC link (the supply's energy with a braking resistor) / returned, whole run: " + ", ".join(
         f"{LABELS[e.controller]} {e.drawn_J:.4g} / {e.returned_J:.4g} J" for e in rec.energies))
-    print("Savings and the recommendation use the net electrical input (regenerative DC link).")
+    low = least_drawn(rec.energies)
+    print("Savings and the recommendation use the net electrical input (regenerative DC link)"
+          + (f"; with a braking resistor the clean run drawing least is {LABELS[low.controller]}, "
+             f"{low.drawn_J:.4g} J." if low else "."))
     print(f"Recommended: {LABELS.get(rec.controller or '', 'none')}. {rec.why}\n")
     print(f"{'':40s}" + "".join(f"{r.controller:>16s}" for r in runs))
     for key, label, unit in SUMMARY:

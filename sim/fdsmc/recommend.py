@@ -100,4 +100,14 @@ def recommend(params: DriveParams, cmp: Comparison) -> Recommendation:
     return Recommendation(best.controller, why, energies)
 
 
-__all__ = ["ControllerEnergy", "Recommendation", "controller_energies", "recommend", "runs_of"]
+def least_drawn(energies: tuple[ControllerEnergy, ...]) -> ControllerEnergy | None:
+    """Return the clean run that draws the least from the DC link (None: no clean run).
+
+    With a braking resistor (no regeneration into the supply) the supply delivers the drawn energy,
+    not the net one, so this is the controller a drive without regeneration would be given.
+    """
+    clean = [e for e in energies if e.clean and e.drawn_J == e.drawn_J]  # NaN: no drawn figure
+    return min(clean, key=lambda e: e.drawn_J) if clean else None
+
+
+__all__ = ["ControllerEnergy", "Recommendation", "controller_energies", "least_drawn", "recommend", "runs_of"]
