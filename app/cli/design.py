@@ -12,14 +12,18 @@ import json
 from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
+from app.io.assumed import Assumptions, assumptions
 from app.io.atomic import write_atomic_text
+from app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
 from app.io.json_data import to_json
-from app.io.presets import dumps, load_preset, to_raw
+from app.io.motor_defaults import DERIVED
+from app.io.presets import dumps, load_preset, load_raw, to_raw
 from app.io.user_text import check_label
 from sim.fdsmc.checks import run_checks
 from sim.fdsmc.criteria import pass_criteria
 from sim.fdsmc.engine import LABELS
 from sim.fdsmc.objective import OBJECTIVES, ObjectiveDesign, design_for
+from sim.fdsmc.recommend import least_drawn
 
 _VERIFIED_KEYS = ("torque_peak_Nm", "i_q_peak_A", "i_peak_A", "over_i_max_s", "u_peak_V", "omega_peak_rad_s",
                   "theta_error_at_Tm_rad", "overshoot_rad", "in_position_s", "hold_i_q_rms_A", "hold_u_q_ptp_V",
@@ -36,6 +40,34 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "in_position_by_T_m: the axis in position by T_m (the move ends earlier), least energy")
     p.add_argument("--name", help="name written in the designed preset (default: the preset's)")
     p.add_argument("--source", help="source written in the designed preset, e.g. the motor's data sheet")
+
+
+#: Which energy the recommendation and the savings use (said in every output).
+ENERGY_BASIS = ("net electrical input over the whole run (drawn − returned: a DC link that takes the regenerated "
+                "energy back); with a braking resistor the supply delivers drawn_J")
+
+
+def _axis_json(od: ObjectiveDesign, assumed: Assumptions) -> dict[str, Any]:
+    """Return the ``assumptions`` and (with a transmission) ``transmission`` entries of ``design --json``."""
+    out: dict[str, Any] = {"assumptions": assumed.to_json()}
+    params, cmp = od.design.params, od.design.comparison
+    if (tr := transmission_json(params)) is not None:
+        runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock) if r is not None] if cmp else []
+        out["transmission"] = tr | {"at_output": {r.controller: run_at_output(r.metrics, params) for r in runs}}
+    return out
+
+
+def _least_drawn_json(rec: Any) -> dict[str, Any] | None:
+    """Return the clean run drawing least from the DC link (the supply's energy with a braking resistor)."""
+    low = least_drawn(rec.energies) if rec is not None else None
+    return None if low is None else {"controller": low.controller, "drawn_J": low.drawn_J}
+
+
+def _designed_preset(preset: dict[str, Any], assumed: Assumptions) -> dict[str, Any]:
+    """Write the derived rated values of the designed preset as ``derived`` (reloaded, they are derived again)."""
+    for a in assumed.derived:
+        preset["motor"][a.key.partition(".")[2]] = DERIVED
+    return preset
 
 
 def design_json(od: ObjectiveDesign) -> dict[str, Any]:
@@ -55,8 +87,12 @@ def design_json(od: ObjectiveDesign) -> dict[str, Any]:
         "objective": od.objective,
         "alpha_max_rule": c.alpha_max_rule,
         "energies": {e.controller: {"net_electrical_J": e.net_electrical_J, "copper_J": e.copper_J,
-                                    "friction_J": e.friction_J, "checks_failed": list(e.failed)}
+                                    "friction_J": e.friction_J, "checks_failed": list(e.failed),
+                                    "drawn_J": e.drawn_J, "returned_J": e.returned_J,
+                                    "braking_resistor_supply_J": e.drawn_J}
                      for e in (rec.energies if rec else ())},
+        "energy_basis": ENERGY_BASIS,
+        "least_drawn": _least_drawn_json(rec),
         "recommended": {"controller": rec.controller, "why": rec.why} if rec else None,
         "clean": dd.clean,
         "verdict": dd.verdict,
@@ -97,7 +133,9 @@ def run(args: argparse.Namespace) -> int:
         check_writable(args.output, "-o")
     od = design_for(params, args.objective)
     dd = od.design
-    out = design_json(od)
+    assumed = assumptions(load_raw(args.preset), params, tuple(args.overrides), params.name)
+    out = design_json(od) | to_json(_axis_json(od, assumed))
+    out["preset"] = _designed_preset(out["preset"], assumed)
     if args.output:
         try:
             write_atomic_text(args.output, dumps(out["preset"]))  # a temporary file renamed when complete
@@ -122,7 +160,21 @@ def run(args: argparse.Namespace) -> int:
     if od.recommendation is not None:
         print("  net electrical input: " + ", ".join(f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J"
                                                     for e in od.recommendation.energies))
+        print("  drawn from the DC link (the supply's energy with a braking resistor) / returned: " + ", ".join(
+            f"{LABELS[e.controller]} {e.drawn_J:.4g} / {e.returned_J:.4g} J" for e in od.recommendation.energies))
+        low = least_drawn(od.recommendation.energies)
+        print("  the recommendation and the savings use the net electrical input (regenerative DC link)"
+              + (f"; with a braking resistor the clean run drawing least is {LABELS[low.controller]}, "
+                 f"{low.drawn_J:.4g} J" if low else ""))
         print(f"  recommended: {od.recommendation.why}")
+    for line in transmission_lines(dd.params):
+        print(f"  {line}")
+    cmp = dd.comparison
+    if cmp is not None and transmission_lines(dd.params):
+        for r in (x for x in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock) if x is not None):
+            print("    " + run_line(r.controller, r.metrics, dd.params))
+    for line in assumed.lines():
+        print(f"  ! {line}")
     for name, v in out["verified"].items():
         inpos = "never" if v["in_position_s"] is None else f"{v['in_position_s']:.4g} s"
         print(f"  {name}: peak {v['torque_peak_Nm']:.4g} N·m, |i_dq| {v['i_peak_A']:.4g} A, {v['u_peak_V']:.4g} V; "
