@@ -76,7 +76,10 @@ def run_line(name: str, metrics: Any, params: DriveParams) -> str:
     parts = []
     for key, v in run_at_output(metrics, params).items():
         if v is not None:
-            parts.append(f"{key.removesuffix('_out').replace('_', ' ')} {v['value']:.4g} {v['unit']}")
+            label = key.removesuffix("_out").replace("_", " ").replace("Tm", "T_m")
+            if params.transmission.linear:
+                label = label.replace("torque", "force")
+            parts.append(f"{label} {v['value']:.4g} {v['unit']}")
     return f"{name} at the output: " + ", ".join(parts)
 
 
