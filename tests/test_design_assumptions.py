@@ -37,3 +37,20 @@ def test_mj5208_class_robotics_datasheet_designs_clean_with_derived_values_label
     overrides = args[3:-3:2]  # the values after each --set
     assert load_preset(str(out_file)).motor.omega_b == pytest.approx(load_preset(BASE, overrides).motor.omega_b,
                                                                      rel=1e-12)
+
+
+def test_an_imported_drive_names_what_it_took_from_its_base(tmp_path, capsys):
+    """import-drive --base writes the base's fields it did not import under ``inherited``; they are listed."""
+    from app.io.assumed import assumptions
+
+    out = tmp_path / "d5065.yaml"
+    data = "tests/data/drives/odrive_d5065_backup.json"
+    assert main(["import-drive", data, "--format", "odrive", "--base", "yaskawa_sgm7j_04a", "-o", str(out)]) == 0
+    capsys.readouterr()
+    raw = load_raw(str(out))
+    a = assumptions(raw, load_preset(str(out)), ())
+    keys = {x.key for x in a.inherited}
+    assert a.base == "yaskawa_sgm7j_04a"
+    assert {"sensors.i_noise", "sensors.i_adc_range", "limits.in_position", "load.F_v", "motor.V_0"} <= keys
+    assert not keys & {"motor.R_s", "motor.psi_pm", "motor.p", "controller.i_max"}
+    assert "sensors.i_noise = 0.0263 A" in " ".join(a.lines())  # the Yaskawa's current noise, carried over

@@ -12,7 +12,7 @@ import json
 from typing import Any
 
 from app.cli.main import add_preset_arguments, check_writable
-from app.io.assumed import Assumptions, assumptions
+from app.io.assumed import INHERITED, Assumptions, assumptions
 from app.io.atomic import write_atomic_text
 from app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
 from app.io.json_data import to_json
@@ -64,9 +64,14 @@ def _least_drawn_json(rec: Any) -> dict[str, Any] | None:
 
 
 def _designed_preset(preset: dict[str, Any], assumed: Assumptions) -> dict[str, Any]:
-    """Write the derived rated values of the designed preset as ``derived`` (reloaded, they are derived again)."""
+    """Write the derived rated values as ``derived`` and the inherited fields' list into the designed preset.
+
+    Reloaded, the rated values are derived again and the inherited values are listed again.
+    """
     for a in assumed.derived:
         preset["motor"][a.key.partition(".")[2]] = DERIVED
+    if assumed.inherited:
+        preset[INHERITED] = {"base": assumed.base, "fields": [a.key for a in assumed.inherited]}
     return preset
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 from app.cli.export import write_atomic
 from app.cli.main import check_writable
 from app.exports.drive_import import IMPORT_FORMATS, import_drive
+from app.io.assumed import INHERITED, inherited_block
 from app.io.presets import MAX_BYTES, dumps, load, to_raw
 from app.io.user_text import check_label, escaped
 from control.common.checks import ParameterError
@@ -64,6 +65,8 @@ def run(args: argparse.Namespace) -> int:
                                      + ", ".join(result.not_imported)])]
     command = escaped(f"python -m app import-drive {args.file} --format {args.format} --base {args.base}")
     head = "".join(f"# {line}\n" for line in [command] + notes)
-    write_atomic(Path(args.output), (head + dumps(to_raw(params))).encode("utf-8"))
+    raw = to_raw(params)
+    raw[INHERITED] = inherited_block(base.name, {x.partition(" = ")[0] for x in result.imported})
+    write_atomic(Path(args.output), (head + dumps(raw)).encode("utf-8"))
     sys.stdout.write("\n".join(notes) + f"\nwrote {escaped(args.output)}\n")
     return 0

@@ -108,6 +108,15 @@ def _listed_keys() -> list[str]:
     return keys
 
 
+def inherited_block(base: str, given: set[str]) -> dict[str, Any]:
+    """Return the ``inherited`` entry of a preset built over ``base``: every listed field not in ``given``.
+
+    ``given`` holds the ``section.field`` keys the new preset's source did set (e.g. an import's
+    motor values); ``design`` and ``simulate`` then list the others as inherited.
+    """
+    return {"base": base, "fields": [k for k in _listed_keys() if k not in given]}
+
+
 def assumptions(raw: Any, params: DriveParams, overrides: tuple[str, ...] = (), base: str | None = None
                 ) -> Assumptions:
     """List what ``params`` took from a base preset and what the loader derived.
@@ -138,4 +147,4 @@ def assumptions(raw: Any, params: DriveParams, overrides: tuple[str, ...] = (), 
     return Assumptions(base, inherited, derived)
 
 
-__all__ = ["INHERITED", "Assumed", "Assumptions", "assumptions"]
+__all__ = ["INHERITED", "Assumed", "Assumptions", "assumptions", "inherited_block"]
