@@ -1,14 +1,15 @@
 """Data shipped with the package: the presets and the example drive log.
 
 The presets live in the project's top-level ``presets/`` folder (the product's layout); a wheel
-installs them as data files under ``<prefix>/share/pmsm-commissioning/presets``. The example drive
-log is package data read through :mod:`importlib.resources`. So the page and the CLI find both from
-an installed wheel as from a clone; nothing in production code reads ``tests/``.
+installs that folder as the data-only package ``app/presets`` (``setup.py`` maps it), so every
+install kind (a venv, ``pip install --user``, ``--target``, ``--prefix``) finds them beside the code
+through :mod:`importlib.resources`, never through the interpreter's data path (which is not where
+``--user`` puts data files). The example drive log is package data too. So the page and the CLI find
+both from an installed wheel as from a clone; nothing in production code reads ``tests/``.
 """
 
 from __future__ import annotations
 
-import sysconfig
 from importlib import resources
 from pathlib import Path
 
@@ -21,16 +22,12 @@ def _package_dir(name: str) -> Path:
     return Path(str(resources.files("app").joinpath(name)))
 
 
-#: Where a wheel installs the presets, below the environment's data prefix.
-INSTALLED_PRESETS = Path("share") / "pmsm-commissioning" / "presets"
-
-
 def preset_dir() -> Path:
-    """Return the folder holding the shipped presets: the clone's ``presets/``, else the installed copy."""
+    """Return the folder holding the shipped presets: the clone's ``presets/``, else the installed ``app/presets``."""
     root = Path(__file__).resolve().parents[1]
     if (root / "pyproject.toml").is_file() and (root / "presets").is_dir():  # a clone (editable install)
         return root / "presets"
-    return Path(sysconfig.get_path("data")) / INSTALLED_PRESETS
+    return _package_dir("presets")
 
 
 def example_log() -> Path:

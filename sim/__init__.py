@@ -4,16 +4,19 @@ The compiled kernels inline the control laws of :mod:`control` (one implementati
 numba's on-disk cache keys an entry on the kernel's own source file only, so an edited law in
 ``control/`` would leave a stale compiled kernel in use. Before any kernel is compiled, this package
 therefore points numba's cache at a folder named after a hash of every ``control/`` and ``sim/``
-source file: any edit selects a fresh folder and recompiles.
+source file: any edit selects a fresh folder and recompiles. The folder lies below
+:func:`sim.numba_cache.cache_base` (``$NUMBA_CACHE_DIR``, a clone's ``.numba_cache``, else the user's
+cache folder), never in site-packages.
 """
 
 from __future__ import annotations
 
 import hashlib
-import os
 from pathlib import Path
 
 import numba
+
+from sim.numba_cache import cache_base
 
 _ROOT = Path(__file__).resolve().parent.parent
 
@@ -29,8 +32,7 @@ def source_hash() -> str:
 
 
 def _keyed_cache_dir() -> str:
-    base = os.environ.get("NUMBA_CACHE_DIR") or str(_ROOT / ".numba_cache")
-    return str(Path(base) / f"src-{source_hash()}")
+    return str(cache_base() / f"src-{source_hash()}")
 
 
-numba.config.CACHE_DIR = _keyed_cache_dir()
+numba.config.CACHE_DIR = _keyed_cache_dir()  # type: ignore[attr-defined]  # set at run time

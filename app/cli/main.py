@@ -1,7 +1,9 @@
-"""Command-line interface: ``python -m app {derive,simulate,export,import-drive,table1,bench,serve,bldc} …``.
+"""Command-line interface of the PMSM position-drive commissioning tool (one sub-command per task).
 
-Each sub-command lives in its own module exposing ``add_arguments(parser)`` and
-``run(args) -> int``. Bad input exits with code 2 and one clear line on stderr, never a traceback.
+Installed as the console command ``pmsm-commission``; ``python -m app`` runs the same. ``--help``
+lists every sub-command of :data:`COMMANDS`, ``--version`` prints the installed version. Each
+sub-command lives in its own module exposing ``add_arguments(parser)`` and ``run(args) -> int``.
+Bad input exits with code 2 and one clear line on stderr, never a traceback.
 """
 
 from __future__ import annotations
@@ -47,7 +49,23 @@ def chosen_command(argv: list[str]) -> str | None:
     return next((a for a in argv if not a.startswith("-")), None)
 
 
-def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+#: Program name of the console command the wheel installs (``[project.scripts]`` of pyproject.toml).
+CONSOLE_PROG = "pmsm-commission"
+#: Program name when run from a clone as a module.
+MODULE_PROG = "python -m app"
+
+
+def version() -> str:
+    """Return the installed distribution's version (``pmsm-commissioning``), or "unknown" when not installed."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("pmsm-commissioning")
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def build_parser(command: str | None = None, prog: str = MODULE_PROG) -> argparse.ArgumentParser:
     """Build the argument parser with every sub-command.
 
     Only the module of ``command`` is imported (and its arguments added): a sub-command's module
@@ -55,8 +73,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     every call pay for the slowest. With ``command=None`` every module is imported; with an empty
     string (``python -m app --help``) none is.
     """
-    parser = _Parser(prog="python -m app", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    parser = _Parser(prog=prog, description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"%(prog)s {version()}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, parser_class=_Parser)
     for name, (module, help_text) in COMMANDS.items():
         p = sub.add_parser(name, help=help_text, description=help_text)
         if command is None or command == name:
@@ -175,14 +194,14 @@ def _stop_interrupted() -> NoReturn:
         os._exit(INTERRUPTED)
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; returns the process exit code (130 at once on Ctrl-C or SIGTERM, from a real process)."""
+def main(argv: list[str] | None = None, prog: str = MODULE_PROG) -> int:
+    """Run the CLI as ``prog``; returns the exit code (130 at once on Ctrl-C or SIGTERM, from a real process)."""
     global _AS_PROCESS
     in_main = threading.current_thread() is threading.main_thread()
     previous = _install_handlers() if in_main else {}
     _AS_PROCESS = in_main and argv is None
     try:
-        return _main(sys.argv[1:] if argv is None else argv)
+        return _main(sys.argv[1:] if argv is None else argv, prog)
     except KeyboardInterrupt:
         if argv is None:  # ``python -m app``: end the process now, whatever threads still run
             _stop_interrupted()
@@ -193,11 +212,11 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signum, handler)
 
 
-def _main(argv: list[str]) -> int:
+def _main(argv: list[str], prog: str) -> int:
     from app.threads import limit_blas_threads
 
     limit_blas_threads()  # before the sub-command imports numpy: then it costs nothing
-    args = build_parser(chosen_command(argv) or "").parse_args(argv)  # "": --help alone imports none
+    args = build_parser(chosen_command(argv) or "", prog).parse_args(argv)  # "": --help alone imports none
     try:
         if args.command in THREADED:
             return _run_in_thread(args)
@@ -211,4 +230,4 @@ def _main(argv: list[str]) -> int:
 
 def entry() -> None:
     """Console entry point ``pmsm-commission …`` (installed by the wheel): :func:`main`, then exit."""
-    sys.exit(main())
+    sys.exit(main(prog=CONSOLE_PROG))

@@ -25,7 +25,7 @@ from app.cli.main import add_preset_arguments, check_writable
 from app.io.json_data import to_json
 from app.io.numbers import integer_option, number_option
 from app.io.plant_overrides import load_model_and_plant
-from app.io.sample_table import write_csv, write_parquet
+from app.io.sample_table import require_parquet, write_csv, write_parquet
 from app.io.study_inputs import parse_spreads
 from control.common.checks import ParameterError
 from sim.studies.robustness import (
@@ -99,6 +99,8 @@ def _check(args: argparse.Namespace) -> None:
     for opt, path in (("--csv", args.csv), ("--parquet", args.parquet)):
         if path:
             check_writable(path, opt)  # before hours of simulation, not after
+    if args.parquet:
+        require_parquet()  # an optional dependency (the "parquet" extra)
 
 
 def _quiet_dask() -> None:

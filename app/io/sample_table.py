@@ -61,6 +61,19 @@ def write_csv(path: str | Path, res: RobustnessResult) -> None:
     write_atomic_text(path, out.getvalue())  # a temporary file renamed when complete
 
 
+#: pip extra that installs pyarrow, the optional Parquet writer (pyproject.toml).
+PARQUET_EXTRA = "parquet"
+
+
+def require_parquet() -> None:
+    """Raise ValueError naming the pip extra to install when pyarrow (the Parquet writer) is missing."""
+    import importlib.util
+
+    if importlib.util.find_spec("pyarrow") is None:
+        raise ValueError(f"--parquet needs pyarrow, which is not installed: allowed after pip install "
+                         f"'pmsm-commissioning[{PARQUET_EXTRA}]' (or pip install pyarrow); --csv needs none")
+
+
 def write_parquet(path: str | Path, res: RobustnessResult, meta: dict[str, Any] | None = None) -> None:
     """Write the table as Parquet.
 
