@@ -21,7 +21,7 @@ F = TypeVar("F", bound=Callable[..., object])
 try:
     from numba.extending import register_jitable as _register
 except ImportError:  # pragma: no cover - numba is a dependency; the laws still run as plain Python
-    _register = None
+    _register = None  # type: ignore[assignment]
 
 
 def jitable(fn: F) -> F:

@@ -15,7 +15,9 @@ applied voltage.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -70,8 +72,8 @@ TRUE_LOAD = {"J_L": 0.10, "F_v": 0.5, "Gamma_Le": 1.5}
 LOG_DURATION = 0.68
 
 
-def perturbed(nominal: DriveParams, motor: dict[str, float] = TRUE_MOTOR,
-              load: dict[str, float] = TRUE_LOAD) -> DriveParams:
+def perturbed(nominal: DriveParams, motor: Mapping[str, Any] = TRUE_MOTOR,
+              load: Mapping[str, Any] = TRUE_LOAD) -> DriveParams:
     """Return the true plant: ``nominal`` with the motor and load fields replaced."""
     return dataclasses.replace(nominal, motor=dataclasses.replace(nominal.motor, **motor),
                                load=dataclasses.replace(nominal.load, **load), source="synthetic plant")

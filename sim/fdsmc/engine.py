@@ -21,6 +21,7 @@ import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -372,7 +373,7 @@ def optimum_omitted(exc: OptimumSolverError) -> str:
 
 def compare(
     params: DriveParams, controllers: tuple[str, ...] = CONTROLLERS, derived: Derived | None = None,
-    plant: DriveParams | None = None, **options: float,
+    plant: DriveParams | None = None, **options: Any,
 ) -> Comparison:
     """Simulate both controllers on the same case (thread-safe; the kernel releases the GIL).
 
@@ -393,8 +394,8 @@ def compare(
     Comparison
         Savings are None unless both runs exist, are stable and reached the 2 % band.
     """
-    for c in controllers:
-        check_controller(c, COMPARATORS)
+    for name in controllers:
+        check_controller(name, COMPARATORS)
     check_budget(params, len(controllers), **options)
     d = derive(params) if derived is None else derived
     _check_feasible(d)

@@ -15,6 +15,7 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -116,7 +117,7 @@ def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUO
                        budget.memory_bytes(trace, window, n_runs, samples))
 
 
-def predict(params: DriveParams, n_runs: int = 1, **options: float) -> budget.Cost:
+def predict(params: DriveParams, n_runs: int = 1, **options: Any) -> budget.Cost:
     """Predicted cost (steps, trace bytes, CPU seconds, peak memory) of ``n_runs`` runs of ``params``."""
     return run_cost(params, n_runs=n_runs, **options)
 
@@ -142,7 +143,7 @@ def _cost_drivers(params: DriveParams, request: Callable[[DriveParams], budget.C
             for name, value, unit, limit, integer in fields]
 
 
-def check_budget(params: DriveParams, n_runs: int = 1, **options: float) -> budget.Cost:
+def check_budget(params: DriveParams, n_runs: int = 1, **options: Any) -> budget.Cost:
     """Raise :class:`~sim.common.budget.BudgetError` unless ``n_runs`` runs of ``params`` fit the budget.
 
     Called before any derivation or allocation by :func:`simulate`, :func:`compare` and

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from control.common.checks import ParameterError
 from control.fdsmc.params import DriveParams
@@ -50,7 +51,7 @@ def table1_sweep(
     params: DriveParams,
     T_m_values: Sequence[float],
     progress: Callable[[int, int], None] | None = None,
-    **options: float,
+    **options: Any,
 ) -> list[Table1Row]:
     """Friction energies and savings over manoeuvre times, as Table 1 of [1].
 

@@ -199,7 +199,10 @@ class DaskChunk:
         helper = threading.Thread(target=fetch, name=f"fetch-chunk-{self.index}", daemon=True)
         helper.start()
         since: float | None = None
-        while helper.join(POLL_S) is None and helper.is_alive():
+        while helper.is_alive():
+            helper.join(POLL_S)
+            if not helper.is_alive():
+                break
             since = None if self._ex.worker_count() else since or time.monotonic()
             if since is not None and time.monotonic() - since > self._ex.no_worker_s:
                 raise ExecutorError(self._ex.no_workers_message())

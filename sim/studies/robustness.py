@@ -114,7 +114,7 @@ def draw(params: DriveParams, spreads: Sequence[Spread], n: int, seed: int) -> d
 
 def plant_for(params: DriveParams, values: dict[str, float]) -> DriveParams:
     """``params`` with the plant values ``{"section.field": value}`` replaced (validated)."""
-    changes: dict[str, dict[str, float]] = {"motor": {}, "load": {}}
+    changes: dict[str, dict[str, Any]] = {"motor": {}, "load": {}}  # replace() fields of any type
     for key, v in values.items():
         section, field = key.split(".")
         changes[section][field] = float(v)

@@ -162,7 +162,7 @@ class RetryingPool:
 
     def processes(self) -> list[int]:
         """Process ids of the current workers (for tests and diagnostics)."""
-        return [p.pid for p in (self._pool._processes or {}).values()]
+        return [p.pid for p in (self._pool._processes or {}).values() if p.pid is not None]
 
     def shutdown(self, wait: bool = True, cancel_futures: bool = False) -> None:
         """Shut the current pool down."""
