@@ -11,7 +11,8 @@
 * replay frame rate actually drawn by the browser (animation frames in which the phase-plane marker
   moved, at 0.1× and 0.01×) and the server traffic meanwhile;
 * live tuning: re-simulated phase planes drawn per second while the K slider is moved
-  (one key step every 50 ms, paper preset at 20 kHz);
+  (one key step every 50 ms, paper preset at 20 kHz); the K sweep's redraws per second while its
+  own slider is dragged, its CPU and bytes (``scripts/ui_bench_sweep.py``);
   these two with one page open (the concurrency rounds' other pages are closed first: nine idle
   pages share the same two cores, which is the concurrency figure's business, not these);
 * server memory (RSS) idle and with the pages connected.
@@ -55,6 +56,9 @@ sys.path.insert(0, str(ROOT))
 from app.ui.k_slider import K_LABEL  # noqa: E402
 from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, VIEWPORT, field  # noqa: E402
 from tests.net import free_port  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "scripts"))
+from ui_bench_sweep import sweep_cost, sweep_redraws  # noqa: E402
 
 PRESET = "paper_12kw_pmsm"
 PHASE_READY = ("(w) => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout && e.layout.meta"
@@ -225,6 +229,7 @@ CLICK_OVERHEAD: list[float] = []
 WITH_REPLAY: list[float] = []
 #: Per user round: K-slider redraws per second while dragged with the mouse [1/s].
 MOUSE: list[float] = []
+SWEEP: list[float] = []  # the K sweep figure's redraws per second (its own slider, frames in the browser)
 #: Records the Date.now() of the next pointerdown in the page as ``window.__down``.
 WATCH_DOWN = ("() => { window.__down = NaN; document.addEventListener('pointerdown', "
               "() => { window.__down = Date.now(); }, {capture: true, once: true}); }")
@@ -395,6 +400,7 @@ def cold_round(browser, with_3d: bool) -> tuple[float, float, float, float]:
         page.wait_for_timeout(1000)
         rate = slider_redraws(page, 2.0, "ArrowLeft")
         MOUSE.append(mouse_redraws(page, 2.0))
+        SWEEP.append(sweep_redraws(page, 2.0))
         ctx.close()
     finally:
         server.terminate()
@@ -419,6 +425,8 @@ def cold_rounds(browser, runs: int, with_3d: bool) -> None:
           f"second {med(list(cols[2]))} ms [target ≤ 100]; K slider {med(list(cols[3]), 1, '.1f')} redraws/s "
           f"[target ≥ 20]")
     print(f"  K slider dragged with the mouse (a move per animation frame): {med(MOUSE, 1, '.1f')} redraws/s")
+    print(f"  K sweep's own slider dragged with the mouse (frames in the browser): {med(SWEEP, 1, '.1f')} "
+          f"redraws/s [target ≥ 25]; {sweep_cost()}")
     print(f"  Simulate → the overview drawn again with its replay controls: {med(WITH_REPLAY)} ms (all clicks); "
           f"the K slider's ceiling is 20 redraws/s: viser sends a slider's value at most every "
           f"50 ms (and the key drag moves it every 50 ms)")

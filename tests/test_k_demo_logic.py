@@ -8,8 +8,8 @@ from types import SimpleNamespace
 import pytest
 
 from app.figures.fdsmc_verdict import VERDICT_FONT_PX, chatter_verdict, verdict_annotation
-from app.figures.style import BAD_COLOUR, GOOD_COLOUR
-from app.ui.k_slider import K_RANGE, K_marks, K_of_position, hide_box_css, log_K_range, readout_html
+from app.figures.style import BAD_COLOUR
+from app.ui.k_slider import K_RANGE, OK_COLOUR, K_marks, K_of_position, hide_box_css, log_K_range, readout_html
 
 
 def _comparison(K: float, K_limit: float, chatter: bool = False, freq: float | None = None,
@@ -56,8 +56,9 @@ def test_the_K_slider_marks_and_reddens_at_the_noise_limit():
     assert marks["noise"] == pytest.approx(math.log10(0.0105)) and marks["lim"] == pytest.approx(math.log10(0.114))
     assert "noise" not in {label for _, label in K_marks(-3.0, 4.0, 0.114, 0.057, 0.2)}  # above K_limit: no mark
     assert BAD_COLOUR in readout_html(0.02, 0.114, 0.00525, 0.0105)  # above K_noise, below K_limit: red
-    assert GOOD_COLOUR in readout_html(0.005, 0.114, 0.00525, 0.0105) and "noise 0.0105" in readout_html(
-        0.005, 0.114, 0.00525, 0.0105)
+    ok = readout_html(0.005, 0.114, 0.00525, 0.0105)
+    assert OK_COLOUR in ok and "✓ no chatter" in ok and "noise 0.0105" in ok
+    assert "✗ chatters" in readout_html(0.02, 0.114, 0.00525, 0.0105)
 
 
 def test_verdict_annotation_is_large_named_and_escaped():

@@ -146,3 +146,20 @@ def test_the_J_L_slider_changes_the_plant_and_not_the_controllers_model(comparis
     # a heavier plant than modelled: the same law gives a slower, different motion
     assert not np.allclose(heavier.fdsmc.trace.omega_r[:200], comparison.fdsmc.trace.omega_r[:200])
     assert heavier.fdsmc.metrics.torque_peak_Nm > 0.0
+
+
+def test_a_slider_dropped_on_its_min_mark_gives_T_m_min_itself_and_simulates():
+    import math
+
+    from app.io.presets import PAPER_PRESET, load_preset
+    from app.ui.log_slider import LOG_STEP, snapped, value_of_position
+    from control.fdsmc.derivations import derive
+
+    params = load_preset(PAPER_PRESET)
+    T_m_min = derive(params).profile.T_m_min
+    on_mark = round(math.log10(T_m_min) / LOG_STEP) * LOG_STEP  # where the track's step puts the thumb
+    assert value_of_position(on_mark) < T_m_min  # rounded: the wrong side (0.479 < 0.4804)
+    assert snapped(on_mark, (("min", T_m_min),)) == T_m_min
+    assert snapped(on_mark + 2 * LOG_STEP, (("min", T_m_min),)) == value_of_position(on_mark + 2 * LOG_STEP)
+    q = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=T_m_min))
+    assert derive(q).profile.feasible

@@ -128,7 +128,7 @@ def test_round_to_meaning_keeps_significant_digits():
 
 
 def test_export_drops_the_replay_ui_and_sets_format_and_size():
-    from app.figures.style import EXPORT_SIZE
+    from app.figures.style import EXPORT_SCALE, EXPORT_SIZE
     from app.ui.figure_export import UI_KEYS, export_figure, export_js
 
     fig = {"data": [{"type": "scatter", "y": [1, 2]}], "layout": {
@@ -138,8 +138,9 @@ def test_export_drops_the_replay_ui_and_sets_format_and_size():
         out, options = export_figure(json.dumps(fig, separators=(",", ":")), fmt_)
         assert not set(UI_KEYS) & set(out["layout"]) and "height" not in out["layout"]
         assert out["data"] == fig["data"] and out["layout"]["title"] == {"text": "t"}
-        assert options == {"format": fmt_, "width": EXPORT_SIZE[0], "height": EXPORT_SIZE[1], "scale": 1,
-                           "filename": "phase_plane"}
-        assert EXPORT_SIZE[0] >= 1920 and "updatemenus" not in export_js(out, options)
+        assert options == {"format": fmt_, "width": EXPORT_SIZE[0], "height": EXPORT_SIZE[1],
+                           "scale": EXPORT_SCALE if fmt_ == "png" else 1, "filename": "phase_plane"}
+        assert EXPORT_SIZE[0] * options["scale"] >= (1920 if fmt_ == "png" else 1280)
+        assert "updatemenus" not in export_js(out, options)
     with pytest.raises(ValueError, match="allowed svg, png"):
         export_figure(json.dumps(fig), "gif")

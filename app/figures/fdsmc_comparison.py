@@ -157,7 +157,8 @@ def phase_plane_spec(comparison: Comparison) -> dict[str, Any]:
                                       "ω_r = %{y:.4g} rad/s<extra>" + label + "</extra>"})
         data.extend(_phase_marks(comparison, key, run, (lo + hi) / 2.0))
         data.append({"type": "scatter", "x": x[-1:], "y": y[-1:], "mode": "markers+text", "text": [""],
-                     "textposition": "bottom right", "name": f"{label} now", "showlegend": False,
+                     # above the marker: below it, the time sat on the zoom inset's rectangle in a replay
+                     "textposition": "top right", "name": f"{label} now", "showlegend": False,
                      "hoverinfo": "skip", "textfont": {"size": FONT_PX},
                      "marker": {"color": colour, "size": 14, "line": {"color": "white", "width": 2}}})
     prof = d.profile

@@ -27,7 +27,9 @@ from control.fdsmc.feasibility import torque_limit
 from control.fdsmc.model import electromagnetic_torque
 
 #: Horizontal domains [-] of the phase plane and of the compact time plot.
-PHASE_X, TIME_X = (0.0, 0.55), (0.66, 1.0)
+#: The time rows end short of the right edge: the Γ_L axis's red tick labels stand outside its plot
+#: area there (inside, they sat on the blue band of a chattering Γ).
+PHASE_X, TIME_X = (0.0, 0.55), (0.66, 0.95)
 #: Vertical domains [-] of the two time rows: ω_r on top, Γ below.
 ROW_Y = ((0.56, 1.0), (0.0, 0.44))
 #: Names of the two cursor traces the replay moves (one per time row).
@@ -102,7 +104,7 @@ def _time_layout(comparison: Any, t_end: float, ranges: list[list[float]]) -> di
                              "title": {"text": title, "standoff": 4}}
     axes["xaxis3"]["title"] = {"text": "t [s]", "standoff": 4}
     axes["yaxis4"] = {"overlaying": "y3", "side": "right", "anchor": "x3", "range": ranges[2], "showgrid": False,
-                      "zeroline": False, "ticklabelposition": "inside", "tickfont": {"color": LOAD_STEP_COLOUR},
+                      "zeroline": False, "ticklabelposition": "outside", "tickfont": {"color": LOAD_STEP_COLOUR},
                       "nticks": 4}  # no title: the row's note names it (a title at the edge hid the ticks)
     # two short lines: one did not fit the column's width at 1280×720 (its end was cut off)
     notes = [{"text": f"motor Γ [N·m]; ±Γ_max = {g_max:.4g} dashed<br>load Γ_L dotted, scale right (red)",

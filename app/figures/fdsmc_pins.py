@@ -19,8 +19,10 @@ from app.figures.decimate import BINS_PHASE, f32, minmax_index
 
 #: Most pins kept (the oldest goes first).
 MAX_PINS = 4
-#: Ghost colour and dashes, one per pin in order (grey; the dash tells pins apart).
-GHOST_COLOUR = "rgba(110, 110, 110, 0.75)"
+#: Ghost colour and dashes, one per pin in order (grey; the dash tells pins apart). Dark enough to
+#: stay ΔE ≥ 10 from the linear phase's reddish purple for deutan and protan viewers (≈ #656565 on
+#: white: ΔE 17–19; the lighter grey of before, ≈ #929292, was 6.5).
+GHOST_COLOUR = "rgba(80, 80, 80, 0.85)"
 GHOST_DASHES = ("dot", "dash", "dashdot", "longdash")
 
 

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from app.figures.fdsmc_comparison import runs
+from app.figures.style import FONT_PX
 from sim.fdsmc.engine import Comparison
 
 #: Replay speeds: button label → simulated seconds per wall-clock second.
@@ -180,7 +181,7 @@ def replay_layout(comparison: Comparison, data: list[dict[str, Any]],
         # fraction of its height (at 1920×1080 y = -0.1 put the buttons past the bottom margin)
         "updatemenus": [{"type": "buttons", "direction": "left", "showactive": False, "x": 1.0, "y": 0.0,
                          "xanchor": "right", "yanchor": "top", "pad": {"t": BUTTONS_BELOW_PX, "b": 2},
-                         "font": {"size": 11}, "buttons": buttons}],
+                         "font": {"size": FONT_PX}, "buttons": buttons}],
     }, raw
 
 

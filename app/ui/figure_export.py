@@ -1,5 +1,8 @@
 """Figure export for slides and papers: SVG or a 1920×1080 PNG, drawn by the browser without the page's UI.
 
+Both are laid out at 1280×720 (a 720p slide); the PNG is drawn at scale 1.5, so its 1920×1080 pixels
+carry the page's 14 px text as 21 px, 14 px again on a 720p slide (at scale 1 it was 9 px there).
+
 The modebar's camera button writes the plot as it is on screen (≈ 840×540 px, replay buttons
 included). Here the server takes the figure it last sent, removes the interactive parts
 (:data:`UI_KEYS`: the replay buttons and their inline frames, sliders) and sends it with the
@@ -16,13 +19,14 @@ from typing import Any
 
 import viser
 
-from app.figures.style import EXPORT_SIZE
+from app.figures.style import EXPORT_SCALE, EXPORT_SIZE
 from app.ui.viser_adapter import figure_json_shown, run_script
 
 #: Layout keys of the interactive UI a figure carries in the page, left out of an export.
 UI_KEYS: tuple[str, ...] = ("updatemenus", "sliders")
 #: Export formats: key → (label, Plotly format).
-FORMATS: dict[str, str] = {"svg": "SVG (vector)", "png": f"PNG {EXPORT_SIZE[0]}×{EXPORT_SIZE[1]}"}
+FORMATS: dict[str, str] = {"svg": f"SVG (vector, {EXPORT_SIZE[0]}×{EXPORT_SIZE[1]})",
+                           "png": f"PNG {EXPORT_SIZE[0] * EXPORT_SCALE:.0f}×{EXPORT_SIZE[1] * EXPORT_SCALE:.0f}"}
 _ID = re.compile(r'"meta":\{"id":"([^"]+)"')
 
 
@@ -48,7 +52,8 @@ def export_figure(json_str: str, fmt: str) -> tuple[dict[str, Any], dict[str, An
     layout.pop("height", None)
     width, height = EXPORT_SIZE
     name = figure_id(json_str) or "figure"
-    options = {"format": fmt, "width": width, "height": height, "scale": 1, "filename": name}
+    scale = EXPORT_SCALE if fmt == "png" else 1
+    options = {"format": fmt, "width": width, "height": height, "scale": scale, "filename": name}
     return {"data": spec.get("data", []), "layout": layout}, options
 
 

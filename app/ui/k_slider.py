@@ -18,7 +18,7 @@ from collections.abc import Callable
 
 import viser
 
-from app.figures.style import BAD_COLOUR, GOOD_COLOUR
+from app.figures.style import BAD_COLOUR, POSITION_COLOURS
 from app.ui.log_slider import (
     LogSlider,
     Mark,
@@ -34,6 +34,8 @@ from app.ui.log_slider import (
 K_RANGE = (0.01, 5000.0)
 #: The slider's label.
 K_LABEL = "K [s/rad] (log)"
+#: Colour of a K below the chatter limit in the readout (the FDSMC's blue; red above it).
+OK_COLOUR = POSITION_COLOURS["fdsmc"]
 
 
 def log_K_range(K: float, K_limit: float, K_rec: float | None) -> tuple[float, float]:
@@ -64,10 +66,14 @@ def K_marks(lo: float, hi: float, K_limit: float, K_rec: float | None,
 def readout_html(K: float, K_limit: float, K_rec: float | None, K_noise: float = math.inf) -> str:
     """Return one line for under the slider: K [s/rad] and the marked gains, K in red where it chatters.
 
-    K is red at or above K_limit, or above the sensors' noise limit K_noise.
+    K is red with "✗ chatters" at or above K_limit, or above the sensors' noise limit K_noise; blue
+    with "✓ no chatter" below (:data:`OK_COLOUR`).
     """
     over = (positive(K_limit) and K_limit <= K) or K_noise < K
-    parts = [f'<b style="color:{BAD_COLOUR if over else GOOD_COLOUR}">K = {K:.4g} s/rad</b>']
+    # a word and a sign besides the colour; red against blue (ΔE ≥ 40 for deutan and protan viewers:
+    # the red/green pair of before was 6.2 for deutans)
+    word = "✗ chatters" if over else "✓ no chatter"
+    parts = [f'<b style="color:{BAD_COLOUR if over else OK_COLOUR}">K = {K:.4g} s/rad {word}</b>']
     if positive(K_rec):
         parts.append(f"rec {K_rec:.3g}")
     if K_noise < K_limit:
@@ -94,5 +100,5 @@ class KSlider(LogSlider):
         self.show(K, _gain_marks(K_limit, K_rec, K_noise))
 
 
-__all__ = ["K_LABEL", "K_RANGE", "KSlider", "K_marks", "K_of_position", "hide_box_css", "log_K_range",
+__all__ = ["K_LABEL", "K_RANGE", "OK_COLOUR", "KSlider", "K_marks", "K_of_position", "hide_box_css", "log_K_range",
            "readout_html"]

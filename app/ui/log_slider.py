@@ -22,6 +22,8 @@ from app.ui.viser_adapter import set_slider_marks, widget_id
 LOG_STEP, LOG_PRECISION = 0.01, 2
 #: Significant digits of a value written by a slider.
 DIGITS = 3
+#: A position within this many steps of a mark gives the mark's exact value [-].
+SNAP = 0.75
 #: A mark on the track: (label, value in the shown unit).
 Mark = tuple[str, float]
 
@@ -43,6 +45,18 @@ def log_range(values: Iterable[float | None], least: tuple[float, float]) -> tup
 def value_of_position(position: float) -> float:
     """Return the value at slider position ``position`` [log₁₀], to :data:`DIGITS` significant digits."""
     return float(f"{10.0 ** position:.{DIGITS}g}")
+
+
+def snapped(position: float, marks: Iterable[Mark]) -> float:
+    """Return the value at ``position`` [log₁₀]: a mark's exact value within :data:`SNAP` steps of it, else rounded.
+
+    A slider dropped on its "min" mark (T_m,min = 0.48044 s) must give T_m,min itself: the track's
+    position there is a multiple of the step (log₁₀ 0.4786), and three significant digits of it
+    (0.479 s) fall below the minimum, on the infeasible side.
+    """
+    near = [(abs(math.log10(v) - position), v) for _, v in marks if positive(v)]
+    best = min(near, default=(math.inf, 0.0))
+    return float(best[1]) if best[0] <= SNAP * LOG_STEP else value_of_position(position)
 
 
 def track_marks(lo: float, hi: float, marks: Iterable[Mark]) -> tuple[tuple[float, str], ...]:
@@ -73,7 +87,7 @@ def default_readout(symbol: str, unit: str) -> Callable[[float, tuple[Mark, ...]
 def readout_line(role: str, inner_html: str) -> str:
     """One readout line (``data-role="<role>-readout"``) that never wraps (the slider never moves)."""
     key = role.split()[0].lower().replace("_", "-")
-    return (f'<div data-role="{key}-readout" style="font-size:0.85em;white-space:nowrap;overflow:hidden;'
+    return (f'<div data-role="{key}-readout" style="font-size:14px;white-space:nowrap;overflow:hidden;'
             f'text-overflow:ellipsis">{inner_html}</div>')
 
 
@@ -124,8 +138,8 @@ class LogSlider:
 
     @property
     def value(self) -> float:
-        """The value the slider stands at [shown unit]."""
-        return value_of_position(float(self.slider.value))
+        """The value the slider stands at [shown unit]: a mark's exact value on (or next to) it (:func:`snapped`)."""
+        return snapped(float(self.slider.value), self._marks)
 
     def show(self, value: float, marks: tuple[Mark, ...] = (), least: tuple[float, float] | None = None) -> None:
         """Mirror ``value`` (unless the slider already stands there) and mark ``marks``.
@@ -153,5 +167,5 @@ class LogSlider:
         self._moved(value)
 
 
-__all__ = ["DIGITS", "LOG_PRECISION", "LOG_STEP", "LogSlider", "Mark", "default_readout", "hide_box_css",
-           "log_range", "positive", "readout_line", "track_marks", "value_of_position"]
+__all__ = ["DIGITS", "LOG_PRECISION", "LOG_STEP", "SNAP", "LogSlider", "Mark", "default_readout", "hide_box_css",
+           "log_range", "positive", "readout_line", "snapped", "track_marks", "value_of_position"]

@@ -44,7 +44,7 @@ def errata_html(tab: str) -> str:
     """Return the errata of [1] that concern the figures of results tab ``tab``, one line each with the equation."""
     items = "".join(f'<li><b>{html_text(eq)}</b>: {html_text(text)}</li>'
                     for eq, text in (ERRATA[k] for k in ERRATA_OF_TAB[tab]))
-    return (f'<div data-role="errata-{html_text(tab)}" style="font-size:0.85em;color:#495057">'
+    return (f'<div data-role="errata-{html_text(tab)}" style="font-size:14px;color:#495057">'
             f'<b>Errata in the paper, beside this figure</b><ul style="margin:2px 0 0 1.1em;padding:0">'
             f'{items}</ul></div>')
 
@@ -74,7 +74,7 @@ def table1_html(rows: Sequence[Any], paper: Mapping[float, float]) -> str:
     body = "".join(f'<tr data-row="{i}"><th style="text-align:left;padding:2px 8px">{html_text(name)}</th>'
                    + "".join(f"<td {style}>{_cell(vals[k])}</td>" for k in t_m) + "</tr>"
                    for i, (name, vals) in enumerate(lines))
-    return (f'<table data-role="table1" style="border-collapse:collapse;font-size:0.95em">'
+    return (f'<table data-role="table1" style="border-collapse:collapse;font-size:14px">'
             f'<tr><th style="text-align:left;padding:2px 8px">friction saving [%] at T_m [s]</th>{head}</tr>'
             f"{body}</table>")
 

@@ -56,6 +56,7 @@ class PositionTab:
         self._recentre = True
         self._plant_J_L: float | None = None  # the J_L slider's plant [kg·m²]; None: the model's
         self.results: ResultsPanel | None = None  # the right-hand panel, given by the page once built
+        self.demo_link: Any = None  # the page's address (app.ui.demo_link.DemoLink), given by the page
         self.tuner = TuneRunner(worker, self._run_latest, self._tuned)
         self._controls(client.gui)
 
@@ -99,7 +100,9 @@ class PositionTab:
         return self.inputs.collect()
 
     def open_case(self, params: DriveParams, origin: str) -> None:
-        """Show ``params`` in the inputs as coming from ``origin`` (not simulated yet)."""
+        """Show ``params`` in the inputs as coming from ``origin`` (not simulated yet); its preset in the dropdown."""
+        if origin in self._preset_names and origin != self.preset.value:  # e.g. a loaded demo state
+            self.preset.value = self._preset_shown = origin
         self.inputs.populate(params)
         self._state.opened(params, origin)
 
@@ -145,6 +148,8 @@ class PositionTab:
         # the sliders sit above everything a run changes (warnings, status, Cancel): a drag never moves them
         self.tuning = LiveTuning(gui, self._apply_knob, self.tuner.request)
         self.lecture = LecturePins(gui, self)
+        # the K demo's remedies and warnings next, in the first screen at 1280×720 (the inputs below)
+        self.verdicts = VerdictPanel(gui, self._use_recommended_k, self._use_T_c_min)
         self.files = FilesPanel(self._client, self.export_state, self._imported, case.params)
         self.demo_files = DemoStateFiles(gui, self)
         self.log_panel = LogPanel(self)
@@ -162,7 +167,6 @@ class PositionTab:
         self.cancel_button = gui.add_button("Cancel", icon=viser.Icon.PLAYER_STOP, color="red", visible=False)
         self.cancel_button.on_click(lambda _: self.cancel_run())
         self.status = gui.add_markdown("Ready.")
-        self.verdicts = VerdictPanel(gui, self._use_recommended_k, self._use_T_c_min)
         with gui.add_form(None) as form:
             self.inputs = InputsPanel(gui, case.params)
         form.on_submit(lambda _: self.simulate())
@@ -313,6 +317,8 @@ class PositionTab:
         if status:  # not during a drag: the sliders stand where the user's pointer holds them
             self.tuning.show(d, case.plant_J_L, recentre=self._recentre)
             self._recentre = False
+            if self.demo_link is not None:  # a reload of the page opens this demo again
+                self.demo_link.remember()
             if self.results is not None:  # the K sweep of this run, after it (yields to the next job)
                 self.results.k_sweep.schedule(self._worker.submit_tail, self._worker.tail_checkpoint,
                                               case.comparison, case.plant_J_L)

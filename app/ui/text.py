@@ -64,11 +64,11 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
     warning…") folds it to that one line in the browser, and a second click opens it again.
     """
     extra = "".join(f'<div data-role="note" style="margin-top:4px;padding:4px 10px;border-radius:6px;'
-                    f'background:#f1f3f5;color:#495057;font-size:0.8em">ℹ {html_text(n)}</div>'
+                    f'background:#f1f3f5;color:#495057;font-size:14px">ℹ {html_text(n)}</div>'
                     for n in notes or [])
     if error is None and not items:
         return (f'<div style="padding:6px 10px;border-radius:6px;background:#ebfbee;color:{GOOD_COLOUR};'
-                'font-size:0.85em">✔ No warnings.</div>' + extra)
+                'font-size:14px">✔ No warnings.</div>' + extra)
     parts = []
     if error is not None:
         parts.append(f'<div data-role="input-error" style="font-weight:600">⛔ Input error — nothing '
@@ -81,7 +81,7 @@ def warnings_html(items: list[str], error: str | None = None, notes: list[str] |
                      f'<b>⚠ {len(items)} warning(s)</b> <span style="font-weight:400">— {html_text(items[0])}'
                      f'</span></summary><ul style="margin:4px 0 0 0;padding-left:18px">{lis}</ul></details>')
     return ('<div data-role="warnings" style="padding:8px 10px;border-radius:6px;background:#fff5f5;'
-            f'border:2px solid #e03131;color:{BAD_COLOUR};font-size:0.85em">' + "".join(parts) + "</div>" + extra)
+            f'border:2px solid #e03131;color:{BAD_COLOUR};font-size:14px">' + "".join(parts) + "</div>" + extra)
 
 
 def _saves(pct: float | None) -> str:
@@ -96,7 +96,7 @@ def pins_html(pins: Any) -> str:
     if not pins:
         return ""
     lines = "".join(f"<div>{html_text(line)}</div>" for line in pins_note(tuple(pins)).splitlines())
-    return f'<div data-role="pins" style="font-size:0.8em;color:#495057">{lines}</div>'
+    return f'<div data-role="pins" style="font-size:14px;color:#495057">{lines}</div>'
 
 
 def key_numbers_html(comparison: Any) -> str:
@@ -108,7 +108,7 @@ def key_numbers_html(comparison: Any) -> str:
     """
     f, c = comparison.fdsmc, comparison.conventional
     if f is None:
-        return '<div data-role="key-numbers" style="font-size:0.9em">Not simulated (infeasible manoeuvre).</div>'
+        return '<div data-role="key-numbers" style="font-size:16px">Not simulated (infeasible manoeuvre).</div>'
     g_max = torque_limit(comparison.derived.params)
     rec = recommend(comparison.derived.params, comparison)
 

@@ -26,16 +26,18 @@ class VerdictPanel:
     """Warnings box with its fold choice, and the remedy buttons, of one client."""
 
     def __init__(self, gui: viser.GuiApi, use_K: Callable[[], None], use_T_c: Callable[[], None]) -> None:
-        self.fold = gui.add_checkbox("Fold warnings to one line", False,
-                                     hint="Keeps the warnings box folded over new runs; a click on its first "
-                                          "line still opens it once")
-        self.fold.on_update(lambda _: self.render())
-        self._parts: WarningParts = ([], None, [])
-        self.box = gui.add_html("")
+        # the remedies first, right under the lecture's controls (the first screen at 1280×720),
+        # then the box: its height changes with the warnings, and nothing of the K demo sits below it
         self.use_k = gui.add_button("Use recommended K", visible=False, color="orange")
         self.use_k.on_click(lambda _: use_K())
         self.use_tc = gui.add_button("Use T_c,min", visible=False, color="orange")
         self.use_tc.on_click(lambda _: use_T_c())
+        self._parts: WarningParts = ([], None, [])
+        self.box = gui.add_html("")
+        self.fold = gui.add_checkbox("Fold warnings to one line", False,
+                                     hint="Keeps the warnings box folded over new runs; a click on its first "
+                                          "line still opens it once")
+        self.fold.on_update(lambda _: self.render())
 
     def render(self, parts: WarningParts | None = None) -> None:
         """Show the warnings (new ``parts``, or the last ones), folded to one line if the user asked."""

@@ -1,4 +1,4 @@
-"""Browser tests: a figure saved as SVG / 1920×1080 PNG without the replay buttons; no console errors over a demo.
+"""Browser tests: a figure saved as SVG (1280×720) / 1920×1080 PNG (1280×720 at scale 1.5) without the replay buttons; no console errors over a demo.
 
 Uses the shared in-process server of ``tests/browser/conftest.py``.
 """
@@ -33,8 +33,8 @@ def test_overview_saved_as_svg_and_png_without_replay_buttons(browser, ui_server
     context, page = open_page(browser, ui_server)
     try:
         assert figure(page, "phase_plane") is not None
-        svg = _save(page, "phase_plane", "Save SVG (vector)").decode("utf-8")
-        assert svg.startswith("<svg") and 'width="1920"' in svg[:400] and 'height="1080"' in svg[:400]
+        svg = _save(page, "phase_plane", "Save SVG (vector, 1280×720)").decode("utf-8")
+        assert svg.startswith("<svg") and 'width="1280"' in svg[:400] and 'height="720"' in svg[:400]
         assert "updatemenu" not in svg and "1×" not in svg  # no replay buttons
         assert "ω" in svg  # the axes and traces are there
         png = _save(page, "phase_plane", "Save PNG 1920×1080")
