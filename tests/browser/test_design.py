@@ -153,7 +153,7 @@ def test_a_window_narrower_than_a_count_is_refused_and_the_inputs_stay(page, def
     K_before = field(page, "K boundary-layer gain [s/rad]").input_value()
     page.get_by_role("button", name="Design for this drive").click()
     page.get_by_text("Design: NOT CLEAN", exact=False).wait_for(timeout=60_000)
-    page.get_by_text("Nothing designed or simulated", exact=False).wait_for()
+    page.get_by_text("Nothing designed or simulated", exact=False).first.wait_for()  # status, warnings, stale
     page.get_by_text("narrower than one count of the 8192-count encoder", exact=False).first.wait_for()
     page.get_by_text("≥ 32768 counts/rev", exact=False).first.wait_for()
     assert field(page, "K boundary-layer gain [s/rad]").input_value() == K_before
