@@ -32,6 +32,8 @@ def drive_json(tu: StockTuning) -> dict[str, Any]:
     """One vendor drive's tuned route: verdict, checks, in-position time and the settings it runs (SI)."""
     checks = [c.text for c in tu.checks] + ([] if tu.robust or tu.checks else
                                             [f"not robust to J_L × {ROBUST_J_L[0]:g} … × {ROBUST_J_L[1]:g}"])
+    if tu.budget_stop:
+        checks.append(f"the search stopped at the run budget after {tu.tried} settings")
     loop = tu.loop
     return {"verdict": verdict_word(checks), "checks": checks, "in_position_s": tu.run.metrics.in_position_s,
             "loop_rate_Hz": loop.f_loop, "law": loop.law, "accel_rad_s2": tu.trapezoid.alpha,
@@ -39,7 +41,8 @@ def drive_json(tu: StockTuning) -> dict[str, Any]:
             "kp": loop.kp, "kd_Nms_per_rad": loop.kd, "ki": loop.ki, "inertia_kgm2": loop.J_ff,
             "pll_bandwidth_rad_s": loop.omega_e, "current_kp_V_per_A": loop.current_kp,
             "current_ki_V_per_As": loop.current_ki, "robust_J_L_factors": list(ROBUST_J_L),
-            "speed_clamp_rad_s": None if math.isinf(loop.omega_lim) else loop.omega_lim}
+            "speed_clamp_rad_s": None if math.isinf(loop.omega_lim) else loop.omega_lim,
+            "settings_tried": tu.tried, "search_stopped_at_budget": tu.budget_stop}
 
 
 def stock_json(cmp: Comparison) -> dict[str, Any]:

@@ -13,15 +13,18 @@ The rule (closed form, one free bandwidth ω_v [rad/s], total inertia J = J_r + 
 * the current loop at the drive's bandwidth 3/T_si (eq. (8) in [1]), kp = L·ω_c, ki = R·ω_c;
 * ω_v at most ω_c/4 and 2π·f_loop/40 (a decade and more inside the current loop and the cycle).
 
-The free choices are searched, fastest first, on the **simulated checks** of the drive's own loops
+The free choices are searched on the **simulated checks** of the drive's own loops
 (:func:`sim.stock.route.simulate_stock` with the case's sensors, limits and pass criteria): the
 planner's acceleration as a fraction of the design's α_max (ACCEL_FRACTIONS: the drive's feedback
 needs torque headroom above J·α) and ω_v as a fraction of its ceiling (BANDWIDTH_FRACTIONS: slower
-loops pass the encoder's quantization less, faster ones track tighter). The first setting whose
-nominal run passes every check **and** that stays stable, within the drive's limits and settles in
-the window with the load inertia J_L at ×0.5 and ×2 (ROBUST_J_L) is the tuned one. A pass/fail
-search over a monotone two-parameter family is what the checks allow: they are not smooth in the
-gains, so a gradient optimiser has nothing to follow.
+loops pass the encoder's quantization less, faster ones track tighter). The search starts from the
+fastest move and loops and lets each failure choose the next step (:func:`next_step`): a limit or
+saturation lowers the acceleration, anything else (the sensors' ripple, the window, overshoot)
+lowers ω_v first — the worst case's cost checked before the first run.
+The first setting whose nominal run passes every check **and** that stays stable, within the
+drive's limits, unsaturated and free of chatter with the load inertia J_L at ×0.5 and ×2
+(ROBUST_J_L, the robustness margin) is the tuned one. A guided pass/fail search is what the checks
+allow: they are not smooth in the gains, so a gradient optimiser has nothing to follow.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -39,10 +42,12 @@ from control.fdsmc.derivations import Derived
 from control.fdsmc.model import torque_constant
 from control.fdsmc.params import DriveParams
 from control.fdsmc.trapezoid import TrapezoidTiming, trapezoid_samples, trapezoid_timing
+from sim.common.budget import MAX_CPU_S
 from sim.fdsmc.checks import Constraint, run_checks
 from sim.fdsmc.criteria import drive_current
 from sim.fdsmc.engine import RunResult
-from sim.stock.route import StockLoop, simulate_stock
+from sim.fdsmc.grid import check_budget
+from sim.stock.route import StockLoop, at_loop_rate, simulate_stock
 
 #: pos_gain = ω_v/POSITION_RATIO [-].
 POSITION_RATIO = 4.0
@@ -56,6 +61,10 @@ ACCEL_FRACTIONS = (1.0, 0.85, 0.7, 0.6, 0.5, 0.4)
 BANDWIDTH_FRACTIONS = (1.0, 0.7, 0.5, 0.35, 0.25, 0.18, 0.125)
 #: Load-inertia factors the tuned route must stay stable and in position with [-].
 ROBUST_J_L = (0.5, 2.0)
+#: Failed checks that ask for a gentler move (torque headroom) rather than slower loops.
+LIMITS = frozenset({"torque", "current", "voltage", "speed", "saturation"})
+#: The search's most nominal runs, each with at most len(ROBUST_J_L) detuned ones [-].
+MAX_TRIES = len(ACCEL_FRACTIONS) * len(BANDWIDTH_FRACTIONS)
 #: Checks the detuned-inertia runs may fail: the window, its overshoot and the 2 % band at T_m (what the
 #: inertia feed-forward buys); they must stay stable, within the limits, unsaturated and free of chatter.
 ROBUST_EXEMPT = ("overshoot", "arrival", "in_position")
@@ -103,6 +112,7 @@ class StockTuning:
     checks : tuple               Its violated checks (empty: the route passes).
     robust : bool                Stable, within limits and settling at J_L ×ROBUST_J_L.
     tried : int                  Settings simulated [-].
+    budget_stop : bool           The search stopped at the request budget before a setting passed.
     """
 
     trapezoid: TrapezoidTiming
@@ -113,6 +123,7 @@ class StockTuning:
     checks: tuple[Constraint, ...]
     robust: bool
     tried: int
+    budget_stop: bool = False
 
     @property
     def clean(self) -> bool:
@@ -162,13 +173,13 @@ def with_load_inertia(params: DriveParams, factor: float) -> DriveParams:
     return dataclasses.replace(params, load=dataclasses.replace(params.load, J_L=factor * params.load.J_L))
 
 
-def robust(params: DriveParams, loop: StockLoop, d: Derived) -> bool:
-    """Return True when the route stays stable, within limits and settles with J_L at every ROBUST_J_L factor."""
+def robust_failures(params: DriveParams, loop: StockLoop, d: Derived) -> set[str]:
+    """Return the checks the route fails with J_L at any ROBUST_J_L factor (ROBUST_EXEMPT aside); empty: robust."""
+    failed: set[str] = set()
     for factor in ROBUST_J_L:
         run = simulate_stock(params, loop, d, plant=with_load_inertia(params, factor))
-        if any(c.name not in ROBUST_EXEMPT for c in run_checks(params, run)):
-            return False
-    return True
+        failed |= {c.name for c in run_checks(params, run) if c.name not in ROBUST_EXEMPT}
+    return failed
 
 
 def trapezoids(params: DriveParams, d: Derived) -> list[tuple[float, TrapezoidTiming]]:
@@ -183,35 +194,60 @@ def trapezoids(params: DriveParams, d: Derived) -> list[tuple[float, TrapezoidTi
     return out
 
 
-def tune(spec: DriveSpec, params: DriveParams, d: Derived) -> StockTuning:
-    """Return the fastest setting of the family that passes (see the module doc), else the last one tried.
+def next_step(failed: set[str], ia: int, js: int) -> tuple[int, int]:
+    """Return the search's next (acceleration index, bandwidth index) after a setting failed ``failed``.
 
-    The trial that failed least (fewest violated checks) is returned when none passes, with its checks.
+    A limit of the drive or the saturation asks for a gentler move (more torque headroom: the next
+    acceleration, the same loops); anything else — the sensors' ripple, chatter, the window, the
+    overshoot, a detuned-inertia failure — for slower loops, and once the slowest has failed, for the
+    next acceleration from the fastest loops again.
+    """
+    if failed & LIMITS:
+        return ia + 1, js
+    if js + 1 < len(BANDWIDTH_FRACTIONS):
+        return ia, js + 1
+    return ia + 1, 0
+
+
+def tune(spec: DriveSpec, params: DriveParams, d: Derived) -> StockTuning:
+    """Return the first setting of the guided search that passes (see the module doc).
+
+    From the fastest move and loops, each failure steps the acceleration or the bandwidth down
+    (:func:`next_step`), at most MAX_TRIES settings. The cost of each setting's runs (nominal and
+    detuned) is predicted before they start: the search stops where the next setting would take the
+    whole search past the request budget (:data:`sim.common.budget.MAX_CPU_S`), and ``budget_stop``
+    says so. When none passes, the trial that failed fewest checks is returned with its checks.
+
+    Raises
+    ------
+    BudgetError
+        When even one run of the drive's loops exceeds the run budget (naming the fields that set it).
     """
     f = loop_rate(spec, params)
-    ceiling = bandwidth_ceiling(params, f)
+    one = check_budget(at_loop_rate(params, f), 1).cpu_s or 0.0  # a single run must fit: else nothing runs
+    per_setting = (1 + len(ROBUST_J_L)) * one
+    ceiling, moves = bandwidth_ceiling(params, f), trapezoids(params, d)
+    if not moves:  # no feasible trapezoid: the design's own α_max move, as it is
+        moves = [(1.0, trapezoid_timing(params.manoeuvre.theta_dem, d.alpha.alpha_max, params.manoeuvre.T_m))]
     best: StockTuning | None = None
-    tried = 0
-    for frac, tr in trapezoids(params, d):
-        for s in BANDWIDTH_FRACTIONS:
-            loop = make_loop(spec, params, tr, s * ceiling)
-            run = simulate_stock(params, loop, d)
-            tried += 1
-            checks = tuple(run_checks(params, run))
-            ok = not checks and robust(params, loop, d)
-            cand = StockTuning(tr, loop, s * ceiling, frac, run, checks, ok, tried)
-            if ok:
-                return cand
-            if best is None or len(checks) < len(best.checks):
-                best = cand
-    if best is None:  # no feasible trapezoid: the design's own α_max move
-        tr = trapezoid_timing(params.manoeuvre.theta_dem, d.alpha.alpha_max, params.manoeuvre.T_m)
-        loop = make_loop(spec, params, tr, ceiling)
+    ia = js = tried = 0
+    while ia < len(moves) and js < len(BANDWIDTH_FRACTIONS):
+        if (tried + 1) * per_setting > MAX_CPU_S and best is not None:
+            return dataclasses.replace(best, tried=tried, budget_stop=True)
+        (frac, tr), w_v = moves[ia], BANDWIDTH_FRACTIONS[js] * ceiling
+        loop = make_loop(spec, params, tr, w_v)
         run = simulate_stock(params, loop, d)
-        best = StockTuning(tr, loop, ceiling, 1.0, run, tuple(run_checks(params, run)), False, tried + 1)
+        tried += 1
+        checks = tuple(run_checks(params, run))
+        failed = {c.name for c in checks} or robust_failures(params, loop, d)
+        cand = StockTuning(tr, loop, w_v, frac, run, checks, not failed, tried)
+        if not failed:
+            return cand
+        if best is None or len(checks) < len(best.checks):
+            best = cand
+        ia, js = next_step(failed, ia, js)
+    assert best is not None
     return dataclasses.replace(best, tried=tried)
-
-
 
 
 #: Tuned routes by (drive, case without its K and T_c); the oldest dropped beyond CACHE_SIZE.
