@@ -265,3 +265,19 @@ def test_pool_workers_start_with_sigint_blocked():
     with RetryingPool(1) as pool:
         mask = pool.submit(signal.pthread_sigmask, signal.SIG_BLOCK, set()).result()
     assert signal.SIGINT in mask and signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())
+
+
+@pytest.mark.parametrize("kv", ["0", "-0", "-304"])
+def test_a_speed_constant_that_gives_no_flux_is_refused_naming_it(kv, capsys):
+    assert main(["derive", "odrive_d5065_belt", "--set", f"motor.Kv_rpm_per_V={kv}"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: motor.Kv_rpm_per_V = ") and "allowed > 0 rpm/V" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("mode", ["[a, b]", "{a: 1}"])
+def test_a_mode_that_is_not_a_name_is_refused(mode, tmp_path, capsys):
+    path = tmp_path / "m.yaml"
+    path.write_text(f"schema: 2\nmode: {mode}\n")
+    assert main(["derive", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "mode = " in err and "allowed: position, bldc" in err and "Traceback" not in err

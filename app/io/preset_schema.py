@@ -199,7 +199,7 @@ def parse_preset(raw: Any) -> Any:
                           "source and sections")
     raw = migrate(raw)
     mode = raw.get("mode", "position")
-    if mode not in MODES:
+    if not isinstance(mode, str) or mode not in MODES:
         raise PresetError(f"mode = {shown(mode)} is not known{hint(str(mode), list(MODES))}")
     cls = MODES[mode]
     sections = [f.name for f in dataclasses.fields(cls) if f.name not in ("name", "source")]

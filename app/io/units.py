@@ -276,7 +276,14 @@ def kv_rpm_per_v_to_psi_pm(Kv_rpm_per_V: float, p: int) -> float:
     Kv is the speed per volt of line-to-line **peak** back-EMF (the hobby/robotics convention; ODrive's
     torque_constant = 8.27/Kv follows from it). The line-to-line peak at mechanical speed ω is
     √3·p·ω·Ψ_PM, so Ψ_PM = 1/(√3·p·Kv·2π/60); then Kt = (3/2)·p·Ψ_PM = 8.27/Kv [N·m/A].
+
+    Raises
+    ------
+    ParameterError
+        For Kv ≤ 0 or not finite (no flux follows from it), naming ``motor.Kv_rpm_per_V``.
     """
+    if not (math.isfinite(Kv_rpm_per_V) and Kv_rpm_per_V > 0.0):
+        raise ParameterError(f"motor.Kv_rpm_per_V = {Kv_rpm_per_V!r} rpm/V is not allowed: allowed > 0 rpm/V")
     return 1.0 / (math.sqrt(3.0) * p * rpm_to_rad_s(Kv_rpm_per_V))
 
 
