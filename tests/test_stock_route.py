@@ -130,3 +130,21 @@ def test_stock_energy_balance_closes():
     rhs = m.copper_total_J + m.friction_total_J + m.load_work_total_J + stored
     assert lhs == pytest.approx(rhs, rel=1e-5, abs=1e-9)
     assert np.all(np.diff(cmp.stock.trace.E_copper) >= -1e-12)
+
+
+def test_the_tuning_search_stops_at_the_run_budget_and_says_so():
+    """A 60 s move at 20 kHz: each setting costs ≈ 0.6 s predicted; the search stops before 3 s of CPU."""
+    import dataclasses
+
+    from app.io.presets import load_preset
+    from control.fdsmc.derivations import derive
+    from sim.common.budget import MAX_CPU_S
+    from sim.fdsmc.grid import predict
+    from sim.stock.route import at_loop_rate
+    from sim.stock.tuning import DRIVES, ROBUST_J_L, tune
+
+    p = load_preset("paper_12kw_pmsm")
+    p = dataclasses.replace(p, manoeuvre=dataclasses.replace(p.manoeuvre, T_m=60.0))
+    tu = tune(DRIVES["setpoints"], p, derive(p))
+    per_setting = (1 + len(ROBUST_J_L)) * predict(at_loop_rate(p, 20000.0)).cpu_s
+    assert tu.budget_stop and tu.tried >= 1 and tu.tried * per_setting <= MAX_CPU_S < (tu.tried + 1) * per_setting
