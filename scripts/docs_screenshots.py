@@ -4,6 +4,8 @@ Writes, from one in-process server (paper preset, 3D view off):
 
 * ``docs/k_demo_chatter_1280x720.png`` (K = 1000: chattering) and ``docs/k_demo_clean_1280x720.png``
   (after "Use recommended K");
+* ``docs/k_sweep_chatter_1280x720.png`` and ``docs/k_sweep_clean_1280x720.png``: the *K sweep* tab
+  mid-drag, its own slider held at a chattering K, then at a clean one;
 * ``docs/sliding_zoom_1280x720.png``: the overview at the recommended K with its phase plane
   zoomed onto the window of the automatic sliding-region inset (boundary layer, sliding at ω_p);
 * ``docs/projector_1280x720.png``: the same page half-way through a replay (the trail drawn so far);
@@ -95,6 +97,25 @@ def _k_demo(page: Any) -> None:
         _shot(page, "sliding_zoom_1280x720.png")
 
 
+def _k_sweep(page: Any) -> None:
+    """The K sweep tab mid-drag: its own slider held at a chattering K, then at a clean one (the pointer down)."""
+    click_tab(page, "K sweep")
+    page.wait_for_function(FIGURE_DRAWN, arg="k_sweep")
+    page.wait_for_timeout(800)
+    rail = page.locator(".js-plotly-plot .slider-rail-rect").first.bounding_box()
+    steps = page.evaluate("() => [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta"
+                          " && e.layout.meta.id === 'k_sweep')._fullLayout.sliders[0].steps.length")
+    y, dx = rail["y"] + rail["height"] / 2, (rail["width"] - 4) / (steps - 1)
+    page.mouse.move(rail["x"] + 2 + (steps - 1) * dx, y)
+    page.mouse.down()
+    for k, name in ((steps - 6, "k_sweep_chatter_1280x720.png"), (7, "k_sweep_clean_1280x720.png")):
+        page.mouse.move(rail["x"] + 2 + k * dx, y, steps=12)
+        page.wait_for_timeout(400)
+        page.screenshot(path=str(DOCS / name))
+    page.mouse.up()
+    click_tab(page, "Overview")
+
+
 def _table1(page: Any) -> None:
     """The Table 1 sweep tab after its sweep: the numeric table and figure, then the errata."""
     click_tab(page, "Table 1 sweep")
@@ -142,6 +163,7 @@ def main() -> int:
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=LAUNCH_ARGS)
             page = _open(browser, server.get_port(), SIZE)
             _k_demo(page)
+            _k_sweep(page)
             _table1(page)
             _bldc(page)
             page.close()

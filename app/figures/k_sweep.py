@@ -125,12 +125,12 @@ def _extent(points: list[Any]) -> tuple[list[float], list[float], list[float], l
     return [lo, hi], [w[0] - pad, w[1] + pad], [w[0] - pad, w[1] + pad], g
 
 
-def _step_label(K: float, marks: dict[str, float], first: bool, last: bool) -> str:
-    """Return a step's label on the slider: the ends and the marked gains only (30 labels would overlap)."""
-    for name, value in marks.items():
-        if value > 0.0 and abs(K / value - 1.0) < 0.005:
-            return name
-    return f"{K:.3g}" if first or last else ""
+def _step_label(K: float) -> str:
+    """Return a step's label on the slider: K [s/rad] in two significant digits ("0.3", "1000").
+
+    Plotly labels every n-th step only, n set by the widest label; short labels keep n at 2.
+    """
+    return f"{K:.0f}" if K >= 100.0 else f"{K:.2g}"
 
 
 def _static_traces(points: list[Any], active: Any, boundary: tuple[np.ndarray, np.ndarray]) -> list[dict[str, Any]]:
@@ -159,8 +159,10 @@ def _static_traces(points: list[Any], active: Any, boundary: tuple[np.ndarray, n
          "line": REF_LINE},
         {**line, "x": [0.0, t_end, None, 0.0, t_end], "y": [g_max, g_max, None, -g_max, -g_max],
          "name": "±Γ_max", "xaxis": "x3", "yaxis": "y3", "line": REF_LINE},
-        {"type": "scatter", "mode": "text", "x": [0.98], "y": [0.98], "text": [text], "xaxis": "x4", "yaxis": "y4",
-         "textposition": "bottom left", "textfont": {"color": colour, "size": VERDICT_FONT_PX},
+        # in the phase plane's empty half (below the cruise for a positive move): not on the trajectory
+        {"type": "scatter", "mode": "text", "x": [0.5], "y": [0.3 if sign > 0 else 0.7], "text": [text],
+         "xaxis": "x4", "yaxis": "y4", "textposition": "middle center",
+         "textfont": {"color": colour, "size": VERDICT_FONT_PX},
          "hoverinfo": "skip", "showlegend": False, "name": "verdict"},
     ]
 
@@ -193,7 +195,7 @@ def k_sweep_spec(points: list[Any], K_now: float, marks: dict[str, float],
     K_now : float
         The K in force [s/rad]: the slider starts at its step.
     marks : dict
-        Label → gain [s/rad] named on the slider (``{"lim": K_limit, "rec": K_rec}``).
+        Label → gain [s/rad] of the marked gains (``{"lim": K_limit, "rec": K_rec}``), kept in ``meta.marks``.
     plant_J_L : float or None
         The plant's load inertia [kg·m²] when it differs from the controller's model.
 
@@ -214,14 +216,14 @@ def k_sweep_spec(points: list[Any], K_now: float, marks: dict[str, float],
     if plant_J_L is not None:  # the active frame's verdict says so too
         data[7]["text"] = [_verdict_text(points[active], plant_J_L)[0]]
     raw = {f"__k_frame_{k}__": "[" + _frame_json(c, boundary, plant_J_L) + "]" for k, c in enumerate(points)}
-    steps = [{"label": _step_label(K, marks, k == 0, k == len(Ks) - 1), "value": f"{K:.4g}", "method": "animate",
+    steps = [{"label": _step_label(K), "value": f"{K:.4g}", "method": "animate",
               "execute": False, "args": [f"__k_frame_{k}__", STEP_ANIMATE]} for k, K in enumerate(Ks)]
     layout = {**_layout(points, float(points[active].fdsmc.trace.t[-1])),
-              "meta": {"id": "k_sweep", "K": Ks}, "template": "plotly_white", "showlegend": False,
+              "meta": {"id": "k_sweep", "K": Ks, "marks": marks}, "template": "plotly_white", "showlegend": False,
               "title": {"text": f"K sweep: {len(Ks)} runs, drag the slider (in the browser)",
                         "font": {"size": TITLE_PX}, "x": 0.01},
               "margin": {"l": 60, "r": 16, "t": 48, "b": 110},
-              "sliders": [{"active": active, "steps": steps, "x": 0.0, "len": 1.0, "y": 0.0, "yanchor": "top",
+              "sliders": [{"active": active, "steps": steps, "x": 0.0, "len": 0.96, "y": 0.0, "yanchor": "top",
                            "pad": {"t": 56, "b": 4}, "currentvalue": {"visible": False},
                            "font": {"size": FONT_PX}, "transition": {"duration": 0}}]}
     return {"data": data, "layout": layout}, raw

@@ -62,6 +62,9 @@ class AppConfig:
     _initial: Comparison | None = None
     _lock: threading.Lock = field(default_factory=threading.Lock)
     sessions: dict[int, Session] = field(default_factory=dict)
+    #: Clients that left while their page was still being built (never registered, closed once built).
+    gone: set[int] = field(default_factory=set)
+    _sessions_lock: threading.Lock = field(default_factory=threading.Lock)
     guard: Guard | None = None
     slots: StudySlots = field(default_factory=StudySlots.for_machine)
 
@@ -261,11 +264,21 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
 
     @server.on_client_connect
     def _(client: viser.ClientHandle) -> None:
-        config.sessions[client.client_id] = Session(client, config)
+        session = Session(client, config)
+        with config._sessions_lock:
+            gone = client.client_id in config.gone
+            config.gone.discard(client.client_id)
+            if not gone:
+                config.sessions[client.client_id] = session
+        if gone:  # the client left while its page was built: nothing of it may outlive it
+            session.close()
 
     @server.on_client_disconnect
     def _(client: viser.ClientHandle) -> None:
-        session = config.sessions.pop(client.client_id, None)
+        with config._sessions_lock:
+            session = config.sessions.pop(client.client_id, None)
+            if session is None:  # still being built: closed by the connect handler once it is
+                config.gone.add(client.client_id)
         if session is not None:
             session.close()
             # once its job has stopped (next checkpoint), the page's memory goes back to the system

@@ -25,5 +25,6 @@ def test_a_reload_restores_the_demo_and_the_preset_dropdown(browser, ui_server):
         assert field(second, K_FIELD).input_value() == "2.5"
         preset = second.locator('xpath=//label[normalize-space(.)="Preset"]/ancestor::*[.//input][1]//input').first
         assert preset.input_value() == PAPER_PRESET  # the dropdown names the preset of the loaded demo
+        second.get_by_text("Ready — ").wait_for(timeout=60_000)  # its run ends before the page closes
     finally:
         context.close()

@@ -1,4 +1,5 @@
-"""Browser tests: a figure saved as SVG (1280×720) / 1920×1080 PNG (1280×720 at scale 1.5) without the replay buttons; no console errors over a demo.
+"""Browser tests: a figure saved as SVG (1280×720) and PNG (1920×1080: 1280×720 at scale 1.5) without the
+replay buttons; no console errors over a demo.
 
 Uses the shared in-process server of ``tests/browser/conftest.py``.
 """
