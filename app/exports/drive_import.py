@@ -30,7 +30,8 @@ SOURCES: dict[str, dict[str, tuple[str, str]]] = {
                "motor.L_q": ("axis0.motor.config.phase_inductance", "H"),
                "motor.psi_pm": ("axis0.motor.config.torque_constant", "Nm/A"),
                "motor.p": ("axis0.motor.config.pole_pairs", "-"),
-               "controller.i_max": ("axis0.motor.config.current_lim", "A")},
+               "controller.i_max": ("axis0.motor.config.current_lim", "A"),
+               "sensors.encoder_cpr": ("axis0.encoder.config.cpr", "counts/rev")},
     "moteus": {"motor.R_s": ("motor.resistance_ohm", "Ohm"), "motor.L_d": ("motor.inductance_d_H", "H"),
                "motor.L_q": ("motor.inductance_q_H", "H"), "motor.psi_pm": ("motor.Kv", "rpm/V"),
                "motor.p": ("motor.poles", "poles"), "controller.i_max": ("servo.max_current_A", "A")},
@@ -40,7 +41,7 @@ SOURCES: dict[str, dict[str, tuple[str, str]]] = {
 }
 
 #: Keys that shape an imported value without being its source (VESC: L_d, L_q = L ∓ diff/2).
-ALSO_USED = {"vesc": ("foc_motor_ld_lq_diff",)}
+ALSO_USED = {"vesc": ("foc_motor_ld_lq_diff",), "odrive": ("axis0.motor.config.motor_type",)}
 
 
 @dataclass(frozen=True)
@@ -96,14 +97,16 @@ def import_drive(text: str, fmt: str, base: DriveParams, origin: str = "<drive f
     if fmt == "odrive":
         R, L, psi, p, i_max = motor
         values = {"motor.R_s": R, "motor.L_d": L, "motor.L_q": L, "motor.psi_pm": psi, "motor.p": p,
-                  "controller.i_max": i_max}
+                  "controller.i_max": i_max, "sensors.encoder_cpr": f.get("axis0.encoder.config.cpr")}
     else:
         R, Ld, Lq, psi, p, i_max = motor
         values = {"motor.R_s": R, "motor.L_d": Ld, "motor.L_q": Lq, "motor.psi_pm": psi, "motor.p": p,
                   "controller.i_max": i_max}
     given = {k: _checked(fmt, k, v, f) for k, v in values.items() if v is not None}
     motor_kw = {k.split(".")[1]: v for k, v in given.items() if k.startswith("motor.")}
-    params = dataclasses.replace(base, motor=dataclasses.replace(base.motor, **motor_kw),
+    sensors = base.sensors if "sensors.encoder_cpr" not in given else dataclasses.replace(
+        base.sensors, encoder_cpr=int(given["sensors.encoder_cpr"]))
+    params = dataclasses.replace(base, motor=dataclasses.replace(base.motor, **motor_kw), sensors=sensors,
                                  controller=dataclasses.replace(base.controller, i_max=given["controller.i_max"]))
     used = {SOURCES[fmt][k][0] for k in given} | set(ALSO_USED.get(fmt, ()))
     imported = tuple(f"{k} = {v!r} (from {SOURCES[fmt][k][0]})" for k, v in given.items())

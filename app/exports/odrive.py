@@ -9,7 +9,11 @@ inertia feed-forward, speed limit), the current-loop and encoder-PLL bandwidths 
 planner's limits (turn, turn/s, turn/s²), all tuned on the simulated stock route (:mod:`sim.stock.tuning`),
 with a ``_comment`` key holding the header (odrivetool reports it as "property not found" and
 restores the rest). Firmware 0.6.x moved the motor settings to ``axis0.config.motor`` and is not
-written.
+written; a 0.6.x backup is refused naming its layout (:func:`odrive_motor`). The file carries the encoder's
+``cpr`` (counts per motor revolution, 4× the pulses per revolution) and ``motor_type`` 0 (HIGH_CURRENT);
+a backup with ``motor_type`` 2 (GIMBAL), where ``current_lim`` is a voltage limit [V] ("When using gimbal
+motors, current_lim and calibration_current actually mean voltage limit and calibration voltage",
+ODrive docs/getting-started.rst, fw 0.5.6), or 3 (ACIM, an induction motor) is refused.
 """
 
 from __future__ import annotations
@@ -39,6 +43,8 @@ _IF = "odrive-interface.yaml (fw 0.5.x)"
 #: Every key written, with its ODrive type and unit (units as the interface file states them, those
 #: of the motor config from the ODrive docs' parameter reference).
 KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
+    VendorKey("axis0.motor.config.motor_type", "enum", "-", f"{_IF}: ODrive.Motor.MotorType (0 = HIGH_CURRENT; "
+              "2 = GIMBAL: current_lim is then a voltage)"),
     VendorKey("axis0.motor.config.pole_pairs", "int", "-", f"{_IF}: ODrive.Motor config pole_pairs int32"),
     VendorKey("axis0.motor.config.phase_resistance", "float", "Ohm", f"{_IF}: phase_resistance float32"),
     VendorKey("axis0.motor.config.phase_inductance", "float", "H", f"{_IF}: phase_inductance float32"),
@@ -47,6 +53,8 @@ KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
     VendorKey("axis0.motor.config.current_control_bandwidth", "float", "rad/s",
               f"{_IF}: current_control_bandwidth (current PI kp = L·bw, ki = R·bw)"),
     VendorKey("axis0.encoder.config.bandwidth", "float", "rad/s", f"{_IF}: Encoder config bandwidth (PLL)"),
+    VendorKey("axis0.encoder.config.cpr", "int", "counts/rev",
+              f"{_IF}: Encoder config cpr int32, counts per revolution (4× the pulses per revolution)"),
     VendorKey("axis0.controller.config.control_mode", "enum", "-", f"{_IF}: ControlMode (3 = POSITION_CONTROL)"),
     VendorKey("axis0.controller.config.input_mode", "enum", "-", f"{_IF}: InputMode (5 = TRAP_TRAJ)"),
     VendorKey("axis0.controller.config.pos_gain", "float", "(turn/s) / turn", f"{_IF}: pos_gain"),
@@ -60,18 +68,26 @@ KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
 )}
 CONTROL_MODE_POSITION_CONTROL = 3
 INPUT_MODE_TRAP_TRAJ = 5
+#: ODrive.Motor.MotorType of odrive-interface.yaml (fw 0.5.x): the one this tool reads and writes.
+MOTOR_TYPE_HIGH_CURRENT = 0
+#: The other motor types and why a backup with one is refused.
+MOTOR_TYPES_REFUSED = {2: "GIMBAL: current_lim is a voltage limit [V] in gimbal mode, not a current",
+                       3: "ACIM: an induction motor, not a PMSM"}
 
 
 def odrive_values(s: StockSettings) -> dict[str, float]:
     """Every written key → value in ODrive's units (the one conversion from SI)."""
     tr, g = s.trapezoid, s.gains
     accel = rad_to_turn(tr.alpha)
-    values = [s.p, s.R_s, 0.5 * (s.L_d + s.L_q), torque_constant(s.psi_pm, s.p), s.current_limit,
-              s.current_bandwidth, s.pll_bandwidth, CONTROL_MODE_POSITION_CONTROL, INPUT_MODE_TRAP_TRAJ, g.pos_gain,
-              per_rad_to_per_turn(g.vel_gain),
+    values = [MOTOR_TYPE_HIGH_CURRENT, s.p, s.R_s, 0.5 * (s.L_d + s.L_q), torque_constant(s.psi_pm, s.p),
+              s.current_limit, s.current_bandwidth, s.pll_bandwidth, s.encoder_cpr, CONTROL_MODE_POSITION_CONTROL,
+              INPUT_MODE_TRAP_TRAJ, g.pos_gain, per_rad_to_per_turn(g.vel_gain),
               per_rad_to_per_turn(g.vel_integrator_gain), rad_to_turn(s.speed_limit), per_rad_to_per_turn(g.inertia),
               rad_to_turn(abs(tr.omega_c)), accel, accel]
-    return dict(zip(KEYS, values, strict=True))
+    out = dict(zip(KEYS, values, strict=True))
+    if s.encoder_cpr <= 0:  # an ideal encoder has no count to write: the drive's own cpr stays
+        del out["axis0.encoder.config.cpr"]
+    return out
 
 
 def _nest(flat: dict[str, Any]) -> dict[str, Any]:
@@ -152,8 +168,35 @@ def parse_odrive(text: str, origin: str = "<odrive>") -> VendorFile:
     return vendor_file(pairs, KEYS, (str(c) for c in comment))
 
 
+#: A leaf of the fw 0.6.x layout (motor settings under axis0.config.motor).
+LAYOUT_06 = "axis0.config.motor."
+
+
+def _check_layout_and_type(f: VendorFile) -> None:
+    """Refuse a fw 0.6.x backup by its layout, and a motor type whose current_lim is not a current.
+
+    Raises
+    ------
+    ParameterError
+        Naming the layout or the key, its value and what is allowed.
+    """
+    keys = [k for k, _ in f.values] + list(f.unknown)
+    new = next((k for k in keys if k.startswith(LAYOUT_06)), None)
+    if new is not None and f.get("axis0.motor.config.pole_pairs") is None:
+        raise ParameterError(f"the backup has the fw 0.6.x layout axis0.config.motor.… ({new}): allowed fw 0.5.x "
+                             "(axis0.motor.config.…); read the motor values off the 0.6 device by hand")
+    kind = f.get("axis0.motor.config.motor_type")
+    if kind is not None and kind != MOTOR_TYPE_HIGH_CURRENT:
+        why = MOTOR_TYPES_REFUSED.get(int(kind), "not a motor type of fw 0.5.x")
+        lim = f.get("axis0.motor.config.current_lim")
+        raise ParameterError(f"axis0.motor.config.motor_type = {kind:g} ({why}; current_lim = {lim!r}) is not "
+                             f"allowed: {MOTOR_TYPE_HIGH_CURRENT} (HIGH_CURRENT); give controller.i_max from the "
+                             "motor's datasheet instead")
+
+
 def odrive_motor(f: VendorFile) -> tuple[float, float, float, int, float]:
-    """R_s [Ω], L [H], Ψ_PM [Wb], p [-], i_max [A] of a parsed backup (axis 0)."""
+    """R_s [Ω], L [H], Ψ_PM [Wb], p [-], i_max [A] of a parsed backup (axis 0), after :func:`_check_layout_and_type`."""
+    _check_layout_and_type(f)
     p = int(f.require("axis0.motor.config.pole_pairs", "the pole pairs"))
     if p < 1:
         raise ParameterError(f"axis0.motor.config.pole_pairs = {p} is not allowed: allowed ≥ 1")

@@ -50,6 +50,7 @@ class StockSettings:
     pll_bandwidth : float        Encoder PLL bandwidth [rad/s].
     f_loop : float               The drive's loop rate [Hz].
     tuning : StockTuning         The tuned route (its verifying run and checks).
+    encoder_cpr : int            Encoder counts per motor revolution (``sensors.encoder_cpr``; 0 = ideal).
     """
 
     trapezoid: TrapezoidTiming
@@ -66,6 +67,7 @@ class StockSettings:
     pll_bandwidth: float
     f_loop: float
     tuning: StockTuning
+    encoder_cpr: int = 0
 
 
 def loop_gains(loop: StockLoop) -> CascadeGains:
@@ -85,7 +87,8 @@ def stock_settings(cmp: Comparison, drive: str = "setpoints") -> StockSettings:
     i_lim = drive_current(p)  # the simulated hard limit min(i_max, Γ_max/K_t), else Γ_max/K_t
     cycle = CONTINUOUS_CYCLE_S if c.is_continuous else 1.0 / float(c.f_s)
     return StockSettings(tr, loop_gains(loop), m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, i_lim,
-                         max(m.omega_b, abs(tr.omega_c)), 3.0 / c.T_si, cycle, loop.omega_e, loop.f_loop, tu)
+                         max(m.omega_b, abs(tr.omega_c)), 3.0 / c.T_si, cycle, loop.omega_e, loop.f_loop, tu,
+                         p.sensors.encoder_cpr)
 
 
 def with_stock_runs(cmp: Comparison) -> Comparison:

@@ -33,8 +33,18 @@ from sim.stock.tuning import setpoint_table
 _DOC = "VESC Tool res/config parameters_mcconf.xml (fw 5.03+ / 6.x)"
 #: Root element and version element of VESC Tool's mcconf XML.
 ROOT, VERSION_TAG = "MCConfiguration", "ConfigVersion"
-#: The ConfigVersion written (VESC Tool's mcconf XML version field).
-CONFIG_VERSION = 2
+#: The ConfigVersion written: VESC Tool's VT_CONFIG_VERSION (vesc_tool.pro) of VESC Tool 6.06 and 7.0x
+#: (fw 6.06+), which load the file without their "different firmware and/or different version of VESC
+#: Tool" dialog (vescinterface.cpp mcconfUpdated: shown when fw ≥ 5.03 and the file's version differs).
+#: VESC Tool 3.01–6.05 (fw 5.03–6.05) wrote 2; they show the dialog for this file but read the same
+#: keys in the same units.
+CONFIG_VERSION = 4
+#: ConfigVersions read: 2 (VESC Tool 3.01–6.05), 3 (6.06 betas), 4 (6.06+). Before fw 5.03 (bldc
+#: CHANGELOG 5.03 "Correct scaling for resistance and inductance", mcpwm_foc.c of 2021-10-15) the
+#: firmware stored foc_motor_r, foc_motor_l and foc_motor_ld_lq_diff as 2/3 of the phase values; a
+#: file from then has no ConfigVersion (VESC Tool ≤ 3.00) or 1 (a VESC Tool 3.01 test build of
+#: 2021-10-31 only): which scaling it holds is not known, so it is refused.
+CONFIG_VERSIONS_READ = (2, 3, 4)
 #: Every key written, with its VESC type and stored unit.
 KEYS: dict[str, VendorKey] = {vk.key: vk for vk in (
     VendorKey("motor_type", "enum", "-", f"{_DOC}: motor_type (2 = FOC)"),
@@ -110,7 +120,9 @@ def parse_vesc(text: str, origin: str = "<mcconf>") -> VendorFile:
         raise ParameterError(f"{origin}: root element <{root.tag}> is not allowed: <{ROOT}>")
     version = root.find(VERSION_TAG)
     if version is None:
-        raise ParameterError(f"{origin}: <{VERSION_TAG}> is missing: an mcconf XML states its version")
+        raise ParameterError(f"{origin}: <{VERSION_TAG}> is missing: an mcconf XML of VESC Tool ≥ 3.01 states its "
+                             "version (an older file may hold R and L as 2/3 of the phase values, fw ≤ 5.02)")
+    _check_version((version.text or "").strip(), origin)
     pairs = []
     for el in root:
         if len(el):
@@ -119,6 +131,17 @@ def parse_vesc(text: str, origin: str = "<mcconf>") -> VendorFile:
             pairs.append((el.tag, (el.text or "").strip()))
     comment = tuple(line.strip() for line in _comments(text))
     return vendor_file(pairs, KEYS, comment)
+
+
+def _check_version(text: str, origin: str) -> None:
+    """Refuse a ConfigVersion this reader cannot interpret (see :data:`CONFIG_VERSIONS_READ`)."""
+    allowed = ", ".join(map(str, CONFIG_VERSIONS_READ))
+    if not text.isdigit() or int(text) not in CONFIG_VERSIONS_READ:
+        old = text.isdigit() and int(text) < CONFIG_VERSIONS_READ[0]
+        why = ("before fw 5.03 foc_motor_r, foc_motor_l and foc_motor_ld_lq_diff were stored as 2/3 of the phase "
+               "values; re-save the configuration with VESC Tool ≥ 3.01 on fw ≥ 5.03, or re-measure"
+               if old else "a version this reader does not know")
+        raise ParameterError(f"{origin}: <{VERSION_TAG}> = {text[:20]!r} is not allowed ({why}): allowed {allowed}")
 
 
 def _comments(text: str) -> list[str]:
