@@ -21,7 +21,6 @@ from app.threads import limit_blas_threads, release_memory
 from app.ui.bldc_results import follow_tabs_js
 from app.ui.bldc_tab import add_bldc_tab, warm_bldc
 from app.ui.case import Case, CaseState
-from app.ui.demo_link import DemoLink
 from app.ui.demo_view import PageViewProbe
 from app.ui.figure_export import FigureExport
 from app.ui.files import FilesPanel
@@ -125,7 +124,6 @@ class Session:
             self.fit = WindowFit(self._apply_layout)
             self.tab.demo_files.probe = probe = PageViewProbe(gui)  # outside the mode tabs: in every mode
             run_script(gui, hide_field_js(widget_id(probe.field)))
-            self.tab.demo_link = DemoLink(gui, self.tab.demo_files)  # a reload keeps the demo
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
