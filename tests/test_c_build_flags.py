@@ -13,6 +13,7 @@ import math
 import os
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -67,12 +68,25 @@ def test_fast_math_builds_stop_naming_the_flag_to_add(tmp_path, flags):
 @pytest.mark.parametrize("flags", FAST_MATH + [("-ffast-math", "-fno-finite-math-only")])
 @pytest.mark.parametrize("single", [False, True])
 def test_nan_and_inf_latch_the_fault_under_fast_math(tmp_path, flags, single):
-    """Accepted anyway (FDSMC_ALLOW_FINITE_MATH): the checks on the bit pattern still see NaN and inf."""
+    """Accepted anyway (FDSMC_ALLOW_FINITE_MATH): the checks on the bit pattern still see NaN and inf.
+
+    The fast-math library is loaded in a child process: a shared object built with -ffast-math or -Ofast
+    sets flush-to-zero for the whole process that loads it (crtfastmath), which would change every later
+    test's arithmetic (subnormals read as 0).
+    """
     _module(tmp_path)
     defines = ("-DFDSMC_ALLOW_FINITE_MATH",) + (("-DFDSMC_USE_FLOAT",) if single else ())
     run = _compile(tmp_path, *flags, *defines)
     assert run.returncode == 0, run.stderr
-    m = CModule(ctypes.CDLL(str(tmp_path / "lib.so")), single)
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    child = subprocess.run([sys.executable, __file__, str(tmp_path / "lib.so"), "1" if single else "0"],
+                           capture_output=True, text=True, env=env, cwd=ROOT, timeout=120)
+    assert child.returncode == 0 and child.stdout.strip() == "ok", child.stdout + child.stderr
+
+
+def _check_fault_latch(lib_path: str, single: bool) -> None:
+    """In this (child) process: NaN/inf currents latch fault 1, a NaN estimate fault 4, a NaN T_m is refused."""
+    m = CModule(ctypes.CDLL(lib_path), single)
     for i_d, i_q in ((0.0, math.nan), (math.inf, 1.0), (0.0, -math.nan), (-math.inf, 0.0)):
         s, out = m.new_state(0), m.Output()
         for _ in range(3):
@@ -165,3 +179,8 @@ def test_float32_is_the_default_on_a_single_precision_fpu(tmp_path):
     subprocess.run([*base, "-o", "f.o"], cwd=tmp_path, check=True, capture_output=True)
     subprocess.run([*base, "-DFDSMC_USE_DOUBLE", "-o", "d.o"], cwd=tmp_path, check=True, capture_output=True)
     assert double_symbols(tmp_path / "f.o") == [] and double_symbols(tmp_path / "d.o") != []
+
+
+if __name__ == "__main__":
+    _check_fault_latch(sys.argv[1], sys.argv[2] == "1")
+    print("ok")
