@@ -82,10 +82,10 @@ def test_tracked_optimum_is_clean_recommended_and_within_10pct_of_the_optimum(na
 
 
 def test_tracking_to_the_very_end_overshoots_the_window(monkeypatch):
-    # without the slide (the stock cascade's law on the optimum's reference) the observer's lag on J_L
+    # without the slide (the reference tracked to the very end) the observer's lag on J_L
     # carries the rotor past θ_dem, out of a 10-count window: what the terminal slide removes
     p = load_preset("siemens_1ft7044_ak7")
-    monkeypatch.setitem(engine.KERNEL_LAW, "optimum", engine.KERNEL_LAW["stock"])
+    monkeypatch.setitem(engine.KERNEL_LAW, "optimum", engine.TRACKING_TO_THE_END)
     m = simulate(p, "optimum").metrics
     assert m.overshoot_rad > 3.0 * pass_criteria(p).overshoot
 

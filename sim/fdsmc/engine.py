@@ -67,6 +67,9 @@ LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum"
 #: The kernel's outer law (P_CTRL) of each comparator on the FDC inner loops; the stock drive runs its own
 #: loops instead (P_CTRL = 4, :mod:`sim.stock.route`).
 KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 3.0}
+#: The kernel's law that tracks the optimum's reference to the very end, without its terminal slide:
+#: the yardstick of what the slide removes (the observer's lag carries the rotor past θ_dem).
+TRACKING_TO_THE_END = 2.0
 #: Threads that run the second and further controllers of every :func:`compare` in this process
 #: (the caller's thread runs the first). Shared, so that many callers at once (one per browser
 #: client) do not oversubscribe the cores, and no thread is started per call.

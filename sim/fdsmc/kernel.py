@@ -17,7 +17,7 @@ agree. Formulas (see [1], the FDSMC paper):
 * outer loop: eqs. (41)–(46) (FDSMC), eq. (62) sign-corrected (conventional), or tracking of a
   reference move (θ_ref, ω_ref, α_ref) by α_ref fed forward plus gains on the tracking error — the
   minimum-energy optimum ending on the FDSMC's terminal slide (``P_CTRL`` = 3,
-  :mod:`control.fdsmc.terminal_slide`);
+  :mod:`control.fdsmc.terminal_slide`), or tracked to the very end without it (``P_CTRL`` = 2);
 * or, instead of all of the above but the plant and sensors, a stock drive's own loops (``P_CTRL`` = 4,
   :mod:`control.stock.loops`): encoder PLL, position/speed law on a setpoint table interpolated between
   its rows, dq current PI;
@@ -131,12 +131,16 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
               ref: np.ndarray) -> tuple[float, float]:
     """Return the outer loop's demanded acceleration [rad/s²] and S [rad/s].
 
-    Eqs. (44)–(46), (62) or the tracked optimum's :func:`control.fdsmc.terminal_slide.slide_in_demand`
-    (``P_CTRL`` = 3), all of :mod:`control`.
+    Eqs. (44)–(46), (62), the tracked optimum's :func:`control.fdsmc.terminal_slide.slide_in_demand`
+    (``P_CTRL`` = 3) or the same reference tracked to the very end without the slide,
+    :func:`control.fdsmc.conventional.tracking_demand` (``P_CTRL`` = 2, the yardstick of what the slide
+    removes), all of :mod:`control`.
     """
-    if prm[P_CTRL] == 3.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
+    if prm[P_CTRL] >= 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
         th_r, w_r, _ = reference_at(t, ref, prm[P_TM])
         a_r = reference_at(t + prm[P_LEAD], ref, prm[P_TM])[2]
+        if prm[P_CTRL] == 2.0:
+            return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
         return terminal_slide.slide_in_demand(th_r, w_r, a_r, ref[0, 0], theta_hat, omega_hat, prm[P_G1], prm[P_G2],
                                               prm[P_THDEM], prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
     if prm[P_CTRL] == 1.0:
