@@ -85,7 +85,7 @@ def test_dwell_holding_a_load_costs_its_copper_loss():
 
 
 @pytest.mark.parametrize(("text", "match"), [
-    ("- {theta_dem: 1.0}\n", "T_m = None"), ("- {theta_dem: 1.0, T_m: -1}\n", "T_m > 0"),
+    ("- {theta_dem: 1.0}\n", "T_m = None"), ("- {theta_dem: 1.0, T_m: -1}\n", "0 < T_m"),
     ("- {theta_dem: 1.0, T_m: 0.5, speed: 2}\n", "theta_dem, T_m and optional dwell"), ("{}\n", "YAML list"),
 ])
 def test_bad_cycle_file_is_refused(tmp_path, capsys, text, match):
