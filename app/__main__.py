@@ -1,7 +1,7 @@
-"""``python -m app`` entry point."""
+"""``pmsm-commission`` entry point."""
 
 import sys
 
-from app.cli.main import main
+from pmsm_commissioning.app.cli.main import main
 
 sys.exit(main())

@@ -81,10 +81,10 @@ print(json.dumps({"cpu": cpu, "mem": rss("VmHWM:") - base, "pred_cpu": pred.cpu_
 
 CHILD = r"""
 import json, resource, sys
-from app.io.presets import load_preset
-from sim.common import budget
-from sim.fdsmc.engine import compare
-from sim.fdsmc.grid import predict
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.sim.common import budget
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.grid import predict
 preset, overrides = sys.argv[1], json.loads(sys.argv[2])
 ctrls = ("fdsmc", "conventional", "optimum")
 compare(load_preset("paper_12kw_pmsm", ["manoeuvre.T_m=0.6"]), ctrls)  # JIT, cvxpy, caches
@@ -96,9 +96,9 @@ def run():
 
 BLDC_CHILD = r"""
 import dataclasses, json, resource, sys
-from app.io.presets import load
-from sim.common import budget
-from sim.bldc.engine import check_budget, compare_bldc, run_cost, simulate_bldc
+from pmsm_commissioning.app.io.presets import load
+from pmsm_commissioning.sim.common import budget
+from pmsm_commissioning.sim.bldc.engine import check_budget, compare_bldc, run_cost, simulate_bldc
 f_s, t_end, n_sub, active, emf, drives = json.loads(sys.argv[1])
 def case(f_s, t_end, active, emf):
     p = load("bldc_smc_paper", [f"scenario.active={active}", f"inverter.f_s={f_s}", f"machine.emf={emf}"],

@@ -28,10 +28,10 @@ import psutil
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from bench_scale import PRESET, SPREAD, load, start_cluster  # noqa: E402
 
-from app.io.presets import load_preset  # noqa: E402
-from app.io.study_inputs import parse_spreads  # noqa: E402
-from sim.studies.robustness import robustness  # noqa: E402
-from sim.studies.runner import RetryingPool  # noqa: E402
+from pmsm_commissioning.app.io.presets import load_preset  # noqa: E402
+from pmsm_commissioning.app.io.study_inputs import parse_spreads  # noqa: E402
+from pmsm_commissioning.sim.studies.robustness import robustness  # noqa: E402
+from pmsm_commissioning.sim.studies.runner import RetryingPool  # noqa: E402
 
 MODES = ("defaults", "plugin")
 
@@ -89,7 +89,7 @@ def report(label: str, runs: list[dict[str, object]]) -> float:
 
 
 def dask_runs(address: str, procs, params, spreads, n: int, repeat: int, mode: str) -> list[dict[str, object]]:
-    from sim.studies import dask_runner
+    from pmsm_commissioning.sim.studies import dask_runner
 
     nannies = [p.pid for p in procs[1:]]
 

@@ -13,8 +13,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from app.io import yaml_text  # noqa: E402
-from app.io.presets import PresetError, load_preset, loads_preset  # noqa: E402
+from pmsm_commissioning.app.io import yaml_text  # noqa: E402
+from pmsm_commissioning.app.io.presets import PresetError, load_preset, loads_preset  # noqa: E402
 from tests.hostile_inputs import attacks  # noqa: E402
 
 PAPER = "paper_12kw_pmsm"

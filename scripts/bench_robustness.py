@@ -20,9 +20,9 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 
-from app.io.presets import load_preset
-from app.io.study_inputs import parse_spreads
-from sim.studies.robustness import robustness, simulate_chunk
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.study_inputs import parse_spreads
+from pmsm_commissioning.sim.studies.robustness import robustness, simulate_chunk
 
 
 def _load() -> str:

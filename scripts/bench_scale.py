@@ -5,7 +5,7 @@
 3. samples/s on a real loopback Dask cluster (``dask scheduler`` + 2 ``dask worker`` subprocesses)
    with the project's worker tuning (allocator kept, profiler off) and without it, vs the pool;
 4. the 10 000-sample robustness of the paper preset at 20 kHz through the CLI (pool start-up included);
-5. cold start of ``python -m app simulate paper_12kw_pmsm --json`` (wall, new process each time).
+5. cold start of ``pmsm-commission simulate paper_12kw_pmsm --json`` (wall, new process each time).
 
 Every figure is the median of ``--repeat`` (≥ 5) runs, printed with its range and the load average:
 the machine may be shared, so read the figures with the load beside them.
@@ -26,11 +26,11 @@ import tempfile
 import time
 from collections.abc import Callable
 
-from app.io.presets import load_preset
-from app.io.study_inputs import parse_spreads
-from control.fdsmc.derivations import derive
-from sim.studies.robustness import draw, plant_for, robustness, sample_metrics, simulate_chunk
-from sim.studies.runner import RetryingPool
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.study_inputs import parse_spreads
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.studies.robustness import draw, plant_for, robustness, sample_metrics, simulate_chunk
+from pmsm_commissioning.sim.studies.runner import RetryingPool
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PRESET = "paper_12kw_pmsm"
@@ -131,7 +131,7 @@ def worker_pids(nannies: list[int]) -> list[int]:
 
 
 def dask_rates(params, spreads, n: int, repeat: int, pool2: float) -> None:
-    from sim.studies.dask_runner import connect, nanny_plugin, worker_plugin
+    from pmsm_commissioning.sim.studies.dask_runner import connect, nanny_plugin, worker_plugin
 
     with tempfile.TemporaryDirectory() as tmp:
         address, procs = start_cluster(pathlib.Path(tmp))
@@ -165,7 +165,8 @@ def full_run(samples: int, repeat: int) -> None:
     walls = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "app", "robustness", PRESET, "--samples", str(samples), "--spread",
+        subprocess.run([sys.executable, "-m", "pmsm_commissioning.app", "robustness", PRESET, "--samples", str(samples),
+                        "--spread",
                         SPREAD, "--workers", "2", "--json"], check=True, cwd=ROOT, stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL, env={**os.environ, "PYTHONPATH": str(ROOT)})
         walls.append(time.perf_counter() - t0)
@@ -176,7 +177,8 @@ def cold_start(repeat: int) -> None:
     walls = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "app", "simulate", PRESET, "--json"], check=True, cwd=ROOT,
+        subprocess.run([sys.executable, "-m", "pmsm_commissioning.app", "simulate", PRESET, "--json"], check=True,
+                       cwd=ROOT,
                        stdout=subprocess.DEVNULL, env={**os.environ, "PYTHONPATH": str(ROOT)})
         walls.append(time.perf_counter() - t0)
     figure("cold start: simulate --json (wall)", walls, "s")

@@ -33,8 +33,8 @@ sys.path.insert(0, str(ROOT))
 
 from playwright.sync_api import sync_playwright  # noqa: E402
 
-from app.io.presets import PAPER_PRESET, load_preset  # noqa: E402
-from app.ui.page import create_server  # noqa: E402
+from pmsm_commissioning.app.io.presets import PAPER_PRESET, load_preset  # noqa: E402
+from pmsm_commissioning.app.ui.page import create_server  # noqa: E402
 from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, click_tab  # noqa: E402
 from tests.net import free_port  # noqa: E402
 

@@ -3,7 +3,7 @@
 Run: ``.venv/bin/python scripts/load_test.py [--pages 10] [--disconnect 5] [--samples 20000]
 [--study robustness|multiaxis]`` (``multiaxis``: 16-axis moves, run in the server's threads).
 
-Starts ``python -m app serve`` on a free loopback port, warms it with one page and measures the
+Starts ``pmsm-commission serve`` on a free loopback port, warms it with one page and measures the
 idle server. Then ``--pages`` pages (hand-written websocket clients, :mod:`tests.page_client`) each
 start a robustness study of ``--samples`` samples (or a multi-axis move); an extra page opens while
 they run and its first figure is timed; ``--disconnect`` pages leave, then all the rest. Prints the
@@ -98,9 +98,10 @@ async def cpu_share(pid: int, window_s: float = 0.5) -> float:
 
 
 def start_server(port: int) -> subprocess.Popen:
-    """Start ``python -m app serve`` on ``port`` and wait for its URL line."""
+    """Start ``pmsm-commission serve`` on ``port`` and wait for its URL line."""
     env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
-    proc = subprocess.Popen([sys.executable, "-m", "app", "serve", "--port", str(port), "--no-3d"], cwd=ROOT,
+    proc = subprocess.Popen([sys.executable, "-m", "pmsm_commissioning.app", "serve", "--port", str(port), "--no-3d"],
+                            cwd=ROOT,
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     for line in proc.stdout or ():  # viser's banner first, then the tool's URL line
         if line.startswith("PMSM commissioning tool: http://"):

@@ -22,10 +22,17 @@ from pathlib import Path
 
 import numpy as np
 
-from app.io.presets import load_preset
-from app.resources import example_log
-from control.fdsmc.derivations import derive
-from sim.drivelog.synthetic import LOG_DURATION, LOG_OVERRIDES, LogNoise, add_noise, clean_log, perturbed
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.resources import example_log
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.drivelog.synthetic import (
+    LOG_DURATION,
+    LOG_OVERRIDES,
+    LogNoise,
+    add_noise,
+    clean_log,
+    perturbed,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 HEADER = "# Synthetic drive log made by scripts/make_test_logs.py from the project's plant (seed {seed}).\n"

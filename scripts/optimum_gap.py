@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import argparse
 
-from app.io.presets import load_preset
-from sim.fdsmc.engine import compare
-from sim.fdsmc.optimum_gap import saving_vs_optimum
-from sim.fdsmc.table1 import TABLE1_T_M
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.optimum_gap import saving_vs_optimum
+from pmsm_commissioning.sim.fdsmc.table1 import TABLE1_T_M
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a")
 

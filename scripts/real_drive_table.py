@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 
-from app.io.presets import load_preset
-from control.fdsmc.feasibility import current_limit
-from control.fdsmc.params import Sensors
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.engine import simulate
-from sim.fdsmc.objective import design_for
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit
+from pmsm_commissioning.control.fdsmc.params import Sensors
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.engine import simulate
+from pmsm_commissioning.sim.fdsmc.objective import design_for
 
 PRESETS = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yaskawa_sgm7a_50a",
            "odrive_d5065_belt")

@@ -18,10 +18,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from app.io.presets import load_preset  # noqa: E402
-from app.io.study_inputs import parse_spreads  # noqa: E402
-from sim.studies.robustness import robustness  # noqa: E402
-from sim.studies.runner import RetryingPool  # noqa: E402
+from pmsm_commissioning.app.io.presets import load_preset  # noqa: E402
+from pmsm_commissioning.app.io.study_inputs import parse_spreads  # noqa: E402
+from pmsm_commissioning.sim.studies.robustness import robustness  # noqa: E402
+from pmsm_commissioning.sim.studies.runner import RetryingPool  # noqa: E402
 
 PRESETS = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yaskawa_sgm7a_50a", "odrive_d5065_belt")
 CONTROLLERS = ("fdsmc", "optimum", "conventional")

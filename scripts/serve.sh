@@ -4,4 +4,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 export NUMBA_CACHE_DIR="${NUMBA_CACHE_DIR:-$PWD/.numba_cache}"
-exec .venv/bin/python -m app serve "$@"
+exec .venv/bin/python -m pmsm_commissioning.app serve "$@"

@@ -18,11 +18,11 @@ fi
 # Compile the numba kernels now (into the cache the server and tests use), so that no user's
 # first click (and no test) pays the ≈ 20 s of CPU of a JIT compile. With a warm cache this takes ≈ 6 s.
 export NUMBA_CACHE_DIR="${NUMBA_CACHE_DIR:-$PWD/.numba_cache}"
-.venv/bin/python -m app simulate paper_12kw_pmsm --json >/dev/null
-.venv/bin/python -m app simulate paper_12kw_pmsm --set controller.f_s=continuous --json >/dev/null
-.venv/bin/python -m app bldc bldc_smc_paper --json >/dev/null
+.venv/bin/python -m pmsm_commissioning.app simulate paper_12kw_pmsm --json >/dev/null
+.venv/bin/python -m pmsm_commissioning.app simulate paper_12kw_pmsm --set controller.f_s=continuous --json >/dev/null
+.venv/bin/python -m pmsm_commissioning.app bldc bldc_smc_paper --json >/dev/null
 # The duty-cycle kernel (sim/studies/cycle_kernel.py): one short move and dwell compiles it.
 moves=$(mktemp --suffix=.yaml)
 trap 'rm -f "$moves"' EXIT
 printf -- '- {theta_dem: 1.0, T_m: 0.2, dwell: 0.05}\n' >"$moves"
-.venv/bin/python -m app dutycycle siemens_1ft7044_ak7 "$moves" --json >/dev/null
+.venv/bin/python -m pmsm_commissioning.app dutycycle siemens_1ft7044_ak7 "$moves" --json >/dev/null

@@ -18,13 +18,13 @@ import dataclasses
 import math
 from pathlib import Path
 
-from app.io.presets import load
-from control.fdsmc.derivations import derive
-from control.fdsmc.trapezoid import trapezoid_timing
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.criteria import pass_criteria
-from sim.stock.route import StockLoop, simulate_stock
-from sim.stock.tuning import DRIVES, make_loop, tuned
+from pmsm_commissioning.app.io.presets import load
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_timing
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.stock.route import StockLoop, simulate_stock
+from pmsm_commissioning.sim.stock.tuning import DRIVES, make_loop, tuned
 
 CATALOGUE = Path(__file__).resolve().parent.parent / "tests" / "data" / "catalogue"
 CASES = ("siemens_1ft7044_ak7", "yaskawa_sgm7a_50a", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "odrive_d5065_belt",

@@ -29,7 +29,7 @@ average is printed at the start and at the end (figures from a shared machine ar
 The whole script takes about 3–5 minutes. It is a measurement, never a test.
 
 Websocket bytes are the decoded message payloads (msgpack) as the page receives them; the wire
-carries them deflate-compressed. The server runs as a separate ``python -m app serve`` process
+carries them deflate-compressed. The server runs as a separate ``pmsm-commission serve`` process
 (as the README starts it).
 
 Usage: ``.venv/bin/python scripts/ui_bench.py [--runs 5] [--clients 1,5,10]``
@@ -53,7 +53,7 @@ from playwright.sync_api import sync_playwright
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from app.ui.k_slider import K_LABEL  # noqa: E402
+from pmsm_commissioning.app.ui.k_slider import K_LABEL  # noqa: E402
 from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, VIEWPORT, field  # noqa: E402
 from tests.net import free_port  # noqa: E402
 
@@ -155,8 +155,8 @@ def rss_mb(pid: int) -> float:
 def start_server(port: int, scene_3d: bool) -> subprocess.Popen:
     env = dict(os.environ, NUMBA_CACHE_DIR=os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba_cache")))
     extra = [] if scene_3d else ["--no-3d"]
-    # UI_BENCH_SERVER: what python runs instead of "-m app" (e.g. a script timing the server's calls)
-    server = os.environ.get("UI_BENCH_SERVER", "-m app").split()
+    # UI_BENCH_SERVER: what python runs instead of "-m pmsm_commissioning.app" (e.g. a script timing the server's calls)
+    server = os.environ.get("UI_BENCH_SERVER", "-m pmsm_commissioning.app").split()
     proc = subprocess.Popen([sys.executable, *server, "serve", "--port", str(port), "--preset", PRESET, *extra],
                             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert proc.stdout is not None
@@ -179,8 +179,8 @@ def open_page(browser, url: str, keep: bool = False) -> tuple[float, int, object
 
 
 def omega_p_of(T_m: float) -> float:
-    from app.io.presets import load_preset
-    from control.fdsmc.derivations import derive
+    from pmsm_commissioning.app.io.presets import load_preset
+    from pmsm_commissioning.control.fdsmc.derivations import derive
 
     params = load_preset(PRESET)
     return derive(dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=T_m))).profile.omega_p

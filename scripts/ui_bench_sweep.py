@@ -57,9 +57,9 @@ def sweep_cost(rounds: int = 5) -> str:
     """One line: server CPU of the grid's runs and of the figure, its JSON and zstd bytes (paper preset, warm)."""
     import zstandard
 
-    from app.io.presets import PAPER_PRESET, load_preset
-    from app.ui.k_sweep import k_sweep_json, sweep_points
-    from sim.fdsmc.engine import compare
+    from pmsm_commissioning.app.io.presets import PAPER_PRESET, load_preset
+    from pmsm_commissioning.app.ui.k_sweep import k_sweep_json, sweep_points
+    from pmsm_commissioning.sim.fdsmc.engine import compare
 
     base = compare(load_preset(PAPER_PRESET), ("fdsmc",))
     sweep_points(base, None)  # the kernels loaded

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numba
 
-from sim.numba_cache import cache_base
+from pmsm_commissioning.sim.numba_cache import cache_base
 
 _ROOT = Path(__file__).resolve().parent.parent
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 
 @pytest.fixture(scope="session")

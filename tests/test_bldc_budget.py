@@ -9,9 +9,9 @@ import dataclasses
 
 import pytest
 
-from app.io.presets import load_preset
-from sim.bldc import engine
-from sim.common import budget
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.sim.bldc import engine
+from pmsm_commissioning.sim.common import budget
 
 
 def _case(f_s: float, t_end: float):

@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from app.io.bldc_emf import read_measured, with_measured
-from app.io.preset_schema import PresetError
-from app.io.presets import dumps_preset, load_preset, loads_preset
-from app.io.units import rad_s_to_rpm
-from control.common.checks import ParameterError
-from sim.bldc import emf as bldc_emf
-from sim.bldc.engine import simulate_bldc
+from pmsm_commissioning.app.io.bldc_emf import read_measured, with_measured
+from pmsm_commissioning.app.io.preset_schema import PresetError
+from pmsm_commissioning.app.io.presets import dumps_preset, load_preset, loads_preset
+from pmsm_commissioning.app.io.units import rad_s_to_rpm
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.bldc import emf as bldc_emf
+from pmsm_commissioning.sim.bldc.engine import simulate_bldc
 
 
 def _csv(theta_deg, cols, header="theta_e_deg,phi_a,phi_b,phi_c"):

@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from app.io.units import rad_s_to_rpm
-from control.bldc.design import bldc_design
-from control.bldc.dqx import trapezoid_unit
-from control.bldc.speed_smc import reachability_bound, reachability_check
-from sim.bldc import emf as bldc_emf
-from sim.bldc import kernel as kn
-from sim.bldc.engine import CONTROLLERS, pack_parameters, simulate_bldc
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.units import rad_s_to_rpm
+from pmsm_commissioning.control.bldc.design import bldc_design
+from pmsm_commissioning.control.bldc.dqx import trapezoid_unit
+from pmsm_commissioning.control.bldc.speed_smc import reachability_bound, reachability_check
+from pmsm_commissioning.sim.bldc import emf as bldc_emf
+from pmsm_commissioning.sim.bldc import kernel as kn
+from pmsm_commissioning.sim.bldc.engine import CONTROLLERS, pack_parameters, simulate_bldc
 
 
 @pytest.fixture(scope="module")

@@ -8,13 +8,13 @@ import math
 import numpy as np
 import pytest
 
-from app.cli.main import main
-from app.io.presets import load_preset
-from app.io.units import rad_s_to_rpm
-from control.bldc.plain_smc import steady_state_error
-from sim.bldc import engine
-from sim.bldc.engine import anti_windup_pair, compare_bldc, simulate_bldc
-from sim.bldc.metrics import steady_windows
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.units import rad_s_to_rpm
+from pmsm_commissioning.control.bldc.plain_smc import steady_state_error
+from pmsm_commissioning.sim.bldc import engine
+from pmsm_commissioning.sim.bldc.engine import anti_windup_pair, compare_bldc, simulate_bldc
+from pmsm_commissioning.sim.bldc.metrics import steady_windows
 
 RPM = 60.0 / (2.0 * math.pi)
 
@@ -135,7 +135,7 @@ def test_cli_no_anti_windup_says_so_and_winds_up(capsys):
 
 
 def test_cli_json_has_the_contract_keys(capsys):
-    """``python -m app bldc PRESET --json``: each controller has the four comparison keys."""
+    """``pmsm-commission bldc PRESET --json``: each controller has the four comparison keys."""
     assert main(["bldc", "bldc_smc_paper", "--json", "--set", "scenario.active=2000rpm"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert set(data["controllers"]) == {"smc_integral", "smc_plain", "pi_sinusoidal", "six_step"}

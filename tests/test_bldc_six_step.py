@@ -14,11 +14,11 @@ import pytest
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from app.io.presets import load_preset
-from app.io.units import rad_s_to_rpm
-from control.bldc import six_step as six
-from control.bldc.dqx import torque_constant_fig7, trapezoid_unit, trapezoid_unit_slope
-from sim.bldc.engine import simulate_bldc
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.units import rad_s_to_rpm
+from pmsm_commissioning.control.bldc import six_step as six
+from pmsm_commissioning.control.bldc.dqx import torque_constant_fig7, trapezoid_unit, trapezoid_unit_slope
+from pmsm_commissioning.sim.bldc.engine import simulate_bldc
 
 PHI_M, NPP = 0.12, 3
 SHIFTS = (0.0, 2.0 * math.pi / 3.0, 4.0 * math.pi / 3.0)

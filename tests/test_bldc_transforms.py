@@ -10,7 +10,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from control.bldc import dqx
+from pmsm_commissioning.control.bldc import dqx
 
 angles = st.floats(-20.0, 20.0, allow_nan=False)
 values = st.floats(-100.0, 100.0, allow_nan=False)

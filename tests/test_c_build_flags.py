@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.exports.c_arm import arm_compiler, double_symbols
-from app.exports.c_module import HEADER_NAME
-from app.exports.c_verify import (
+from pmsm_commissioning.app.exports.c_arm import arm_compiler, double_symbols
+from pmsm_commissioning.app.exports.c_module import HEADER_NAME
+from pmsm_commissioning.app.exports.c_verify import (
     CFLAGS,
     CModule,
     accept_flag,
@@ -33,10 +33,10 @@ from app.exports.c_verify import (
     readings,
     write_module,
 )
-from app.io.presets import load_preset
-from control.fdsmc.feasibility import current_limit
-from sim.common import sensors
-from sim.fdsmc.plant import PlantInTheLoop
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit
+from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.fdsmc.plant import PlantInTheLoop
 
 CI = os.environ.get("CI") == "true"
 ROOT = Path(__file__).resolve().parent.parent

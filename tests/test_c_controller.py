@@ -21,8 +21,8 @@ from pathlib import Path
 
 import pytest
 
-from app.exports.c_vectors import c_files
-from app.exports.c_verify import (
+from pmsm_commissioning.app.exports.c_vectors import c_files
+from pmsm_commissioning.app.exports.c_verify import (
     CFLAGS,
     CModule,
     accept_flag,
@@ -33,12 +33,12 @@ from app.exports.c_verify import (
     count_params,
     write_module,
 )
-from app.io.presets import list_presets, load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import velocity_profile
-from sim.fdsmc.design import run_checks
-from sim.fdsmc.engine import compare, simulate
+from pmsm_commissioning.app.io.presets import list_presets, load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import velocity_profile
+from pmsm_commissioning.sim.fdsmc.design import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
 
 
 def _compiler() -> str:

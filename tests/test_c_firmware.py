@@ -17,17 +17,31 @@ from pathlib import Path
 
 import pytest
 
-from app.exports.c_arm import arm_compiler, count_instructions, cross_compile, double_symbols, symbols
-from app.exports.c_module import HEADER_NAME, Verdict, controller_files, parameter_hash
-from app.exports.c_text import MAX_CHARS, c_string
-from app.exports.c_vectors import c_files
-from app.exports.c_verify import CFLAGS, CModule, accept_flag, build, compiler, count_params, write_module
-from app.exports.model import parameter_yaml
-from app.io.presets import SCHEMA, load_preset
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from sim.fdsmc.design import run_checks
-from sim.fdsmc.engine import compare
+from pmsm_commissioning.app.exports.c_arm import (
+    arm_compiler,
+    count_instructions,
+    cross_compile,
+    double_symbols,
+    symbols,
+)
+from pmsm_commissioning.app.exports.c_module import HEADER_NAME, Verdict, controller_files, parameter_hash
+from pmsm_commissioning.app.exports.c_text import MAX_CHARS, c_string
+from pmsm_commissioning.app.exports.c_vectors import c_files
+from pmsm_commissioning.app.exports.c_verify import (
+    CFLAGS,
+    CModule,
+    accept_flag,
+    build,
+    compiler,
+    count_params,
+    write_module,
+)
+from pmsm_commissioning.app.exports.model import parameter_yaml
+from pmsm_commissioning.app.io.presets import SCHEMA, load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.fdsmc.design import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import compare
 
 ROOT = Path(__file__).resolve().parent.parent
 #: The designed move of yaskawa_sgm7j_04a (10 rev in 0.5 s) in counts of its module.

@@ -15,11 +15,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.exports.c_arm import LONG_SYMBOL, arm_compiler, cross_compile, helper_symbols, symbols
-from app.exports.c_verify import CFLAGS, CModule, accept_flag, build, compiler, count_params, readings, write_module
-from app.io.presets import load_preset
-from sim.common import sensors
-from sim.fdsmc.plant import PlantInTheLoop
+from pmsm_commissioning.app.exports.c_arm import LONG_SYMBOL, arm_compiler, cross_compile, helper_symbols, symbols
+from pmsm_commissioning.app.exports.c_verify import (
+    CFLAGS,
+    CModule,
+    accept_flag,
+    build,
+    compiler,
+    count_params,
+    readings,
+    write_module,
+)
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.fdsmc.plant import PlantInTheLoop
 
 CI = os.environ.get("CI") == "true"
 PRESET = "yaskawa_sgm7j_04a"

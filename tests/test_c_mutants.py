@@ -16,11 +16,11 @@ from pathlib import Path
 
 import pytest
 
-from app.exports.c_vectors import c_files
-from app.exports.c_verify import CFLAGS, accept_flag, compiler
-from app.io.presets import load_preset
-from sim.fdsmc.design import run_checks
-from sim.fdsmc.engine import compare
+from pmsm_commissioning.app.exports.c_vectors import c_files
+from pmsm_commissioning.app.exports.c_verify import CFLAGS, accept_flag, compiler
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.sim.fdsmc.design import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import compare
 
 PRESET = "yaskawa_sgm7j_04a"
 BUILDS = {"double": (), "float": ("-DFDSMC_USE_FLOAT",)}

@@ -19,21 +19,27 @@ from pathlib import Path
 
 import pytest
 
-from app.cli.main import main
-from app.exports import c_verify as cv
-from app.exports.c_arm import arm_compiler, code_size, count_instructions, cross_compile, double_symbols
-from app.exports.c_module import HEADER_NAME
-from app.exports.c_optimum import NODE_BYTES_FLOAT, reference_table
-from app.exports.drive_files import ExportOptions
-from app.exports.model import export_download, export_files
-from app.exports.provenance import ExportRefusedError
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from control.fdsmc.optimum import tracked_move
-from control.fdsmc.tracking import slide_time_constant
-from sim.fdsmc.design import run_checks
-from sim.fdsmc.engine import compare, simulate
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.exports import c_verify as cv
+from pmsm_commissioning.app.exports.c_arm import (
+    arm_compiler,
+    code_size,
+    count_instructions,
+    cross_compile,
+    double_symbols,
+)
+from pmsm_commissioning.app.exports.c_module import HEADER_NAME
+from pmsm_commissioning.app.exports.c_optimum import NODE_BYTES_FLOAT, reference_table
+from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.model import export_download, export_files
+from pmsm_commissioning.app.exports.provenance import ExportRefusedError
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.optimum import tracked_move
+from pmsm_commissioning.control.fdsmc.tracking import slide_time_constant
+from pmsm_commissioning.sim.fdsmc.design import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
 
 CI = os.environ.get("CI") == "true"
 OPTIMUM = ExportOptions(force=True, controller="optimum")
@@ -159,7 +165,7 @@ def test_cli_writes_the_optimum_module_and_refuses_it_for_other_formats(tmp_path
 
 def test_the_page_offers_the_optimum_module_as_its_own_zip():
     """The page's Export button of the optimum's module downloads the same files as the CLI, named apart."""
-    from app.ui.files import LAW_EXPORTS
+    from pmsm_commissioning.app.ui.files import LAW_EXPORTS
 
     assert list(LAW_EXPORTS.values()) == [("c", "optimum")]
     cmp = compare(load_preset("yaskawa_sgm7j_04a"))  # the optimum is simulated on demand

@@ -1,4 +1,4 @@
-"""``python -m app derive``: JSON contract, human table, and bad input → exit 2 with one line."""
+"""``pmsm-commission derive``: JSON contract, human table, and bad input → exit 2 with one line."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from app.cli.main import main
+from pmsm_commissioning.app.cli.main import main
 
 
 def test_derive_json_keys_and_values(capsys):
@@ -35,7 +35,7 @@ def test_derive_table(capsys):
 
 def test_bad_input_exit_2_single_line_subprocess():
     r = subprocess.run(
-        [sys.executable, "-m", "app", "derive", "paper_12kw_pmsm", "--set", "motor.J_r=-1"],
+        [sys.executable, "-m", "pmsm_commissioning.app", "derive", "paper_12kw_pmsm", "--set", "motor.J_r=-1"],
         capture_output=True, text=True, check=False,
     )
     assert r.returncode == 2

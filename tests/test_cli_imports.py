@@ -6,11 +6,11 @@ import json
 import subprocess
 import sys
 
-from app.cli.main import COMMANDS
+from pmsm_commissioning.app.cli.main import COMMANDS
 
 PROBE = """
 import json, sys
-from app.cli.main import main
+from pmsm_commissioning.app.cli.main import main
 code = main(sys.argv[1:])
 from threadpoolctl import threadpool_info
 print(json.dumps({"code": code, "modules": sorted(m for m in ("plotly", "viser", "yaml", "numba", "cvxpy")
@@ -32,7 +32,7 @@ def test_derive_imports_neither_plotly_nor_viser_and_uses_one_blas_thread() -> N
 
 
 def test_top_level_help_lists_every_command_without_importing_them() -> None:
-    res = subprocess.run([sys.executable, "-c", "import sys; from app.cli.main import main\n"
+    res = subprocess.run([sys.executable, "-c", "import sys; from pmsm_commissioning.app.cli.main import main\n"
                           "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
                           "print('numpy' in sys.modules)"], capture_output=True, text=True, check=True)
     for name in COMMANDS:

@@ -23,12 +23,12 @@ from collections.abc import Iterator
 import psutil
 import pytest
 
-from app.cli.main import main
-from app.io.presets import load_preset
-from app.io.sample_table import read_parquet
-from app.io.study_inputs import parse_spreads
-from control.fdsmc.derivations import derive
-from sim.studies.robustness import METRICS, draw, simulate_chunk
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.sample_table import read_parquet
+from pmsm_commissioning.app.io.study_inputs import parse_spreads
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.studies.robustness import METRICS, draw, simulate_chunk
 from tests.child_signals import default_signals
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -199,11 +199,12 @@ def test_the_cluster_waits_for_a_complete_scheduler_file_and_always_cleans_up(tm
 
 
 class CliRun:
-    """``python -m app robustness … --scheduler`` in a subprocess; its stderr is read as it comes."""
+    """``pmsm-commission robustness … --scheduler`` in a subprocess; its stderr is read as it comes."""
 
     def __init__(self, address: str, samples: int, parquet: pathlib.Path, *extra: str) -> None:
         env = {**os.environ, "PYTHONPATH": str(ROOT)}
-        self.p = subprocess.Popen([sys.executable, "-m", "app", "robustness", PRESET, "--samples", str(samples),
+        self.p = subprocess.Popen([sys.executable, "-m", "pmsm_commissioning.app", "robustness", PRESET, "--samples",
+                                   str(samples),
                                    "--spread", SPREAD, "--seed", "9", "--scheduler", address, "--parquet",
                                    str(parquet), "--json", *extra], stdout=subprocess.PIPE,
                                   stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env, preexec_fn=default_signals)
@@ -292,8 +293,8 @@ def test_every_worker_killed_fails_cleanly_with_the_finished_samples(cluster, tm
 def test_a_worker_with_other_source_is_refused_by_name(tmp_path):
     other = tmp_path / "other"
     for pkg in ("control", "sim"):
-        shutil.copytree(ROOT / pkg, other / pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    with open(other / "sim" / "studies" / "batch.py", "a", encoding="utf-8") as fh:
+        shutil.copytree(ROOT / pkg, other / "pmsm_commissioning" / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    with open(other / "pmsm_commissioning" / "sim" / "studies" / "batch.py", "a", encoding="utf-8") as fh:
         fh.write("# another version\n")
     with running_cluster(tmp_path, 1, pythonpath=other) as c:
         rc, out, err = CliRun(c.address, 10, tmp_path / "r.parquet").finish()
@@ -314,11 +315,11 @@ def test_no_scheduler_is_one_line_and_exit_2(capsys):
 _PAGE = """
 import json, os, sys
 from types import SimpleNamespace
-from app.io.presets import load_preset
-from app.io.study_inputs import parse_spreads
-from app.ui.studies_robustness import SCHEDULER_ENV, RobustnessView
-from sim.studies import dask_runner
-from sim.studies.robustness import robustness
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.study_inputs import parse_spreads
+from pmsm_commissioning.app.ui.studies_robustness import SCHEDULER_ENV, RobustnessView
+from pmsm_commissioning.sim.studies import dask_runner
+from pmsm_commissioning.sim.studies.robustness import robustness
 used = []
 connect = dask_runner.connect
 dask_runner.connect = lambda address, *a: used.append(address) or connect(address, *a)
@@ -357,8 +358,8 @@ def test_a_lost_scheduler_is_one_line_and_exit_2(cluster, tmp_path):
 
 _KILLER = """
 import os, sys
-from sim.studies.dask_runner import connect
-from sim.studies.runner import ExecutorError
+from pmsm_commissioning.sim.studies.dask_runner import connect
+from pmsm_commissioning.sim.studies.runner import ExecutorError
 def kill_my_worker(x):
     os._exit(1)
 with connect(sys.argv[1], 60.0) as ex:
@@ -383,7 +384,7 @@ def test_a_task_that_kills_its_workers_is_one_line(cluster):
 
 _PERIODS = """
 import json, sys
-from sim.studies.dask_runner import QUIET_MS, connect, nanny_plugin
+from pmsm_commissioning.sim.studies.dask_runner import QUIET_MS, connect, nanny_plugin
 def periods(dask_worker):
     return {k: dask_worker.periodic_callbacks[k].callback_time for k in QUIET_MS}
 with connect(sys.argv[1], 60.0) as ex:

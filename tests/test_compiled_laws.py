@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numba import njit
 
-from control.fdsmc import conventional, fdc, sliding_mode
+from pmsm_commissioning.control.fdsmc import conventional, fdc, sliding_mode
 
 finite = st.floats(-1e3, 1e3, allow_nan=False)
 positive = st.floats(1e-3, 1e3, allow_nan=False)

@@ -27,9 +27,9 @@ CONTROLLERS = ("fdsmc", "conventional")
 
 def _case(rng: np.random.Generator):
     """One random (params, plant, controller) case with a short horizon (few thousand samples)."""
-    from app.io.presets import load_preset
-    from control.fdsmc.derivations import derive
-    from control.fdsmc.params import Limits, Sensors
+    from pmsm_commissioning.app.io.presets import load_preset
+    from pmsm_commissioning.control.fdsmc.derivations import derive
+    from pmsm_commissioning.control.fdsmc.params import Limits, Sensors
 
     base = load_preset(PRESETS[rng.integers(len(PRESETS))])
     theta = float(rng.uniform(0.5, 6.0)) * (1 if rng.random() < 0.8 else -1)
@@ -58,8 +58,8 @@ def _case(rng: np.random.Generator):
 
 def run_cases(seed: int, n: int) -> list[dict]:
     """Metrics of the n cases of ``seed`` as plain data (JSON-able, None for a refused case)."""
-    from control.common.checks import ParameterError
-    from sim.fdsmc.engine import simulate
+    from pmsm_commissioning.control.common.checks import ParameterError
+    from pmsm_commissioning.sim.fdsmc.engine import simulate
 
     rng = np.random.default_rng(seed)
     out = []

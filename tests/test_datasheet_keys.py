@@ -12,9 +12,9 @@ import sys
 
 import pytest
 
-from app.io.presets import PresetError, load_preset, load_raw, parse_preset
-from control.common.checks import ParameterError
-from control.fdsmc.model import torque_constant
+from pmsm_commissioning.app.io.presets import PresetError, load_preset, load_raw, parse_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.model import torque_constant
 
 BASE = "yaskawa_sgm7j_02a"
 
@@ -82,7 +82,8 @@ def test_bad_values_name_the_field_value_and_range(key, message):
 
 def test_cli_design_writes_the_users_name_and_source_and_the_sensor_figures(tmp_path):
     out = tmp_path / "my_axis.yaml"
-    r = subprocess.run([sys.executable, "-m", "app", "design", "odrive_d5065_belt", "--json", "-o", str(out),
+    r = subprocess.run([sys.executable, "-m", "pmsm_commissioning.app", "design", "odrive_d5065_belt", "--json", "-o",
+                        str(out),
                         "--name", "my_axis", "--source", "D5065 on the lab arm"],
                        capture_output=True, text=True, check=True)
     import json

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from app.cli.main import main
+from pmsm_commissioning.app.cli.main import main
 
 PRESET = "yaskawa_sgm7j_02a"  # a clean shipped design; the tracked optimum is recommended
 
@@ -62,7 +62,7 @@ def test_the_recommended_optimum_alone_is_exported_and_its_energy_recomputes(tmp
 
 def test_least_drawn_is_the_clean_run_a_braking_resistor_drive_would_be_given():
     """Net and drawn rank the runs differently: a run that regenerates much is cheap netted, not drawn."""
-    from sim.fdsmc.recommend import ControllerEnergy, least_drawn
+    from pmsm_commissioning.sim.fdsmc.recommend import ControllerEnergy, least_drawn
 
     energies = (ControllerEnergy("optimum", 3.99, 3.0, 0.9, (), 35.1, 31.1),
                 ControllerEnergy("stock", 7.76, 6.0, 1.7, (), 23.9, 16.1),

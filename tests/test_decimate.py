@@ -7,11 +7,11 @@ import json
 import numpy as np
 import pytest
 
-from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, minmax_index
-from app.figures.fdsmc_comparison import TIME_ROWS, time_plots_spec
-from app.figures.fdsmc_overview import motor_torque, overview_spec
-from app.figures.plain import figure_json
-from sim.fdsmc.engine import LABELS, compare
+from pmsm_commissioning.app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, minmax_index
+from pmsm_commissioning.app.figures.fdsmc_comparison import TIME_ROWS, time_plots_spec
+from pmsm_commissioning.app.figures.fdsmc_overview import motor_torque, overview_spec
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.sim.fdsmc.engine import LABELS, compare
 
 
 def _chatter(n: int = 20_001) -> tuple[np.ndarray, np.ndarray]:

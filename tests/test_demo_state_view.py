@@ -8,9 +8,17 @@ import json
 
 import pytest
 
-from app.figures.fdsmc_pins import Pin
-from app.ui.demo_state import MODE_TABS, RESULTS_TABS, DemoState, PageView, dumps_state, loads_state, loads_view
-from app.ui.demo_view import PageViewProbe, select_tabs_js, view_report_js, zoomed_json
+from pmsm_commissioning.app.figures.fdsmc_pins import Pin
+from pmsm_commissioning.app.ui.demo_state import (
+    MODE_TABS,
+    RESULTS_TABS,
+    DemoState,
+    PageView,
+    dumps_state,
+    loads_state,
+    loads_view,
+)
+from pmsm_commissioning.app.ui.demo_view import PageViewProbe, select_tabs_js, view_report_js, zoomed_json
 
 VIEW = PageView("BLDC speed SMC", "Time plots", {"xaxis": (-62.5, -28.0), "yaxis2": (40.0, 80.0)})
 

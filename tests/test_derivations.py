@@ -9,11 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from control.common.checks import ParameterError
-from control.fdsmc.conventional import conventional_gains, friction_energy_conventional
-from control.fdsmc.derivations import derive
-from control.fdsmc.model import model_coefficients
-from control.fdsmc.profile import (
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.conventional import conventional_gains, friction_energy_conventional
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.model import model_coefficients
+from pmsm_commissioning.control.fdsmc.profile import (
     C_52,
     C_57,
     friction_energy_eq52,

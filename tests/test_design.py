@@ -9,14 +9,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from app.io.presets import load_preset
-from control.fdsmc.feasibility import current_limit, torque_limit, voltage_limit
-from control.fdsmc.flux_tolerance import flux_tolerance
-from control.fdsmc.params import Controller, DriveParams, Load, Manoeuvre, Motor
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.design import design_drive, run_checks
-from sim.fdsmc.objective import design_for
-from sim.fdsmc.verdicts import comparator_notes, run_warnings
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit, torque_limit, voltage_limit
+from pmsm_commissioning.control.fdsmc.flux_tolerance import flux_tolerance
+from pmsm_commissioning.control.fdsmc.params import Controller, DriveParams, Load, Manoeuvre, Motor
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.design import design_drive, run_checks
+from pmsm_commissioning.sim.fdsmc.objective import design_for
+from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a", "odrive_d5065_belt")
 
@@ -136,8 +136,8 @@ def test_design_keeps_the_users_nameplate():
 def test_design_cli_json_contract_and_loadable_preset(capsys, tmp_path):
     import json
 
-    from app.cli.main import main
-    from app.io.presets import load_preset as load
+    from pmsm_commissioning.app.cli.main import main
+    from pmsm_commissioning.app.io.presets import load_preset as load
 
     out_file = tmp_path / "designed.yaml"
     assert main(["design", "yaskawa_sgm7j_04a", "--set", "controller.K=1000", "--json", "-o", str(out_file)]) == 0

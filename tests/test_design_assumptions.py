@@ -7,8 +7,8 @@ import math
 
 import pytest
 
-from app.cli.main import main
-from app.io.presets import load_preset, load_raw
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import load_preset, load_raw
 
 BASE = "odrive_d5065_belt"  # Kv 270, 7 pole pairs, V_dc 24 V, i_max 40 A
 DERIVED = ["motor.V_0=derived", "motor.P_r=derived", "motor.omega_b_rpm=derived"]
@@ -41,7 +41,7 @@ def test_mj5208_class_robotics_datasheet_designs_clean_with_derived_values_label
 
 def test_an_imported_drive_names_what_it_took_from_its_base(tmp_path, capsys):
     """import-drive --base writes the base's fields it did not import under ``inherited``; they are listed."""
-    from app.io.assumed import assumptions
+    from pmsm_commissioning.app.io.assumed import assumptions
 
     out = tmp_path / "d5065.yaml"
     data = "tests/data/drives/odrive_d5065_backup.json"

@@ -12,15 +12,15 @@ import json
 
 import pytest
 
-import sim.fdsmc.design_verify as design_verify
-from app.cli.main import main
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.feasibility import alpha_max
-from control.fdsmc.profile import shortest_manoeuvre_time
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.design import EXIT_STATUS, design_drive
-from sim.fdsmc.design_verify import sampled_loop_stable
+import pmsm_commissioning.sim.fdsmc.design_verify as design_verify
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.feasibility import alpha_max
+from pmsm_commissioning.control.fdsmc.profile import shortest_manoeuvre_time
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.design import EXIT_STATUS, design_drive
+from pmsm_commissioning.sim.fdsmc.design_verify import sampled_loop_stable
 
 
 @pytest.fixture

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from control.common.discrete import block_exponential, zoh
+from pmsm_commissioning.control.common.discrete import block_exponential, zoh
 
 
 def test_double_integrator() -> None:

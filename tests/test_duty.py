@@ -6,11 +6,11 @@ import json
 
 import pytest
 
-from app.cli.main import main
-from app.io.presets import load_preset
-from control.fdsmc.optimum import move_model
-from sim.fdsmc.engine import compare
-from sim.studies.duty import J_PER_KWH, Move, duty_cycle
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.optimum import move_model
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.studies.duty import J_PER_KWH, Move, duty_cycle
 
 PRESET = "siemens_1ft7044_ak7"
 

@@ -20,16 +20,16 @@ import math
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.model import torque_constant
-from control.fdsmc.optimum import optimal_move
-from control.fdsmc.profile import C_57
-from control.fdsmc.profile_energy import min_energy_alpha, profile_energy
-from control.fdsmc.trapezoid import trapezoid_samples, trapezoid_timing
-from sim.fdsmc.design import design_drive
-from sim.fdsmc.engine import compare, simulate
-from sim.fdsmc.objective import design_for
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.model import torque_constant
+from pmsm_commissioning.control.fdsmc.optimum import optimal_move
+from pmsm_commissioning.control.fdsmc.profile import C_57
+from pmsm_commissioning.control.fdsmc.profile_energy import min_energy_alpha, profile_energy
+from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_samples, trapezoid_timing
+from pmsm_commissioning.sim.fdsmc.design import design_drive
+from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
+from pmsm_commissioning.sim.fdsmc.objective import design_for
 
 
 def _frictionless(alpha_rule: str = "min_energy"):

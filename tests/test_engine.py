@@ -11,13 +11,13 @@ import math
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from control.fdsmc.feasibility import current_limit
-from control.fdsmc.params import DriveParams, LoadStep
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.engine import compare, simulate
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit
+from pmsm_commissioning.control.fdsmc.params import DriveParams, LoadStep
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
 
 
 def _with(params: DriveParams, section: str, **changes: object) -> DriveParams:
@@ -249,7 +249,7 @@ def test_inverter_limits_are_respected_and_reported(paper_params):
 
 def test_hysteretic_sign_changes_counts_half_cycles_and_ignores_small_noise():
     """A sine of k periods has 2k half-cycles, i.e. 2k − 1 sign changes; noise inside ±hyst none."""
-    from sim.fdsmc.metrics import hysteretic_sign_changes
+    from pmsm_commissioning.sim.fdsmc.metrics import hysteretic_sign_changes
 
     t = np.linspace(0.0, 1.0, 20001)
     for k in (1, 4, 37):
@@ -274,7 +274,7 @@ def test_continuous_step_follows_the_fastest_designed_pole(continuous_paper):
     larger) would make that RK4 step diverge (h·q = 1.9 per stage on a four-fold pole), so the
     step shrinks tenfold and the run still reproduces eq. (52).
     """
-    from sim.fdsmc.grid import continuous_step
+    from pmsm_commissioning.sim.fdsmc.grid import continuous_step
 
     assert continuous_step(continuous_paper) == pytest.approx(5e-6, rel=1e-12)
     fast = _with(continuous_paper, "controller", T_so=2e-5, K=0.45)
@@ -288,7 +288,7 @@ def test_slow_digital_controller_plant_substeps_converged():
     """A 2 kHz controller (T_so = 2 ms, T_sα = 10 ms, stable by the sample-rate check) gets 10 RK4
     plant substeps of 50 µs per sample; doubling them changes the friction by < 0.05 %.
     """
-    from sim.fdsmc.grid import plant_substeps
+    from pmsm_commissioning.sim.fdsmc.grid import plant_substeps
 
     base = ["controller.T_so=0.002", "controller.T_salpha=0.01", "controller.f_s=2000"]
     d = derive(load_preset("paper_12kw_pmsm", base))
@@ -316,7 +316,7 @@ def test_divergence_near_the_sample_rate_limit_names_the_K_limit(paper_params):
 def test_chatter_window_never_counts_the_unrecorded_horizon_step():
     # The kernel records steps 0 … n_steps − 1; a hold window ending at the horizon n_steps·T_step
     # must stop at step n_steps − 1 (a never-written 0.0 sample inflated hold_omega_ptp_rad_s).
-    from sim.fdsmc.metrics import chatter_window_steps
+    from pmsm_commissioning.sim.fdsmc.metrics import chatter_window_steps
 
     T_step, n_steps = 5e-5, 117_000
     k0, n = chatter_window_steps((5.0, n_steps * T_step), T_step, n_steps)
@@ -330,7 +330,7 @@ def test_table1_printed_row_read_right_to_left_within_0p2_points(paper_params):
     # 0.2 percentage points, and disagrees with it as printed (the saving rises toward 28.57 %).
     import dataclasses
 
-    from sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
+    from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
 
     p = dataclasses.replace(paper_params, controller=dataclasses.replace(paper_params.controller, f_s="continuous"))
     T_m = sorted(PAPER_TABLE1)

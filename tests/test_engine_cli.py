@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from app.cli.main import main
+from pmsm_commissioning.app.cli.main import main
 
 RUN_KEYS = {
     "friction_J", "copper_J", "electrical_in_J", "regenerated_J", "friction_total_J",
@@ -91,7 +91,7 @@ def test_bad_input_exits_2_with_one_line(argv, capsys):
 
 
 def test_bench_prints_figures():
-    r = subprocess.run([sys.executable, "-m", "app", "bench", "--smoke"], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "pmsm_commissioning.app", "bench", "--smoke"], capture_output=True,
                        text=True, check=False, timeout=120)
     assert r.returncode == 0, r.stderr
     out = r.stdout

@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import run_steps
-from sim.fdsmc.reference import run_reference
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc.engine import run_steps
+from pmsm_commissioning.sim.fdsmc.reference import run_reference
 
 CASES = [
     ("fdsmc", ["controller.K=0.3"]),

@@ -14,11 +14,11 @@ import zipfile
 import pytest
 import yaml
 
-from app.cli.export import case as export_case
-from app.cli.main import main
-from app.exports.drive_files import ExportOptions
-from app.exports.html import ROW_HEIGHT_PX, html_report
-from app.exports.model import (
+from pmsm_commissioning.app.cli.export import case as export_case
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.html import ROW_HEIGHT_PX, html_report
+from pmsm_commissioning.app.exports.model import (
     FORMATS,
     drive_gains,
     export_download,
@@ -27,12 +27,12 @@ from app.exports.model import (
     parameter_yaml,
     trace_csv,
 )
-from app.io.presets import SCHEMA, load_preset, loads_preset, loads_raw
-from app.io.units import SI_UNITS
-from app.ui.files import parse_upload, safe_stem, uncommitted
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from sim.fdsmc.engine import Comparison, compare
+from pmsm_commissioning.app.io.presets import SCHEMA, load_preset, loads_preset, loads_raw
+from pmsm_commissioning.app.io.units import SI_UNITS
+from pmsm_commissioning.app.ui.files import parse_upload, safe_stem, uncommitted
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, compare
 
 #: The paper's case is not clean (K = 1000 chatters, torque and voltage beyond the drive's): its
 #: exports pass the gate only forced (the gate itself: tests/test_stock_exports.py).
@@ -206,7 +206,7 @@ def test_upload_rejects_bad_files_with_clear_messages(paper_params, case):
 
 
 def test_page_rename_sets_file_name_and_refuses_blank(case):
-    from app.ui.files import ExportRefusedError, renamed
+    from pmsm_commissioning.app.ui.files import ExportRefusedError, renamed
 
     name, content = export_download("yaml", renamed(case, " line 3 axis ", "nameplate"), FORCE)
     assert name == "line_3_axis.yaml" and loads_raw(content.decode())["source"] == "nameplate"
@@ -230,7 +230,7 @@ def test_round_trip_in_continuous_mode(tmp_path, paper_params, fmt):
 
 
 def test_bldc_mode_presets_load_from_yaml_and_json():
-    from app.io.presets import dumps_preset, to_raw
+    from pmsm_commissioning.app.io.presets import dumps_preset, to_raw
 
     bldc = load_preset("bldc_smc_paper")
     assert loads_preset(dumps_preset(bldc), "b.yaml") == bldc

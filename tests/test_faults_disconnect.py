@@ -11,9 +11,9 @@ import time
 import msgspec
 import websockets
 
-from app.io.presets import DEFAULT_PRESET, load_preset
-from app.ui.page import create_server
-from app.ui.worker import Cancelled, Worker
+from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset
+from pmsm_commissioning.app.ui.page import create_server
+from pmsm_commissioning.app.ui.worker import Cancelled, Worker
 from tests.net import free_port
 from tests.test_ui_hostile import CAMERA, PROTOCOL, _run
 

@@ -11,13 +11,13 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from app.exports.html import html_report
-from app.io.presets import load_preset
-from app.ui.log import identified_markdown, overlay_markdown
-from app.ui.text import html_text, md_text, warnings_html
-from control.fdsmc.identification import Estimate, Identification
-from sim.drivelog.overlay import SignalError
-from sim.fdsmc.engine import compare
+from pmsm_commissioning.app.exports.html import html_report
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.ui.log import identified_markdown, overlay_markdown
+from pmsm_commissioning.app.ui.text import html_text, md_text, warnings_html
+from pmsm_commissioning.control.fdsmc.identification import Estimate, Identification
+from pmsm_commissioning.sim.drivelog.overlay import SignalError
+from pmsm_commissioning.sim.fdsmc.engine import compare
 
 SCRIPT = '<img src=x onerror=alert(1)><script>alert(2)</script><iframe srcdoc="x"></iframe>'
 #: Raw HTML that would run or load something: never in the escaped output.

@@ -12,10 +12,10 @@ import re
 
 import pytest
 
-from app.io.drive_log import LogError, parse_log
-from app.io.numbers import NumberFormatError, integer_option, number_option, parse_number
-from app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
-from app.ui.files import parse_upload
+from pmsm_commissioning.app.io.drive_log import LogError, parse_log
+from pmsm_commissioning.app.io.numbers import NumberFormatError, integer_option, number_option, parse_number
+from pmsm_commissioning.app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
+from pmsm_commissioning.app.ui.files import parse_upload
 
 PAPER = "paper_12kw_pmsm"
 PAPER_TEXT = (PRESET_DIR / f"{PAPER}.yaml").read_text(encoding="utf-8")
@@ -38,7 +38,7 @@ def _yaml_with(text: str) -> str:
 
 
 def _json_with(text: str) -> str:
-    from app.io.presets import to_raw
+    from pmsm_commissioning.app.io.presets import to_raw
 
     data = to_raw(load_preset(PAPER))
     data["motor"]["R_s"] = "@@"
@@ -114,7 +114,7 @@ def test_integer_options_refuse_everything_else(text):
                                   ["dutycycle", PAPER, "x.yaml", "--price", "０.25"],
                                   ["log", "x.csv", "--t0", "nan"], ["serve", "--port", "8_080"]])
 def test_cli_options_refuse_outside_the_grammar_with_exit_2(argv, capsys):
-    from app.cli.main import main
+    from pmsm_commissioning.app.cli.main import main
 
     with pytest.raises(SystemExit) as info:
         main(argv)

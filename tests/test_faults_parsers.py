@@ -12,8 +12,8 @@ import sys
 
 import pytest
 
-from app.io.presets import MAX_DEPTH, PRESET_DIR, PresetError, load_preset, loads_preset, to_raw
-from app.ui.files import parse_upload
+from pmsm_commissioning.app.io.presets import MAX_DEPTH, PRESET_DIR, PresetError, load_preset, loads_preset, to_raw
+from pmsm_commissioning.app.ui.files import parse_upload
 from tests.hostile_inputs import attacks
 
 PAPER = "paper_12kw_pmsm"
@@ -79,7 +79,7 @@ def test_json_huge_integer_is_a_message_not_an_overflow(digits):
 
 def test_cli_set_reproduction_exits_2_with_one_line():
     value = "motor.R_s=[a#, " + "[" * 10_000 + "]" * 10_000 + "]"
-    proc = subprocess.run([sys.executable, "-m", "app", "derive", PAPER, "--set", value],
+    proc = subprocess.run([sys.executable, "-m", "pmsm_commissioning.app", "derive", PAPER, "--set", value],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert proc.stderr.count("\n") == 1 and "nested too deeply" in proc.stderr and len(proc.stderr) <= 300
@@ -88,7 +88,7 @@ def test_cli_set_reproduction_exits_2_with_one_line():
 @pytest.mark.parametrize("name", [n for n in ATTACKS if ATTACKS[n][2] == "nested too deeply"])
 def test_pure_python_yaml_path_refuses_the_same_attacks(name, monkeypatch):
     """Without libyaml the guarded pure-Python scanner refuses the same texts (its own counting)."""
-    from app.io import yaml_text as presets  # the YAML module (moved out of app.io.presets)
+    from pmsm_commissioning.app.io import yaml_text as presets  # the YAML module (moved out of app.io.presets)
 
     monkeypatch.setattr(presets, "_CLoader", None)
     kind, text, says = ATTACKS[name]
@@ -97,7 +97,7 @@ def test_pure_python_yaml_path_refuses_the_same_attacks(name, monkeypatch):
 
 
 def test_anchors_and_aliases_refused_on_both_paths(monkeypatch):
-    from app.io import yaml_text as presets  # the YAML module (moved out of app.io.presets)
+    from pmsm_commissioning.app.io import yaml_text as presets  # the YAML module (moved out of app.io.presets)
 
     text = "a: &x 1\nb: *x\n"
     with pytest.raises(PresetError, match="anchors/aliases"):

@@ -22,8 +22,8 @@ from typing import Any
 
 import pytest
 
-from app.io import atomic
-from app.io.atomic import discard_partial, write_atomic
+from pmsm_commissioning.app.io import atomic
+from pmsm_commissioning.app.io.atomic import discard_partial, write_atomic
 from tests.child_signals import default_signals
 from tests.net import free_port
 
@@ -51,11 +51,12 @@ def _working(pid: int) -> bool:
 
 
 def interrupt(argv: list[str], after_s: float, sig: int = signal.SIGINT) -> tuple[subprocess.CompletedProcess, float]:
-    """Run ``python -m app ARGV``; ``after_s`` after its command started working, send ``sig`` to its
+    """Run ``pmsm-commission ARGV``; ``after_s`` after its command started working, send ``sig`` to its
     process group as a terminal does. Returns (result, time from the signal to the exit [s]).
     """
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    proc = subprocess.Popen([sys.executable, "-m", "app", *argv], cwd=ROOT, env=env, stdout=subprocess.PIPE,
+    proc = subprocess.Popen([sys.executable, "-m", "pmsm_commissioning.app", *argv], cwd=ROOT, env=env,
+                            stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, start_new_session=True, preexec_fn=default_signals)
     for _ in range(3000):  # imports, preset, argument parsing: then the worker thread starts
         if _working(proc.pid) or proc.poll() is not None:
@@ -160,7 +161,7 @@ def test_the_server_stops_at_once_with_130_and_one_line(sig, side):
     # hand a process's signal to any thread; Python then only sets a flag the main thread reads
     # when it wakes, so the serve loop must not sleep long (it slept an hour: the server ignored it)
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    argv = [sys.executable, "-m", "app", "serve", "--port", str(free_port()), "--no-3d"]
+    argv = [sys.executable, "-m", "pmsm_commissioning.app", "serve", "--port", str(free_port()), "--no-3d"]
     proc = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True, preexec_fn=default_signals)
     try:
@@ -186,7 +187,8 @@ def test_robustness_stops_at_once_on_sigterm_to_a_side_thread_and_ends_its_worke
     # the main thread waits for a chunk of ≈ 3000 samples (≈ 10 s); it used to read the signal's flag
     # only when that chunk ended, and then waited for the running chunks of the other worker too
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    argv = [sys.executable, "-m", "app", "robustness", "paper_12kw_pmsm", "--samples", "100000", "--workers", "2",
+    argv = [sys.executable, "-m", "pmsm_commissioning.app", "robustness", "paper_12kw_pmsm", "--samples", "100000",
+            "--workers", "2",
             "--spread", "plant.J_L=±20%"]
     proc = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True, preexec_fn=default_signals)
@@ -253,7 +255,7 @@ def notify(cls, module, buf):
         sent.append(os.kill(os.getpid(), signal.SIGTERM))
     return hook(cls, module, buf)
 codegen.CPUCodeLibrary._object_compiled_hook = classmethod(notify)
-from app.cli.main import main
+from pmsm_commissioning.app.cli.main import main
 sys.argv[0] = "app"
 sys.exit(main())
 """
@@ -295,7 +297,7 @@ def test_sigterm_handled_inside_numbas_compile_callback_ends_the_run(tmp_path):
 
 def test_sigterm_during_a_cold_compile_ends_the_run(tmp_path):
     csv = tmp_path / "samples.csv"
-    proc = _cold(tmp_path, ["-m", "app"], csv)
+    proc = _cold(tmp_path, ["-m", "pmsm_commissioning.app"], csv)
     # the imports take < 1 s of CPU, a cold compile of the kernels ≈ 20 s: at 2 s it compiles
     _wait_until(lambda: proc.poll() is not None or _cpu_s(proc.pid) >= 2.0, 60.0, "2 s of CPU used")
     proc.send_signal(signal.SIGTERM)

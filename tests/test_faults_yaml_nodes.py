@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.io import yaml_text
-from app.io.bldc_emf import parse_yaml
-from app.io.presets import PresetError, loads_preset
-from control.bldc.params import EMF_SAMPLES_MAX
+from pmsm_commissioning.app.io import yaml_text
+from pmsm_commissioning.app.io.bldc_emf import parse_yaml
+from pmsm_commissioning.app.io.presets import PresetError, loads_preset
+from pmsm_commissioning.control.bldc.params import EMF_SAMPLES_MAX
 
 
 @pytest.fixture(params=["libyaml", "pure"])

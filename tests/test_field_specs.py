@@ -16,15 +16,23 @@ import typing
 
 import pytest
 
-from app.exports.c_module import INPUT_KEYS, c_unit, controller_header
-from app.io import units
-from app.io.presets import SCHEMA, annotate_units, dumps_preset, load_preset, loads_raw, parse_preset, to_raw
-from app.ui import bldc_tab as bldc_tab
-from app.ui import inputs
-from control.bldc.params import BldcParams
-from control.common.checks import FieldSpec, ParameterError, field_specs
-from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.app.exports.c_module import INPUT_KEYS, c_unit, controller_header
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.app.io.presets import (
+    SCHEMA,
+    annotate_units,
+    dumps_preset,
+    load_preset,
+    loads_raw,
+    parse_preset,
+    to_raw,
+)
+from pmsm_commissioning.app.ui import bldc_tab as bldc_tab
+from pmsm_commissioning.app.ui import inputs
+from pmsm_commissioning.control.bldc.params import BldcParams
+from pmsm_commissioning.control.common.checks import FieldSpec, ParameterError, field_specs
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 POSITION, BLDC = "paper_12kw_pmsm", "bldc_smc_paper"
 

@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from app.figures.decimate import BINS_PHASE
-from app.figures.fdsmc_comparison import (
+from pmsm_commissioning.app.figures.decimate import BINS_PHASE
+from pmsm_commissioning.app.figures.fdsmc_comparison import (
     cursor_index,
     decimate_index,
     layer_entry_index,
@@ -16,13 +16,13 @@ from app.figures.fdsmc_comparison import (
     make_time_plots_figure,
     phase_plane_spec,
 )
-from app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
-from app.figures.fdsmc_replay import KEY_RATE, MAX_FRAMES, SPEEDS
-from app.figures.plain import figure_json
-from app.figures.style import FONT_PX, TEMPLATE_LAYOUT
-from app.ui.replay import phase_plane_json
-from sim.fdsmc.engine import Comparison, compare
-from sim.fdsmc.table1 import PAPER_TABLE1, Table1Row
+from pmsm_commissioning.app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure, make_table1_figure
+from pmsm_commissioning.app.figures.fdsmc_replay import KEY_RATE, MAX_FRAMES, SPEEDS
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.app.figures.style import FONT_PX, TEMPLATE_LAYOUT
+from pmsm_commissioning.app.ui.replay import phase_plane_json
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, compare
+from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, Table1Row
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +114,7 @@ def test_dict_figure_json_matches_plotly(comparison):
 
 def test_phase_plane_marks_boundary_layer_entry(comparison):
     """The FDSMC marker of the boundary-layer entry lies within ±1/K of the switching boundary, eq. (45)."""
-    from control.fdsmc.sliding_mode import boundary_speed
+    from pmsm_commissioning.control.fdsmc.sliding_mode import boundary_speed
 
     k = layer_entry_index(comparison, comparison.fdsmc)
     assert k is not None and 0 < k < len(comparison.fdsmc.trace.t) - 1

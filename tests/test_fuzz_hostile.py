@@ -23,20 +23,20 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from app.io import units
-from app.io.bldc_emf import read_measured
-from app.io.numbers import NumberFormatError, parse_integer, parse_number, parse_T_m_list
-from app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
-from app.ui.choices import checked_choice
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive, predicted_energy
-from control.fdsmc.feasibility import alpha_max, feasibility
-from control.fdsmc.model import model_coefficients
-from control.fdsmc.observer import discrete_observer, observer_gains
-from control.fdsmc.profile import velocity_profile
-from sim.bldc.engine import check_budget as bldc_check_budget
-from sim.common import budget
-from sim.fdsmc import engine, grid
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.app.io.bldc_emf import read_measured
+from pmsm_commissioning.app.io.numbers import NumberFormatError, parse_integer, parse_number, parse_T_m_list
+from pmsm_commissioning.app.io.presets import PRESET_DIR, PresetError, load_preset, loads_preset
+from pmsm_commissioning.app.ui.choices import checked_choice
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive, predicted_energy
+from pmsm_commissioning.control.fdsmc.feasibility import alpha_max, feasibility
+from pmsm_commissioning.control.fdsmc.model import model_coefficients
+from pmsm_commissioning.control.fdsmc.observer import discrete_observer, observer_gains
+from pmsm_commissioning.control.fdsmc.profile import velocity_profile
+from pmsm_commissioning.sim.bldc.engine import check_budget as bldc_check_budget
+from pmsm_commissioning.sim.common import budget
+from pmsm_commissioning.sim.fdsmc import engine, grid
 
 PAPER = (PRESET_DIR / "paper_12kw_pmsm.yaml").read_text(encoding="utf-8")
 BLDC = (PRESET_DIR / "bldc_smc_paper.yaml").read_text(encoding="utf-8")
@@ -279,7 +279,7 @@ def test_fuzz_bldc_budget(t_end, f_s, n):
 
 def test_accepted_runs_take_no_more_steps_than_the_budget_counted(monkeypatch):
     """The kernel is called with exactly the steps the budget counted (sub-steps included)."""
-    import sim.fdsmc.kernel_run as kernel_run
+    import pmsm_commissioning.sim.fdsmc.kernel_run as kernel_run
 
     real, seen = kernel_run.run_kernel, []
 

@@ -12,14 +12,14 @@ from pathlib import Path
 
 import pytest
 
-from app.cli.main import main
-from app.io.presets import MAX_BYTES, PRESET_DIR, PresetError, load_preset, loads_preset
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from sim.bldc.engine import check_budget as bldc_check_budget
-from sim.bldc.engine import compare_bldc
-from sim.common import budget
-from sim.fdsmc import engine, grid
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import MAX_BYTES, PRESET_DIR, PresetError, load_preset, loads_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.bldc.engine import check_budget as bldc_check_budget
+from pmsm_commissioning.sim.bldc.engine import compare_bldc
+from pmsm_commissioning.sim.common import budget
+from pmsm_commissioning.sim.fdsmc import engine, grid
 
 PAPER = (PRESET_DIR / "paper_12kw_pmsm.yaml").read_text(encoding="utf-8")
 BLDC = (PRESET_DIR / "bldc_smc_paper.yaml").read_text(encoding="utf-8")
@@ -121,13 +121,14 @@ def test_csv_path_checked_before_the_simulation(capsys, monkeypatch):
     def boom(*_a, **_k):
         raise AssertionError("the simulation must not run")
 
-    monkeypatch.setattr("app.cli.simulate.compare", boom)
+    monkeypatch.setattr("pmsm_commissioning.app.cli.simulate.compare", boom)
     _fails(["simulate", "paper_12kw_pmsm", "--csv", "/nonexistent/x.csv"], capsys, "--csv", "/nonexistent")
 
 
 def test_substeps_count_in_the_budget_and_are_refused_before_work(monkeypatch, capsys):
     """ω_b = 1e5 rad/s at p = 100 asks for 2500 RK4 sub-steps per sample: over budget, no kernel call."""
-    monkeypatch.setattr("sim.fdsmc.kernel_run.run_kernel", lambda *a: (_ for _ in ()).throw(AssertionError("ran")))
+    monkeypatch.setattr("pmsm_commissioning.sim.fdsmc.kernel_run.run_kernel",
+                        lambda *a: (_ for _ in ()).throw(AssertionError("ran")))
     err = _fails(["simulate", "paper_12kw_pmsm", "--set", "motor.omega_b=1e5", "--set", "motor.p=100"],
                  capsys, "integration steps", "motor.omega_b = 100000 rad/s → largest accepted",
                  "motor.p = 100 → largest accepted")
@@ -201,7 +202,7 @@ def test_json_is_strict_json(capsys):
 
 
 def test_subprocess_one_line_exit_2():
-    r = subprocess.run([sys.executable, "-m", "app", "bldc", "paper_12kw_pmsm"], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "pmsm_commissioning.app", "bldc", "paper_12kw_pmsm"], capture_output=True,
                        text=True, check=False, cwd=Path(__file__).resolve().parent.parent)
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
 

@@ -19,17 +19,17 @@ from pathlib import Path
 
 import pytest
 
-from app.cli.export import case
-from app.cli.main import main
-from app.exports import moteus, odrive, setpoints, vesc
-from app.exports.provenance import header_lines
-from app.exports.stock import stock_settings
-from app.io import atomic
-from app.io.numbers import one_line, parse_number
-from app.io.presets import load_preset
-from app.io.user_text import check_label, csv_comment, escaped, forbidden, xml_comment
-from app.io.yaml_text import loads_any_raw, loads_raw, plain_scalar
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.cli.export import case
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.exports import moteus, odrive, setpoints, vesc
+from pmsm_commissioning.app.exports.provenance import header_lines
+from pmsm_commissioning.app.exports.stock import stock_settings
+from pmsm_commissioning.app.io import atomic
+from pmsm_commissioning.app.io.numbers import one_line, parse_number
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.user_text import check_label, csv_comment, escaped, forbidden, xml_comment
+from pmsm_commissioning.app.io.yaml_text import loads_any_raw, loads_raw, plain_scalar
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: Every kind of line break, control, C1, bidi and format character.
 SEPARATORS = "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
@@ -122,7 +122,7 @@ def test_names_are_refused_at_the_edge_naming_field_value_and_allowed():
 
 
 def test_page_export_source_is_refused(base):
-    from app.ui.files import ExportRefusedError, renamed
+    from pmsm_commissioning.app.ui.files import ExportRefusedError, renamed
 
     with pytest.raises(ExportRefusedError, match="Export › source = .*holds"):
         renamed(base[0], "ok", "x\u2028servo.max_voltage 1000")
@@ -235,7 +235,7 @@ def test_c_folder_is_all_old_or_all_new_on_a_full_disk(tmp_path, monkeypatch):
 
 
 def test_robustness_disk_full_is_one_line(tmp_path, monkeypatch, capsys):
-    import app.cli.robustness as rb
+    import pmsm_commissioning.app.cli.robustness as rb
 
     def full(path, *args):
         with open(path, "wb") as fh:
@@ -260,7 +260,7 @@ def test_dutycycle_huge_dwell_and_unreadable_file(tmp_path, capsys):
 
 
 def test_pool_workers_start_with_sigint_blocked():
-    from sim.studies.runner import RetryingPool
+    from pmsm_commissioning.sim.studies.runner import RetryingPool
 
     with RetryingPool(1) as pool:
         mask = pool.submit(signal.pthread_sigmask, signal.SIG_BLOCK, set()).result()

@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.identification import identify
-from sim.drivelog.synthetic import (
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.identification import identify
+from pmsm_commissioning.sim.drivelog.synthetic import (
     LOG_DURATION,
     LOG_OVERRIDES,
     TRUE_LOAD,

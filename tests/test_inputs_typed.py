@@ -11,9 +11,9 @@ from collections.abc import Iterator
 import pytest
 import viser
 
-from app.io.preset_schema import parse_preset
-from app.io.presets import list_presets_of, load, to_raw
-from app.ui.inputs import FIELDS, InputError, InputsPanel, _with_label
+from pmsm_commissioning.app.io.preset_schema import parse_preset
+from pmsm_commissioning.app.io.presets import list_presets_of, load, to_raw
+from pmsm_commissioning.app.ui.inputs import FIELDS, InputError, InputsPanel, _with_label
 
 
 @pytest.fixture(scope="module")

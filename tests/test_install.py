@@ -114,7 +114,8 @@ def _env(installed: dict[str, Path]) -> dict[str, str]:
 
 
 def test_the_installed_package_is_the_one_imported_with_its_data(installed: dict[str, Path]) -> None:
-    code = ("import app, app.resources as r, app.io.presets as p;"
+    code = ("import pmsm_commissioning.app as app, pmsm_commissioning.app.resources as r, "
+            "pmsm_commissioning.app.io.presets as p;"
             "print(app.__file__); print(r.example_log().is_file()); print(','.join(p.list_presets()))")
     r = _run([str(installed["python"]), "-c", code], cwd=installed["cwd"], env=_env(installed))
     assert r.returncode == 0, r.stderr
@@ -139,7 +140,7 @@ def test_console_entry_point_designs_a_shipped_preset(installed: dict[str, Path]
     # the kernels compiled into the user's cache folder, nothing into the environment (site-packages)
     assert list((installed["home"] / ".cache" / "pmsm-commissioning" / "numba").rglob("*.nbi"))
     assert list(installed["venv"].rglob("*.nbi")) == [] and list(installed["venv"].rglob("*.nbc")) == []
-    clone = _run([sys.executable, "-m", "app", "design", "yaskawa_sgm7j_04a", "--json"], cwd=ROOT)
+    clone = _run([sys.executable, "-m", "pmsm_commissioning.app", "design", "yaskawa_sgm7j_04a", "--json"], cwd=ROOT)
     assert clone.returncode == 0, clone.stderr
     assert r.stdout == clone.stdout  # the installed package designs exactly as the clone
 
@@ -152,7 +153,8 @@ def test_the_installed_package_writes_the_c_controller_and_has_the_pages_scripts
              cwd=installed["cwd"], env=_env(installed))
     assert r.returncode == 0, r.stderr
     assert "fdsmc_step" in (out / "fdsmc_controller.c").read_text(encoding="utf-8")
-    code = "import app.ui.plotly_js as p, app.ui.replay as r; print(len(p.bundle_source()), len(r.BUTTONS_JS))"
+    code = ("import pmsm_commissioning.app.ui.plotly_js as p, pmsm_commissioning.app.ui.replay as r; "
+            "print(len(p.bundle_source()), len(r.BUTTONS_JS))")
     r = _run([str(installed["python"]), "-c", code], cwd=installed["cwd"], env=_env(installed))
     assert r.returncode == 0, r.stderr
     assert all(int(n) > 100 for n in r.stdout.split())
@@ -169,14 +171,18 @@ def test_the_wheel_carries_the_licence_and_the_metadata(wheel: Path) -> None:
     assert "Author: The pmsm-commissioning developers" in meta and "Description-Content-Type: text/markdown" in meta
     assert "Classifier: Intended Audience :: Manufacturing" in meta
     assert "Provides-Extra: parquet" in meta and "Requires-Dist: pyarrow" in meta.split("Provides-Extra: parquet")[1]
-    # the presets are package data beside the code; nothing named outside the three packages
-    assert {n.split("/")[0] for n in names if not n.startswith("pmsm_commissioning-")} == {"app", "control", "sim"}
-    assert sorted(n for n in names if n.startswith("app/presets/")) == sorted(
-        f"app/presets/{p.name}" for p in (ROOT / "presets").glob("*.yaml"))
+    # one top-level package (nothing named app, control or sim in site-packages); the presets beside the code
+    top = {n.split("/")[0] for n in names if not n.startswith("pmsm_commissioning-")}
+    assert top == {"pmsm_commissioning"}, top
+    parts = {n.split("/")[1] for n in names if n.startswith("pmsm_commissioning/")}
+    assert parts == {"app", "control", "sim", "presets"}, parts
+    assert "pmsm_commissioning/__init__.py" not in names  # a namespace package
+    assert sorted(n for n in names if n.startswith("pmsm_commissioning/presets/")) == sorted(
+        f"pmsm_commissioning/presets/{p.name}" for p in (ROOT / "presets").glob("*.yaml"))
 
 
 def test_console_help_names_the_program_and_every_command_and_version(installed: dict[str, Path]) -> None:
-    from app.cli.main import COMMANDS
+    from pmsm_commissioning.app.cli.main import COMMANDS
 
     r = _run([str(installed["script"]), "--help"], cwd=installed["cwd"], env=_env(installed))
     assert r.returncode == 0, r.stderr
@@ -188,7 +194,8 @@ def test_console_help_names_the_program_and_every_command_and_version(installed:
 
 
 #: Run in an installed environment: where the package, the presets and numba's cache are.
-_WHERE = ("import app, numba, sim, app.io.presets as p; print(app.__file__); print(numba.config.CACHE_DIR);"
+_WHERE = ("import pmsm_commissioning.app as app, numba, pmsm_commissioning.sim as sim, "
+          "pmsm_commissioning.app.io.presets as p; print(app.__file__); print(numba.config.CACHE_DIR);"
           "print(','.join(p.list_presets()))")
 
 

@@ -7,9 +7,17 @@ from types import SimpleNamespace
 
 import pytest
 
-from app.figures.fdsmc_verdict import VERDICT_FONT_PX, chatter_verdict, verdict_annotation
-from app.figures.style import BAD_COLOUR
-from app.ui.k_slider import K_RANGE, OK_COLOUR, K_marks, K_of_position, hide_box_css, log_K_range, readout_html
+from pmsm_commissioning.app.figures.fdsmc_verdict import VERDICT_FONT_PX, chatter_verdict, verdict_annotation
+from pmsm_commissioning.app.figures.style import BAD_COLOUR
+from pmsm_commissioning.app.ui.k_slider import (
+    K_RANGE,
+    OK_COLOUR,
+    K_marks,
+    K_of_position,
+    hide_box_css,
+    log_K_range,
+    readout_html,
+)
 
 
 def _comparison(K: float, K_limit: float, chatter: bool = False, freq: float | None = None,
@@ -107,7 +115,7 @@ def test_verdict_says_K_limit_is_the_models_when_the_plant_differs():
 
 
 def test_k_grid_holds_the_marked_gains_and_spans_the_slider():
-    from app.figures.k_sweep import N_LOG, k_grid
+    from pmsm_commissioning.app.figures.k_sweep import N_LOG, k_grid
     grid = k_grid(-2.0, 4.0, 1000.0, 0.6048, 0.3024)
     assert grid == tuple(sorted(grid)) and grid[0] == 0.01 and grid[-1] == 1e4
     for K in (1000.0, 0.3024, 0.9 * 0.6048 * 1.1, 0.99 * 0.6048, 1.01 * 0.6048):
@@ -120,11 +128,11 @@ def test_k_grid_holds_the_marked_gains_and_spans_the_slider():
 def test_k_sweep_frames_carry_each_runs_own_verdict():
     import json
 
-    from app.figures.k_sweep import DYNAMIC, k_sweep_spec
-    from app.figures.plain import figure_json
-    from app.io.presets import PAPER_PRESET, load_preset
-    from app.ui.k_sweep import sweep_points
-    from sim.fdsmc.engine import compare
+    from pmsm_commissioning.app.figures.k_sweep import DYNAMIC, k_sweep_spec
+    from pmsm_commissioning.app.figures.plain import figure_json
+    from pmsm_commissioning.app.io.presets import PAPER_PRESET, load_preset
+    from pmsm_commissioning.app.ui.k_sweep import sweep_points
+    from pmsm_commissioning.sim.fdsmc.engine import compare
 
     params = load_preset(PAPER_PRESET)
     points = sweep_points(compare(params, ("fdsmc",)), None)

@@ -10,10 +10,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from control.fdsmc.model import electromagnetic_torque
-from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import Trace
-from sim.fdsmc.summary import STATE_INDEX, KernelState, decode_info, decode_state
+from pmsm_commissioning.control.fdsmc.model import electromagnetic_torque
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc.engine import Trace
+from pmsm_commissioning.sim.fdsmc.summary import STATE_INDEX, KernelState, decode_info, decode_state
 
 
 def test_trace_fields_are_the_kernels_channels():

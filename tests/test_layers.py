@@ -29,14 +29,14 @@ def test_control_and_sim_do_not_import_ui_or_yaml():
         "            culprits.append((name, f.f_globals.get('__name__', '?') if f else '?'))\n"
         "        return None\n"
         "sys.meta_path.insert(0, Spy())\n"
-        "import control, sim\n"
+        "import pmsm_commissioning.control as control, pmsm_commissioning.sim as sim\n"
         "n = 0\n"
         "for pkg in (control, sim):\n"
         "    for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + '.'):\n"
         "        importlib.import_module(m.name)\n"
         "        n += not m.ispkg\n"
         "ui = [m for m in ('viser', 'plotly') if m in sys.modules]\n"
-        "own = [c for c in culprits if c[1].startswith(('control', 'sim'))]\n"
+        "own = [c for c in culprits if c[1].startswith(('pmsm_commissioning.control', 'pmsm_commissioning.sim'))]\n"
         "print(ui, own, n)\n"
     )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
@@ -66,6 +66,6 @@ def _modules(pkg: str) -> list[pathlib.Path]:
 
 
 def test_page_never_imports_command_line():
-    pat = re.compile(r"^\s*(from app\.cli\b|import app\.cli\b)", re.M)
+    pat = re.compile(r"^\s*(from pmsm_commissioning\.app\.cli\b|import pmsm_commissioning\.app\.cli\b)", re.M)
     for path in (ROOT / "app" / "ui").rglob("*.py"):
         assert not pat.search(path.read_text(encoding="utf-8")), f"{path.relative_to(ROOT)} imports app.cli"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from app.ui.layout import (
+from pmsm_commissioning.app.ui.layout import (
     ASPECT_MAX,
     ASPECT_MIN,
     BORDERS,

@@ -11,18 +11,18 @@ import math
 import numpy as np
 import pytest
 
-from app.figures.fdsmc_overview import overview_spec
-from app.figures.fdsmc_pins import MAX_PINS, ghost_traces, pin_of, pinned
-from app.figures.fdsmc_replay import ScrubTargets, replay_layout
-from app.figures.fdsmc_trail import phase_of, pieces
-from app.figures.fdsmc_zoom import zoom_window
-from app.io.preset_schema import PresetError
-from app.io.presets import load_preset
-from app.ui.demo_state import DemoState, dumps_state, loads_state
-from app.ui.log_slider import log_range, track_marks
-from app.ui.paper_text import ERRATA, errata_html, table1_html
-from sim.fdsmc.engine import compare
-from sim.fdsmc.table1 import PAPER_TABLE1, Table1Row, printed_reversed
+from pmsm_commissioning.app.figures.fdsmc_overview import overview_spec
+from pmsm_commissioning.app.figures.fdsmc_pins import MAX_PINS, ghost_traces, pin_of, pinned
+from pmsm_commissioning.app.figures.fdsmc_replay import ScrubTargets, replay_layout
+from pmsm_commissioning.app.figures.fdsmc_trail import phase_of, pieces
+from pmsm_commissioning.app.figures.fdsmc_zoom import zoom_window
+from pmsm_commissioning.app.io.preset_schema import PresetError
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.ui.demo_state import DemoState, dumps_state, loads_state
+from pmsm_commissioning.app.ui.log_slider import log_range, track_marks
+from pmsm_commissioning.app.ui.paper_text import ERRATA, errata_html, table1_html
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, Table1Row, printed_reversed
 
 
 @pytest.fixture(scope="module")
@@ -138,7 +138,7 @@ def test_log_slider_ranges_are_whole_decades_with_named_marks():
 
 
 def test_the_J_L_slider_changes_the_plant_and_not_the_controllers_model(comparison):
-    from app.ui.position_tab import comparison_or_derived
+    from pmsm_commissioning.app.ui.position_tab import comparison_or_derived
 
     params = comparison.derived.params
     heavier = comparison_or_derived(params, plant_J_L=3.0 * params.load.J_L)
@@ -151,9 +151,9 @@ def test_the_J_L_slider_changes_the_plant_and_not_the_controllers_model(comparis
 def test_a_slider_dropped_on_its_min_mark_gives_T_m_min_itself_and_simulates():
     import math
 
-    from app.io.presets import PAPER_PRESET, load_preset
-    from app.ui.log_slider import LOG_STEP, snapped, value_of_position
-    from control.fdsmc.derivations import derive
+    from pmsm_commissioning.app.io.presets import PAPER_PRESET, load_preset
+    from pmsm_commissioning.app.ui.log_slider import LOG_STEP, snapped, value_of_position
+    from pmsm_commissioning.control.fdsmc.derivations import derive
 
     params = load_preset(PAPER_PRESET)
     T_m_min = derive(params).profile.T_m_min

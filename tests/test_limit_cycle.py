@@ -13,12 +13,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.io.preset_modes import load_mode_preset
-from control.fdsmc.derivations import derive
-from sim.fdsmc.engine import simulate
-from sim.fdsmc.limit_cycle import limit_cycle_stats
-from sim.fdsmc.metrics import CHATTER_SMOOTHING_S, detect_chatter, moving_average
-from sim.studies.batch import chatter_rows, chatter_stats
+from pmsm_commissioning.app.io.preset_modes import load_mode_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.fdsmc.engine import simulate
+from pmsm_commissioning.sim.fdsmc.limit_cycle import limit_cycle_stats
+from pmsm_commissioning.sim.fdsmc.metrics import CHATTER_SMOOTHING_S, detect_chatter, moving_average
+from pmsm_commissioning.sim.studies.batch import chatter_rows, chatter_stats
 
 ALPHA_MAX = 400.0  # [rad/s²]
 T = np.arange(5000) * 5e-5  # a 0.25 s window at 20 kHz [s]

@@ -10,9 +10,9 @@ import multiprocessing
 import threading
 import time
 
-from app.io.presets import DEFAULT_PRESET, load_preset
-from app.ui.page import create_server
-from app.ui.studies_queue import StudySlots
+from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset
+from pmsm_commissioning.app.ui.page import create_server
+from pmsm_commissioning.app.ui.studies_queue import StudySlots
 from tests.net import free_port
 from tests.page_client import PageClient
 from tests.test_ui_hostile import _run

@@ -9,14 +9,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli.simulate import write_csv
-from app.io import drive_log as log_io
-from app.io.drive_log import LogError, parse_log, read_log
-from app.io.presets import load_preset, loads_log_mapping
-from control.fdsmc.derivations import derive
-from control.fdsmc.identification import identify
-from sim.drivelog.synthetic import LOG_OVERRIDES, TRUE_LOAD, TRUE_MOTOR, perturbed
-from sim.fdsmc.engine import Comparison, simulate
+from pmsm_commissioning.app.cli.simulate import write_csv
+from pmsm_commissioning.app.io import drive_log as log_io
+from pmsm_commissioning.app.io.drive_log import LogError, parse_log, read_log
+from pmsm_commissioning.app.io.presets import load_preset, loads_log_mapping
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.identification import identify
+from pmsm_commissioning.sim.drivelog.synthetic import LOG_OVERRIDES, TRUE_LOAD, TRUE_MOTOR, perturbed
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, simulate
 
 DATA = Path(__file__).resolve().parent / "data"
 TOLERANCE = {"R_s": 0.02, "L_d": 0.02, "L_q": 0.02, "psi_pm": 0.02, "J_total": 0.03, "F_v": 0.10}
@@ -145,7 +145,7 @@ def test_cli_log_json_overlay_of_own_export_is_exact_and_identifies_the_shipped_
     """
     import json
 
-    from app.cli.main import main
+    from pmsm_commissioning.app.cli.main import main
 
     params = load_preset("example_log_drive")
     run = simulate(params, "fdsmc")
@@ -170,7 +170,7 @@ def test_cli_log_json_overlay_of_own_export_is_exact_and_identifies_the_shipped_
 
 
 def test_cli_log_bad_file_is_one_line_exit_2(tmp_path, capsys):
-    from app.cli.main import main
+    from pmsm_commissioning.app.cli.main import main
 
     bad = tmp_path / "bad.csv"
     bad.write_text("t [s],i_q [A]\n" + "\n".join(f"{1 - k * 1e-3},{k}" for k in range(30)), encoding="utf-8")
@@ -180,7 +180,7 @@ def test_cli_log_bad_file_is_one_line_exit_2(tmp_path, capsys):
 
 
 def test_apply_identified_writes_values_sets_J_L_and_names_the_log_in_source():
-    from app.ui.log import apply_identified
+    from pmsm_commissioning.app.ui.log import apply_identified
 
     params = load_preset("example_log_drive")
     r = identify(read_log(DATA / "drive_log_dq.csv").signals, params.motor.p)
@@ -195,8 +195,8 @@ def test_apply_identified_writes_values_sets_J_L_and_names_the_log_in_source():
 
 
 def test_overlay_figure_draws_measured_and_simulated_and_its_energy_matches_the_overlay():
-    from app.figures.fdsmc_drive_log import cumulative_input_energy, make_log_overlay_figure
-    from sim.drivelog.overlay import overlay
+    from pmsm_commissioning.app.figures.fdsmc_drive_log import cumulative_input_energy, make_log_overlay_figure
+    from pmsm_commissioning.sim.drivelog.overlay import overlay
 
     params = load_preset("example_log_drive")
     ov = overlay(read_log(DATA / "drive_log_dq.csv").signals, simulate(params, "fdsmc").trace)
@@ -207,8 +207,8 @@ def test_overlay_figure_draws_measured_and_simulated_and_its_energy_matches_the_
 
 
 def test_page_csv_export_with_unit_suffixes_and_run_column_is_accepted():
-    from app.exports.model import trace_csv
-    from sim.fdsmc.engine import compare
+    from pmsm_commissioning.app.exports.model import trace_csv
+    from pmsm_commissioning.sim.fdsmc.engine import compare
 
     params = load_preset("example_log_drive")
     cmp = compare(params)
@@ -224,7 +224,7 @@ def test_given_move_start_shifts_the_overlay_and_a_wrong_one_shows_in_the_errors
     """The own simulation behind 50 ms of rest: detected t0 = 50 ms with zero error; a t0 given
     10 ms late leaves a position error of about ω·10 ms.
     """
-    from sim.drivelog.overlay import overlay
+    from pmsm_commissioning.sim.drivelog.overlay import overlay
 
     run = simulate(load_preset("example_log_drive"), "fdsmc")
     tr = run.trace

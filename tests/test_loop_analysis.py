@@ -11,9 +11,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.loop_analysis import (
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.loop_analysis import (
     affine_loop,
     gain_limit,
     minimum_sample_rate,
@@ -21,9 +21,9 @@ from control.fdsmc.loop_analysis import (
     sample_rate_check,
     stability_measure,
 )
-from control.fdsmc.loop_model import continuous_loop, discrete_loop, reduce_shift_mode
-from control.fdsmc.transient import step_peak
-from sim.fdsmc.engine import simulate
+from pmsm_commissioning.control.fdsmc.loop_model import continuous_loop, discrete_loop, reduce_shift_mode
+from pmsm_commissioning.control.fdsmc.transient import step_peak
+from pmsm_commissioning.sim.fdsmc.engine import simulate
 
 
 def _params(*overrides: str):
@@ -120,7 +120,7 @@ def test_derived_carries_verdicts_and_warning():
 
 def test_slope_damping_matches_ideal_loop_eigenvalues():
     """ζ of s² + α_max·K·s + α_max·K/T_c (eqs. 41, 46 with the plant θ̈ = u of eq. (15))."""
-    from control.fdsmc.loop_analysis import slope_damping
+    from pmsm_commissioning.control.fdsmc.loop_analysis import slope_damping
 
     for a_max, K, T_c in ((2651.0, 0.3, 0.024), (2651.0, 0.3, 3.8e-4), (100.0, 2.0, 0.05)):
         s = np.roots([1.0, a_max * K, a_max * K / T_c])

@@ -14,11 +14,11 @@ import dataclasses
 
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc import loop_analysis as la
-from control.fdsmc import loop_model as lm
-from control.fdsmc import transient
-from control.fdsmc.derivations import derive
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc import loop_analysis as la
+from pmsm_commissioning.control.fdsmc import loop_model as lm
+from pmsm_commissioning.control.fdsmc import transient
+from pmsm_commissioning.control.fdsmc.derivations import derive
 
 
 def _case(*overrides: str):

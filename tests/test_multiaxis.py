@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from app.cli.main import main
+from pmsm_commissioning.app.cli.main import main
 
 AXES = ("- {preset: siemens_1ft7044_ak7, name: X}\n"
         "- {preset: yaskawa_sgm7j_04a, name: Y, set: [manoeuvre.theta_dem=31.4]}\n")

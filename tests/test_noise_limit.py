@@ -13,16 +13,16 @@ import math
 
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, slope_damping
-from control.fdsmc.noise import PTP_PER_RMS, noise_gain, noise_gain_limit
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.criteria import window_below_count
-from sim.fdsmc.design import design_drive
-from sim.fdsmc.engine import compare, simulate
-from sim.fdsmc.grid import with_field
-from sim.fdsmc.verdicts import criteria_warnings, run_warnings
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, slope_damping
+from pmsm_commissioning.control.fdsmc.noise import PTP_PER_RMS, noise_gain, noise_gain_limit
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.criteria import window_below_count
+from pmsm_commissioning.sim.fdsmc.design import design_drive
+from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
+from pmsm_commissioning.sim.fdsmc.grid import with_field
+from pmsm_commissioning.sim.fdsmc.verdicts import criteria_warnings, run_warnings
 
 #: A Σ-7 servo with a catalogue 8192-count encoder instead of its 24-bit one; an in-position
 #: window of a few counts.

@@ -19,11 +19,11 @@ import functools
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.noise import noise_gain
-from sim.fdsmc.engine import simulate
-from sim.fdsmc.grid import TAIL_FRACTION
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.noise import noise_gain
+from pmsm_commissioning.sim.fdsmc.engine import simulate
+from pmsm_commissioning.sim.fdsmc.grid import TAIL_FRACTION
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a", "odrive_d5065_belt")
 #: After the run's own tail: time for the move's settling to die out [s], then the analysed hold [s].

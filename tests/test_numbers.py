@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from app.io.numbers import NumberFormatError, format_number, parse_integer, parse_number
+from pmsm_commissioning.app.io.numbers import NumberFormatError, format_number, parse_integer, parse_number
 
 
 @pytest.mark.parametrize(("text", "value"), [

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from control.common.discrete import zoh
-from control.fdsmc.observer import (
+from pmsm_commissioning.control.common.discrete import zoh
+from pmsm_commissioning.control.fdsmc.observer import (
     discrete_observer,
     error_matrix,
     observer_gains,

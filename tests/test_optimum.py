@@ -12,12 +12,18 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from app.cli.main import main
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
-from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
-from control.fdsmc.optimum import MoveModel, closed_form, hamiltonian_matrix, move_model, numerical_optimum
-from sim.fdsmc.engine import compare
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
+from pmsm_commissioning.control.fdsmc.optimum import (
+    MoveModel,
+    closed_form,
+    hamiltonian_matrix,
+    move_model,
+    numerical_optimum,
+)
+from pmsm_commissioning.sim.fdsmc.engine import compare
 
 PAPER_TM = (1.0, 1.4, 1.8, 2.2, 2.6)  # Table 1 of the FDSMC paper
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "yaskawa_sgm7j_02a", "yaskawa_sgm7a_50a")
@@ -147,7 +153,7 @@ def test_voltage_limit_binds_and_is_respected():
     (its back-EMF alone reaches 69 V at the peak speed); the voltage-limited optimum stays within
     u_max, still arrives, and costs more.
     """
-    from control.fdsmc.optimum import optimal_move, voltage_peak
+    from pmsm_commissioning.control.fdsmc.optimum import optimal_move, voltage_peak
 
     p = load_preset("siemens_1ft7044_ak7", ["controller.V_dc=95"])
     mm = move_model(p)
@@ -168,7 +174,7 @@ def test_voltage_cone_that_does_not_bind_changes_nothing():
     inactive: the same energy and trajectory as the problem without it; and a drive whose DC link
     never binds gets the closed form, exactly as without a DC link.
     """
-    from control.fdsmc.optimum import _problem, _solve, optimal_move, voltage_peak
+    from pmsm_commissioning.control.fdsmc.optimum import _problem, _solve, optimal_move, voltage_peak
 
     free = dataclasses.replace(move_model(load_preset("siemens_1ft7044_ak7")), u_max=math.inf)
     ref = numerical_optimum(free, 400)

@@ -9,11 +9,11 @@ import math
 import cvxpy as cp
 import pytest
 
-from app.cli.main import main
-from app.io.presets import load_preset
-from app.ui.studies import optimum_markdown
-from control.fdsmc.optimum import OptimumSolverError, closed_form, move_model, numerical_optimum
-from sim.fdsmc.engine import compare
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.ui.studies import optimum_markdown
+from pmsm_commissioning.control.fdsmc.optimum import OptimumSolverError, closed_form, move_model, numerical_optimum
+from pmsm_commissioning.sim.fdsmc.engine import compare
 
 #: A drive whose tracked optimum needs the numerical (voltage-limited) solve.
 VOLTAGE_LIMITED = ("siemens_1ft7044_ak7", ["controller.V_dc=120"])

@@ -8,10 +8,10 @@ import json
 import numpy as np
 import pytest
 
-from app.figures.fdsmc_overview import CURSORS, motor_torque, overview_spec
-from app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
-from app.ui.replay import overview_json, phase_plane_json, prebuild_figures, time_plots_json
-from sim.fdsmc.engine import Comparison, compare
+from pmsm_commissioning.app.figures.fdsmc_overview import CURSORS, motor_torque, overview_spec
+from pmsm_commissioning.app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
+from pmsm_commissioning.app.ui.replay import overview_json, phase_plane_json, prebuild_figures, time_plots_json
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, compare
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +65,7 @@ def test_a_scrub_puts_the_markers_on_the_trajectories_at_that_time(comparison):
     """The "Replay t" scrub: markers at (θ_r(t) − θ_dem, ω_r(t)) of each run, cursors at x = [t, t]
     with their vertical extent kept, the time in the first marker's text.
     """
-    from app.figures.fdsmc_replay import ScrubTargets, scrub_update
+    from pmsm_commissioning.app.figures.fdsmc_replay import ScrubTargets, scrub_update
 
     spec = overview_spec(comparison)
     names = [t["name"] for t in spec["data"]]

@@ -7,8 +7,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from app.io.presets import PRESET_DIR
-from app.resources import example_log, preset_dir
+from pmsm_commissioning.app.io.presets import PRESET_DIR
+from pmsm_commissioning.app.resources import example_log, preset_dir
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -33,7 +33,7 @@ def test_no_production_module_reads_the_tests_folder() -> None:
 def test_parquet_without_pyarrow_names_the_extra(tmp_path, monkeypatch, capsys) -> None:
     import importlib.util
 
-    from app.cli.main import main
+    from pmsm_commissioning.app.cli.main import main
 
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "pyarrow" else real(name, *a))
@@ -45,7 +45,7 @@ def test_parquet_without_pyarrow_names_the_extra(tmp_path, monkeypatch, capsys) 
 
 
 def test_numba_cache_goes_to_the_chosen_the_clones_or_the_users_folder(tmp_path, monkeypatch) -> None:
-    from sim import numba_cache
+    from pmsm_commissioning.sim import numba_cache
 
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "chosen"))
     assert numba_cache.cache_base() == tmp_path / "chosen"

@@ -14,7 +14,7 @@ import json
 import numpy as np
 import pytest
 
-from app.figures.style import (
+from pmsm_commissioning.app.figures.style import (
     BLDC_COLOURS,
     BLDC_DASHES,
     FIGURE_GROUPS,
@@ -128,8 +128,8 @@ def test_round_to_meaning_keeps_significant_digits():
 
 
 def test_export_drops_the_replay_ui_and_sets_format_and_size():
-    from app.figures.style import EXPORT_SCALE, EXPORT_SIZE
-    from app.ui.figure_export import UI_KEYS, export_figure, export_js
+    from pmsm_commissioning.app.figures.style import EXPORT_SCALE, EXPORT_SIZE
+    from pmsm_commissioning.app.ui.figure_export import UI_KEYS, export_figure, export_js
 
     fig = {"data": [{"type": "scatter", "y": [1, 2]}], "layout": {
         "meta": {"id": "phase_plane"}, "height": 500, "updatemenus": [{"buttons": []}], "sliders": [{}],

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from app.ui.case import Case, CasePort, CaseState
+from pmsm_commissioning.app.ui.case import Case, CasePort, CaseState
 
 ROOT = Path(__file__).resolve().parents[1]
 PORT_MEMBERS = {n for n in dir(CasePort) if not n.startswith("_")}

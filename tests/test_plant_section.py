@@ -7,10 +7,10 @@ import pathlib
 
 import pytest
 
-from app.cli.main import main
-from app.io.plant_overrides import load_model_and_plant
-from app.io.preset_schema import PresetError
-from app.io.presets import (
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.plant_overrides import load_model_and_plant
+from pmsm_commissioning.app.io.preset_schema import PresetError
+from pmsm_commissioning.app.io.presets import (
     PRESET_DIR,
     dumps_preset,
     load_preset,
@@ -18,8 +18,8 @@ from app.io.presets import (
     loads_preset,
     loads_preset_and_plant,
 )
-from sim.fdsmc.engine import compare
-from sim.studies.robustness import Spread, robustness
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.studies.robustness import Spread, robustness
 
 DATA = pathlib.Path(__file__).resolve().parent / "data"
 MISMATCH = str(DATA / "paper_unknown_load.yaml")  # the paper's drive, plant J_L = 10·J_r, R_s + 20 %

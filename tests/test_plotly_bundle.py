@@ -7,11 +7,18 @@ from pathlib import Path
 
 from plotly.offline.offline import get_plotlyjs_version
 
-from app.figures.fdsmc_comparison import time_plots_spec
-from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
-from app.figures.fdsmc_overview import overview_spec
-from app.ui.plotly_js import BUNDLE, REACT_JS, TRACE_TYPES, bundle_source, bundle_version, use_basic_plotly
-from sim.fdsmc.engine import compare
+from pmsm_commissioning.app.figures.fdsmc_comparison import time_plots_spec
+from pmsm_commissioning.app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
+from pmsm_commissioning.app.figures.fdsmc_overview import overview_spec
+from pmsm_commissioning.app.ui.plotly_js import (
+    BUNDLE,
+    REACT_JS,
+    TRACE_TYPES,
+    bundle_source,
+    bundle_version,
+    use_basic_plotly,
+)
+from pmsm_commissioning.sim.fdsmc.engine import compare
 
 APP = Path(__file__).resolve().parents[1] / "app"
 #: ``fig.add_…`` helpers that add layout items or a prebuilt trace, not a trace type.

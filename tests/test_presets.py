@@ -9,10 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from app.io import presets
-from app.io.preset_schema import PresetError, parse_preset
-from app.io.presets import dumps_preset, load_preset, loads_preset, to_raw
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.io import presets
+from pmsm_commissioning.app.io.preset_schema import PresetError, parse_preset
+from pmsm_commissioning.app.io.presets import dumps_preset, load_preset, loads_preset, to_raw
+from pmsm_commissioning.control.common.checks import ParameterError
 
 RAW_OK = dict  # alias for readability
 

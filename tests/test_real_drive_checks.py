@@ -7,14 +7,14 @@ import math
 
 import pytest
 
-from app.io.presets import load_preset
-from app.io.units import kt_nm_per_arms_to_psi_pm, psi_pm_to_ke_vrms_krpm, psi_pm_to_kt_nm_per_arms
-from control.fdsmc.derivations import derive
-from control.fdsmc.feasibility import LIMIT_TOLERANCE, current_limit, exceeds
-from control.fdsmc.nameplate import nameplate_consistency
-from control.fdsmc.transient import acceleration_overshoot
-from sim.fdsmc.engine import compare
-from sim.fdsmc.verdicts import run_warnings
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.units import kt_nm_per_arms_to_psi_pm, psi_pm_to_ke_vrms_krpm, psi_pm_to_kt_nm_per_arms
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.feasibility import LIMIT_TOLERANCE, current_limit, exceeds
+from pmsm_commissioning.control.fdsmc.nameplate import nameplate_consistency
+from pmsm_commissioning.control.fdsmc.transient import acceleration_overshoot
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.verdicts import run_warnings
 
 
 def _replace(p, section, **kw):

@@ -17,10 +17,10 @@ from dataclasses import dataclass
 
 import pytest
 
-from app.io.presets import load_preset
-from app.io.units import ke_vrms_krpm_to_psi_pm, rpm_to_rad_s
-from control.fdsmc.derivations import derive
-from control.fdsmc.model import torque_constant
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.units import ke_vrms_krpm_to_psi_pm, rpm_to_rad_s
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.model import torque_constant
 
 SIEMENS = "Siemens 1FT7 Configuration Manual (PFT7S) 01/2009, Table 4-8 1FT7044-AK7, p. 90"
 YASKAWA_J = "Yaskawa Σ-7 Rotary Servomotor Product Manual SIEP S800001 36, sec. 4.2.2, SGM7J table"

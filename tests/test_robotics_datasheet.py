@@ -6,10 +6,10 @@ import math
 
 import pytest
 
-from app.io.preset_schema import parse_preset
-from app.io.presets import PresetError, load_preset, load_raw
-from control.fdsmc.derivations import derive
-from control.fdsmc.nameplate import nameplate_consistency, rated_from_inverter
+from pmsm_commissioning.app.io.preset_schema import parse_preset
+from pmsm_commissioning.app.io.presets import PresetError, load_preset, load_raw
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.nameplate import nameplate_consistency, rated_from_inverter
 
 BASE = "odrive_d5065_belt"  # Kv 270, 7 pole pairs, V_dc 24 V, i_max 40 A
 DERIVED = ["motor.V_0=derived", "motor.P_r=derived", "motor.omega_b_rpm=derived"]

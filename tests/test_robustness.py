@@ -10,13 +10,13 @@ import sys
 import numpy as np
 import pytest
 
-from app.cli.main import main
-from app.io.plant_overrides import load_model_and_plant
-from app.io.presets import load_preset
-from app.io.study_inputs import parse_spread, parse_spreads
-from control.common.checks import ParameterError
-from sim.fdsmc.engine import compare
-from sim.studies.robustness import METRICS, TRACE_POINTS, Spread, draw, robustness
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.io.plant_overrides import load_model_and_plant
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.study_inputs import parse_spread, parse_spreads
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.studies.robustness import METRICS, TRACE_POINTS, Spread, draw, robustness
 
 PRESET = "siemens_1ft7044_ak7"
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -92,9 +92,9 @@ def test_zero_spread_reproduces_the_nominal_run_exactly():
 _DASK_SCRIPT = """
 import json
 from dask.distributed import Client, LocalCluster
-from app.io.study_inputs import parse_spreads
-from app.io.presets import load_preset
-from sim.studies.robustness import robustness
+from pmsm_commissioning.app.io.study_inputs import parse_spreads
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.sim.studies.robustness import robustness
 params = load_preset("siemens_1ft7044_ak7")
 spreads = parse_spreads(["plant.J_L=0.001:0.004,plant.R_s=±20%"])
 local = robustness(params, spreads, 5, seed=3)
@@ -136,7 +136,7 @@ def test_parquet_and_csv_tables_hold_the_same_numbers_with_units(tmp_path):
     """
     import csv
 
-    from app.io.sample_table import read_parquet
+    from pmsm_commissioning.app.io.sample_table import read_parquet
 
     pq_path, csv_path = tmp_path / "r.parquet", tmp_path / "r.csv"
     assert main(["robustness", PRESET, "--samples", "3", "--workers", "1", "--seed", "4",

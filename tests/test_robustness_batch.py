@@ -14,13 +14,13 @@ import sys
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from app.io.study_inputs import parse_spreads
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from sim.fdsmc.metrics import detect_chatter, hysteretic_sign_changes, moving_average
-from sim.studies.batch import chatter_stats
-from sim.studies.robustness import (
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.io.study_inputs import parse_spreads
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.fdsmc.metrics import detect_chatter, hysteretic_sign_changes, moving_average
+from pmsm_commissioning.sim.studies.batch import chatter_stats
+from pmsm_commissioning.sim.studies.robustness import (
     IncompleteRunError,
     draw,
     plant_for,
@@ -28,7 +28,7 @@ from sim.studies.robustness import (
     sample_metrics,
     simulate_chunk,
 )
-from sim.studies.runner import ExecutorError, RetryingPool
+from pmsm_commissioning.sim.studies.runner import ExecutorError, RetryingPool
 
 PRESET = "siemens_1ft7044_ak7"
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -78,9 +78,9 @@ def test_batch_chatter_statistics_equal_detect_chatter():
 
 _NOJIT = """
 import json, sys
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from sim.studies.robustness import simulate_chunk
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.studies.robustness import simulate_chunk
 params = load_preset("siemens_1ft7044_ak7", ["controller.f_s_kHz=2", "manoeuvre.T_m=0.5"])
 rows = json.loads(sys.argv[1])
 print(json.dumps(simulate_chunk(params, rows, derive(params), threads=2)))

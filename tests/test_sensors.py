@@ -12,14 +12,14 @@ import math
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from control.fdsmc.noise import noise_gain
-from control.fdsmc.params import Sensors
-from sim.common import sensors
-from sim.fdsmc.design import design_drive, encoder_needed, predicted_noise
-from sim.fdsmc.engine import simulate
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.noise import noise_gain
+from pmsm_commissioning.control.fdsmc.params import Sensors
+from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.fdsmc.design import design_drive, encoder_needed, predicted_noise
+from pmsm_commissioning.sim.fdsmc.engine import simulate
 
 IDEAL = ["sensors.encoder_cpr=0", "sensors.i_noise=0", "sensors.i_adc_bits=0"]
 #: The Siemens drive's loops at the torque limit (T_so = 1 ms, K recommended): a fixed case for the noise gain,

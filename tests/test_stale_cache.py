@@ -19,8 +19,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = """
 import json, dataclasses
-from control.fdsmc.params import Controller, DriveParams, Load, Manoeuvre, Motor
-from sim.fdsmc.engine import simulate
+from pmsm_commissioning.control.fdsmc.params import Controller, DriveParams, Load, Manoeuvre, Motor
+from pmsm_commissioning.sim.fdsmc.engine import simulate
 m = Motor(V_0=430.0, P_r=12e3, omega_b=150.0, Gamma_max=40.0, psi_pm=0.38, L_d=5.4e-3, L_q=5.4e-3, R_s=0.1,
           p=5, J_r=0.03)
 p = DriveParams(m, Load(J_L=0.12, F_v=0.4), Controller(T_si=5e-3, T_salpha=1e-3, T_so=2e-4, K=0.3, f_s=20e3),
@@ -40,10 +40,10 @@ def _run(pkg: Path, cache: Path) -> float:
 def test_editing_a_control_law_recompiles_the_kernel(tmp_path):
     pkg = tmp_path / "pkg"
     for name in ("control", "sim"):
-        shutil.copytree(ROOT / name, pkg / name, ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copytree(ROOT / name, pkg / "pmsm_commissioning" / name, ignore=shutil.ignore_patterns("__pycache__"))
     cache = tmp_path / "numba_cache"
     before = _run(pkg, cache)
-    law = pkg / "control" / "fdsmc" / "conventional.py"
+    law = pkg / "pmsm_commissioning" / "control" / "fdsmc" / "conventional.py"
     text = law.read_text()
     assert "return g1 * (theta_dem - theta_hat)" in text
     law.write_text(text.replace("return g1 * (theta_dem - theta_hat)", "return 0.5 * g1 * (theta_dem - theta_hat)"))

@@ -25,11 +25,11 @@ PRESETS = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "odrive_d5065_belt")
 
 def _case(rng: np.random.Generator):
     """One random (params, plant, loop) case with a short move."""
-    from app.io.presets import load_preset
-    from control.fdsmc.derivations import derive
-    from control.fdsmc.params import Sensors
-    from control.fdsmc.trapezoid import trapezoid_timing
-    from sim.stock.tuning import DRIVES, bandwidth_ceiling, loop_rate, make_loop
+    from pmsm_commissioning.app.io.presets import load_preset
+    from pmsm_commissioning.control.fdsmc.derivations import derive
+    from pmsm_commissioning.control.fdsmc.params import Sensors
+    from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_timing
+    from pmsm_commissioning.sim.stock.tuning import DRIVES, bandwidth_ceiling, loop_rate, make_loop
 
     base = load_preset(PRESETS[rng.integers(len(PRESETS))])
     c = base.controller
@@ -51,7 +51,7 @@ def _case(rng: np.random.Generator):
 
 def run_cases(seed: int, n: int) -> list[dict]:
     """Metrics of the n cases of ``seed`` as plain data (JSON-able)."""
-    from sim.stock.route import simulate_stock
+    from pmsm_commissioning.sim.stock.route import simulate_stock
 
     rng = np.random.default_rng(seed)
     out = []

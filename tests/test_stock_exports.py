@@ -8,14 +8,14 @@ import json
 import pytest
 import yaml
 
-from app.cli.export import case
-from app.cli.main import main
-from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
-from app.exports.model import FORMATS, export_download, export_files
-from app.exports.provenance import ExportRefusedError, failed_checks, parameter_hash
-from app.exports.stock_route import file_verdict
-from app.io.presets import load_preset
-from sim.fdsmc.design import run_checks
+from pmsm_commissioning.app.cli.export import case
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions
+from pmsm_commissioning.app.exports.model import FORMATS, export_download, export_files
+from pmsm_commissioning.app.exports.provenance import ExportRefusedError, failed_checks, parameter_hash
+from pmsm_commissioning.app.exports.stock_route import file_verdict
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.sim.fdsmc.design import run_checks
 
 FORCE = ExportOptions(force=True)
 
@@ -32,7 +32,7 @@ def clean_case():
 
 
 def test_new_formats_are_in_the_one_export_model_and_the_page_menu():
-    from app.ui.files import EXPORTS
+    from pmsm_commissioning.app.ui.files import EXPORTS
 
     assert FORMATS == ("yaml", "json", "c", "csv", "html", "odrive", "moteus", "vesc", "setpoints")
     assert set(DRIVE_FORMATS) <= set(FORMATS) and set(EXPORTS.values()) == set(FORMATS)

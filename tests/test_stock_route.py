@@ -9,16 +9,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli.export import case
-from app.exports.drive_files import DRIVE_FORMATS
-from app.exports.model import export_files
-from app.exports.provenance import ExportRefusedError
-from app.exports.stock_route import file_loop, file_verdict
-from app.io.presets import load
-from control.fdsmc.trapezoid import trapezoid_from_limits, trapezoid_timing
-from control.stock import loops
-from sim.fdsmc.checks import run_checks
-from sim.stock.route import simulate_stock
+from pmsm_commissioning.app.cli.export import case
+from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS
+from pmsm_commissioning.app.exports.model import export_files
+from pmsm_commissioning.app.exports.provenance import ExportRefusedError
+from pmsm_commissioning.app.exports.stock_route import file_loop, file_verdict
+from pmsm_commissioning.app.io.presets import load
+from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_from_limits, trapezoid_timing
+from pmsm_commissioning.control.stock import loops
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.stock.route import simulate_stock
 
 CATALOGUE = Path(__file__).parent / "data" / "catalogue"
 #: The shipped real presets and two catalogue motors typed from their vendor files (tests/data/catalogue).
@@ -110,7 +110,7 @@ def test_the_stock_route_of_the_paper_case_is_refused_naming_its_checks():
 
 def test_the_file_runs_the_tuned_route():
     """The 9-digit file and the tuned settings give the same run (the file is the tuning, written)."""
-    from app.exports.stock import stock_settings
+    from pmsm_commissioning.app.exports.stock import stock_settings
 
     cmp = _case("yaskawa_sgm7j_04a")
     p = cmp.derived.params
@@ -136,12 +136,12 @@ def test_the_tuning_search_stops_at_the_run_budget_and_says_so():
     """A 60 s move at 20 kHz: each setting costs ≈ 0.6 s predicted; the search stops before 3 s of CPU."""
     import dataclasses
 
-    from app.io.presets import load_preset
-    from control.fdsmc.derivations import derive
-    from sim.common.budget import MAX_CPU_S
-    from sim.fdsmc.grid import predict
-    from sim.stock.route import at_loop_rate
-    from sim.stock.tuning import DRIVES, ROBUST_J_L, tune
+    from pmsm_commissioning.app.io.presets import load_preset
+    from pmsm_commissioning.control.fdsmc.derivations import derive
+    from pmsm_commissioning.sim.common.budget import MAX_CPU_S
+    from pmsm_commissioning.sim.fdsmc.grid import predict
+    from pmsm_commissioning.sim.stock.route import at_loop_rate
+    from pmsm_commissioning.sim.stock.tuning import DRIVES, ROBUST_J_L, tune
 
     p = load_preset("paper_12kw_pmsm")
     p = dataclasses.replace(p, manoeuvre=dataclasses.replace(p.manoeuvre, T_m=60.0))

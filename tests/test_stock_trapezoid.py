@@ -7,17 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from control.fdsmc.profile import friction_energy_eq52
-from control.fdsmc.trapezoid import (
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.profile import friction_energy_eq52
+from pmsm_commissioning.control.fdsmc.trapezoid import (
     trapezoid_omega_square_integral,
     trapezoid_samples,
     trapezoid_timing,
 )
-from sim.fdsmc.engine import COMPARATORS, compare, simulate
-from sim.stock.tuning import DRIVES, tuned
+from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, compare, simulate
+from pmsm_commissioning.sim.stock.tuning import DRIVES, tuned
 
 REAL_MOTORS = ("siemens_1ft7044_ak7", "yaskawa_sgm7a_50a", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a",
                "example_log_drive")

@@ -11,16 +11,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli.export import case
-from app.cli.main import main
-from app.exports import moteus, odrive, setpoints, vesc
-from app.exports.drive_files import ExportOptions
-from app.exports.drive_import import import_drive
-from app.exports.drive_units import KV_KT, TURN_RAD
-from app.exports.model import export_files
-from app.exports.stock import stock_settings
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.cli.export import case
+from pmsm_commissioning.app.cli.main import main
+from pmsm_commissioning.app.exports import moteus, odrive, setpoints, vesc
+from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.drive_import import import_drive
+from pmsm_commissioning.app.exports.drive_units import KV_KT, TURN_RAD
+from pmsm_commissioning.app.exports.model import export_files
+from pmsm_commissioning.app.exports.stock import stock_settings
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
 
 DATA = Path(__file__).parent / "data" / "drives"
 REAL_MOTORS = ("siemens_1ft7044_ak7", "yaskawa_sgm7a_50a", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a",

@@ -7,9 +7,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.figures.fdsmc_comparison import phase_plane_spec, time_plots_spec
-from app.figures.fdsmc_energy import energy_bars_spec, optimum_gaps
-from app.figures.fdsmc_studies import (
+from pmsm_commissioning.app.figures.fdsmc_comparison import phase_plane_spec, time_plots_spec
+from pmsm_commissioning.app.figures.fdsmc_energy import energy_bars_spec, optimum_gaps
+from pmsm_commissioning.app.figures.fdsmc_studies import (
     histogram,
     multiaxis_spec,
     multiaxis_table_markdown,
@@ -17,21 +17,21 @@ from app.figures.fdsmc_studies import (
     robustness_table_markdown,
     sample_values,
 )
-from app.figures.plain import to_figure
-from app.io.presets import load_preset
-from app.ui.studies import optimum_markdown
-from app.ui.studies_multiaxis import axis_line, check_axes, default_axes, parse_page_axes
-from app.ui.studies_robustness import STUDY_MAX_STEPS, check_study, parse_page_spreads
-from app.ui.text import md_text
-from control.common.checks import ParameterError
-from control.fdsmc.feasibility import torque_limit
-from sim.common.budget import BudgetError
-from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, compare
-from sim.fdsmc.grid import check_budget
-from sim.fdsmc.optimum_gap import saving_vs_optimum
-from sim.fdsmc.verdicts import TARGET_BAND
-from sim.studies.multiaxis import coordinate
-from sim.studies.robustness import TRACE_POINTS, robustness
+from pmsm_commissioning.app.figures.plain import to_figure
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.app.ui.studies import optimum_markdown
+from pmsm_commissioning.app.ui.studies_multiaxis import axis_line, check_axes, default_axes, parse_page_axes
+from pmsm_commissioning.app.ui.studies_robustness import STUDY_MAX_STEPS, check_study, parse_page_spreads
+from pmsm_commissioning.app.ui.text import md_text
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
+from pmsm_commissioning.sim.common.budget import BudgetError
+from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, CONTROLLERS, compare
+from pmsm_commissioning.sim.fdsmc.grid import check_budget
+from pmsm_commissioning.sim.fdsmc.optimum_gap import saving_vs_optimum
+from pmsm_commissioning.sim.fdsmc.verdicts import TARGET_BAND
+from pmsm_commissioning.sim.studies.multiaxis import coordinate
+from pmsm_commissioning.sim.studies.robustness import TRACE_POINTS, robustness
 
 PRESET = "siemens_1ft7044_ak7"
 PRESETS = ("paper_12kw_pmsm", "siemens_1ft7044_ak7", "yaskawa_sgm7j_04a")

@@ -9,9 +9,9 @@ import threading
 
 import pytest
 
-from app.ui.studies_queue import STUDY_NICE, StudySlots, run_lowered
-from app.ui.worker import Cancelled, Worker
-from sim.studies.runner import RetryingPool
+from pmsm_commissioning.app.ui.studies_queue import STUDY_NICE, StudySlots, run_lowered
+from pmsm_commissioning.app.ui.worker import Cancelled, Worker
+from pmsm_commissioning.sim.studies.runner import RetryingPool
 from tests.test_faults_disconnect import _wait as _wait_for
 
 #: Generous bound on each queue change being seen [s].
@@ -93,7 +93,7 @@ def test_a_study_pool_s_processes_run_at_lower_priority():
 
 
 def test_the_shared_run_threads_keep_normal_priority_after_a_study_used_them():
-    from sim.fdsmc import engine
+    from pmsm_commissioning.sim.fdsmc import engine
 
     engine.start_run_threads()
     before = _niceness()

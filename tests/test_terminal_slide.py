@@ -12,19 +12,19 @@ import math
 import numpy as np
 import pytest
 
-from app.io.presets import load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.flux_tolerance import flux_tolerance, stall_speed
-from control.fdsmc.optimum import MoveModel, closed_form, optimal_move
-from control.fdsmc.terminal_slide import reference_on_slope, slide_in_demand
-from control.fdsmc.tracking import slide_stability, slide_time_constant, tracking_gains
-from sim.fdsmc import engine
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.engine import compare, simulate
-from sim.fdsmc.recommend import recommend
-from sim.fdsmc.verdicts import flux_warnings, run_warnings
-from sim.studies.robustness import Spread, plant_for, robustness, sample_metrics, simulate_chunk
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.flux_tolerance import flux_tolerance, stall_speed
+from pmsm_commissioning.control.fdsmc.optimum import MoveModel, closed_form, optimal_move
+from pmsm_commissioning.control.fdsmc.terminal_slide import reference_on_slope, slide_in_demand
+from pmsm_commissioning.control.fdsmc.tracking import slide_stability, slide_time_constant, tracking_gains
+from pmsm_commissioning.sim.fdsmc import engine
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
+from pmsm_commissioning.sim.fdsmc.recommend import recommend
+from pmsm_commissioning.sim.fdsmc.verdicts import flux_warnings, run_warnings
+from pmsm_commissioning.sim.studies.robustness import Spread, plant_for, robustness, sample_metrics, simulate_chunk
 
 REAL = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yaskawa_sgm7a_50a", "odrive_d5065_belt")
 

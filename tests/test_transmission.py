@@ -6,12 +6,12 @@ import math
 
 import pytest
 
-from app.io.axis_view import run_at_output, transmission_json
-from app.io.presets import dumps_preset, load_preset, loads_preset, to_raw
-from control.common.checks import ParameterError
-from control.fdsmc import transmission as tx
-from control.fdsmc.derivations import derive
-from control.fdsmc.transmission import Transmission
+from pmsm_commissioning.app.io.axis_view import run_at_output, transmission_json
+from pmsm_commissioning.app.io.presets import dumps_preset, load_preset, loads_preset, to_raw
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc import transmission as tx
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.transmission import Transmission
 
 BASE = "odrive_d5065_belt"
 

@@ -17,13 +17,13 @@ import pytest
 import viser
 import websockets
 
-from app.io.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
-from app.ui.choices import checked_choice
-from app.ui.page import create_server
-from app.ui.text import md_text
-from app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
-from app.ui.worker import Cancelled, Worker
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
+from pmsm_commissioning.app.ui.choices import checked_choice
+from pmsm_commissioning.app.ui.page import create_server
+from pmsm_commissioning.app.ui.text import md_text
+from pmsm_commissioning.app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
+from pmsm_commissioning.app.ui.worker import Cancelled, Worker
+from pmsm_commissioning.control.common.checks import ParameterError
 from tests.net import free_port
 
 PROTOCOL = f"viser-v{viser.__version__}"

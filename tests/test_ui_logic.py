@@ -9,15 +9,15 @@ import time
 
 import pytest
 
-from app.cli.serve import is_loopback
-from app.io.numbers import parse_T_m_list
-from app.ui.inputs import InputError, parse_steps
-from app.ui.savings import annual_savings
-from app.ui.text import derived_markdown, warnings_html
-from app.ui.worker import Worker
-from control.fdsmc.derivations import derive
-from sim.fdsmc.engine import compare
-from sim.fdsmc.verdicts import recommended_K, run_warnings
+from pmsm_commissioning.app.cli.serve import is_loopback
+from pmsm_commissioning.app.io.numbers import parse_T_m_list
+from pmsm_commissioning.app.ui.inputs import InputError, parse_steps
+from pmsm_commissioning.app.ui.savings import annual_savings
+from pmsm_commissioning.app.ui.text import derived_markdown, warnings_html
+from pmsm_commissioning.app.ui.worker import Worker
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.verdicts import recommended_K, run_warnings
 
 
 def test_worker_refuses_a_second_job_while_one_runs():
@@ -93,7 +93,7 @@ def test_tune_runner_runs_the_latest_value_and_draws_the_rest_once_the_drag_stop
     """Moves faster than a run: no stale value is queued, the last move's value is what runs last,
     and the rest of the results is drawn once, only after no move came for TUNE_SETTLE_S.
     """
-    from app.ui.tuning import TUNE_SETTLE_S, TuneRunner
+    from pmsm_commissioning.app.ui.tuning import TUNE_SETTLE_S, TuneRunner
 
     value, ran, finished = [0], [], []
     runner: TuneRunner
@@ -122,7 +122,7 @@ def test_tune_runner_runs_the_latest_value_and_draws_the_rest_once_the_drag_stop
 
 
 def test_tune_runner_stops_on_an_input_error_without_drawing_the_rest():
-    from app.ui.tuning import TuneRunner
+    from pmsm_commissioning.app.ui.tuning import TuneRunner
 
     finished: list[int] = []
     w = Worker(lambda busy: None, lambda exc: None)
@@ -138,7 +138,7 @@ def test_tune_runner_stops_on_an_input_error_without_drawing_the_rest():
 
 def test_assign_sends_only_changed_properties():
     """Viser sends every assignment; assign() leaves equal values alone (nothing re-sent, nothing re-drawn)."""
-    from app.ui.props import assign
+    from pmsm_commissioning.app.ui.props import assign
 
     class Handle:
         def __init__(self) -> None:
@@ -163,7 +163,7 @@ def test_a_live_tuning_key_step_moves_the_value_whatever_its_size(value):
     move the value by one step of the logarithmic track (≈ 2.3 %) whatever its size (a K of
     0.043 s/rad was rounded back to 0.04 on a linear track).
     """
-    from app.ui.log_slider import LOG_PRECISION, LOG_STEP, value_of_position
+    from pmsm_commissioning.app.ui.log_slider import LOG_PRECISION, LOG_STEP, value_of_position
 
     position = round(math.log10(value), LOG_PRECISION)
     for sign in (1, -1):

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from app.io import units
+from pmsm_commissioning.app.io import units
 
 
 def test_rpm():
@@ -33,8 +33,8 @@ def test_ke_to_psi_pm_hand_calculation():
 
 
 def test_ke_in_preset(paper_params):
-    from app.io.preset_schema import parse_preset
-    from app.io.presets import to_raw
+    from pmsm_commissioning.app.io.preset_schema import parse_preset
+    from pmsm_commissioning.app.io.presets import to_raw
 
     raw = to_raw(paper_params)
     del raw["motor"]["psi_pm"]

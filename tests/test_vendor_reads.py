@@ -7,14 +7,14 @@ from pathlib import Path
 
 import pytest
 
-from app.cli.export import case
-from app.exports import odrive, vesc
-from app.exports.drive_files import ExportOptions
-from app.exports.drive_import import import_drive
-from app.exports.model import export_files
-from app.exports.stock import stock_settings
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.cli.export import case
+from pmsm_commissioning.app.exports import odrive, vesc
+from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.drive_import import import_drive
+from pmsm_commissioning.app.exports.model import export_files
+from pmsm_commissioning.app.exports.stock import stock_settings
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
 
 DATA = Path(__file__).parent / "data" / "drives"
 ODRIVE = (DATA / "odrive_d5065_backup.json").read_text()

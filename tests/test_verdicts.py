@@ -6,15 +6,15 @@ import dataclasses
 
 import pytest
 
-from control.fdsmc.model import available_voltage
-from sim.fdsmc.engine import compare
-from sim.fdsmc.verdicts import T_c_advice, limit_warnings, recommended_K, run_warnings
+from pmsm_commissioning.control.fdsmc.model import available_voltage
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.verdicts import T_c_advice, limit_warnings, recommended_K, run_warnings
 
 
 @pytest.fixture(scope="module")
 def quiet_paper(paper_params):
     """Paper preset (section 5) with the recommended K: no chatter, but α_max needs ≈ 400 N·m."""
-    from control.fdsmc.derivations import derive
+    from pmsm_commissioning.control.fdsmc.derivations import derive
 
     k = recommended_K(derive(paper_params))
     return compare(dataclasses.replace(paper_params, controller=dataclasses.replace(paper_params.controller, K=k)))
@@ -34,7 +34,7 @@ def test_paper_case_exceeds_torque_and_voltage_of_the_real_drive(quiet_paper):
 def test_a_drive_big_enough_gets_no_limit_warning(quiet_paper):
     p = quiet_paper.derived.params
     big = dataclasses.replace(p, motor=dataclasses.replace(p.motor, Gamma_max=2000.0, V_0=3000.0, omega_b=400.0))
-    from control.fdsmc.derivations import derive
+    from pmsm_commissioning.control.fdsmc.derivations import derive
 
     d = derive(big)
     assert limit_warnings(quiet_paper.fdsmc, d) == []
@@ -59,7 +59,7 @@ def test_slow_manoeuvre_gets_T_c_advice_that_removes_the_limit_cycle(paper_param
     """T_m = 60 s: T_c = T_a ≈ 0.38 ms gives ζ ≈ 0.28 on the −1/T_c line even with the
     recommended K, and the run limit-cycles about θ_dem; T_c,min = 4/(α_max·K_rec) cures it.
     """
-    from control.fdsmc.derivations import derive
+    from pmsm_commissioning.control.fdsmc.derivations import derive
 
     slow = dataclasses.replace(paper_params, manoeuvre=dataclasses.replace(paper_params.manoeuvre, T_m=60.0))
     d = derive(slow)

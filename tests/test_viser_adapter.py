@@ -16,9 +16,9 @@ import pytest
 import viser
 from viser import _icons
 
-from app.figures.plain import figure_json
-from app.ui import viser_adapter as va
-from app.ui.viser_adapter import PAGE_ICONS, warm_icons
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.app.ui import viser_adapter as va
+from pmsm_commissioning.app.ui.viser_adapter import PAGE_ICONS, warm_icons
 
 ROOT = Path(__file__).resolve().parents[1]
 

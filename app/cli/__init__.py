@@ -1,1 +1,1 @@
-"""Sub-commands of ``python -m app`` (``main`` holds the parser): simulate, design, bench, serve and the studies."""
+"""Sub-commands of ``pmsm-commission`` (``main`` holds the parser): simulate, design, bench, serve and the studies."""

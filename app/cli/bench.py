@@ -1,10 +1,10 @@
-"""``python -m app bench``: speed figures of the simulation engine (prints, never asserts).
+"""``pmsm-commission bench``: speed figures of the simulation engine (prints, never asserts).
 
 1. one FDSMC-vs-conventional comparison, paper preset, T_m = 2.6 s + tail, f_s = 20 kHz (warm);
 2. the five-point Table-1 sweep in digital mode (20 kHz) and in continuous mode;
 3. the compiled kernel's throughput in steps/s against the plain-Python reference step;
 4. concurrency: N comparisons on N threads at once against the same N one after the other;
-5. cold start: ``python -m app simulate PRESET --json`` in a new process (imports, cache load).
+5. cold start: ``pmsm-commission simulate PRESET --json`` in a new process (imports, cache load).
 """
 
 from __future__ import annotations
@@ -20,16 +20,16 @@ import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
-from app.cli.bldc import bench_figure
-from app.cli.main import add_preset_arguments
-from app.io.numbers import integer_option
-from app.io.presets import load, load_preset
-from control.fdsmc.derivations import clear_caches, derive
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import compare, run_steps
-from sim.fdsmc.grid import CONTINUOUS_STEP_S
-from sim.fdsmc.reference import run_reference
-from sim.fdsmc.table1 import TABLE1_T_M, table1_sweep
+from pmsm_commissioning.app.cli.bldc import bench_figure
+from pmsm_commissioning.app.cli.main import add_preset_arguments
+from pmsm_commissioning.app.io.numbers import integer_option
+from pmsm_commissioning.app.io.presets import load, load_preset
+from pmsm_commissioning.control.fdsmc.derivations import clear_caches, derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import compare, run_steps
+from pmsm_commissioning.sim.fdsmc.grid import CONTINUOUS_STEP_S
+from pmsm_commissioning.sim.fdsmc.reference import run_reference
+from pmsm_commissioning.sim.fdsmc.table1 import TABLE1_T_M, table1_sweep
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -150,7 +150,7 @@ def _parallel(n: int, fn: object, *args: object) -> None:
 
 def _compare_in_process(p: object) -> object:
     """One comparison in a worker process; the Comparison (traces included) is pickled back."""
-    from app.threads import limit_blas_threads
+    from pmsm_commissioning.app.threads import limit_blas_threads
 
     limit_blas_threads()
     return compare(p)  # type: ignore[arg-type]
@@ -177,8 +177,8 @@ def concurrency_figure(p: object, repeat: int) -> str:
 
 
 def cold_start_figure(preset: str, overrides: list[str], repeat: int) -> str:
-    """One line: wall and CPU time of ``python -m app simulate PRESET --json`` in a new process."""
-    cmd = [sys.executable, "-m", "app", "simulate", preset, "--json"]
+    """One line: wall and CPU time of ``pmsm-commission simulate PRESET --json`` in a new process."""
+    cmd = [sys.executable, "-m", "pmsm_commissioning.app", "simulate", preset, "--json"]
     for o in overrides:
         cmd += ["--set", o]
     walls, cpus = [], []
@@ -189,6 +189,6 @@ def cold_start_figure(preset: str, overrides: list[str], repeat: int) -> str:
         walls.append(time.perf_counter() - t0)
         r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpus.append(r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime)
-    return (f"cold start `python -m app simulate {preset} --json` (new process, {len(walls)} runs): "
+    return (f"cold start `pmsm-commission simulate {preset} --json` (new process, {len(walls)} runs): "
             f"{_ms((statistics.median(walls), statistics.median(cpus)))}, min {min(walls) * 1e3:.0f} ms, "
             f"max {max(walls) * 1e3:.0f} ms wall   [target ≤ 1.5 s]")

@@ -1,4 +1,4 @@
-"""``python -m app bldc PRESET [--set …] [--json] [--bench]``: the BLDC speed-drive comparison.
+"""``pmsm-commission bldc PRESET [--set …] [--json] [--bench]``: the BLDC speed-drive comparison.
 
 Prints the metrics of the compared drives side by side (or JSON), the derived values and the
 warnings. The metric rows and the JSON form are shared with the web UI's BLDC tab.
@@ -10,13 +10,13 @@ import argparse
 import json
 import time
 
-from app.cli.main import add_preset_arguments
-from app.io.bldc_view import anti_windup_text, comparison_json, metric_table
-from app.io.presets import load, load_preset
-from app.io.units import Hz_to_kHz, rad_s_to_rpm, s_to_ms
-from control.bldc.params import BldcParams
-from control.common.checks import ParameterError
-from sim.bldc.engine import CONTROLLERS, LABELS, compare_bldc, simulate_bldc
+from pmsm_commissioning.app.cli.main import add_preset_arguments
+from pmsm_commissioning.app.io.bldc_view import anti_windup_text, comparison_json, metric_table
+from pmsm_commissioning.app.io.presets import load, load_preset
+from pmsm_commissioning.app.io.units import Hz_to_kHz, rad_s_to_rpm, s_to_ms
+from pmsm_commissioning.control.bldc.params import BldcParams
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.bldc.engine import CONTROLLERS, LABELS, compare_bldc, simulate_bldc
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

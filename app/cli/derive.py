@@ -1,15 +1,15 @@
-"""``python -m app derive PRESET [--set …] [--json]``."""
+"""``pmsm-commission derive PRESET [--set …] [--json]``."""
 
 from __future__ import annotations
 
 import argparse
 import json
 
-from app.cli.main import add_preset_arguments
-from app.io.derived_view import derived_json, derived_rows, format_table
-from app.io.json_data import to_json
-from app.io.presets import load
-from control.fdsmc.derivations import derive
+from pmsm_commissioning.app.cli.main import add_preset_arguments
+from pmsm_commissioning.app.io.derived_view import derived_json, derived_rows, format_table
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.presets import load
+from pmsm_commissioning.control.fdsmc.derivations import derive
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

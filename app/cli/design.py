@@ -1,4 +1,4 @@
-"""``python -m app design PRESET [--set …] [--json] [-o FILE] [--objective …]``: a clean design for this drive.
+"""``pmsm-commission design PRESET [--set …] [--json] [-o FILE] [--objective …]``: a clean design for this drive.
 
 Exit status: 0 clean, 3 not as asked (clean only at a longer T_m, or in position later than asked),
 4 not clean (:data:`sim.fdsmc.design.EXIT_STATUS`); 2 bad input, 130 interrupted.
@@ -11,19 +11,19 @@ import dataclasses
 import json
 from typing import Any
 
-from app.cli.main import add_preset_arguments, check_writable
-from app.io.assumed import INHERITED, Assumptions, assumptions
-from app.io.atomic import write_atomic_text
-from app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
-from app.io.json_data import to_json
-from app.io.motor_defaults import DERIVED
-from app.io.presets import dumps, load_preset, load_raw, to_raw
-from app.io.user_text import check_label
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.engine import LABELS
-from sim.fdsmc.objective import OBJECTIVES, ObjectiveDesign, design_for
-from sim.fdsmc.recommend import least_drawn
+from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
+from pmsm_commissioning.app.io.assumed import INHERITED, Assumptions, assumptions
+from pmsm_commissioning.app.io.atomic import write_atomic_text
+from pmsm_commissioning.app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.motor_defaults import DERIVED
+from pmsm_commissioning.app.io.presets import dumps, load_preset, load_raw, to_raw
+from pmsm_commissioning.app.io.user_text import check_label
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.engine import LABELS
+from pmsm_commissioning.sim.fdsmc.objective import OBJECTIVES, ObjectiveDesign, design_for
+from pmsm_commissioning.sim.fdsmc.recommend import least_drawn
 
 _VERIFIED_KEYS = ("torque_peak_Nm", "i_q_peak_A", "i_peak_A", "over_i_max_s", "u_peak_V", "omega_peak_rad_s",
                   "theta_error_at_Tm_rad", "overshoot_rad", "in_position_s", "hold_i_q_rms_A", "hold_u_q_ptp_V",

@@ -1,4 +1,4 @@
-"""``python -m app dutycycle PRESET FILE [--cycles-per-hour N] [--hours-per-year H] [--price P] [--json]``.
+"""``pmsm-commission dutycycle PRESET FILE [--cycles-per-hour N] [--hours-per-year H] [--price P] [--json]``.
 
 FILE is a YAML list of moves ``{theta_dem: RAD, T_m: S, dwell: S}`` (dwell optional, default 0),
 simulated back to back (one continuous run per comparator, :mod:`sim.studies.duty`) with the FDSMC,
@@ -13,13 +13,13 @@ import math
 from pathlib import Path
 from typing import Any
 
-from app.cli.main import add_preset_arguments
-from app.io.json_data import to_json
-from app.io.numbers import number_option, parse_number
-from app.io.presets import MAX_BYTES, load_preset, loads_raw
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from sim.studies.duty import Move, duty_cycle
+from pmsm_commissioning.app.cli.main import add_preset_arguments
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.numbers import number_option, parse_number
+from pmsm_commissioning.app.io.presets import MAX_BYTES, load_preset, loads_raw
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.studies.duty import Move, duty_cycle
 
 MAX_MOVES = 50
 

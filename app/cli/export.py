@@ -1,4 +1,4 @@
-"""``python -m app export PRESET [--set …] --format FORMAT [-o PATH] [--force] [--controller LAW]``.
+"""``pmsm-commission export PRESET [--set …] --format FORMAT [-o PATH] [--force] [--controller LAW]``.
 
 Writes the same files as the page's Export menu (:func:`app.exports.model.export_files`): for ``c``,
 PATH is a folder receiving ``fdsmc_controller.h`` and ``.c`` (outer law ``--controller``: the FDSMC, or
@@ -20,19 +20,19 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from app.cli.main import add_preset_arguments, check_writable
-from app.exports.c_module import LAWS
-from app.exports.drive_files import DRIVE_FORMATS, ExportOptions
-from app.exports.drive_units import ANGLE_UNITS
-from app.exports.model import FORMATS, c_law, export_files
-from app.io import atomic
-from app.io.numbers import parse_number
-from app.io.presets import load, load_with_plant
-from app.io.user_text import check_label, escaped
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Comparison, compare
+from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
+from pmsm_commissioning.app.exports.c_module import LAWS
+from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions
+from pmsm_commissioning.app.exports.drive_units import ANGLE_UNITS
+from pmsm_commissioning.app.exports.model import FORMATS, c_law, export_files
+from pmsm_commissioning.app.io import atomic
+from pmsm_commissioning.app.io.numbers import parse_number
+from pmsm_commissioning.app.io.presets import load, load_with_plant
+from pmsm_commissioning.app.io.user_text import check_label, escaped
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Comparison, compare
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     if plant is not None:  # the files carry the controller's model; the drive's true values are not theirs
         raise ParameterError("plant: export writes the controller's model (motor, load, controller); a plant "
                              "section or --set plant.* (the drive's true values) is not exported: allowed none — "
-                             "simulate it with `python -m app simulate`, or move the values into motor/load")
+                             "simulate it with `pmsm-commission simulate`, or move the values into motor/load")
     renamed = {k: check_label(v, f"--{k}") for k, v in (("name", args.name), ("source", args.source))
                if v is not None}
     params = dataclasses.replace(params, **renamed)

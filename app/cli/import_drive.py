@@ -1,4 +1,4 @@
-"""``python -m app import-drive FILE --format odrive|moteus|vesc --base PRESET -o preset.yaml``.
+"""``pmsm-commission import-drive FILE --format odrive|moteus|vesc --base PRESET -o preset.yaml``.
 
 Reads a stock drive's own file (ODrive backup JSON, moteus configuration dump, VESC mcconf XML) and
 writes a preset: the base preset with the file's motor data (:func:`app.exports.drive_import.import_drive`).
@@ -17,13 +17,13 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from app.cli.export import write_atomic
-from app.cli.main import check_writable
-from app.exports.drive_import import IMPORT_FORMATS, import_drive
-from app.io.assumed import INHERITED, inherited_block
-from app.io.presets import MAX_BYTES, dumps, load, to_raw
-from app.io.user_text import check_label, escaped
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.cli.export import write_atomic
+from pmsm_commissioning.app.cli.main import check_writable
+from pmsm_commissioning.app.exports.drive_import import IMPORT_FORMATS, import_drive
+from pmsm_commissioning.app.io.assumed import INHERITED, inherited_block
+from pmsm_commissioning.app.io.presets import MAX_BYTES, dumps, load, to_raw
+from pmsm_commissioning.app.io.user_text import check_label, escaped
+from pmsm_commissioning.control.common.checks import ParameterError
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
                                   + [f"kept from {base.name}: {x}" for x in result.kept]
                                   + [f"not imported ({len(result.not_imported)} keys): "
                                      + ", ".join(result.not_imported)])]
-    command = escaped(f"python -m app import-drive {args.file} --format {args.format} --base {args.base}")
+    command = escaped(f"pmsm-commission import-drive {args.file} --format {args.format} --base {args.base}")
     head = "".join(f"# {line}\n" for line in [command] + notes)
     raw = to_raw(params)
     raw[INHERITED] = inherited_block(base.name, {x.partition(" = ")[0] for x in result.imported})

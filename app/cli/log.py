@@ -1,4 +1,4 @@
-"""``python -m app log FILE [--preset P] [--set …] [--mapping M] [--run R] [--t0 S] [--identify] [--json]``.
+"""``pmsm-commission log FILE [--preset P] [--set …] [--mapping M] [--run R] [--t0 S] [--identify] [--json]``.
 
 Imports a drive log, overlays it on the preset's simulated move and, with ``--identify``,
 identifies R_s, L_d, L_q, Ψ_PM, J_total, F_v and Γ_Le from it.
@@ -11,15 +11,15 @@ import json
 from pathlib import Path
 from typing import Any
 
-from app.io.drive_log import DriveLog, read_log, run_identification
-from app.io.json_data import to_json
-from app.io.numbers import number_option
-from app.io.presets import DEFAULT_PRESET, load_preset, loads_log_mapping
-from control.common.checks import ParameterError
-from control.fdsmc.identification import Identification
-from control.fdsmc.params import DriveParams
-from sim.drivelog.overlay import Overlay, overlay
-from sim.fdsmc.engine import CONTROLLERS, simulate
+from pmsm_commissioning.app.io.drive_log import DriveLog, read_log, run_identification
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.numbers import number_option
+from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset, loads_log_mapping
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.identification import Identification
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.drivelog.overlay import Overlay, overlay
+from pmsm_commissioning.sim.fdsmc.engine import CONTROLLERS, simulate
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -1,6 +1,6 @@
 """Command-line interface of the PMSM position-drive commissioning tool (one sub-command per task).
 
-Installed as the console command ``pmsm-commission``; ``python -m app`` runs the same. ``--help``
+Installed as the console command ``pmsm-commission``; ``pmsm-commission`` runs the same. ``--help``
 lists every sub-command of :data:`COMMANDS`, ``--version`` prints the installed version. Each
 sub-command lives in its own module exposing ``add_arguments(parser)`` and ``run(args) -> int``.
 Bad input exits with code 2 and one clear line on stderr, never a traceback.
@@ -20,25 +20,32 @@ from typing import Any, NoReturn
 
 #: sub-command → (module, help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "derive": ("app.cli.derive", "derive α_max, observer gains, profile, comparator gains, energies"),
-    "design": ("app.cli.design", "design a clean setting for this drive and verify it by simulation"),
-    "simulate": ("app.cli.simulate", "simulate the FDSMC and the conventional controller"),
-    "export": ("app.cli.export", "write the drive parameter file, C controller, CSV or HTML report"),
-    "table1": ("app.cli.table1", "Table-1 sweep of the friction saving over manoeuvre times"),
-    "bench": ("app.cli.bench", "print speed figures of the simulation engine"),
-    "serve": ("app.cli.serve", "start the commissioning web UI"),
-    "bldc": ("app.cli.bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
-    "log": ("app.cli.log", "import a drive log: overlay on the simulation, identify the motor and load"),
-    "multiaxis": ("app.cli.multiaxis", "axes that must finish together: common T_m, designs, energies"),
-    "dutycycle": ("app.cli.duty", "a duty cycle of moves with dwells: energy per cycle and per year"),
-    "robustness": ("app.cli.robustness", "Monte-Carlo robustness to plant values the controller does not know"),
-    "import-drive": ("app.cli.import_drive", "import a stock drive's file (ODrive, moteus, VESC) into a preset"),
+    "derive": ("pmsm_commissioning.app.cli.derive",
+               "derive α_max, observer gains, profile, comparator gains, energies"),
+    "design": ("pmsm_commissioning.app.cli.design",
+               "design a clean setting for this drive and verify it by simulation"),
+    "simulate": ("pmsm_commissioning.app.cli.simulate", "simulate the FDSMC and the conventional controller"),
+    "export": ("pmsm_commissioning.app.cli.export", "write the drive parameter file, C controller, CSV or HTML report"),
+    "table1": ("pmsm_commissioning.app.cli.table1", "Table-1 sweep of the friction saving over manoeuvre times"),
+    "bench": ("pmsm_commissioning.app.cli.bench", "print speed figures of the simulation engine"),
+    "serve": ("pmsm_commissioning.app.cli.serve", "start the commissioning web UI"),
+    "bldc": ("pmsm_commissioning.app.cli.bldc", "sliding-mode speed control of a trapezoidal-EMF PMSM"),
+    "log": ("pmsm_commissioning.app.cli.log",
+            "import a drive log: overlay on the simulation, identify the motor and load"),
+    "multiaxis": ("pmsm_commissioning.app.cli.multiaxis",
+                  "axes that must finish together: common T_m, designs, energies"),
+    "dutycycle": ("pmsm_commissioning.app.cli.duty",
+                  "a duty cycle of moves with dwells: energy per cycle and per year"),
+    "robustness": ("pmsm_commissioning.app.cli.robustness",
+                   "Monte-Carlo robustness to plant values the controller does not know"),
+    "import-drive": ("pmsm_commissioning.app.cli.import_drive",
+                     "import a stock drive's file (ODrive, moteus, VESC) into a preset"),
 }
 
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # one line, exit 2
-        from app.io.numbers import one_line
+        from pmsm_commissioning.app.io.numbers import one_line
 
         sys.stderr.write(f"error: {one_line(message, 293)}\n")
         raise SystemExit(2)
@@ -51,8 +58,8 @@ def chosen_command(argv: list[str]) -> str | None:
 
 #: Program name of the console command the wheel installs (``[project.scripts]`` of pyproject.toml).
 CONSOLE_PROG = "pmsm-commission"
-#: Program name when run from a clone as a module.
-MODULE_PROG = "python -m app"
+#: Program name when run as a module (``python -m pmsm_commissioning.app``).
+MODULE_PROG = "python -m pmsm_commissioning.app"
 
 
 def version() -> str:
@@ -71,7 +78,7 @@ def build_parser(command: str | None = None, prog: str = MODULE_PROG) -> argpars
     Only the module of ``command`` is imported (and its arguments added): a sub-command's module
     imports what it needs (numba kernels, scipy, plotly …), so importing all of them would make
     every call pay for the slowest. With ``command=None`` every module is imported; with an empty
-    string (``python -m app --help``) none is.
+    string (``pmsm-commission --help``) none is.
     """
     parser = _Parser(prog=prog, description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"%(prog)s {version()}")
@@ -97,7 +104,7 @@ def add_preset_arguments(p: argparse.ArgumentParser, default: str | None = None)
 
 def check_writable(path: str, option: str) -> None:
     """Raise ValueError unless ``path`` can be written (checked before any simulation runs)."""
-    from app.io.atomic import target_problem
+    from pmsm_commissioning.app.io.atomic import target_problem
 
     target = Path(path)
     try:
@@ -122,7 +129,7 @@ THREADED = frozenset({"derive", "design", "simulate", "export", "import-drive", 
 INTERRUPTED = 130
 
 
-#: True while :func:`main` runs as the process itself (``python -m app``, the console script).
+#: True while :func:`main` runs as the process itself (``pmsm-commission``, the console script).
 _AS_PROCESS = False
 
 
@@ -182,7 +189,7 @@ def _run_in_thread(args: argparse.Namespace) -> int:
 
 def _stop_interrupted() -> NoReturn:
     """Remove files being written, say so in one line, exit 130 at once (threads are not waited for)."""
-    from app.io.atomic import discard_partial
+    from pmsm_commissioning.app.io.atomic import discard_partial
 
     discard_partial()
     try:
@@ -203,7 +210,7 @@ def main(argv: list[str] | None = None, prog: str = MODULE_PROG) -> int:
     try:
         return _main(sys.argv[1:] if argv is None else argv, prog)
     except KeyboardInterrupt:
-        if argv is None:  # ``python -m app``: end the process now, whatever threads still run
+        if argv is None:  # ``pmsm-commission``: end the process now, whatever threads still run
             _stop_interrupted()
         return INTERRUPTED
     finally:
@@ -213,7 +220,7 @@ def main(argv: list[str] | None = None, prog: str = MODULE_PROG) -> int:
 
 
 def _main(argv: list[str], prog: str) -> int:
-    from app.threads import limit_blas_threads
+    from pmsm_commissioning.app.threads import limit_blas_threads
 
     limit_blas_threads()  # before the sub-command imports numpy: then it costs nothing
     args = build_parser(chosen_command(argv) or "", prog).parse_args(argv)  # "": --help alone imports none
@@ -222,7 +229,7 @@ def _main(argv: list[str], prog: str) -> int:
             return _run_in_thread(args)
         return int(args._run(args) or 0)
     except ValueError as exc:  # ParameterError, PresetError: bad input
-        from app.io.numbers import one_line
+        from pmsm_commissioning.app.io.numbers import one_line
 
         sys.stderr.write(f"error: {one_line(exc, 293)}\n")  # ≤ 300 characters with "error: "
         return 2

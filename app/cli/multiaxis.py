@@ -1,4 +1,4 @@
-"""``python -m app multiaxis FILE [--T-m SECONDS] [--json]``: axes that must finish together.
+"""``pmsm-commission multiaxis FILE [--T-m SECONDS] [--json]``: axes that must finish together.
 
 FILE is a YAML list of axes, each ``{preset: NAME_OR_PATH, set: [SECTION.FIELD=VALUE, …],
 name: LABEL}`` (``set`` and ``name`` optional), e.g.::
@@ -14,12 +14,12 @@ import json
 from pathlib import Path
 from typing import Any
 
-from app.io.json_data import to_json
-from app.io.numbers import number_option
-from app.io.presets import loads_raw
-from app.io.study_inputs import parse_axes
-from control.common.checks import ParameterError
-from sim.studies.multiaxis import MultiAxisResult, coordinate
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.numbers import number_option
+from pmsm_commissioning.app.io.presets import loads_raw
+from pmsm_commissioning.app.io.study_inputs import parse_axes
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.studies.multiaxis import MultiAxisResult, coordinate
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -1,4 +1,4 @@
-"""``python -m app robustness PRESET --samples N [--seed S] [--spread …] [--json] [--scheduler …]``.
+"""``pmsm-commission robustness PRESET --samples N [--seed S] [--spread …] [--json] [--scheduler …]``.
 
 Spreads (comma-separated or repeated), each on a plant value (see :mod:`app.io.plant_overrides`), in SI:
 ``plant.J_L=0:0.3`` uniform between 0 and 0.3; ``plant.R_s=±20%`` (or ``+-20%``) uniform within
@@ -21,14 +21,14 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from app.cli.main import add_preset_arguments, check_writable
-from app.io.json_data import to_json
-from app.io.numbers import integer_option, number_option
-from app.io.plant_overrides import load_model_and_plant
-from app.io.sample_table import require_parquet, write_csv, write_parquet
-from app.io.study_inputs import parse_spreads
-from control.common.checks import ParameterError
-from sim.studies.robustness import (
+from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.numbers import integer_option, number_option
+from pmsm_commissioning.app.io.plant_overrides import load_model_and_plant
+from pmsm_commissioning.app.io.sample_table import require_parquet, write_csv, write_parquet
+from pmsm_commissioning.app.io.study_inputs import parse_spreads
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.studies.robustness import (
     CONTROLLERS,
     METRICS,
     STUDY_CONTROLLERS,
@@ -36,7 +36,7 @@ from sim.studies.robustness import (
     RobustnessResult,
     robustness,
 )
-from sim.studies.runner import ExecutorError, RetryingPool
+from pmsm_commissioning.sim.studies.runner import ExecutorError, RetryingPool
 
 SCHEDULER_ENV = "PMSM_DASK_SCHEDULER"
 MAX_SAMPLES = 1_000_000
@@ -118,7 +118,7 @@ def _compute(args: argparse.Namespace) -> RobustnessResult:
     spreads = parse_spreads(args.spread)
     ctrl = tuple(c.strip() for c in args.controllers.split(","))
     if args.scheduler:
-        from sim.studies.dask_runner import connect
+        from pmsm_commissioning.sim.studies.dask_runner import connect
 
         _quiet_dask()
         with connect(args.scheduler, args.cluster_timeout) as ex:

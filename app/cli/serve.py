@@ -1,4 +1,4 @@
-"""``python -m app serve [--host 127.0.0.1] [--port 8080] [--preset NAME]``: start the web UI.
+"""``pmsm-commission serve [--host 127.0.0.1] [--port 8080] [--preset NAME]``: start the web UI.
 
 Binds to the loopback interface by default (viser's own default, 0.0.0.0, would expose the tool
 to the plant network); a non-loopback host prints a warning. If the port is taken viser moves to
@@ -12,10 +12,10 @@ import ipaddress
 import sys
 import time
 
-from app.io.numbers import integer_option
-from app.io.presets import DEFAULT_PRESET, load
-from app.ui.web_guard import Guard, new_token
-from control.fdsmc.derivations import derive
+from pmsm_commissioning.app.io.numbers import integer_option
+from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load
+from pmsm_commissioning.app.ui.web_guard import Guard, new_token
+from pmsm_commissioning.control.fdsmc.derivations import derive
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: binding to {args.host}: the tool is reachable from other machines on the "
               "network; only browsers that open the URL below (with its token) get in. Use --host "
               "127.0.0.1 unless you need this.", file=sys.stderr)
-    from app.ui.page import create_server  # imports viser; keep `--help` fast
+    from pmsm_commissioning.app.ui.page import create_server  # imports viser; keep `--help` fast
 
     guard = Guard.for_host(args.host, args.allow_origin, token)
     try:

@@ -1,4 +1,4 @@
-"""``python -m app simulate PRESET [--set …] [--controller …] [--json] [--csv FILE]``."""
+"""``pmsm-commission simulate PRESET [--set …] [--controller …] [--json] [--csv FILE]``."""
 
 from __future__ import annotations
 
@@ -6,21 +6,21 @@ import argparse
 import json
 from typing import Any
 
-from app.cli.main import add_preset_arguments, check_writable
-from app.io.assumed import assumptions
-from app.io.atomic import write_atomic_text
-from app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
-from app.io.derived_view import derived_json
-from app.io.json_data import to_json
-from app.io.numbers import format_metric
-from app.io.plant_overrides import load_model_and_plant
-from app.io.presets import load_raw
-from app.io.stock_view import stock_json, stock_lines
-from control.common.checks import ParameterError
-from sim.fdsmc.engine import COMPARATORS, LABELS, Comparison, compare
-from sim.fdsmc.optimum_gap import DRAWN_BASIS, saving_vs_optimum
-from sim.fdsmc.recommend import least_drawn, recommend, runs_of
-from sim.fdsmc.verdicts import comparator_notes, run_warnings
+from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
+from pmsm_commissioning.app.io.assumed import assumptions
+from pmsm_commissioning.app.io.atomic import write_atomic_text
+from pmsm_commissioning.app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
+from pmsm_commissioning.app.io.derived_view import derived_json
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.numbers import format_metric
+from pmsm_commissioning.app.io.plant_overrides import load_model_and_plant
+from pmsm_commissioning.app.io.presets import load_raw
+from pmsm_commissioning.app.io.stock_view import stock_json, stock_lines
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, LABELS, Comparison, compare
+from pmsm_commissioning.sim.fdsmc.optimum_gap import DRAWN_BASIS, saving_vs_optimum
+from pmsm_commissioning.sim.fdsmc.recommend import least_drawn, recommend, runs_of
+from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
 SUMMARY = (
@@ -126,7 +126,7 @@ def _drawn_saving(cmp: Comparison) -> float | None:
 
 def write_csv(path: str, cmp: Comparison) -> None:
     """Write the time series in the one CSV format of the exports (:func:`app.exports.model.trace_csv`)."""
-    from app.exports.model import trace_csv  # the export model's imports cost ≈ 0.25 s of cold start
+    from pmsm_commissioning.app.exports.model import trace_csv  # the export model's imports cost ≈ 0.25 s of cold start
 
     try:
         write_atomic_text(path, trace_csv(cmp))  # a temporary file renamed when complete

@@ -1,4 +1,4 @@
-"""``python -m app table1 PRESET [--set …] [--tm 1.0,1.4,1.8,2.2,2.6] [--json]``.
+"""``pmsm-commission table1 PRESET [--set …] [--tm 1.0,1.4,1.8,2.2,2.6] [--json]``.
 
 The Table-1 sweep of [1]: per manoeuvre time the simulated FDSMC and conventional friction
 energies over [0, T_m], the saving, eq. (52)'s prediction, the bound 1 − 4/5.6, and the paper's
@@ -15,11 +15,11 @@ import dataclasses
 import json
 import sys
 
-from app.cli.main import add_preset_arguments
-from app.io.json_data import to_json
-from app.io.numbers import format_metric, parse_T_m_list
-from app.io.presets import load
-from sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M, Table1Row, table1_sweep
+from pmsm_commissioning.app.cli.main import add_preset_arguments
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.numbers import format_metric, parse_T_m_list
+from pmsm_commissioning.app.io.presets import load
+from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M, Table1Row, table1_sweep
 
 DEFAULT_TM = ",".join(map(str, TABLE1_T_M))
 

@@ -16,15 +16,15 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from app.io.units import spec_of
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived
-from control.fdsmc.fdc import mismatch_filter_factor
-from control.fdsmc.feasibility import current_limit, feasibility
-from control.fdsmc.inverter import decay_factors
-from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import C_57
+from pmsm_commissioning.app.io.units import spec_of
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.fdc import mismatch_filter_factor
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit, feasibility
+from pmsm_commissioning.control.fdsmc.inverter import decay_factors
+from pmsm_commissioning.control.fdsmc.loop_analysis import ZETA_SLOPE_MIN
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import C_57
 
 #: Encoder resolution of the C module when the preset's encoder is ideal [counts/rev]: 2^22 resolves
 #: 1.5 µrad and leaves ±512 revolutions in an int32 count.

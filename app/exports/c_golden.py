@@ -23,15 +23,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from app.exports.c_module import controller_source
-from app.exports.c_verify import count_params, readings
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from control.fdsmc.feasibility import current_limit
-from control.fdsmc.params import DriveParams, LoadStep
-from sim.common import sensors
-from sim.fdsmc.engine import simulate
-from sim.fdsmc.grid import time_grid
+from pmsm_commissioning.app.exports.c_module import controller_source
+from pmsm_commissioning.app.exports.c_verify import count_params, readings
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit
+from pmsm_commissioning.control.fdsmc.params import DriveParams, LoadStep
+from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.fdsmc.engine import simulate
+from pmsm_commissioning.sim.fdsmc.grid import time_grid
 
 #: Most samples of all segments together [-]: ≈ 110 bytes of text each (1.8 MB).
 MAX_SAMPLES = 16000

@@ -25,15 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from app.exports.c_design import design_constants, design_initializer, encoder_counts_per_rev
-from app.exports.c_text import c_string
-from app.io.json_data import to_json
-from app.io.presets import to_raw
-from app.io.units import spec_of
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived
-from control.fdsmc.params import DriveParams
-from control.fdsmc.tracking import slide_gain
+from pmsm_commissioning.app.exports.c_design import design_constants, design_initializer, encoder_counts_per_rev
+from pmsm_commissioning.app.exports.c_text import c_string
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.presets import to_raw
+from pmsm_commissioning.app.io.units import spec_of
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.tracking import slide_gain
 
 from .c_optimum import STATE_FIELDS, ReferenceTable, law_parts, optimum_constants, reference_table
 from .c_source import FDSMC_MOVE, LIMIT_CODE, SOURCE

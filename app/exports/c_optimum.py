@@ -29,14 +29,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from app.exports.c_design import encoder_counts_per_rev
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived
-from control.fdsmc.optimum import tracked_move
-from control.fdsmc.params import DriveParams
-from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import pack_parameters
-from sim.fdsmc.grid import time_grid
+from pmsm_commissioning.app.exports.c_design import encoder_counts_per_rev
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.optimum import tracked_move
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc.engine import pack_parameters
+from pmsm_commissioning.sim.fdsmc.grid import time_grid
 
 #: Largest reference table of the float32 (target) build [bytes]: a quarter of a 256 KiB flash.
 MAX_TABLE_BYTES = 64 * 1024

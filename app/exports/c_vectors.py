@@ -15,8 +15,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from app.exports.c_golden import Segment, segments
-from app.exports.c_module import (
+from pmsm_commissioning.app.exports.c_golden import Segment, segments
+from pmsm_commissioning.app.exports.c_module import (
     CONTINUOUS_REFUSED,
     HEADER_NAME,
     Verdict,
@@ -25,14 +25,14 @@ from app.exports.c_module import (
     parameter_hash,
     verdict_of,
 )
-from app.exports.c_source import c_text
-from app.exports.c_text import c_string
-from app.exports.c_verify import count_params
-from app.io.presets import SCHEMA
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison
+from pmsm_commissioning.app.exports.c_source import c_text
+from pmsm_commissioning.app.exports.c_text import c_string
+from pmsm_commissioning.app.exports.c_verify import count_params
+from pmsm_commissioning.app.io.presets import SCHEMA
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import Comparison
 
 VECTORS_NAME, TEST_NAME = "fdsmc_vectors.h", "fdsmc_test.c"
 

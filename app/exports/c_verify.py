@@ -9,8 +9,8 @@ the seeded noise and ADC of :mod:`sim.common.sensors`), sets the move with the d
 and the simulator runs on the same demand and encoder (:func:`count_params`). Agreement = max |C − simulator|
 / max |simulator| over the run, per signal (error relative to the signal's peak), at every sample.
 
-``python -m app.exports.c_verify [--controller optimum]`` prints the figures for the paper preset and the
-real-motor presets (of the FDSMC's module, or the tracked optimum's).
+``python -m pmsm_commissioning.app.exports.c_verify [--controller optimum]`` prints the figures for the paper
+preset and the real-motor presets (of the FDSMC's module, or the tracked optimum's).
 """
 
 from __future__ import annotations
@@ -26,14 +26,14 @@ from pathlib import Path
 
 import numpy as np
 
-from app.exports.c_design import encoder_counts_per_rev
-from app.exports.c_module import Verdict, controller_files
-from app.io.presets import SCHEMA, list_presets, load_preset
-from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams
-from sim.common import sensors
-from sim.fdsmc.engine import simulate
-from sim.fdsmc.plant import PlantInTheLoop
+from pmsm_commissioning.app.exports.c_design import encoder_counts_per_rev
+from pmsm_commissioning.app.exports.c_module import Verdict, controller_files
+from pmsm_commissioning.app.io.presets import SCHEMA, list_presets, load_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.fdsmc.engine import simulate
+from pmsm_commissioning.sim.fdsmc.plant import PlantInTheLoop
 
 #: Warnings the generated module must compile cleanly with.
 CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wdouble-promotion", "-Wconversion")
@@ -235,11 +235,12 @@ def main(argv: list[str] | None = None) -> None:
     """
     import argparse
 
-    from app.exports.c_vectors import c_files  # the vectors module imports this one
-    from sim.fdsmc.design import run_checks
-    from sim.fdsmc.engine import compare
+    from pmsm_commissioning.app.exports.c_vectors import c_files  # the vectors module imports this one
+    from pmsm_commissioning.sim.fdsmc.design import run_checks
+    from pmsm_commissioning.sim.fdsmc.engine import compare
 
-    ap = argparse.ArgumentParser(prog="python -m app.exports.c_verify", description=main.__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m pmsm_commissioning.app.exports.c_verify",
+                                 description=main.__doc__.splitlines()[0])
     ap.add_argument("--controller", choices=("fdsmc", "optimum"), default="fdsmc")
     law = ap.parse_args(argv).controller
     limits = ["controller.K=0.3", "controller.delay_samples=1", "controller.V_dc=300", "controller.i_max=40"]

@@ -12,16 +12,16 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from app.exports.moteus import moteus_text
-from app.exports.odrive import odrive_json
-from app.exports.provenance import ExportRefusedError, check_text, header_lines
-from app.exports.setpoints import setpoints_csv
-from app.exports.stock import StockSettings, stock_settings, with_stock_runs
-from app.exports.stock_route import ROUTE_NAMES, file_verdict
-from app.exports.vesc import vesc_xml
-from control.common.checks import ParameterError
-from sim.fdsmc.design import Constraint
-from sim.fdsmc.engine import Comparison
+from pmsm_commissioning.app.exports.moteus import moteus_text
+from pmsm_commissioning.app.exports.odrive import odrive_json
+from pmsm_commissioning.app.exports.provenance import ExportRefusedError, check_text, header_lines
+from pmsm_commissioning.app.exports.setpoints import setpoints_csv
+from pmsm_commissioning.app.exports.stock import StockSettings, stock_settings, with_stock_runs
+from pmsm_commissioning.app.exports.stock_route import ROUTE_NAMES, file_verdict
+from pmsm_commissioning.app.exports.vesc import vesc_xml
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.fdsmc.design import Constraint
+from pmsm_commissioning.sim.fdsmc.engine import Comparison
 
 #: Stock-drive format → file-name suffix (after the case's stem).
 DRIVE_FORMATS = {"odrive": ".odrive.json", "moteus": ".moteus.cfg", "vesc": ".vesc.xml",

@@ -13,14 +13,14 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from app.exports.moteus import moteus_motor, parse_moteus
-from app.exports.odrive import odrive_motor, parse_odrive
-from app.exports.vendor_keys import VendorFile
-from app.exports.vesc import parse_vesc, vesc_motor
-from app.io.units import spec_of
-from app.io.user_text import escaped
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.app.exports.moteus import moteus_motor, parse_moteus
+from pmsm_commissioning.app.exports.odrive import odrive_motor, parse_odrive
+from pmsm_commissioning.app.exports.vendor_keys import VendorFile
+from pmsm_commissioning.app.exports.vesc import parse_vesc, vesc_motor
+from pmsm_commissioning.app.io.units import spec_of
+from pmsm_commissioning.app.io.user_text import escaped
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 IMPORT_FORMATS = ("odrive", "moteus", "vesc")
 #: Preset field → (vendor key, vendor unit) per format: where each imported value comes from.

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: One turn (revolution) [rad].
 TURN_RAD = 2.0 * math.pi

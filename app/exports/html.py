@@ -12,18 +12,18 @@ import math
 import plotly.graph_objects as go
 import plotly.io as pio
 
-from app.exports.c_module import TOOL
-from app.figures.fdsmc_comparison import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
-from app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure
-from app.figures.style import BAD_COLOUR
-from app.io.derived_view import derived_rows
-from app.io.numbers import format_metric
-from app.io.presets import to_raw
-from app.ui.text import html_text
-from control.fdsmc.model import available_voltage
-from sim.fdsmc.engine import LABELS, Comparison
-from sim.fdsmc.recommend import recommend
-from sim.fdsmc.verdicts import comparator_notes, run_warnings
+from pmsm_commissioning.app.exports.c_module import TOOL
+from pmsm_commissioning.app.figures.fdsmc_comparison import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
+from pmsm_commissioning.app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure
+from pmsm_commissioning.app.figures.style import BAD_COLOUR
+from pmsm_commissioning.app.io.derived_view import derived_rows
+from pmsm_commissioning.app.io.numbers import format_metric
+from pmsm_commissioning.app.io.presets import to_raw
+from pmsm_commissioning.app.ui.text import html_text
+from pmsm_commissioning.control.fdsmc.model import available_voltage
+from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison
+from pmsm_commissioning.sim.fdsmc.recommend import recommend
+from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 #: Height of each time-plot row and of every other figure [px].
 ROW_HEIGHT_PX, FIGURE_HEIGHT_PX = 280, 520

@@ -1,4 +1,4 @@
-"""The export model shared by the page's Export menu and ``python -m app export``.
+"""The export model shared by the page's Export menu and ``pmsm-commission export``.
 
 :func:`export_files` turns one simulated case (a :class:`sim.fdsmc.engine.Comparison`, whose
 ``derived.params`` are the inputs) into the files of one format — the same bytes whoever asks:
@@ -37,19 +37,19 @@ from typing import Any
 
 import numpy as np
 
-from app.exports.c_module import LAWS, TOOL
-from app.exports.c_vectors import c_files
-from app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
-from app.exports.provenance import check_text, failed_checks, gate, verdict_lines
-from app.io.derived_view import derived_rows
-from app.io.json_data import to_json
-from app.io.presets import SCHEMA, annotate_units, dumps, to_raw
-from app.io.units import SI_UNITS
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.engine import Comparison, simulate
-from sim.fdsmc.verdicts import comparator_notes, run_warnings
+from pmsm_commissioning.app.exports.c_module import LAWS, TOOL
+from pmsm_commissioning.app.exports.c_vectors import c_files
+from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
+from pmsm_commissioning.app.exports.provenance import check_text, failed_checks, gate, verdict_lines
+from pmsm_commissioning.app.io.derived_view import derived_rows
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.presets import SCHEMA, annotate_units, dumps, to_raw
+from pmsm_commissioning.app.io.units import SI_UNITS
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, simulate
+from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 FORMATS = ("yaml", "json", "c", "csv", "html") + tuple(DRIVE_FORMATS)
 #: Options of an export when none are given (not forced, setpoints in rad at the drive's cycle).
@@ -125,7 +125,7 @@ def parameter_yaml(cmp: Comparison) -> str:
     """Drive parameter file as YAML (written by :func:`app.io.presets.dumps`)."""
     head = (f"# Drive parameter file (schema {SCHEMA}) — {TOOL}. SI units; the unit and allowed range of each\n"
             "# input are in the comment beside it, the units also in `units`. Re-import: the page's Import\n"
-            "# button or any command taking PRESET, e.g. `python -m app derive FILE`; drive_gains, verdicts\n"
+            "# button or any command taking PRESET, e.g. `pmsm-commission derive FILE`; drive_gains, verdicts\n"
             "# and results are then recomputed.\n")
     return head + annotate_units(dumps(parameter_data(cmp)))
 
@@ -241,7 +241,7 @@ def export_files(fmt: str, cmp: Comparison, options: ExportOptions = DEFAULT_OPT
         files = c_files(cmp, checks, force=True, controller=law)
         return {name: _warned(fmt, text, failed).encode("utf-8") for name, text in files.items()}
     if fmt == "html":
-        from app.exports.html import html_report  # plotly: imported only when a report is made
+        from pmsm_commissioning.app.exports.html import html_report  # plotly: imported only when a report is made
 
         return {f"{stem}.html": _warned(fmt, html_report(cmp), failed).encode("utf-8")}
     writers = {"yaml": parameter_yaml, "json": parameter_json, "csv": trace_csv}

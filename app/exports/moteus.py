@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import re
 
-from app.exports.drive_units import (
+from pmsm_commissioning.app.exports.drive_units import (
     per_rad_to_per_turn,
     per_turn_to_per_rad,
     pole_pairs_to_poles,
@@ -30,15 +30,15 @@ from app.exports.drive_units import (
     rad_to_turn,
     turn_to_rad,
 )
-from app.exports.stock import StockSettings
-from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
-from app.io.user_text import escaped
-from control.common.checks import ParameterError
-from control.fdsmc.model import torque_constant
-from control.fdsmc.params import DriveParams
-from control.fdsmc.trapezoid import trapezoid_from_limits
-from sim.stock.route import StockLoop
-from sim.stock.tuning import setpoint_table
+from pmsm_commissioning.app.exports.stock import StockSettings
+from pmsm_commissioning.app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from pmsm_commissioning.app.io.user_text import escaped
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.model import torque_constant
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_from_limits
+from pmsm_commissioning.sim.stock.route import StockLoop
+from pmsm_commissioning.sim.stock.tuning import setpoint_table
 
 _REF = "moteus docs/reference.md, configurable parameters"
 _FW = "moteus fw/bldc_servo_structs.h"

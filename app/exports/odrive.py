@@ -22,7 +22,7 @@ import json
 import math
 from typing import Any
 
-from app.exports.drive_units import (
+from pmsm_commissioning.app.exports.drive_units import (
     per_rad_to_per_turn,
     per_turn_to_per_rad,
     psi_from_torque_constant,
@@ -30,14 +30,14 @@ from app.exports.drive_units import (
     torque_constant,
     turn_to_rad,
 )
-from app.exports.stock import StockSettings
-from app.exports.vendor_keys import VendorFile, VendorKey, vendor_file
-from app.io.user_text import escaped
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from control.fdsmc.trapezoid import trapezoid_from_limits
-from sim.stock.route import StockLoop
-from sim.stock.tuning import DRIVES, setpoint_table
+from pmsm_commissioning.app.exports.stock import StockSettings
+from pmsm_commissioning.app.exports.vendor_keys import VendorFile, VendorKey, vendor_file
+from pmsm_commissioning.app.io.user_text import escaped
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_from_limits
+from pmsm_commissioning.sim.stock.route import StockLoop
+from pmsm_commissioning.sim.stock.tuning import DRIVES, setpoint_table
 
 _IF = "odrive-interface.yaml (fw 0.5.x)"
 #: Every key written, with its ODrive type and unit (units as the interface file states them, those

@@ -18,13 +18,13 @@ import importlib.metadata
 import json
 from collections.abc import Sequence
 
-from app.exports.c_module import TOOL
-from app.io.json_data import to_json
-from app.io.presets import to_raw
-from app.io.user_text import escaped
-from control.common.checks import ParameterError
-from sim.fdsmc.design import Constraint, run_checks
-from sim.fdsmc.engine import Comparison, RunResult
+from pmsm_commissioning.app.exports.c_module import TOOL
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.presets import to_raw
+from pmsm_commissioning.app.io.user_text import escaped
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.fdsmc.design import Constraint, run_checks
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, RunResult
 
 
 class ExportRefusedError(ParameterError):
@@ -73,7 +73,7 @@ def gate(fmt: str, cmp: Comparison, force: bool, controller: str = "fdsmc") -> l
         names = "; ".join(check_text(c) for c in failed)
         run = " (the tracked optimum's run)" if controller == "optimum" else ""
         raise ExportRefusedError(f"export --format {fmt} refused: the design of {cmp.derived.params.name!r} is not "
-                                 f"clean{run} — {names}. Fix the design (python -m app design …) or export with "
+                                 f"clean{run} — {names}. Fix the design (pmsm-commission design …) or export with "
                                  "--force to write it with these warnings inside")
     return failed
 

@@ -15,13 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from app.exports.drive_units import ANGLE_UNITS, rad_to_angle_unit
-from app.exports.stock import StockSettings
-from app.exports.stock_lines import CASCADE_UNITS, cascade_lines, parse_cascade
-from app.io.user_text import csv_comment
-from control.common.checks import ParameterError
-from control.fdsmc.trapezoid import trapezoid_samples
-from sim.stock.route import StockLoop
+from pmsm_commissioning.app.exports.drive_units import ANGLE_UNITS, rad_to_angle_unit
+from pmsm_commissioning.app.exports.stock import StockSettings
+from pmsm_commissioning.app.exports.stock_lines import CASCADE_UNITS, cascade_lines, parse_cascade
+from pmsm_commissioning.app.io.user_text import csv_comment
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_samples
+from pmsm_commissioning.sim.stock.route import StockLoop
 
 #: Most rows of a setpoint table (a longer table needs a longer cycle time).
 MAX_ROWS = 2_000_000

@@ -20,11 +20,11 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from control.fdsmc.trapezoid import CascadeGains, TrapezoidTiming
-from sim.fdsmc.criteria import drive_current
-from sim.fdsmc.engine import Comparison, simulate
-from sim.stock.route import StockLoop
-from sim.stock.tuning import DRIVES, StockTuning, tuned
+from pmsm_commissioning.control.fdsmc.trapezoid import CascadeGains, TrapezoidTiming
+from pmsm_commissioning.sim.fdsmc.criteria import drive_current
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, simulate
+from pmsm_commissioning.sim.stock.route import StockLoop
+from pmsm_commissioning.sim.stock.tuning import DRIVES, StockTuning, tuned
 
 #: Cycle time of a continuous-time case's setpoint table [s].
 CONTINUOUS_CYCLE_S = 1e-3

@@ -12,7 +12,7 @@ import math
 import re
 from collections.abc import Iterable
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: The comment lines' keys and units, in the order written.
 CASCADE_UNITS = {"pos_gain": "1/s", "vel_gain": "N*m*s/rad", "vel_integrator_gain": "N*m/rad",

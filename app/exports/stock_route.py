@@ -10,15 +10,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from app.exports.moteus import moteus_loop, parse_moteus
-from app.exports.odrive import odrive_loop, parse_odrive
-from app.exports.setpoints import setpoints_loop
-from app.exports.vesc import parse_vesc, vesc_loop
-from control.fdsmc.derivations import Derived
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.checks import Constraint, run_checks
-from sim.fdsmc.engine import RunResult
-from sim.stock.route import StockLoop, simulate_stock
+from pmsm_commissioning.app.exports.moteus import moteus_loop, parse_moteus
+from pmsm_commissioning.app.exports.odrive import odrive_loop, parse_odrive
+from pmsm_commissioning.app.exports.setpoints import setpoints_loop
+from pmsm_commissioning.app.exports.vesc import parse_vesc, vesc_loop
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.checks import Constraint, run_checks
+from pmsm_commissioning.sim.fdsmc.engine import RunResult
+from pmsm_commissioning.sim.stock.route import StockLoop, simulate_stock
 
 #: The firmware each drive format's route models, as the header names it.
 ROUTE_NAMES = {"odrive": "ODrive fw 0.5.x loops at 8 kHz", "moteus": "moteus PID, current PI and PLL",

@@ -12,8 +12,8 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-from app.io.numbers import NumberFormatError, parse_number
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.io.numbers import NumberFormatError, parse_number
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: Value kinds of a vendor key.
 KINDS = ("float", "int", "enum")

@@ -19,16 +19,16 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
-from app.exports.drive_units import pole_pairs_to_poles, poles_to_pole_pairs
-from app.exports.stock import StockSettings
-from app.exports.stock_lines import cascade_lines, parse_cascade
-from app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
-from app.io.user_text import xml_comment
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from control.fdsmc.trapezoid import trapezoid_from_limits
-from sim.stock.route import StockLoop
-from sim.stock.tuning import setpoint_table
+from pmsm_commissioning.app.exports.drive_units import pole_pairs_to_poles, poles_to_pole_pairs
+from pmsm_commissioning.app.exports.stock import StockSettings
+from pmsm_commissioning.app.exports.stock_lines import cascade_lines, parse_cascade
+from pmsm_commissioning.app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from pmsm_commissioning.app.io.user_text import xml_comment
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_from_limits
+from pmsm_commissioning.sim.stock.route import StockLoop
+from pmsm_commissioning.sim.stock.tuning import setpoint_table
 
 _DOC = "VESC Tool res/config parameters_mcconf.xml (fw 5.03+ / 6.x)"
 #: Root element and version element of VESC Tool's mcconf XML.

@@ -15,12 +15,12 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from app.figures.bldc_speed_smc import finish_layout, xy
-from app.figures.decimate import BINS_OVERVIEW_ROWS, f32, time_axis
-from app.figures.style import REFERENCE_COLOUR, fmt
-from app.figures.style import line as style_line
-from app.io.units import rad_s_to_rpm
-from sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
+from pmsm_commissioning.app.figures.bldc_speed_smc import finish_layout, xy
+from pmsm_commissioning.app.figures.decimate import BINS_OVERVIEW_ROWS, f32, time_axis
+from pmsm_commissioning.app.figures.style import REFERENCE_COLOUR, fmt
+from pmsm_commissioning.app.figures.style import line as style_line
+from pmsm_commissioning.app.io.units import rad_s_to_rpm
+from pmsm_commissioning.sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
 
 _REF = {"color": REFERENCE_COLOUR, "dash": "dot", "width": 1.5}
 #: Height of one small-multiple row [px].

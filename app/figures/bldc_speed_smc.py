@@ -14,9 +14,9 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from app.figures.decimate import BINS_TIME_PLOTS, envelope, f32
-from app.figures.plain import slim_template
-from app.figures.style import (
+from pmsm_commissioning.app.figures.decimate import BINS_TIME_PLOTS, envelope, f32
+from pmsm_commissioning.app.figures.plain import slim_template
+from pmsm_commissioning.app.figures.style import (
     BLDC_COLOURS,
     PHASE_COLOURS,
     PHASE_DASHES,
@@ -24,12 +24,12 @@ from app.figures.style import (
     TITLE_PX,
     WARNING_COLOUR,
 )
-from app.figures.style import line as style_line
-from app.io.units import rad_s_to_rpm
-from control.bldc.design import BldcDesign
-from control.bldc.dqx import dqx_coefficients, ideal_coefficients
-from sim.bldc import emf as bldc_emf
-from sim.bldc.engine import LABELS, BldcComparison
+from pmsm_commissioning.app.figures.style import line as style_line
+from pmsm_commissioning.app.io.units import rad_s_to_rpm
+from pmsm_commissioning.control.bldc.design import BldcDesign
+from pmsm_commissioning.control.bldc.dqx import dqx_coefficients, ideal_coefficients
+from pmsm_commissioning.sim.bldc import emf as bldc_emf
+from pmsm_commissioning.sim.bldc.engine import LABELS, BldcComparison
 
 _MARGIN = {"l": 64, "r": 15, "t": 48, "b": 40}
 _IDEAL = {"dash": "dash", "color": REFERENCE_COLOUR}

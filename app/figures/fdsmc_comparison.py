@@ -15,11 +15,11 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
-from app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index
-from app.figures.plain import to_figure
-from app.figures.style import BAD_COLOUR, FONT_PX, POSITION_COLOURS, POSITION_DASHES, WARNING_COLOUR
-from control.fdsmc.sliding_mode import boundary_speed, in_boundary_layer
-from sim.fdsmc.engine import LABELS, Comparison, RunResult
+from pmsm_commissioning.app.figures.decimate import BINS_PHASE, BINS_TIME_PLOTS, envelope, f32, minmax_index
+from pmsm_commissioning.app.figures.plain import to_figure
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, FONT_PX, POSITION_COLOURS, POSITION_DASHES, WARNING_COLOUR
+from pmsm_commissioning.control.fdsmc.sliding_mode import boundary_speed, in_boundary_layer
+from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison, RunResult
 
 #: Most points drawn per trace by :func:`decimate_index` (the drive-log overlay).
 MAX_POINTS = 2000

@@ -6,9 +6,9 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from app.figures.decimate import f32
-from app.figures.fdsmc_comparison import decimate_index
-from sim.drivelog.overlay import Overlay
+from pmsm_commissioning.app.figures.decimate import f32
+from pmsm_commissioning.app.figures.fdsmc_comparison import decimate_index
+from pmsm_commissioning.sim.drivelog.overlay import Overlay
 
 MEASURED, SIMULATED = "#2b2b2b", "#1f6fd1"
 #: Panels: (row, col, signals, y title).

@@ -10,12 +10,12 @@ from typing import Any
 
 import plotly.graph_objects as go
 
-from app.figures.decimate import f32, time_axis
-from app.figures.fdsmc_comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
-from app.figures.style import BAD_COLOUR, GOOD_COLOUR
-from sim.fdsmc.engine import LABELS, Comparison, RunResult
-from sim.fdsmc.optimum_gap import saving_vs_optimum
-from sim.fdsmc.table1 import Table1Row, printed_reversed
+from pmsm_commissioning.app.figures.decimate import f32, time_axis
+from pmsm_commissioning.app.figures.fdsmc_comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, GOOD_COLOUR
+from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison, RunResult
+from pmsm_commissioning.sim.fdsmc.optimum_gap import saving_vs_optimum
+from pmsm_commissioning.sim.fdsmc.table1 import Table1Row, printed_reversed
 
 #: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
 ENERGIES = (

@@ -16,15 +16,22 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
-from app.figures.fdsmc_comparison import COLOURS, DASHES, LABELS, load_step_times, phase_plane_spec, runs
-from app.figures.fdsmc_pins import Pin, ghost_traces
-from app.figures.fdsmc_trail import piece_traces, pieces
-from app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
-from app.figures.fdsmc_zoom import zoom_parts
-from app.figures.style import BAD_COLOUR, FONT_PX, TITLE_PX
-from control.fdsmc.feasibility import torque_limit
-from control.fdsmc.model import electromagnetic_torque
+from pmsm_commissioning.app.figures.decimate import BINS_OVERVIEW_ROWS, envelope, f32
+from pmsm_commissioning.app.figures.fdsmc_comparison import (
+    COLOURS,
+    DASHES,
+    LABELS,
+    load_step_times,
+    phase_plane_spec,
+    runs,
+)
+from pmsm_commissioning.app.figures.fdsmc_pins import Pin, ghost_traces
+from pmsm_commissioning.app.figures.fdsmc_trail import piece_traces, pieces
+from pmsm_commissioning.app.figures.fdsmc_verdict import chatter_verdict, verdict_annotation
+from pmsm_commissioning.app.figures.fdsmc_zoom import zoom_parts
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, FONT_PX, TITLE_PX
+from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
+from pmsm_commissioning.control.fdsmc.model import electromagnetic_torque
 
 #: Horizontal domains [-] of the phase plane and of the compact time plot.
 #: The time rows end short of the right edge: the Γ_L axis's red tick labels stand outside its plot

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.decimate import BINS_PHASE, f32, minmax_index
+from pmsm_commissioning.app.figures.decimate import BINS_PHASE, f32, minmax_index
 
 #: Most pins kept (the oldest goes first).
 MAX_PINS = 4

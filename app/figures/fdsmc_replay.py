@@ -36,9 +36,9 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.fdsmc_comparison import runs
-from app.figures.style import FONT_PX
-from sim.fdsmc.engine import Comparison
+from pmsm_commissioning.app.figures.fdsmc_comparison import runs
+from pmsm_commissioning.app.figures.style import FONT_PX
+from pmsm_commissioning.sim.fdsmc.engine import Comparison
 
 #: Replay speeds: button label → simulated seconds per wall-clock second.
 SPEEDS = {"1×": 1.0, "0.25×": 0.25, "0.1×": 0.1, "0.01×": 0.01}

@@ -16,13 +16,13 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
-from app.figures.decimate import f32, time_axis
-from app.figures.fdsmc_comparison import COLOURS, LABELS, MAX_POINTS_TIME, stride_index
-from app.figures.plain import to_figure
-from app.figures.style import FONT_PX
-from sim.fdsmc.verdicts import TARGET_BAND
-from sim.studies.multiaxis import MultiAxisResult
-from sim.studies.robustness import RobustnessResult
+from pmsm_commissioning.app.figures.decimate import f32, time_axis
+from pmsm_commissioning.app.figures.fdsmc_comparison import COLOURS, LABELS, MAX_POINTS_TIME, stride_index
+from pmsm_commissioning.app.figures.plain import to_figure
+from pmsm_commissioning.app.figures.style import FONT_PX
+from pmsm_commissioning.sim.fdsmc.verdicts import TARGET_BAND
+from pmsm_commissioning.sim.studies.multiaxis import MultiAxisResult
+from pmsm_commissioning.sim.studies.robustness import RobustnessResult
 
 #: The two controllers compared by the robustness study, in drawing order.
 CONTROLLERS = ("fdsmc", "conventional")

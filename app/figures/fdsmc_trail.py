@@ -24,11 +24,16 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.decimate import f32, minmax_index
-from app.figures.fdsmc_comparison import runs
-from app.figures.style import POSITION_COLOURS, POSITION_DASHES, TRAIL_PHASE_COLOURS, TRAIL_PHASE_DASHES
-from control.fdsmc.sliding_mode import in_boundary_layer
-from sim.fdsmc.engine import LABELS
+from pmsm_commissioning.app.figures.decimate import f32, minmax_index
+from pmsm_commissioning.app.figures.fdsmc_comparison import runs
+from pmsm_commissioning.app.figures.style import (
+    POSITION_COLOURS,
+    POSITION_DASHES,
+    TRAIL_PHASE_COLOURS,
+    TRAIL_PHASE_DASHES,
+)
+from pmsm_commissioning.control.fdsmc.sliding_mode import in_boundary_layer
+from pmsm_commissioning.sim.fdsmc.engine import LABELS
 
 #: Pieces per trajectory in time (more where the FDSMC changes phase), and min/max bins of the
 #: trail's points (each key frame of each replay speed carries them once).

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from app.figures.style import BAD_COLOUR, GOOD_COLOUR
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, GOOD_COLOUR
 
 #: Font size of the verdict on the plot [px] (a projector's back row).
 VERDICT_FONT_PX = 20

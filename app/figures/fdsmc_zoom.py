@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.decimate import f32, minmax_index
-from app.figures.fdsmc_comparison import BOUNDARY_COLOUR
-from app.figures.style import FONT_PX, POSITION_COLOURS
+from pmsm_commissioning.app.figures.decimate import f32, minmax_index
+from pmsm_commissioning.app.figures.fdsmc_comparison import BOUNDARY_COLOUR
+from pmsm_commissioning.app.figures.style import FONT_PX, POSITION_COLOURS
 
 #: Inset domain in the figure [paper]: x within the phase plane's, y from its bottom.
 INSET_X, INSET_Y = (0.13, 0.40), (0.07, 0.40)

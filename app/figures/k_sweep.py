@@ -27,13 +27,13 @@ from typing import Any
 
 import numpy as np
 
-from app.figures.decimate import envelope, minmax_index
-from app.figures.fdsmc_comparison import BAND_COLOUR, BOUNDARY_COLOUR, COLOURS, phase_plane_extent
-from app.figures.fdsmc_overview import REF_LINE, motor_torque
-from app.figures.fdsmc_verdict import DETAIL_FONT_PX, VERDICT_FONT_PX, chatter_verdict
-from app.figures.style import BAD_COLOUR, FONT_PX, GOOD_COLOUR, TITLE_PX
-from control.fdsmc.feasibility import torque_limit
-from control.fdsmc.sliding_mode import boundary_speed
+from pmsm_commissioning.app.figures.decimate import envelope, minmax_index
+from pmsm_commissioning.app.figures.fdsmc_comparison import BAND_COLOUR, BOUNDARY_COLOUR, COLOURS, phase_plane_extent
+from pmsm_commissioning.app.figures.fdsmc_overview import REF_LINE, motor_torque
+from pmsm_commissioning.app.figures.fdsmc_verdict import DETAIL_FONT_PX, VERDICT_FONT_PX, chatter_verdict
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, FONT_PX, GOOD_COLOUR, TITLE_PX
+from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
+from pmsm_commissioning.control.fdsmc.sliding_mode import boundary_speed
 
 #: Log-spaced points of the grid over the slider's range (the marked gains are added to them).
 N_LOG = 26

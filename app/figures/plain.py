@@ -19,7 +19,7 @@ import numpy as np
 import plotly.graph_objects as go
 import plotly.io as pio
 
-from app.figures.style import FONT_PX, TEMPLATE_LAYOUT, TITLE_PX
+from pmsm_commissioning.app.figures.style import FONT_PX, TEMPLATE_LAYOUT, TITLE_PX
 
 #: Trace types whose template defaults are kept (the only ones the page draws), and the layout
 #: parts of a template that cartesian 2D figures never use (polar, ternary, 3D scene, geo, …).

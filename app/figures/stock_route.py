@@ -16,12 +16,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from app.figures.decimate import f32, time_axis
-from app.figures.fdsmc_comparison import MAX_POINTS_TIME, stride_index
-from app.figures.style import BAD_COLOUR, GOOD_COLOUR, POSITION_COLOURS, POSITION_DASHES, fmt
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.criteria import drive_current, pass_criteria
-from sim.fdsmc.engine import Comparison, RunResult
+from pmsm_commissioning.app.figures.decimate import f32, time_axis
+from pmsm_commissioning.app.figures.fdsmc_comparison import MAX_POINTS_TIME, stride_index
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, GOOD_COLOUR, POSITION_COLOURS, POSITION_DASHES, fmt
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.criteria import drive_current, pass_criteria
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, RunResult
 
 #: Half-height of the error row, in in-position windows [-].
 ERROR_ROW_WINDOWS = 12.0

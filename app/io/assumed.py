@@ -15,12 +15,12 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
-from app.io import motor_defaults, units
-from app.io.preset_schema import field_of
-from app.io.presets import apply_overrides
-from app.io.transmission_keys import as_aliases
-from control.common.checks import field_specs
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.app.io import motor_defaults, units
+from pmsm_commissioning.app.io.preset_schema import field_of
+from pmsm_commissioning.app.io.presets import apply_overrides
+from pmsm_commissioning.app.io.transmission_keys import as_aliases
+from pmsm_commissioning.control.common.checks import field_specs
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 #: Top-level key of a preset listing the fields that came from a base preset (``import-drive``).
 INHERITED = "inherited"

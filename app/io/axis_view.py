@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from control.fdsmc import transmission as tx
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc import transmission as tx
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 #: Output display units: (angle or travel, speed, inertia or mass, torque or force) per kind of axis.
 _UNITS = {False: ("deg", "rpm", "kg·m²", "N·m"), True: ("mm", "mm/s", "kg", "N")}

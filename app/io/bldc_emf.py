@@ -21,12 +21,12 @@ from typing import Any
 
 import numpy as np
 
-from app.io.numbers import NumberFormatError, parse_number
-from app.io.presets import loads_raw
-from app.io.units import rpm_to_rad_s
-from control.bldc.params import EMF_SAMPLES_MAX, BldcParams
-from control.common.checks import ParameterError
-from sim.bldc.emf import MeasuredEmf, resample_measured
+from pmsm_commissioning.app.io.numbers import NumberFormatError, parse_number
+from pmsm_commissioning.app.io.presets import loads_raw
+from pmsm_commissioning.app.io.units import rpm_to_rad_s
+from pmsm_commissioning.control.bldc.params import EMF_SAMPLES_MAX, BldcParams
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.bldc.emf import MeasuredEmf, resample_measured
 
 STORE_SAMPLES = 360  # samples per period kept in a preset (1° electrical)
 MAX_BYTES = 512 * 1024

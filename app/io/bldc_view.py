@@ -1,18 +1,18 @@
 """Presentation of a BLDC comparison: the side-by-side metric table and the stable JSON form.
 
-Shared by the page's BLDC tab and ``python -m app bldc``.
+Shared by the page's BLDC tab and ``pmsm-commission bldc``.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from app.io.json_data import to_json
-from app.io.numbers import format_metric
-from app.io.units import rad_s_to_rpm
-from control.bldc.design import BldcDesign
-from sim.bldc.engine import LABELS, BldcComparison
-from sim.bldc.metrics import BldcMetrics
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.app.io.numbers import format_metric
+from pmsm_commissioning.app.io.units import rad_s_to_rpm
+from pmsm_commissioning.control.bldc.design import BldcDesign
+from pmsm_commissioning.sim.bldc.engine import LABELS, BldcComparison
+from pmsm_commissioning.sim.bldc.metrics import BldcMetrics
 
 #: (JSON key, label, unit, format) of the side-by-side table, in reading order.
 METRIC_ROWS: tuple[tuple[str, str, str, str], ...] = (

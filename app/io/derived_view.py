@@ -9,9 +9,9 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from app.io.json_data import to_json
-from control.fdsmc.derivations import Derived
-from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
+from pmsm_commissioning.app.io.json_data import to_json
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
 
 
 @dataclass(frozen=True)

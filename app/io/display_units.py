@@ -13,8 +13,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from app.io import units
-from control.common.checks import FieldSpec
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.control.common.checks import FieldSpec
 
 Conv = Callable[[float, int], float]  # (value, pole pairs) → value
 

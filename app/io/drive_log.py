@@ -27,11 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
-from app.io import units
-from app.io.numbers import FORMS, NumberFormatError, parse_number, shorten, shown
-from control.fdsmc.identification import Identification, identify
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.kernel import CHANNELS
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.app.io.numbers import FORMS, NumberFormatError, parse_number, shorten, shown
+from pmsm_commissioning.control.fdsmc.identification import Identification, identify
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.kernel import CHANNELS
 
 #: Largest log file accepted [bytes]; checked before reading.
 MAX_BYTES = 50 * 1024 * 1024

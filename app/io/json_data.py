@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from app.io.numbers import QuotedText, shorten
-from app.io.preset_schema import PresetError
+from pmsm_commissioning.app.io.numbers import QuotedText, shorten
+from pmsm_commissioning.app.io.preset_schema import PresetError
 
 #: Largest preset or parameter file accepted [bytes] (YAML or JSON).
 MAX_BYTES = 256 * 1024

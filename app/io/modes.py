@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.bldc.params import BldcParams
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.bldc.params import BldcParams
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 
 @dataclass(frozen=True)

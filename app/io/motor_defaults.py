@@ -15,10 +15,10 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from app.io import units
-from control.common.checks import ParameterError
-from control.fdsmc.nameplate import rated_from_inverter
-from control.fdsmc.params import Controller, Motor
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.nameplate import rated_from_inverter
+from pmsm_commissioning.control.fdsmc.params import Controller, Motor
 
 #: The motor fields that may be derived, and the text that asks for it explicitly.
 DERIVABLE = ("V_0", "P_r", "omega_b")

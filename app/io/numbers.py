@@ -19,7 +19,7 @@ import math
 import re
 from collections.abc import Callable
 
-from app.io.user_text import escaped
+from pmsm_commissioning.app.io.user_text import escaped
 
 _GROUPED = r"[0-9]{1,3}(?:[ \u2009\u202f][0-9]{3})+"
 _NUMBER = re.compile(rf"[+-]?(?:(?:{_GROUPED}|[0-9]+)(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")

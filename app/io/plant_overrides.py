@@ -11,9 +11,9 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterable
 
-from app.io.presets import load_with_plant, require_mode
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams, Load, Motor
+from pmsm_commissioning.app.io.presets import load_with_plant, require_mode
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams, Load, Motor
 
 PREFIX = "plant."
 MOTOR_FIELDS = tuple(f.name for f in dataclasses.fields(Motor))

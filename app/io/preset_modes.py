@@ -11,8 +11,8 @@ from __future__ import annotations
 import typing
 from typing import Any
 
-from app.io.modes import mode_for
-from app.io.presets import list_presets_of, load, preset_mode, require_mode
+from pmsm_commissioning.app.io.modes import mode_for
+from pmsm_commissioning.app.io.presets import list_presets_of, load, preset_mode, require_mode
 
 
 def mode_of(params: Any) -> str:

@@ -16,12 +16,12 @@ import types
 import typing
 from typing import Any
 
-from app.io import motor_defaults, transmission_keys, units
-from app.io.modes import MODES as _MODES
-from app.io.numbers import NumberFormatError, parse_integer, parse_number, shorten, shown
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from control.fdsmc.transmission import Transmission
+from pmsm_commissioning.app.io import motor_defaults, transmission_keys, units
+from pmsm_commissioning.app.io.modes import MODES as _MODES
+from pmsm_commissioning.app.io.numbers import NumberFormatError, parse_integer, parse_number, shorten, shown
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.transmission import Transmission
 
 SCHEMA = 2
 #: Schemas read: 1 (inputs only) is migrated to 2 (adds the informational export sections).

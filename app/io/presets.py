@@ -23,12 +23,12 @@ import typing
 from pathlib import Path
 from typing import Any
 
-from app.io import units
-from app.io.atomic import write_atomic_text
-from app.io.json_data import MAX_BYTES, MAX_DEPTH, loads_json_raw  # noqa: F401 - re-exported
-from app.io.modes import mode_for
-from app.io.numbers import shown
-from app.io.preset_schema import (
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.app.io.atomic import write_atomic_text
+from pmsm_commissioning.app.io.json_data import MAX_BYTES, MAX_DEPTH, loads_json_raw  # noqa: F401 - re-exported
+from pmsm_commissioning.app.io.modes import mode_for
+from pmsm_commissioning.app.io.numbers import shown
+from pmsm_commissioning.app.io.preset_schema import (
     MODES,
     PLANT,
     SCHEMA,
@@ -41,11 +41,11 @@ from app.io.preset_schema import (
     plain,
     plant_raw,
 )
-from app.io.transmission_keys import as_aliases
-from app.io.yaml_text import dumps, loads_any_raw, loads_raw, plain_scalar
-from app.resources import preset_dir
-from control.common.checks import field_specs
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.app.io.transmission_keys import as_aliases
+from pmsm_commissioning.app.io.yaml_text import dumps, loads_any_raw, loads_raw, plain_scalar
+from pmsm_commissioning.app.resources import preset_dir
+from pmsm_commissioning.control.common.checks import field_specs
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 #: Folder of the shipped presets (package data, :mod:`app.resources`).
 PRESET_DIR = preset_dir()

@@ -14,8 +14,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-from app.io.atomic import write_atomic, write_atomic_text
-from sim.studies.robustness import METRICS, RobustnessResult
+from pmsm_commissioning.app.io.atomic import write_atomic, write_atomic_text
+from pmsm_commissioning.sim.studies.robustness import METRICS, RobustnessResult
 
 #: SI unit of each per-sample column, by the key's last part (plant fields and metrics).
 UNITS: dict[str, str] = {

@@ -11,9 +11,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.engine import Comparison, RunResult
-from sim.stock.tuning import DRIVES, ROBUST_J_L, StockTuning, tuned
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, RunResult
+from pmsm_commissioning.sim.stock.tuning import DRIVES, ROBUST_J_L, StockTuning, tuned
 
 #: The drives' names in messages.
 DRIVE_LABELS = {"odrive": "ODrive fw 0.5.x", "moteus": "moteus", "vesc": "VESC", "setpoints": "setpoint table"}

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from app.io.numbers import NumberFormatError, parse_number
-from app.io.plant_overrides import plant_section
-from app.io.presets import load_preset
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from sim.studies.robustness import MAX_NORMAL_SIGMA, Spread
+from pmsm_commissioning.app.io.numbers import NumberFormatError, parse_number
+from pmsm_commissioning.app.io.plant_overrides import plant_section
+from pmsm_commissioning.app.io.presets import load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.studies.robustness import MAX_NORMAL_SIGMA, Spread
 
 #: Most axes of one multi-axis set [-].
 MAX_AXES = 16

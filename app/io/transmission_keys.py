@@ -19,10 +19,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from app.io.units import ALIASES, Alias, spec_of
-from control.common.checks import ParameterError
-from control.fdsmc import transmission as tx
-from control.fdsmc.transmission import Transmission
+from pmsm_commissioning.app.io.units import ALIASES, Alias, spec_of
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc import transmission as tx
+from pmsm_commissioning.control.fdsmc.transmission import Transmission
 
 
 @dataclass(frozen=True)

@@ -16,8 +16,8 @@ import typing
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from app.io.modes import MODE_CLASSES as _MODE_CLASSES
-from control.common.checks import FieldSpec, ParameterError, field_specs, range_text
+from pmsm_commissioning.app.io.modes import MODE_CLASSES as _MODE_CLASSES
+from pmsm_commissioning.control.common.checks import FieldSpec, ParameterError, field_specs, range_text
 
 
 def rpm_to_rad_s(n_rpm: float) -> float:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import re
 import unicodedata
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: Unicode categories never written raw: controls, format (bidi) characters, surrogates,
 #: private-use and unassigned code points, line and paragraph separators.

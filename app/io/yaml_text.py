@@ -14,11 +14,11 @@ from typing import Any
 
 import yaml
 
-from app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
-from app.io.numbers import QuotedText, shorten
-from app.io.preset_schema import PresetError
-from app.io.user_text import check_label, escaped, forbidden
-from control.common.checks import ParameterError
+from pmsm_commissioning.app.io.json_data import MAX_BYTES, MAX_DEPTH, check_size, loads_json_raw
+from pmsm_commissioning.app.io.numbers import QuotedText, shorten
+from pmsm_commissioning.app.io.preset_schema import PresetError
+from pmsm_commissioning.app.io.user_text import check_label, escaped, forbidden
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: Keys whose text is written into files (a preset's name and source): one printable line.
 LABEL_KEYS = ("name", "source")

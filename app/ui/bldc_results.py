@@ -13,12 +13,12 @@ from typing import Any
 
 import viser
 
-from app.figures.bldc_panels import make_antiwindup_figure, make_torque_grid_figure
-from app.figures.bldc_speed_smc import make_currents_figure, make_sigma_figure, make_speed_figure
-from app.figures.plain import placeholder_json
-from app.io.bldc_view import metric_table
-from app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
-from sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
+from pmsm_commissioning.app.figures.bldc_panels import make_antiwindup_figure, make_torque_grid_figure
+from pmsm_commissioning.app.figures.bldc_speed_smc import make_currents_figure, make_sigma_figure, make_speed_figure
+from pmsm_commissioning.app.figures.plain import placeholder_json
+from pmsm_commissioning.app.io.bldc_view import metric_table
+from pmsm_commissioning.app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
+from pmsm_commissioning.sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
 
 #: Plot aspects (height / width) of the speed, torque-grid and anti-windup figures.
 ASPECT_SPEED, ASPECT_TORQUE, ASPECT_AW, ASPECT_MORE = 0.55, 0.8, 0.6, 0.6

@@ -15,25 +15,25 @@ from typing import Any
 
 import viser
 
-from app.figures.bldc_speed_smc import make_dqx_figure, make_emf_figure, make_reachability_figure
-from app.io.bldc_emf import read_measured, with_measured
-from app.io.bldc_view import anti_windup_text
-from app.io.display_units import field_hint, field_label, shown_value, si_value
-from app.io.numbers import NumberFormatError
-from app.io.presets import annotate_units, dumps_preset, load
-from app.io.units import s_to_ms, spec_of
-from app.ui.bldc_results import BldcResults
-from app.ui.choices import checked_choice
-from app.ui.files import parse_upload, upload_text
-from app.ui.number_fields import NumberInput
-from app.ui.text import md_text
-from app.ui.viser_adapter import figure_json_of
-from app.ui.worker import Cancelled, Worker
-from control.bldc.design import bldc_design
-from control.bldc.params import EMF_SHAPES, BldcParams
-from control.common.checks import ParameterError
-from sim.bldc.emf import machine_table
-from sim.bldc.engine import CONTROLLERS, BldcComparison, anti_windup_pair, compare_bldc
+from pmsm_commissioning.app.figures.bldc_speed_smc import make_dqx_figure, make_emf_figure, make_reachability_figure
+from pmsm_commissioning.app.io.bldc_emf import read_measured, with_measured
+from pmsm_commissioning.app.io.bldc_view import anti_windup_text
+from pmsm_commissioning.app.io.display_units import field_hint, field_label, shown_value, si_value
+from pmsm_commissioning.app.io.numbers import NumberFormatError
+from pmsm_commissioning.app.io.presets import annotate_units, dumps_preset, load
+from pmsm_commissioning.app.io.units import s_to_ms, spec_of
+from pmsm_commissioning.app.ui.bldc_results import BldcResults
+from pmsm_commissioning.app.ui.choices import checked_choice
+from pmsm_commissioning.app.ui.files import parse_upload, upload_text
+from pmsm_commissioning.app.ui.number_fields import NumberInput
+from pmsm_commissioning.app.ui.text import md_text
+from pmsm_commissioning.app.ui.viser_adapter import figure_json_of
+from pmsm_commissioning.app.ui.worker import Cancelled, Worker
+from pmsm_commissioning.control.bldc.design import bldc_design
+from pmsm_commissioning.control.bldc.params import EMF_SHAPES, BldcParams
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.sim.bldc.emf import machine_table
+from pmsm_commissioning.sim.bldc.engine import CONTROLLERS, BldcComparison, anti_windup_pair, compare_bldc
 
 PRESET = "bldc_smc_paper"
 

@@ -17,8 +17,8 @@ from typing import Any, Protocol
 
 import viser
 
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import Comparison
 
 
 @dataclass(frozen=True)

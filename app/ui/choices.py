@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 
 def checked_choice(value: object, options: tuple[str, ...] | list[str], label: str) -> str:

@@ -28,13 +28,13 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from app.figures.fdsmc_pins import MAX_PINS, Pin
-from app.io.json_data import loads_json_raw
-from app.io.numbers import QuotedText, parse_number, shorten
-from app.io.plant_overrides import with_plant_J_L
-from app.io.preset_schema import PresetError
-from app.io.presets import dumps_preset, loads_preset_and_plant
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.app.figures.fdsmc_pins import MAX_PINS, Pin
+from pmsm_commissioning.app.io.json_data import loads_json_raw
+from pmsm_commissioning.app.io.numbers import QuotedText, parse_number, shorten
+from pmsm_commissioning.app.io.plant_overrides import with_plant_J_L
+from pmsm_commissioning.app.io.preset_schema import PresetError
+from pmsm_commissioning.app.io.presets import dumps_preset, loads_preset_and_plant
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 #: The format's version, and the keys of a demo-state file of each version read.
 VERSION = 2

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import viser
 
-from app.ui.demo_state import MODE_TABS, RESULTS_TABS, PageView, loads_view
-from app.ui.viser_adapter import figure_json_shown, run_script, set_figure_json, widget_id
+from pmsm_commissioning.app.ui.demo_state import MODE_TABS, RESULTS_TABS, PageView, loads_view
+from pmsm_commissioning.app.ui.viser_adapter import figure_json_shown, run_script, set_figure_json, widget_id
 
 #: Longest report read from the page [characters] (a view with every axis zoomed is ≈ 700).
 MAX_REPORT = 4000

@@ -19,8 +19,8 @@ from typing import Any
 
 import viser
 
-from app.figures.style import EXPORT_SCALE, EXPORT_SIZE
-from app.ui.viser_adapter import figure_json_shown, run_script
+from pmsm_commissioning.app.figures.style import EXPORT_SCALE, EXPORT_SIZE
+from pmsm_commissioning.app.ui.viser_adapter import figure_json_shown, run_script
 
 #: Layout keys of the interactive UI a figure carries in the page, left out of an export.
 UI_KEYS: tuple[str, ...] = ("updatemenus", "sliders")

@@ -2,7 +2,7 @@
 
 Downloads go to the one client that asked (``client.send_file_download``) and are produced by the
 export model shared with the CLI (:func:`app.exports.model.export_download`), so the page and
-``python -m app export`` write the same bytes. An export describes the simulated case; when the
+``pmsm-commission export`` write the same bytes. An export describes the simulated case; when the
 inputs shown differ from it (edited but not simulated) the export is refused with a message naming
 the uncommitted fields. An export of a design that is not clean
 is refused with the failed checks named, unless "Export even if not clean" is ticked. An upload
@@ -19,15 +19,15 @@ from typing import Any
 
 import viser
 
-from app.exports.drive_files import ExportOptions
-from app.exports.model import export_download, safe_stem
-from app.io.modes import REGISTRY
-from app.io.preset_schema import PresetError
-from app.io.presets import MAX_BYTES, loads_preset, to_raw
-from app.io.user_text import check_label
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison
+from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.model import export_download, safe_stem
+from pmsm_commissioning.app.io.modes import REGISTRY
+from pmsm_commissioning.app.io.preset_schema import PresetError
+from pmsm_commissioning.app.io.presets import MAX_BYTES, loads_preset, to_raw
+from pmsm_commissioning.app.io.user_text import check_label
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import Comparison
 
 #: Export label → format of :func:`app.exports.model.export_files`.
 EXPORTS = {

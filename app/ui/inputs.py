@@ -17,15 +17,15 @@ from typing import Any
 
 import viser
 
-from app.io import units
-from app.io.display_units import UNIT_GROUPS, Field, Unit
-from app.io.numbers import NumberFormatError
-from app.io.presets import to_raw
-from app.ui.choices import checked_choice
-from app.ui.number_fields import NumberInput
-from control.common.checks import ParameterError
-from control.fdsmc.nameplate import nameplate_consistency
-from control.fdsmc.params import ALPHA_MAX_RULES, DriveParams, LoadStep, Motor
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.app.io.display_units import UNIT_GROUPS, Field, Unit
+from pmsm_commissioning.app.io.numbers import NumberFormatError
+from pmsm_commissioning.app.io.presets import to_raw
+from pmsm_commissioning.app.ui.choices import checked_choice
+from pmsm_commissioning.app.ui.number_fields import NumberInput
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.nameplate import nameplate_consistency
+from pmsm_commissioning.control.fdsmc.params import ALPHA_MAX_RULES, DriveParams, LoadStep, Motor
 
 SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), ("inertia", "Inertia unit"),
              ("angle", "Move unit"), ("current", "i_max given as"))
@@ -67,7 +67,7 @@ def format_steps(steps: tuple[Any, ...]) -> str:
 
 def parse_steps(text: str) -> list[dict[str, float]]:
     """``"t:Γ, t:Γ"`` [s, N·m] → list of step mappings; InputError on malformed text."""
-    from app.io.numbers import parse_number
+    from pmsm_commissioning.app.io.numbers import parse_number
 
     out: list[dict[str, float]] = []
     for item in filter(None, (s.strip() for s in text.replace(";", ",").split(","))):

@@ -18,8 +18,8 @@ from collections.abc import Callable
 
 import viser
 
-from app.figures.style import BAD_COLOUR, POSITION_COLOURS
-from app.ui.log_slider import (
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, POSITION_COLOURS
+from pmsm_commissioning.app.ui.log_slider import (
     LogSlider,
     Mark,
     hide_box_css,

@@ -24,14 +24,14 @@ from typing import Any
 
 import viser
 
-from app.figures.k_sweep import k_grid, k_sweep_spec
-from app.figures.plain import figure_json
-from app.io.plant_overrides import with_plant_J_L
-from app.ui.k_slider import log_K_range
-from app.ui.props import assign
-from app.ui.viser_adapter import add_figure, run_script, set_figure_json
-from sim.fdsmc.engine import compare
-from sim.fdsmc.verdicts import recommended_K
+from pmsm_commissioning.app.figures.k_sweep import k_grid, k_sweep_spec
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.app.io.plant_overrides import with_plant_J_L
+from pmsm_commissioning.app.ui.k_slider import log_K_range
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.viser_adapter import add_figure, run_script, set_figure_json
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.verdicts import recommended_K
 
 #: Plot height / width of the sweep figure [-].
 ASPECT_SWEEP = 0.62

@@ -17,13 +17,13 @@ from typing import Any
 
 import viser
 
-from app.exports.model import safe_stem
-from app.figures.fdsmc_pins import MAX_PINS, Pin, pin_of, pinned
-from app.ui.demo_state import DemoState, PageView, dumps_state, loads_state
-from app.ui.demo_view import PageViewProbe
-from app.ui.files import upload_text
-from app.ui.props import assign
-from app.ui.text import pins_html
+from pmsm_commissioning.app.exports.model import safe_stem
+from pmsm_commissioning.app.figures.fdsmc_pins import MAX_PINS, Pin, pin_of, pinned
+from pmsm_commissioning.app.ui.demo_state import DemoState, PageView, dumps_state, loads_state
+from pmsm_commissioning.app.ui.demo_view import PageViewProbe
+from pmsm_commissioning.app.ui.files import upload_text
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.text import pins_html
 
 
 class LecturePins:

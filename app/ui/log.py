@@ -1,6 +1,6 @@
 """Drive-log section of the position-drive tab: upload a log, overlay it, identify, apply.
 
-The log goes through the same import as ``python -m app log`` (:mod:`app.io.drive_log`) and is
+The log goes through the same import as ``pmsm-commission log`` (:mod:`app.io.drive_log`) and is
 compared with the session's current simulation (the FDSMC run, or the conventional one); the
 identified values can be written into the inputs, which marks the parameters' ``source``.
 """
@@ -12,18 +12,18 @@ from typing import Any
 
 import viser
 
-from app.figures.fdsmc_drive_log import make_log_overlay_figure
-from app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
-from app.io.numbers import one_line
-from app.io.presets import load
-from app.resources import example_log
-from app.ui.case import CasePort
-from app.ui.text import html_text, md_text
-from app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
-from control.common.checks import ParameterError
-from control.fdsmc.identification import Identification
-from control.fdsmc.params import DriveParams
-from sim.drivelog.overlay import Overlay, overlay
+from pmsm_commissioning.app.figures.fdsmc_drive_log import make_log_overlay_figure
+from pmsm_commissioning.app.io.drive_log import DriveLog, LogError, read_bytes, run_identification
+from pmsm_commissioning.app.io.numbers import one_line
+from pmsm_commissioning.app.io.presets import load
+from pmsm_commissioning.app.resources import example_log
+from pmsm_commissioning.app.ui.case import CasePort
+from pmsm_commissioning.app.ui.text import html_text, md_text
+from pmsm_commissioning.app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.identification import Identification
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.drivelog.overlay import Overlay, overlay
 
 EXAMPLE_LOG = example_log()
 EXAMPLE_PRESET = "example_log_drive"

@@ -15,8 +15,8 @@ from collections.abc import Callable, Iterable
 
 import viser
 
-from app.ui.props import assign
-from app.ui.viser_adapter import set_slider_marks, widget_id
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.viser_adapter import set_slider_marks, widget_id
 
 #: Step of a slider's position [decades] and the decimals it keeps.
 LOG_STEP, LOG_PRECISION = 0.01, 2

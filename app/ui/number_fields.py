@@ -12,9 +12,9 @@ from collections.abc import Callable
 
 import viser
 
-from app.figures.style import fmt
-from app.io.numbers import NumberFormatError, parse_integer, parse_number
-from app.ui.props import assign
+from pmsm_commissioning.app.figures.style import fmt
+from pmsm_commissioning.app.io.numbers import NumberFormatError, parse_integer, parse_number
+from pmsm_commissioning.app.ui.props import assign
 
 #: Significant digits a field shows (the exact value stays behind an untouched field).
 FIELD_DIGITS = 5

@@ -16,16 +16,16 @@ from dataclasses import dataclass, field
 
 import viser
 
-from app.figures.style import SLIDER_CSS
-from app.threads import limit_blas_threads, release_memory
-from app.ui.bldc_results import follow_tabs_js
-from app.ui.bldc_tab import add_bldc_tab, warm_bldc
-from app.ui.case import Case, CaseState
-from app.ui.demo_view import PageViewProbe
-from app.ui.figure_export import FigureExport
-from app.ui.files import FilesPanel
-from app.ui.inputs import InputsPanel
-from app.ui.layout import (
+from pmsm_commissioning.app.figures.style import SLIDER_CSS
+from pmsm_commissioning.app.threads import limit_blas_threads, release_memory
+from pmsm_commissioning.app.ui.bldc_results import follow_tabs_js
+from pmsm_commissioning.app.ui.bldc_tab import add_bldc_tab, warm_bldc
+from pmsm_commissioning.app.ui.case import Case, CaseState
+from pmsm_commissioning.app.ui.demo_view import PageViewProbe
+from pmsm_commissioning.app.ui.figure_export import FigureExport
+from pmsm_commissioning.app.ui.files import FilesPanel
+from pmsm_commissioning.app.ui.inputs import InputsPanel
+from pmsm_commissioning.app.ui.layout import (
     PanelLayout,
     WindowFit,
     hide_field_js,
@@ -34,21 +34,21 @@ from app.ui.layout import (
     page_marks_js,
     window_report_js,
 )
-from app.ui.log import LogPanel
-from app.ui.plotly_js import use_basic_plotly
-from app.ui.position_tab import PositionTab
-from app.ui.replay import prebuild_figures
-from app.ui.results import ResultsPanel, empty_table1_json
-from app.ui.runs import comparison_or_derived
-from app.ui.scene import RotorScene, aim_camera
-from app.ui.studies import StudiesSection
-from app.ui.studies_queue import StudySlots
-from app.ui.text import md_text
-from app.ui.viser_adapter import run_script, warm_icons, widget_id
-from app.ui.web_guard import Guard, guarded
-from app.ui.worker import Worker
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison, start_run_threads
+from pmsm_commissioning.app.ui.log import LogPanel
+from pmsm_commissioning.app.ui.plotly_js import use_basic_plotly
+from pmsm_commissioning.app.ui.position_tab import PositionTab
+from pmsm_commissioning.app.ui.replay import prebuild_figures
+from pmsm_commissioning.app.ui.results import ResultsPanel, empty_table1_json
+from pmsm_commissioning.app.ui.runs import comparison_or_derived
+from pmsm_commissioning.app.ui.scene import RotorScene, aim_camera
+from pmsm_commissioning.app.ui.studies import StudiesSection
+from pmsm_commissioning.app.ui.studies_queue import StudySlots
+from pmsm_commissioning.app.ui.text import md_text
+from pmsm_commissioning.app.ui.viser_adapter import run_script, warm_icons, widget_id
+from pmsm_commissioning.app.ui.web_guard import Guard, guarded
+from pmsm_commissioning.app.ui.worker import Worker
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, start_run_threads
 
 
 @dataclass
@@ -66,6 +66,23 @@ class AppConfig:
     _sessions_lock: threading.Lock = field(default_factory=threading.Lock)
     guard: Guard | None = None
     slots: StudySlots = field(default_factory=StudySlots.for_machine)
+
+    def register(self, client_id: int, session: Session) -> bool:
+        """Register a built page; return False when its client left while it was built (it is then closed)."""
+        with self._sessions_lock:
+            gone = client_id in self.gone
+            self.gone.discard(client_id)
+            if not gone:
+                self.sessions[client_id] = session
+        return not gone
+
+    def unregister(self, client_id: int) -> Session | None:
+        """Remove a leaving client's page and return it; None if still being built (closed once it is)."""
+        with self._sessions_lock:
+            session = self.sessions.pop(client_id, None)
+            if session is None:
+                self.gone.add(client_id)
+        return session
 
     def initial(self) -> Comparison:
         """Return the comparison of the start-up preset (computed on first use)."""
@@ -263,20 +280,12 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     @server.on_client_connect
     def _(client: viser.ClientHandle) -> None:
         session = Session(client, config)
-        with config._sessions_lock:
-            gone = client.client_id in config.gone
-            config.gone.discard(client.client_id)
-            if not gone:
-                config.sessions[client.client_id] = session
-        if gone:  # the client left while its page was built: nothing of it may outlive it
+        if not config.register(client.client_id, session):  # it left while its page was built
             session.close()
 
     @server.on_client_disconnect
     def _(client: viser.ClientHandle) -> None:
-        with config._sessions_lock:
-            session = config.sessions.pop(client.client_id, None)
-            if session is None:  # still being built: closed by the connect handler once it is
-                config.gone.add(client.client_id)
+        session = config.unregister(client.client_id)
         if session is not None:
             session.close()
             # once its job has stopped (next checkpoint), the page's memory goes back to the system

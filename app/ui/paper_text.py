@@ -13,8 +13,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from app.ui.text import html_text
-from sim.fdsmc.table1 import printed_reversed
+from pmsm_commissioning.app.ui.text import html_text
+from pmsm_commissioning.sim.fdsmc.table1 import printed_reversed
 
 #: Erratum id → (equation, what [1] prints and what the engine does).
 ERRATA: dict[str, tuple[str, str]] = {

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import viser
 
-from app.ui.viser_adapter import mark_plotly_js_sent, plotly_js_sent, run_script
+from pmsm_commissioning.app.ui.viser_adapter import mark_plotly_js_sent, plotly_js_sent, run_script
 
 BUNDLE = Path(__file__).resolve().parent / "assets" / "plotly-basic.min.js"
 #: Trace types the basic bundle draws (scatter comes with plotly.js's core).

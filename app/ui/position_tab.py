@@ -17,25 +17,25 @@ from typing import Any
 
 import viser
 
-from app.io.presets import list_presets_of, load, require_mode
-from app.ui.case import Case, CaseState
-from app.ui.choices import checked_choice
-from app.ui.files import ExportRefusedError, FilesPanel, uncommitted
-from app.ui.inputs import InputError, InputsPanel
-from app.ui.lecture import DemoStateFiles, LecturePins
-from app.ui.log import LogPanel
-from app.ui.props import assign
-from app.ui.results import ResultsPanel
-from app.ui.runs import OBJECTIVE_LABELS, comparison_or_derived, table1_job
-from app.ui.studies import OptimumToggle
-from app.ui.text import derived_markdown, design_markdown, md_text, stale_results_html
-from app.ui.tuning import PLANT_J_L, LiveTuning, TuneRunner
-from app.ui.verdict_panel import VerdictPanel
-from app.ui.worker import Cancelled, Worker
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import Comparison
-from sim.fdsmc.objective import OBJECTIVES, design_for
-from sim.fdsmc.verdicts import T_c_advice, recommended_K
+from pmsm_commissioning.app.io.presets import list_presets_of, load, require_mode
+from pmsm_commissioning.app.ui.case import Case, CaseState
+from pmsm_commissioning.app.ui.choices import checked_choice
+from pmsm_commissioning.app.ui.files import ExportRefusedError, FilesPanel, uncommitted
+from pmsm_commissioning.app.ui.inputs import InputError, InputsPanel
+from pmsm_commissioning.app.ui.lecture import DemoStateFiles, LecturePins
+from pmsm_commissioning.app.ui.log import LogPanel
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.results import ResultsPanel
+from pmsm_commissioning.app.ui.runs import OBJECTIVE_LABELS, comparison_or_derived, table1_job
+from pmsm_commissioning.app.ui.studies import OptimumToggle
+from pmsm_commissioning.app.ui.text import derived_markdown, design_markdown, md_text, stale_results_html
+from pmsm_commissioning.app.ui.tuning import PLANT_J_L, LiveTuning, TuneRunner
+from pmsm_commissioning.app.ui.verdict_panel import VerdictPanel
+from pmsm_commissioning.app.ui.worker import Cancelled, Worker
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import Comparison
+from pmsm_commissioning.sim.fdsmc.objective import OBJECTIVES, design_for
+from pmsm_commissioning.sim.fdsmc.verdicts import T_c_advice, recommended_K
 
 
 class PositionTab:

@@ -22,15 +22,22 @@ from typing import Any
 import numpy as np
 import viser
 
-from app.figures.fdsmc_comparison import runs, time_plots_spec
-from app.figures.fdsmc_overview import overview_spec
-from app.figures.fdsmc_pins import Pin
-from app.figures.fdsmc_replay import PAUSE, SPEEDS, ScrubTargets, end_time, replay_layout, scrub_update
-from app.figures.plain import figure_json
-from app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
-from app.ui.props import assign
-from app.ui.scene import RotorScene
-from app.ui.viser_adapter import run_script, set_figure_json
+from pmsm_commissioning.app.figures.fdsmc_comparison import runs, time_plots_spec
+from pmsm_commissioning.app.figures.fdsmc_overview import overview_spec
+from pmsm_commissioning.app.figures.fdsmc_pins import Pin
+from pmsm_commissioning.app.figures.fdsmc_replay import (
+    PAUSE,
+    SPEEDS,
+    ScrubTargets,
+    end_time,
+    replay_layout,
+    scrub_update,
+)
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.scene import RotorScene
+from pmsm_commissioning.app.ui.viser_adapter import run_script, set_figure_json
 
 FRAME_HZ = 25.0
 

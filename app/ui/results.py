@@ -15,21 +15,21 @@ from typing import Any
 
 import viser
 
-from app.figures.fdsmc_comparison import runs
-from app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
-from app.figures.plain import figure_json
-from app.figures.stock_route import stock_route_spec
-from app.io.numbers import parse_T_m_list
-from app.ui.k_sweep import KSweepView
-from app.ui.layout import PanelLayout
-from app.ui.paper_text import errata_html, table1_html
-from app.ui.props import assign
-from app.ui.replay import Replay, overview_json, time_plots_json
-from app.ui.savings import annual_savings, savings_markdown
-from app.ui.scene import RotorScene
-from app.ui.text import key_numbers_html, stock_html
-from app.ui.viser_adapter import add_figure, set_figure_json
-from sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M
+from pmsm_commissioning.app.figures.fdsmc_comparison import runs
+from pmsm_commissioning.app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.app.figures.stock_route import stock_route_spec
+from pmsm_commissioning.app.io.numbers import parse_T_m_list
+from pmsm_commissioning.app.ui.k_sweep import KSweepView
+from pmsm_commissioning.app.ui.layout import PanelLayout
+from pmsm_commissioning.app.ui.paper_text import errata_html, table1_html
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.replay import Replay, overview_json, time_plots_json
+from pmsm_commissioning.app.ui.savings import annual_savings, savings_markdown
+from pmsm_commissioning.app.ui.scene import RotorScene
+from pmsm_commissioning.app.ui.text import key_numbers_html, stock_html
+from pmsm_commissioning.app.ui.viser_adapter import add_figure, set_figure_json
+from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M
 
 #: Plot height / width per figure [-].
 ASPECT_PHASE, ASPECT_TIME, ASPECT_SMALL, ASPECT_STOCK = 0.72, 1.45, 0.55, 0.95

@@ -5,11 +5,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from app.io.plant_overrides import with_plant_J_L
-from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Comparison, compare
-from sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
+from pmsm_commissioning.app.io.plant_overrides import with_plant_J_L
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Comparison, compare
+from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
 
 #: The page's words for the design objectives (same order as :data:`sim.fdsmc.objective.OBJECTIVES`).
 OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")

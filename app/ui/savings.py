@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from sim.common.economics import cost_per_year, kwh_per_year
+from pmsm_commissioning.sim.common.economics import cost_per_year, kwh_per_year
 
 
 @dataclass(frozen=True)

@@ -17,15 +17,15 @@ from typing import Any
 
 import viser
 
-from app.figures.fdsmc_comparison import LABELS
-from app.figures.fdsmc_energy import optimum_gaps
-from app.ui.case import CasePort
-from app.ui.props import assign
-from app.ui.studies_multiaxis import MultiAxisView
-from app.ui.studies_robustness import RobustnessView
-from app.ui.text import md_text
-from sim.fdsmc.engine import OPTIMUM_OMITTED
-from sim.fdsmc.optimum_gap import OPTIMUM_BASIS
+from pmsm_commissioning.app.figures.fdsmc_comparison import LABELS
+from pmsm_commissioning.app.figures.fdsmc_energy import optimum_gaps
+from pmsm_commissioning.app.ui.case import CasePort
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.studies_multiaxis import MultiAxisView
+from pmsm_commissioning.app.ui.studies_robustness import RobustnessView
+from pmsm_commissioning.app.ui.text import md_text
+from pmsm_commissioning.sim.fdsmc.engine import OPTIMUM_OMITTED
+from pmsm_commissioning.sim.fdsmc.optimum_gap import OPTIMUM_BASIS
 
 
 def optimum_markdown(comparison: Any) -> str:

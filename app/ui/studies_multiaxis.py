@@ -15,18 +15,18 @@ from typing import Any
 
 import viser
 
-from app.figures.fdsmc_studies import multiaxis_spec, multiaxis_table_markdown
-from app.figures.plain import figure_json
-from app.io.preset_modes import list_presets_of
-from app.io.presets import MAX_BYTES, loads_raw
-from app.io.study_inputs import parse_axes
-from app.ui.case import CasePort
-from app.ui.text import md_text
-from app.ui.viser_adapter import add_figure, set_figure_json
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.grid import check_budget
-from sim.studies.multiaxis import MultiAxisResult, coordinate
+from pmsm_commissioning.app.figures.fdsmc_studies import multiaxis_spec, multiaxis_table_markdown
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.app.io.preset_modes import list_presets_of
+from pmsm_commissioning.app.io.presets import MAX_BYTES, loads_raw
+from pmsm_commissioning.app.io.study_inputs import parse_axes
+from pmsm_commissioning.app.ui.case import CasePort
+from pmsm_commissioning.app.ui.text import md_text
+from pmsm_commissioning.app.ui.viser_adapter import add_figure, set_figure_json
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.grid import check_budget
+from pmsm_commissioning.sim.studies.multiaxis import MultiAxisResult, coordinate
 
 #: Where the axes come from in messages.
 ORIGIN = "Multi-axis › axes"
@@ -90,7 +90,7 @@ class MultiAxisView:
         gui = port.client.gui
         self._presets = tuple(list_presets_of("position"))
         self.axes = gui.add_text("Axes (YAML list)", default_axes(self._presets), multiline=True,
-                                 hint="The list `python -m app multiaxis FILE` takes: - {preset: NAME, name: LABEL, "
+                                 hint="The list `pmsm-commission multiaxis FILE` takes: - {preset: NAME, name: LABEL, "
                                       "set: [manoeuvre.theta_dem=31.4]}")
         with gui.add_folder("Add an axis", expand_by_default=False):
             self.add_preset = gui.add_dropdown("Axis preset", self._presets, initial_value=self._presets[0])

@@ -24,8 +24,8 @@ from collections import deque
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from app.ui.worker import Cancelled
-from sim.studies.runner import lower_priority
+from pmsm_commissioning.app.ui.worker import Cancelled
+from pmsm_commissioning.sim.studies.runner import lower_priority
 
 #: How much a study's threads and processes lower their scheduling priority (nice increment) [-].
 STUDY_NICE = 10

@@ -21,21 +21,27 @@ from typing import Any
 
 import viser
 
-from app.figures.fdsmc_studies import robustness_spec, robustness_table_markdown
-from app.figures.plain import figure_json
-from app.io.study_inputs import parse_spread
-from app.ui.case import CasePort
-from app.ui.studies_queue import STUDY_NICE
-from app.ui.text import md_text
-from app.ui.viser_adapter import add_figure, set_figure_json
-from app.ui.worker import Cancelled
-from control.common.checks import ParameterError
-from control.fdsmc.feasibility import torque_limit
-from control.fdsmc.params import DriveParams
-from sim.common.budget import MAX_STEPS, BudgetError
-from sim.fdsmc.grid import check_budget
-from sim.studies.robustness import TRACE_POINTS, IncompleteRunError, RobustnessResult, Spread, robustness
-from sim.studies.runner import ExecutorError, RetryingPool
+from pmsm_commissioning.app.figures.fdsmc_studies import robustness_spec, robustness_table_markdown
+from pmsm_commissioning.app.figures.plain import figure_json
+from pmsm_commissioning.app.io.study_inputs import parse_spread
+from pmsm_commissioning.app.ui.case import CasePort
+from pmsm_commissioning.app.ui.studies_queue import STUDY_NICE
+from pmsm_commissioning.app.ui.text import md_text
+from pmsm_commissioning.app.ui.viser_adapter import add_figure, set_figure_json
+from pmsm_commissioning.app.ui.worker import Cancelled
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.common.budget import MAX_STEPS, BudgetError
+from pmsm_commissioning.sim.fdsmc.grid import check_budget
+from pmsm_commissioning.sim.studies.robustness import (
+    TRACE_POINTS,
+    IncompleteRunError,
+    RobustnessResult,
+    Spread,
+    robustness,
+)
+from pmsm_commissioning.sim.studies.runner import ExecutorError, RetryingPool
 
 #: Most samples of one study from the page [-].
 MAX_SAMPLES = 100_000
@@ -195,7 +201,7 @@ class RobustnessView:
             return robustness(params, spreads, samples, seed, progress=self._progress,
                               cancelled=self._cancel_requested)
         if os.environ.get(SCHEDULER_ENV):
-            from sim.studies.dask_runner import connect
+            from pmsm_commissioning.sim.studies.dask_runner import connect
 
             with connect(os.environ[SCHEDULER_ENV]) as ex:
                 return robustness(params, spreads, samples, seed, ex, ex.workers, self._progress,

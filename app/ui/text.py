@@ -12,14 +12,14 @@ import html
 import re
 from typing import Any
 
-from app.figures.fdsmc_pins import pins_note
-from app.figures.style import BAD_COLOUR, GOOD_COLOUR, KEY_PX, fmt
-from app.io.derived_view import derived_rows
-from control.fdsmc.derivations import Derived
-from control.fdsmc.feasibility import torque_limit
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.engine import LABELS
-from sim.fdsmc.recommend import recommend
+from pmsm_commissioning.app.figures.fdsmc_pins import pins_note
+from pmsm_commissioning.app.figures.style import BAD_COLOUR, GOOD_COLOUR, KEY_PX, fmt
+from pmsm_commissioning.app.io.derived_view import derived_rows
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.engine import LABELS
+from pmsm_commissioning.sim.fdsmc.recommend import recommend
 
 _MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
 
@@ -189,7 +189,7 @@ __all__ = ["derived_markdown", "design_failure_items", "design_markdown", "html_
 
 def stock_html(comparison: Any) -> str:
     """Return the stock routes' verdicts, one line per drive (ODrive, moteus, VESC, setpoint table), green or red."""
-    from app.io.stock_view import stock_lines  # tunes the vendor routes (cached per case)
+    from pmsm_commissioning.app.io.stock_view import stock_lines  # tunes the vendor routes (cached per case)
 
     if getattr(comparison, "stock", None) is None:
         return "<p>Stock route: not simulated for this case.</p>"

@@ -24,14 +24,14 @@ from collections.abc import Callable
 
 import viser
 
-from app.io import units
-from app.ui.k_slider import KSlider
-from app.ui.layout import install_css_js
-from app.ui.log_slider import LogSlider, default_readout, hide_box_css
-from app.ui.viser_adapter import run_script
-from app.ui.worker import Worker
-from control.fdsmc.derivations import Derived
-from sim.fdsmc.verdicts import recommended_K
+from pmsm_commissioning.app.io import units
+from pmsm_commissioning.app.ui.k_slider import KSlider
+from pmsm_commissioning.app.ui.layout import install_css_js
+from pmsm_commissioning.app.ui.log_slider import LogSlider, default_readout, hide_box_css
+from pmsm_commissioning.app.ui.viser_adapter import run_script
+from pmsm_commissioning.app.ui.worker import Worker
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.sim.fdsmc.verdicts import recommended_K
 
 #: Quiet time after the last slider move before the rest of the results (replay, time plots,
 #: energy figures) is drawn [s]: a drag's moves arrive tens of ms apart.

@@ -13,10 +13,10 @@ from typing import Any
 
 import viser
 
-from app.ui.props import assign
-from app.ui.text import design_failure_items, warnings_html
-from sim.fdsmc.engine import Comparison
-from sim.fdsmc.verdicts import K_advice, T_c_advice, comparator_notes, run_warnings
+from pmsm_commissioning.app.ui.props import assign
+from pmsm_commissioning.app.ui.text import design_failure_items, warnings_html
+from pmsm_commissioning.sim.fdsmc.engine import Comparison
+from pmsm_commissioning.sim.fdsmc.verdicts import K_advice, T_c_advice, comparator_notes, run_warnings
 
 #: What the warnings box shows: warnings, input error (or None) and grey notes.
 WarningParts = tuple[list[str], str | None, list[str]]

@@ -34,7 +34,7 @@ import viser
 import viser._gui_api as _viser_gui
 from viser import _icons, _messages
 
-from app.figures.plain import blank_json
+from pmsm_commissioning.app.figures.plain import blank_json
 
 #: The viser release this adapter was written for (``tests/test_viser_adapter.py`` pins it).
 WRITTEN_FOR = "1.1.1"

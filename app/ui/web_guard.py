@@ -45,8 +45,8 @@ from urllib.parse import parse_qs, urlsplit
 
 import websockets.asyncio.server as ws_server
 
-from app.io.numbers import shorten
-from app.ui.viser_adapter import (
+from pmsm_commissioning.app.io.numbers import shorten
+from pmsm_commissioning.app.ui.viser_adapter import (
     GUI_UPDATES,
     UPLOAD_PART,
     UPLOAD_START,

@@ -26,7 +26,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from app.ui.studies_queue import StudySlots
+    from pmsm_commissioning.app.ui.studies_queue import StudySlots
 
 
 class Cancelled(Exception):  # noqa: N818 - an outcome, not an error

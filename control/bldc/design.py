@@ -8,12 +8,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.bldc.current_smc import CurrentLoopDesign, current_loop_design
-from control.bldc.dqx import torque_constant_dqx, torque_constant_fig7
-from control.bldc.params import BldcParams
-from control.bldc.pi_vector import PiVectorDesign, pi_vector_design
-from control.bldc.plain_smc import steady_state_error
-from control.bldc.speed_smc import ReachabilityCheck, reachability_check
+from pmsm_commissioning.control.bldc.current_smc import CurrentLoopDesign, current_loop_design
+from pmsm_commissioning.control.bldc.dqx import torque_constant_dqx, torque_constant_fig7
+from pmsm_commissioning.control.bldc.params import BldcParams
+from pmsm_commissioning.control.bldc.pi_vector import PiVectorDesign, pi_vector_design
+from pmsm_commissioning.control.bldc.plain_smc import steady_state_error
+from pmsm_commissioning.control.bldc.speed_smc import ReachabilityCheck, reachability_check
 
 
 @dataclass(frozen=True)

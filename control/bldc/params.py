@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError, check_fields, spec_field
+from pmsm_commissioning.control.common.checks import ParameterError, check_fields, spec_field
 
 #: Back-EMF shapes of the machine model: the ideal trapezoid of Fig. 2 in [2], the built-in
 #: smooth distorted example, or a measured table (``BldcMachine.emf_samples``).

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.bldc.params import BldcParams
+from pmsm_commissioning.control.bldc.params import BldcParams
 
 
 def pi_output(integ: float, err: float, K_p: float, u_lim: float) -> float:

@@ -8,7 +8,7 @@ The laws are compiled as functions of their own and inlined by LLVM, not by numb
 (``inline="always"``): the IR inliner rebuilds SSA form across the inlined body and lost a variable
 assigned in a branch (``NumbaIRAssumptionWarning: variable … is not in scope``), so the compiled
 kernel dropped the inverter's saturation flag that the plain-Python reference kept. Kernel speed
-is the same either way (``python -m app bench``).
+is the same either way (``pmsm-commission bench``).
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.common.jit import jitable
+from pmsm_commissioning.control.common.jit import jitable
 
 
 @dataclass(frozen=True)

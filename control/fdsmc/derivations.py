@@ -10,23 +10,27 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.fdsmc import loop_analysis, loop_model, noise, transient
-from control.fdsmc.conventional import ConventionalGains, conventional_gains, friction_energy_conventional
-from control.fdsmc.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
-from control.fdsmc.loop_analysis import (
+from pmsm_commissioning.control.fdsmc import loop_analysis, loop_model, noise, transient
+from pmsm_commissioning.control.fdsmc.conventional import (
+    ConventionalGains,
+    conventional_gains,
+    friction_energy_conventional,
+)
+from pmsm_commissioning.control.fdsmc.feasibility import AlphaMax, Feasibility, alpha_max, feasibility
+from pmsm_commissioning.control.fdsmc.loop_analysis import (
     GainRecommendation,
     SampleRateCheck,
     loop_warnings,
     recommend_K,
     sample_rate_check,
 )
-from control.fdsmc.loop_model import LoopCase, LoopModel
-from control.fdsmc.model import ModelCoefficients, model_coefficients
-from control.fdsmc.nameplate import nameplate_consistency
-from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer, observer_gains
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import VelocityProfile, friction_energy_eq52, velocity_profile
-from control.fdsmc.transient import acceleration_overshoot
+from pmsm_commissioning.control.fdsmc.loop_model import LoopCase, LoopModel
+from pmsm_commissioning.control.fdsmc.model import ModelCoefficients, model_coefficients
+from pmsm_commissioning.control.fdsmc.nameplate import nameplate_consistency
+from pmsm_commissioning.control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer, observer_gains
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import VelocityProfile, friction_energy_eq52, velocity_profile
+from pmsm_commissioning.control.fdsmc.transient import acceleration_overshoot
 
 
 @dataclass(frozen=True)

@@ -12,8 +12,8 @@ kernel in :mod:`sim.fdsmc.kernel`.
 
 from __future__ import annotations
 
-from control.common.jit import jitable
-from control.fdsmc.model import ModelCoefficients
+from pmsm_commissioning.control.common.jit import jitable
+from pmsm_commissioning.control.fdsmc.model import ModelCoefficients
 
 
 def acceleration_estimate(i_d: float, i_q: float, Gamma_L_hat: float, c: ModelCoefficients) -> float:

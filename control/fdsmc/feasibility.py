@@ -8,11 +8,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError
-from control.fdsmc.model import available_voltage, model_coefficients, torque_constant
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import peak_speed, shortest_manoeuvre_time
-from control.fdsmc.profile_energy import min_energy_alpha
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.model import available_voltage, model_coefficients, torque_constant
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import peak_speed, shortest_manoeuvre_time
+from pmsm_commissioning.control.fdsmc.profile_energy import min_energy_alpha
 
 #: Relative precision of the steady-state limit checks [-]: the model's torque and voltage estimates
 #: are not more exact than this, so a peak within it of a limit is not reported as exceeding it.

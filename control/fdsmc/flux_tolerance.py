@@ -30,7 +30,7 @@ T_dv = 1 ms the real presets pass every check for flux errors of ±10–20 % (do
 
 from __future__ import annotations
 
-from control.fdsmc.model import ModelCoefficients
+from pmsm_commissioning.control.fdsmc.model import ModelCoefficients
 
 
 def alpha_offset(c: ModelCoefficients, x: float, omega_r: float, T_salpha: float) -> float:

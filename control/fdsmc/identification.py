@@ -37,7 +37,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 from scipy.stats import t as student_t
 
-from control.fdsmc.model import electromagnetic_torque
+from pmsm_commissioning.control.fdsmc.model import electromagnetic_torque
 
 #: Largest relative standard error of a reported estimate [-]; above it the parameter is refused.
 MAX_REL_STDERR = 0.2

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from control.common.jit import jitable
+from pmsm_commissioning.control.common.jit import jitable
 
 
 def decay_factors(rate: float, T_s: float) -> tuple[float, float]:

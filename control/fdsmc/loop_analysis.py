@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.fdsmc.loop_model import (
+from pmsm_commissioning.control.fdsmc.loop_model import (
     K_SEARCH_RATIO,
     K_search_grid,
     LoopCase,
@@ -45,7 +45,7 @@ from control.fdsmc.loop_model import (
     reduce_shift_mode,
     sampled_parts,
 )
-from control.fdsmc.noise import noise_gain_limit
+from pmsm_commissioning.control.fdsmc.noise import noise_gain_limit
 
 #: Default gain margin of the recommended K [-] (2 = 6 dB).
 GAIN_MARGIN = 2.0

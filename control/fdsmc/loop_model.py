@@ -30,10 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.common.discrete import zoh
-from control.fdsmc.model import ModelCoefficients
-from control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.common.discrete import zoh
+from pmsm_commissioning.control.fdsmc.model import ModelCoefficients
+from pmsm_commissioning.control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 N_STATES = 7  # [i_q, θ, ω, θ̂, ω̂, L̂0, L̂1]
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.common.jit import jitable
-from control.fdsmc.params import Motor
+from pmsm_commissioning.control.common.jit import jitable
+from pmsm_commissioning.control.fdsmc.params import Motor
 
 
 @dataclass(frozen=True)

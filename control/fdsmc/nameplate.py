@@ -12,9 +12,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError
-from control.fdsmc.model import available_voltage
-from control.fdsmc.params import Motor
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.model import available_voltage
+from pmsm_commissioning.control.fdsmc.params import Motor
 
 #: Relative disagreement tolerated between two routes to the same nameplate quantity [-]:
 #: catalogue values are typical values, commonly ±10 %.

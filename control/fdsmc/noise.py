@@ -37,9 +37,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import LinAlgWarning, matrix_balance, solve_discrete_lyapunov
 
-from control.fdsmc.fdc import mismatch_filter_factor
-from control.fdsmc.inverter import decay_factors
-from control.fdsmc.loop_model import (
+from pmsm_commissioning.control.fdsmc.fdc import mismatch_filter_factor
+from pmsm_commissioning.control.fdsmc.inverter import decay_factors
+from pmsm_commissioning.control.fdsmc.loop_model import (
     K_SEARCH_RATIO,
     N_STATES,
     K_search_grid,

@@ -58,10 +58,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived
-from control.fdsmc.model import torque_constant
-from control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.model import torque_constant
+from pmsm_commissioning.control.fdsmc.params import DriveParams
 
 #: Default number of QP intervals over [0, T_m] [-].
 N_INTERVALS = 2000
@@ -126,7 +126,7 @@ def move_model(params: DriveParams, margin: float = 1.0) -> MoveModel:
 
     The margin leaves room for the inner loops' overshoot when the optimum is tracked.
     """
-    from control.fdsmc.feasibility import torque_limit  # local: feasibility imports the profile
+    from pmsm_commissioning.control.fdsmc.feasibility import torque_limit  # local: feasibility imports the profile
 
     m, ld, mv = params.motor, params.load, params.manoeuvre
     k_t = torque_constant(m)
@@ -350,7 +350,7 @@ def tracked_move(d: Derived, n: int = N_INTERVALS) -> OptimalMove:
     never held to a tighter limit than the controller it is compared with), divided by the
     inner loops' acceleration overshoot η so that tracking it stays within the limit.
     """
-    from control.fdsmc.feasibility import torque_limit
+    from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
 
     p = d.params
     lim = max(torque_limit(p), d.feasibility.torque_needed)

@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError, check_fields, spec_field
-from control.fdsmc.transmission import Transmission
+from pmsm_commissioning.control.common.checks import ParameterError, check_fields, spec_field
+from pmsm_commissioning.control.fdsmc.transmission import Transmission
 
 ALPHA_MAX_RULES = ("paper", "torque_limit", "min_energy")
 

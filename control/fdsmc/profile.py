@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: (5 + 2·e⁻³), the factor of T_a in eqs. (52), (57) and (60) of [1] [-].
 C_57 = 5.0 + 2.0 * math.exp(-3.0)

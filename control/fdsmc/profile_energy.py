@@ -24,9 +24,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.fdsmc.model import torque_constant
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import C_57, peak_speed
+from pmsm_commissioning.control.fdsmc.model import torque_constant
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import C_57, peak_speed
 
 #: How far above the feasibility bound α_lo the search starts [-] (at α_lo the cruise vanishes).
 ALPHA_LO_MARGIN = 1.02

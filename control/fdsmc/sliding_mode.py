@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from control.common.jit import jitable
+from pmsm_commissioning.control.common.jit import jitable
 
 
 def boundary_speed(theta_re: np.ndarray | float, omega_p: float, T_c: float) -> np.ndarray:

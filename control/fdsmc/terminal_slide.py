@@ -23,9 +23,9 @@ cannot chatter between its two modes.
 
 from __future__ import annotations
 
-from control.common.jit import jitable
-from control.fdsmc.conventional import tracking_demand
-from control.fdsmc.sliding_mode import smc_demand
+from pmsm_commissioning.control.common.jit import jitable
+from pmsm_commissioning.control.fdsmc.conventional import tracking_demand
+from pmsm_commissioning.control.fdsmc.sliding_mode import smc_demand
 
 
 @jitable

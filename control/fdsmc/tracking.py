@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import dataclasses
 
-from control.fdsmc.conventional import ConventionalGains
-from control.fdsmc.loop_analysis import GainRecommendation, stability_measure
-from control.fdsmc.loop_model import LoopCase
+from pmsm_commissioning.control.fdsmc.conventional import ConventionalGains
+from pmsm_commissioning.control.fdsmc.loop_analysis import GainRecommendation, stability_measure
+from pmsm_commissioning.control.fdsmc.loop_model import LoopCase
 
 #: Most halvings of the tracking pole while the sampled loop is unstable [-].
 MAX_HALVINGS = 12

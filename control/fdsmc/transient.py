@@ -18,9 +18,9 @@ import math
 
 import numpy as np
 
-from control.common.checks import ParameterError
-from control.common.discrete import zoh
-from control.fdsmc.loop_model import (
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.common.discrete import zoh
+from pmsm_commissioning.control.fdsmc.loop_model import (
     LoopModel,
     continuous_matrix,
     discrete_matrix,

@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError, check_fields, spec_field
+from pmsm_commissioning.control.common.checks import ParameterError, check_fields, spec_field
 
 
 @dataclass(frozen=True)

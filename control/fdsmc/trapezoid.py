@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 
-from control.common.jit import jitable
+from pmsm_commissioning.control.common.jit import jitable
 
 #: Position/speed law codes: the P–PI cascade (ODrive, the setpoint table) and the parallel PID (moteus).
 LAW_CASCADE, LAW_PID = 0.0, 1.0

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.bldc.dqx import trapezoid_unit
-from control.bldc.params import EMF_SAMPLES_MIN, BldcMachine
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.bldc.dqx import trapezoid_unit
+from pmsm_commissioning.control.bldc.params import EMF_SAMPLES_MIN, BldcMachine
+from pmsm_commissioning.control.common.checks import ParameterError
 
 N_TABLE = 720  # 0.5° electrical per sample; a multiple of 12 keeps the trapezoid corners exact
 HANN_WIDTH = math.radians(30.0)

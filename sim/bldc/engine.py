@@ -25,15 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.bldc.design import BldcDesign, bldc_design
-from control.bldc.params import BldcParams
-from control.bldc.speed_smc import NO_ANTI_WINDUP
-from sim.bldc import kernel as kn
-from sim.bldc.emf import machine_table
-from sim.bldc.metrics import BldcMetrics, run_metrics
-from sim.bldc.trace import BldcTrace
-from sim.common import budget
-from sim.common.choices import check_controller
+from pmsm_commissioning.control.bldc.design import BldcDesign, bldc_design
+from pmsm_commissioning.control.bldc.params import BldcParams
+from pmsm_commissioning.control.bldc.speed_smc import NO_ANTI_WINDUP
+from pmsm_commissioning.sim.bldc import kernel as kn
+from pmsm_commissioning.sim.bldc.emf import machine_table
+from pmsm_commissioning.sim.bldc.metrics import BldcMetrics, run_metrics
+from pmsm_commissioning.sim.bldc.trace import BldcTrace
+from pmsm_commissioning.sim.common import budget
+from pmsm_commissioning.sim.common.choices import check_controller
 
 CONTROLLERS = ("smc_integral", "smc_plain", "pi_sinusoidal", "six_step")
 LABELS = {

@@ -23,12 +23,12 @@ import math
 import numpy as np
 from numba import njit
 
-from control.bldc import current_smc as cur
-from control.bldc import dqx
-from control.bldc import pi_vector as piv
-from control.bldc import plain_smc as plain
-from control.bldc import six_step as six
-from control.bldc import speed_smc as spd
+from pmsm_commissioning.control.bldc import current_smc as cur
+from pmsm_commissioning.control.bldc import dqx
+from pmsm_commissioning.control.bldc import pi_vector as piv
+from pmsm_commissioning.control.bldc import plain_smc as plain
+from pmsm_commissioning.control.bldc import six_step as six
+from pmsm_commissioning.control.bldc import speed_smc as spd
 
 _jit = njit(cache=True)
 _trap = _jit(dqx.trapezoid_unit)

@@ -22,10 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.bldc.params import BldcParams
-from sim.bldc.trace import BldcTrace
-from sim.common import signals
-from sim.common.energy import energy_balance
+from pmsm_commissioning.control.bldc.params import BldcParams
+from pmsm_commissioning.sim.bldc.trace import BldcTrace
+from pmsm_commissioning.sim.common import signals
+from pmsm_commissioning.sim.common.energy import energy_balance
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 #: Most RK4 integration steps of one request, sub-steps and all controllers included [-].
 #: The bound for engines without a calibrated CPU model; the position and BLDC drives are held to

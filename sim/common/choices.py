@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from control.common.checks import ParameterError
+from pmsm_commissioning.control.common.checks import ParameterError
 
 
 def check_controller(controller: str, allowed: Sequence[str]) -> None:

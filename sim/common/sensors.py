@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
-from control.common.jit import jitable
-from control.fdsmc.params import Sensors
+from pmsm_commissioning.control.common.jit import jitable
+from pmsm_commissioning.control.fdsmc.params import Sensors
 
 #: Samples per noise channel [-]: 2¹⁷, 6.6 s of distinct noise at 20 kHz (then it repeats).
 NOISE_SAMPLES = 2**17

@@ -21,12 +21,12 @@ from typing import Any
 
 import numpy as np
 
-from control.fdsmc import fdc
-from control.fdsmc.derivations import Derived
-from control.fdsmc.model import model_coefficients
-from control.fdsmc.params import DriveParams
-from control.fdsmc.sliding_mode import smc_law
-from sim.fdsmc.reference import ReferenceDrive
+from pmsm_commissioning.control.fdsmc import fdc
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.model import model_coefficients
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.sliding_mode import smc_law
+from pmsm_commissioning.sim.fdsmc.reference import ReferenceDrive
 
 
 @dataclass(frozen=True)

@@ -11,11 +11,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.fdsmc.feasibility import current_limit, exceeds, speed_limit, torque_limit, voltage_limit
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.engine import LABELS, RunResult
-from sim.fdsmc.metrics import RunMetrics
+from pmsm_commissioning.control.fdsmc.feasibility import (
+    current_limit,
+    exceeds,
+    speed_limit,
+    torque_limit,
+    voltage_limit,
+)
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.engine import LABELS, RunResult
+from pmsm_commissioning.sim.fdsmc.metrics import RunMetrics
 
 #: Position error at T_m, as a fraction of |θ_dem|, beyond which a run is said to miss T_m [-]:
 #: the FDSMC is designed to arrive by T_m (2 % band); the comparator's Dodds formula (eq. (61) in

@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.fdsmc.feasibility import current_limit, speed_limit
-from control.fdsmc.model import torque_constant
-from control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit, speed_limit
+from pmsm_commissioning.control.fdsmc.model import torque_constant
+from pmsm_commissioning.control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
 
 #: Default in-position window [encoder counts].
 IN_POSITION_COUNTS = 10

@@ -38,11 +38,11 @@ from __future__ import annotations
 
 import dataclasses
 
-from control.fdsmc.derivations import derive
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.checks import TARGET_BAND, Constraint, run_checks
-from sim.fdsmc.criteria import pass_criteria, window_below_count
-from sim.fdsmc.design_result import (
+from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.checks import TARGET_BAND, Constraint, run_checks
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria, window_below_count
+from pmsm_commissioning.sim.fdsmc.design_result import (
     EXIT_STATUS,
     Alternative,
     DriveDesign,
@@ -51,17 +51,23 @@ from sim.fdsmc.design_result import (
     refused,
     with_field,
 )
-from sim.fdsmc.design_search import in_position_by, passes, shortest_clean
-from sim.fdsmc.design_verify import gain_and_T_c, planned, sampled_loop_stable, shortest_fitting_T_m, unstable_rate
-from sim.fdsmc.diagnosis import (
+from pmsm_commissioning.sim.fdsmc.design_search import in_position_by, passes, shortest_clean
+from pmsm_commissioning.sim.fdsmc.design_verify import (
+    gain_and_T_c,
+    planned,
+    sampled_loop_stable,
+    shortest_fitting_T_m,
+    unstable_rate,
+)
+from pmsm_commissioning.sim.fdsmc.diagnosis import (
     T_m_constraint,
     alternatives,
     closed_form_binding,
     sensors_binding,
     simulated_binding,
 )
-from sim.fdsmc.engine import compare
-from sim.fdsmc.verdicts import comparator_notes
+from pmsm_commissioning.sim.fdsmc.engine import compare
+from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes
 
 #: Factors applied to T_so and T_sα when the sensors' ripple exceeds the criterion [-].
 SENSOR_SLOWDOWN = (1.0, 1.5, 2.25, 3.4, 5.0, 7.6, 11.4)

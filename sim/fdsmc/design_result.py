@@ -13,14 +13,14 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.feasibility import torque_limit
-from control.fdsmc.noise import NoiseGain, noise_gain
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.checks import Constraint, run_checks
-from sim.fdsmc.criteria import encoder_cpr_for, pass_criteria
-from sim.fdsmc.engine import Comparison, RunResult
-from sim.fdsmc.verdicts import comparator_notes, flux_warnings
+from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
+from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
+from pmsm_commissioning.control.fdsmc.noise import NoiseGain, noise_gain
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.checks import Constraint, run_checks
+from pmsm_commissioning.sim.fdsmc.criteria import encoder_cpr_for, pass_criteria
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, RunResult
+from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes, flux_warnings
 
 #: Exit status of ``design`` per verdict (documented in README.md and docs/real_drive.md).
 EXIT_STATUS = {"clean": 0, "not as asked": 3, "not clean": 4}

@@ -16,10 +16,10 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.checks import Constraint
-from sim.fdsmc.design_result import DriveDesign, round_down, round_up, with_field
-from sim.fdsmc.design_verify import planned, verify_at
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.checks import Constraint
+from pmsm_commissioning.sim.fdsmc.design_result import DriveDesign, round_down, round_up, with_field
+from pmsm_commissioning.sim.fdsmc.design_verify import planned, verify_at
 
 #: T_m growth per step while bracketing the shortest clean T_m, and the most steps (×4.3 in all) [-].
 GROWTH, MAX_GROWTHS = 1.2, 8

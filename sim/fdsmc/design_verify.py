@@ -11,18 +11,23 @@ from __future__ import annotations
 
 import math
 
-from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.feasibility import alpha_max, feasibility
-from control.fdsmc.loop_analysis import ZETA_SLOPE_MIN, slope_damping, stability_measure, unit_damping_T_c
-from control.fdsmc.loop_model import LoopModel
-from control.fdsmc.model import model_coefficients
-from control.fdsmc.observer import observer_gains
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
-from control.fdsmc.transient import acceleration_overshoot
-from sim.fdsmc.checks import Constraint, run_checks
-from sim.fdsmc.design_result import DriveDesign, refused, round_up, verified, with_field
-from sim.fdsmc.engine import Comparison, compare
+from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
+from pmsm_commissioning.control.fdsmc.feasibility import alpha_max, feasibility
+from pmsm_commissioning.control.fdsmc.loop_analysis import (
+    ZETA_SLOPE_MIN,
+    slope_damping,
+    stability_measure,
+    unit_damping_T_c,
+)
+from pmsm_commissioning.control.fdsmc.loop_model import LoopModel
+from pmsm_commissioning.control.fdsmc.model import model_coefficients
+from pmsm_commissioning.control.fdsmc.observer import observer_gains
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
+from pmsm_commissioning.control.fdsmc.transient import acceleration_overshoot
+from pmsm_commissioning.sim.fdsmc.checks import Constraint, run_checks
+from pmsm_commissioning.sim.fdsmc.design_result import DriveDesign, refused, round_up, verified, with_field
+from pmsm_commissioning.sim.fdsmc.engine import Comparison, compare
 
 #: Most K halvings while the verified run still chatters [-].
 MAX_K_HALVINGS = 4

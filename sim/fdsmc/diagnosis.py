@@ -22,13 +22,19 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from control.fdsmc.feasibility import alpha_max, feasibility, speed_limit, torque_limit, voltage_limit
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
-from sim.fdsmc.checks import Constraint
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.design_result import Alternative, DriveDesign, round_up, with_field
-from sim.fdsmc.design_verify import inner_overshoot
+from pmsm_commissioning.control.fdsmc.feasibility import (
+    alpha_max,
+    feasibility,
+    speed_limit,
+    torque_limit,
+    voltage_limit,
+)
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import shortest_manoeuvre_time, velocity_profile
+from pmsm_commissioning.sim.fdsmc.checks import Constraint
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.design_result import Alternative, DriveDesign, round_up, with_field
+from pmsm_commissioning.sim.fdsmc.design_verify import inner_overshoot
 
 #: Checks the sensors' noise fails (the observer and loops amplify the encoder's count and current noise).
 SENSOR_FAILS = frozenset({"hold_ripple", "chatter"})

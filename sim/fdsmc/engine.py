@@ -25,22 +25,22 @@ from typing import Any
 
 import numpy as np
 
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.fdc import mismatch_filter_factor
-from control.fdsmc.feasibility import current_limit
-from control.fdsmc.inverter import decay_factors
-from control.fdsmc.model import model_coefficients, torque_constant
-from control.fdsmc.optimum import OptimumSolverError
-from control.fdsmc.params import DriveParams
-from control.fdsmc.profile import infeasible_T_m
-from control.fdsmc.tracking import optimum_slide, tracking_gains
-from sim.common import sensors
-from sim.common.choices import check_controller
-from sim.fdsmc import kernel as kn
-from sim.fdsmc import kernel_run
-from sim.fdsmc.criteria import pass_criteria
-from sim.fdsmc.grid import (
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
+from pmsm_commissioning.control.fdsmc.fdc import mismatch_filter_factor
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit
+from pmsm_commissioning.control.fdsmc.inverter import decay_factors
+from pmsm_commissioning.control.fdsmc.model import model_coefficients, torque_constant
+from pmsm_commissioning.control.fdsmc.optimum import OptimumSolverError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.profile import infeasible_T_m
+from pmsm_commissioning.control.fdsmc.tracking import optimum_slide, tracking_gains
+from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.common.choices import check_controller
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import kernel_run
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
+from pmsm_commissioning.sim.fdsmc.grid import (
     CONTINUOUS_STEP_S,
     MAX_POINTS,
     TimeGrid,
@@ -49,14 +49,14 @@ from sim.fdsmc.grid import (
     load_steps,
     time_grid,
 )
-from sim.fdsmc.metrics import (
+from pmsm_commissioning.sim.fdsmc.metrics import (
     RunMetrics,
     WindowSamples,
     chatter_window_steps,
     chatter_windows,
     run_metrics,
 )
-from sim.fdsmc.summary import decode_info
+from pmsm_commissioning.sim.fdsmc.summary import decode_info
 
 CONTROLLERS = ("fdsmc", "conventional")
 #: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
@@ -201,7 +201,7 @@ def _reference(d: Derived, controller: str) -> np.ndarray:
     """Return the kernel's reference rows (θ_ref, ω_ref, α_ref): the tracked optimum's, else zeros."""
     if controller != "optimum":
         return np.zeros((3, 2))
-    from control.fdsmc.optimum import tracked_move  # imports cvxpy only when limits are active
+    from pmsm_commissioning.control.fdsmc.optimum import tracked_move  # imports cvxpy only when limits are active
 
     mv = tracked_move(d)
     return np.ascontiguousarray(np.vstack((mv.theta, mv.omega, mv.alpha)))
@@ -273,8 +273,8 @@ def _simulate_checked(
     f_s, tuned on the simulated checks (:mod:`sim.stock.tuning`), run on ``plant`` when given.
     """
     if controller == "stock":
-        from sim.stock.route import simulate_stock
-        from sim.stock.tuning import DRIVES, tuned
+        from pmsm_commissioning.sim.stock.route import simulate_stock
+        from pmsm_commissioning.sim.stock.tuning import DRIVES, tuned
 
         tu = tuned(DRIVES["setpoints"], params, d)
         return tu.run if plant is None else simulate_stock(params, tu.loop, d, plant)

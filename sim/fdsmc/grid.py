@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
-from control.fdsmc.params import DriveParams
-from sim.common import budget
-from sim.fdsmc import kernel as kn
-from sim.fdsmc.metrics import CHATTER_MAX_WINDOW_S
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.common import budget
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc.metrics import CHATTER_MAX_WINDOW_S
 
 #: Simulated horizon beyond T_m, as a fraction of T_m [-].
 TAIL_FRACTION = 0.3

@@ -31,9 +31,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
-from control.stock import loops
-from sim.common import sensors
+from pmsm_commissioning.control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
+from pmsm_commissioning.control.stock import loops
+from pmsm_commissioning.sim.common import sensors
 
 # ---- prm indices -------------------------------------------------------------------------
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
@@ -91,7 +91,7 @@ WIN_ROWS = 4
 # The hot path works on tuples of scalars (plant p = the first X_THH states, observer o = the
 # last four) and every helper is inlined into the run loop (inline="always"), so numba keeps the
 # states in registers. The earlier array-based version (states in small arrays, stores inside
-# the loop) took ≈ 240 ns per 20 kHz sample; this one ≈ 75 ns (``python -m app bench``).
+# the loop) took ≈ 240 ns per 20 kHz sample; this one ≈ 75 ns (``pmsm-commission bench``).
 inlined = njit(cache=True, error_model="numpy", inline="always")
 
 

@@ -16,8 +16,8 @@ import math
 import numpy as np
 from numba import njit
 
-from sim.common.borrowed import borrowed
-from sim.fdsmc.kernel import (
+from pmsm_commissioning.sim.common.borrowed import borrowed
+from pmsm_commissioning.sim.fdsmc.kernel import (
     HOLD0,
     I_END,
     I_FAILED,

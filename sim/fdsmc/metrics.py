@@ -24,14 +24,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.fdsmc.derivations import Derived
-from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
-from control.fdsmc.params import DriveParams
-from control.fdsmc.tracking import optimum_slide
-from sim.common import signals
-from sim.common.energy import energy_balance
-from sim.fdsmc.limit_cycle import limit_cycles
-from sim.fdsmc.summary import KernelState, RunSummary
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.tracking import optimum_slide
+from pmsm_commissioning.sim.common import signals
+from pmsm_commissioning.sim.common.energy import energy_balance
+from pmsm_commissioning.sim.fdsmc.limit_cycle import limit_cycles
+from pmsm_commissioning.sim.fdsmc.summary import KernelState, RunSummary
 
 #: Thresholds of the chatter criterion (fractions of α_max; its amplitude CHATTER_PTP_FRACTION is
 #: the loop analysis's) and the smoothing window [s].

@@ -21,11 +21,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.design import DriveDesign, design_drive
-from sim.fdsmc.engine import COMPARATORS, Comparison, compare
-from sim.fdsmc.recommend import Recommendation, recommend
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.design import DriveDesign, design_drive
+from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, Comparison, compare
+from pmsm_commissioning.sim.fdsmc.recommend import Recommendation, recommend
 
 #: Design objectives: the first is the default.
 OBJECTIVES = ("electrical", "friction", "in_position_by_T_m")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from sim.fdsmc.engine import RunResult
+from pmsm_commissioning.sim.fdsmc.engine import RunResult
 
 #: Energy compared with the optimum: the net electrical input over the whole simulated horizon.
 OPTIMUM_BASIS = "electrical_in_total_J"

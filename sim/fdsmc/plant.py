@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.params import DriveParams
-from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import pack_parameters
-from sim.fdsmc.grid import load_steps, time_grid
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc.engine import pack_parameters
+from pmsm_commissioning.sim.fdsmc.grid import load_steps, time_grid
 
 
 class PlantInTheLoop:

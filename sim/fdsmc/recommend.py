@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.checks import run_checks
-from sim.fdsmc.engine import LABELS, Comparison, RunResult
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.checks import run_checks
+from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison, RunResult
 
 
 @dataclass(frozen=True)

@@ -15,15 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.fdsmc import fdc
-from control.fdsmc.conventional import conventional_law
-from control.fdsmc.derivations import Derived
-from control.fdsmc.feasibility import current_limit
-from control.fdsmc.inverter import decay_factors, limit_voltage, predict_currents
-from control.fdsmc.model import electromagnetic_torque
-from control.fdsmc.params import DriveParams
-from control.fdsmc.sliding_mode import smc_law
-from sim.common import sensors
+from pmsm_commissioning.control.fdsmc import fdc
+from pmsm_commissioning.control.fdsmc.conventional import conventional_law
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.feasibility import current_limit
+from pmsm_commissioning.control.fdsmc.inverter import decay_factors, limit_voltage, predict_currents
+from pmsm_commissioning.control.fdsmc.model import electromagnetic_torque
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.sliding_mode import smc_law
+from pmsm_commissioning.sim.common import sensors
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import kernel as kn
 
 
 @dataclass(frozen=True)

@@ -13,11 +13,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from control.common.checks import ParameterError
-from control.fdsmc.params import DriveParams
-from sim.common import budget
-from sim.fdsmc.engine import compare, reached_target
-from sim.fdsmc.grid import check_budget, run_cost, with_field
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.common import budget
+from pmsm_commissioning.sim.fdsmc.engine import compare, reached_target
+from pmsm_commissioning.sim.fdsmc.grid import check_budget, run_cost, with_field
 
 #: Paper's Table 1: manoeuvre time [s] → printed friction saving [%].
 PAPER_TABLE1: dict[float, float] = {1.0: 27.9, 1.4: 27.8, 1.8: 27.5, 2.2: 26.8, 2.6: 25.1}

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import math
 
-from control.fdsmc.derivations import Derived
-from control.fdsmc.flux_tolerance import flux_tolerance
-from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, ZETA_SLOPE_MIN
-from sim.fdsmc.checks import TARGET_BAND, exceeded, run_checks, saturation_matters
-from sim.fdsmc.criteria import window_below_count
-from sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.flux_tolerance import flux_tolerance
+from pmsm_commissioning.control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION, ZETA_SLOPE_MIN
+from pmsm_commissioning.sim.fdsmc.checks import TARGET_BAND, exceeded, run_checks, saturation_matters
+from pmsm_commissioning.sim.fdsmc.criteria import window_below_count
+from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison, RunResult, reached_target
 
 #: A flux tolerance of the FDC below this is warned about [-] (a datasheet's 20 °C flux vs magnets 100 K
 #: warmer is ≈ 10 % apart for NdFeB).

@@ -38,16 +38,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.fdsmc.derivations import Derived
-from control.fdsmc.model import torque_constant
-from control.fdsmc.params import DriveParams
-from control.fdsmc.trapezoid import TrapezoidTiming, trapezoid_samples, trapezoid_timing
-from sim.common.budget import MAX_CPU_S
-from sim.fdsmc.checks import Constraint, run_checks
-from sim.fdsmc.criteria import drive_current
-from sim.fdsmc.engine import RunResult
-from sim.fdsmc.grid import check_budget
-from sim.stock.route import StockLoop, at_loop_rate, simulate_stock
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.model import torque_constant
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.trapezoid import TrapezoidTiming, trapezoid_samples, trapezoid_timing
+from pmsm_commissioning.sim.common.budget import MAX_CPU_S
+from pmsm_commissioning.sim.fdsmc.checks import Constraint, run_checks
+from pmsm_commissioning.sim.fdsmc.criteria import drive_current
+from pmsm_commissioning.sim.fdsmc.engine import RunResult
+from pmsm_commissioning.sim.fdsmc.grid import check_budget
+from pmsm_commissioning.sim.stock.route import StockLoop, at_loop_rate, simulate_stock
 
 #: pos_gain = ω_v/POSITION_RATIO [-].
 POSITION_RATIO = 4.0

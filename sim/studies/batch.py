@@ -25,17 +25,17 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from control.fdsmc.derivations import Derived
-from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
-from control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
-from control.fdsmc.params import DriveParams
-from sim.common import sensors, signals
-from sim.fdsmc import kernel as kn
-from sim.fdsmc import kernel_run
-from sim.fdsmc.engine import CONTROLLERS, _observer_arrays, _reference, pack_parameters
-from sim.fdsmc.grid import CONTINUOUS_STEP_S, TimeGrid, load_steps, time_grid
-from sim.fdsmc.limit_cycle import limit_cycles
-from sim.fdsmc.metrics import (
+from pmsm_commissioning.control.fdsmc.derivations import Derived
+from pmsm_commissioning.control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
+from pmsm_commissioning.control.fdsmc.loop_analysis import CHATTER_PTP_FRACTION
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.common import sensors, signals
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import kernel_run
+from pmsm_commissioning.sim.fdsmc.engine import CONTROLLERS, _observer_arrays, _reference, pack_parameters
+from pmsm_commissioning.sim.fdsmc.grid import CONTINUOUS_STEP_S, TimeGrid, load_steps, time_grid
+from pmsm_commissioning.sim.fdsmc.limit_cycle import limit_cycles
+from pmsm_commissioning.sim.fdsmc.metrics import (
     CHATTER_HYSTERESIS_FRACTION,
     CHATTER_MIN_SIGN_CHANGES,
     CHATTER_SMOOTHING_S,

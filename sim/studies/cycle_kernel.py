@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from sim.common.borrowed import borrowed
-from sim.fdsmc import kernel as kn
-from sim.fdsmc import kernel_run
+from pmsm_commissioning.sim.common.borrowed import borrowed
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import kernel_run
 
 #: Per-segment values stored in ``seg_info`` (row per segment): the state at its end.
 SEG_X = kn.N_X

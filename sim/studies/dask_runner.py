@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from sim.studies.runner import ExecutorError
+from pmsm_commissioning.sim.studies.runner import ExecutorError
 
 #: Seconds the cluster may have no worker before a run is abandoned (and the default wait at start).
 NO_WORKER_S = 60.0
@@ -56,15 +56,15 @@ class SourceMismatchError(RuntimeError):
 @functools.lru_cache(maxsize=1)
 def local_hash() -> str:
     """Return :func:`sim.source_hash` of this process (read once)."""
-    import sim
+    import pmsm_commissioning.sim as sim
 
     return sim.source_hash()
 
 
 def warm() -> float:
     """Load (or compile) the batch kernel in this process; returns the seconds it took."""
-    from sim.fdsmc import kernel as kn
-    from sim.studies.batch import run_batch
+    from pmsm_commissioning.sim.fdsmc import kernel as kn
+    from pmsm_commissioning.sim.studies.batch import run_batch
 
     t0 = time.perf_counter()
     z1 = np.zeros(0)

@@ -21,18 +21,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.optimum import OptimumSolverError
-from control.fdsmc.params import DriveParams
-from sim.common import sensors
-from sim.common.economics import J_PER_KWH, cost_per_year, kwh_per_year  # noqa: F401 - J_PER_KWH re-exported
-from sim.fdsmc import kernel as kn
-from sim.fdsmc.engine import optimum_omitted, pack_parameters
-from sim.fdsmc.grid import continuous_step, plant_substeps
-from sim.fdsmc.metrics import kinetic_energy, magnetic_energy
-from sim.fdsmc.summary import decode_state
-from sim.studies.cycle_kernel import run_cycle
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
+from pmsm_commissioning.control.fdsmc.optimum import OptimumSolverError
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.common.economics import J_PER_KWH, cost_per_year, kwh_per_year  # noqa: F401 - J_PER_KWH re-exported
+from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc.engine import optimum_omitted, pack_parameters
+from pmsm_commissioning.sim.fdsmc.grid import continuous_step, plant_substeps
+from pmsm_commissioning.sim.fdsmc.metrics import kinetic_energy, magnetic_energy
+from pmsm_commissioning.sim.fdsmc.summary import decode_state
+from pmsm_commissioning.sim.studies.cycle_kernel import run_cycle
 
 COMPARATORS = ("fdsmc", "conventional", "optimum")
 #: Most trace points kept per comparator's run [-].
@@ -146,7 +146,7 @@ def _segments(params: DriveParams, moves: Sequence[Move]) -> tuple[bool, float, 
 def _pack(cases: list[tuple[DriveParams, Derived]], moves: Sequence[Move], controller: str
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per-segment parameters (absolute targets) and the concatenated references with offsets."""
-    from control.fdsmc.optimum import tracked_move  # cvxpy only where a limit is active
+    from pmsm_commissioning.control.fdsmc.optimum import tracked_move  # cvxpy only where a limit is active
 
     prm_all, refs, start = [], [], 0.0
     for (p, d), mv in zip(cases, moves, strict=True):

@@ -29,14 +29,14 @@ from typing import Any
 
 import numpy as np
 
-from control.common.checks import ParameterError
-from control.fdsmc.derivations import Derived, derive
-from control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
-from control.fdsmc.params import DriveParams
-from sim.fdsmc.engine import CONTROLLERS, RunResult, _check_feasible, reached_target, simulate
-from sim.fdsmc.grid import check_budget
-from sim.studies.batch import simulate_batch
-from sim.studies.runner import ExecutorError
+from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
+from pmsm_commissioning.control.fdsmc.feasibility import LIMIT_TOLERANCE, torque_limit
+from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.engine import CONTROLLERS, RunResult, _check_feasible, reached_target, simulate
+from pmsm_commissioning.sim.fdsmc.grid import check_budget
+from pmsm_commissioning.sim.studies.batch import simulate_batch
+from pmsm_commissioning.sim.studies.runner import ExecutorError
 
 #: The controllers a study can run: the two of [1] and the tracked minimum-energy optimum.
 STUDY_CONTROLLERS = ("fdsmc", "conventional", "optimum")

@@ -48,8 +48,8 @@ class UiServer:
 @pytest.fixture(scope="session")
 def ui_server() -> Iterator[UiServer]:
     """The web UI with the default preset, in-process on a free loopback port."""
-    from app.io.presets import PAPER_PRESET, load_preset
-    from app.ui.page import create_server
+    from pmsm_commissioning.app.io.presets import PAPER_PRESET, load_preset
+    from pmsm_commissioning.app.ui.page import create_server
 
     server, config = create_server(load_preset(PAPER_PRESET), PAPER_PRESET, host="127.0.0.1",
                                    port=free_port(), scene_3d=False, environment_map=False)

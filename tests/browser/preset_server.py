@@ -13,8 +13,8 @@ from tests.net import free_port
 @contextlib.contextmanager
 def preset_server(name: str) -> Iterator[UiServer]:
     """Serve the page on preset ``name`` (no 3D scene) until the block ends."""
-    from app.io.presets import load_preset
-    from app.ui.page import create_server
+    from pmsm_commissioning.app.io.presets import load_preset
+    from pmsm_commissioning.app.ui.page import create_server
 
     srv, config = create_server(load_preset(name), name, port=free_port(), scene_3d=False)
     try:

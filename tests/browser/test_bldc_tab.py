@@ -84,7 +84,7 @@ def test_anti_windup_off_keeps_the_typed_eps_lambda_in_the_inputs_and_the_downlo
     """Unticking the anti-windup runs λ = λ_0; ε_λ stays what was typed (it was replaced by 1e5 rad/s)."""
     from pathlib import Path
 
-    from app.io.presets import load_preset, loads_preset
+    from pmsm_commissioning.app.io.presets import load_preset, loads_preset
 
     typed = load_preset("bldc_smc_paper").gains.eps_lambda
     _open_tab(page)
@@ -119,7 +119,7 @@ def test_bldc_import_scenario_switch_and_export_round_trip(page, tmp_path):
     import dataclasses
     from pathlib import Path
 
-    from app.io.presets import dumps_preset, load_preset, loads_preset
+    from pmsm_commissioning.app.io.presets import dumps_preset, load_preset, loads_preset
 
     params = load_preset("bldc_smc_paper")
     uploaded = dataclasses.replace(params, name="bldc_imported", source="browser test",
@@ -143,7 +143,7 @@ def test_bldc_import_scenario_switch_and_export_round_trip(page, tmp_path):
 
 
 def test_bldc_import_of_a_position_preset_is_rejected_and_changes_nothing(page, tmp_path):
-    from app.io.presets import DEFAULT_PRESET, PRESET_DIR
+    from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, PRESET_DIR
 
     _open_tab(page)
     page.get_by_text("Machine, load, inverter, gains", exact=True).click()

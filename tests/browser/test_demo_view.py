@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from app.ui.demo_state import PageView, loads_state
+from pmsm_commissioning.app.ui.demo_state import PageView, loads_state
 from tests.browser.conftest import click_tab, open_page, session_of, set_number
 
 OVERVIEW = "[...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane')"

@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 
-from app.ui.number_fields import shown_text
+from pmsm_commissioning.app.ui.number_fields import shown_text
 from tests.browser.conftest import UiServer, field, open_page, set_number
 from tests.net import free_port
 
@@ -32,8 +32,8 @@ def choose(page: Any, dropdown: str, option: str) -> None:
 
 @pytest.fixture(scope="module")
 def default_server() -> Iterator[UiServer]:
-    from app.io.presets import DEFAULT_PRESET, load_preset
-    from app.ui.page import create_server
+    from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset
+    from pmsm_commissioning.app.ui.page import create_server
 
     server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(),
                                    scene_3d=False)

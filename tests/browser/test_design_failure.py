@@ -19,7 +19,7 @@ from tests.browser.preset_server import preset_page, preset_server
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[UiServer]:
-    from app.io.presets import DEFAULT_PRESET
+    from pmsm_commissioning.app.io.presets import DEFAULT_PRESET
 
     with preset_server(DEFAULT_PRESET) as srv:
         yield srv

@@ -14,8 +14,8 @@ from typing import Any
 import pytest
 import viser
 
-from app.io.presets import PRESET_DIR, loads_preset
-from app.ui.log import EXAMPLE_LOG
+from pmsm_commissioning.app.io.presets import PRESET_DIR, loads_preset
+from pmsm_commissioning.app.ui.log import EXAMPLE_LOG
 from tests.browser.conftest import click_tab, open_page
 
 OPEN_WS_JS = """async ([url, protocol]) => await new Promise((resolve) => {

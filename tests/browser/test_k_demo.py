@@ -8,7 +8,7 @@ import math
 
 from playwright.sync_api import expect
 
-from app.ui.number_fields import shown_text
+from pmsm_commissioning.app.ui.number_fields import shown_text
 from tests.browser.conftest import field, set_number
 from tests.browser.test_design import choose
 

@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from app.ui.layout import BORDERS, CANVAS_SPARE, RAIL, layout_for_window
+from pmsm_commissioning.app.ui.layout import BORDERS, CANVAS_SPARE, RAIL, layout_for_window
 from tests.browser.conftest import open_page, session_of, wait_for_layout
 
 #: Every animation frame from the page's start: the results panel's width (the dock group of the

@@ -17,8 +17,8 @@ from typing import Any
 
 import pytest
 
-from app.figures.fdsmc_replay import SPEEDS
-from app.ui.demo_state import loads_state
+from pmsm_commissioning.app.figures.fdsmc_replay import SPEEDS
+from pmsm_commissioning.app.ui.demo_state import loads_state
 from tests.browser.conftest import ARTIFACTS, click_tab, field, open_page, set_number
 
 #: Trail pieces as drawn (the SVG, not the data: Plotly can keep a path its data lost):
@@ -211,7 +211,7 @@ def test_the_main_story_fits_1280x720_without_scrolling(lecture):
 def test_clearing_pins_while_a_runs_figures_go_out_leaves_no_ghost(browser, ui_server, monkeypatch):
     # the overview with its replay is built after the light one is sent; a "Clear pins" in between
     # must not be undone by that figure (drawn with the pins read before the click)
-    import app.ui.replay as replay_module
+    import pmsm_commissioning.app.ui.replay as replay_module
 
     built = replay_module.overview_json
 

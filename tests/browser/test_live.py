@@ -6,7 +6,7 @@ import msgspec
 import numpy as np
 import pytest
 
-from app.figures.fdsmc_replay import SPEEDS
+from pmsm_commissioning.app.figures.fdsmc_replay import SPEEDS
 
 MARKER_JS = """() => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');

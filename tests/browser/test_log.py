@@ -5,8 +5,8 @@ from __future__ import annotations
 import re
 import shutil
 
-from app.ui.log import EXAMPLE_LOG
-from sim.drivelog.synthetic import TRUE_MOTOR
+from pmsm_commissioning.app.ui.log import EXAMPLE_LOG
+from pmsm_commissioning.sim.drivelog.synthetic import TRUE_MOTOR
 from tests.browser.conftest import click_tab, figure
 
 

@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
-from app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
-from app.ui.plotly_js import REACT_JS, bundle_source
+from pmsm_commissioning.app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
+from pmsm_commissioning.app.ui.plotly_js import REACT_JS, bundle_source
 
 #: A plot, its data, layout and config as viser holds them (parsed once per figure).
 SETUP = """() => { window.draws = 0; window.gd = document.getElementById('p');

@@ -11,8 +11,8 @@ from typing import Any
 
 import pytest
 
-from app.figures.fdsmc_overview import CURSORS
-from app.figures.fdsmc_replay import SPEEDS
+from pmsm_commissioning.app.figures.fdsmc_overview import CURSORS
+from pmsm_commissioning.app.figures.fdsmc_replay import SPEEDS
 from tests.browser.conftest import (
     ARTIFACTS,
     TIMEOUT_MS,
@@ -191,8 +191,8 @@ def test_folded_warnings_stay_folded_over_a_new_run_with_other_warnings(page):
 @pytest.fixture(scope="module")
 def server_3d() -> Iterator[Any]:
     """The web UI with the 3D view available (folded by default)."""
-    from app.io.presets import PAPER_PRESET, load_preset
-    from app.ui.page import create_server
+    from pmsm_commissioning.app.io.presets import PAPER_PRESET, load_preset
+    from pmsm_commissioning.app.ui.page import create_server
     from tests.browser.conftest import UiServer
     from tests.net import free_port
 

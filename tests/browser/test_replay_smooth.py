@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import pytest
 
-from app.figures.fdsmc_replay import SPEEDS
-from app.io.presets import PAPER_PRESET, load_preset
-from app.ui.plotly_js import BUNDLE
-from app.ui.replay import phase_plane_json
-from sim.fdsmc.engine import compare
+from pmsm_commissioning.app.figures.fdsmc_replay import SPEEDS
+from pmsm_commissioning.app.io.presets import PAPER_PRESET, load_preset
+from pmsm_commissioning.app.ui.plotly_js import BUNDLE
+from pmsm_commissioning.app.ui.replay import phase_plane_json
+from pmsm_commissioning.sim.fdsmc.engine import compare
 from tests.browser.conftest import TIMEOUT_MS
 
 #: Resolves with the drawn [θ_re, ω_r, t] of the FDSMC marker and the ω_r cursor, as fractions of their

@@ -6,8 +6,8 @@ import multiprocessing
 import re
 from typing import Any
 
-from app.figures.fdsmc_comparison import LABELS
-from sim.fdsmc.verdicts import TARGET_BAND
+from pmsm_commissioning.app.figures.fdsmc_comparison import LABELS
+from pmsm_commissioning.sim.fdsmc.verdicts import TARGET_BAND
 from tests.browser.conftest import click_tab, figure, set_number
 
 PROGRESS_JS = """() => {

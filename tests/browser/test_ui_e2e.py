@@ -10,9 +10,9 @@ from pathlib import Path
 
 from playwright.sync_api import expect
 
-from app.exports.c_verify import count_params
-from app.io.presets import PAPER_PRESET, dumps_preset, load_preset, loads_preset
-from control.fdsmc.derivations import derive
+from pmsm_commissioning.app.exports.c_verify import count_params
+from pmsm_commissioning.app.io.presets import PAPER_PRESET, dumps_preset, load_preset, loads_preset
+from pmsm_commissioning.control.fdsmc.derivations import derive
 from tests.browser.conftest import ARTIFACTS, field, figure, open_page, set_number
 
 
@@ -191,7 +191,7 @@ def test_recommended_K_then_T_c_min_one_click_fixes(page):
     """Slow manoeuvre (T_m = 60 s): K = 1000 chatters → "Use recommended K"; the approach to θ_dem
     is then poorly damped with T_c = T_a → "Use T_c = …" selects T_c,min and the chatter is gone.
     """
-    from sim.fdsmc.verdicts import T_c_advice
+    from pmsm_commissioning.sim.fdsmc.verdicts import T_c_advice
 
     params = load_preset(PAPER_PRESET)
     slow = dataclasses.replace(params, manoeuvre=dataclasses.replace(params.manoeuvre, T_m=60.0))
