@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Sets up (idempotent), installs chromium and a C compiler if missing, and runs the whole test suite.
+# Sets up (idempotent), installs chromium and a C compiler if missing, and runs the whole test suite
+# (with arguments: pytest with those arguments).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -10,4 +11,12 @@ if ! bash scripts/ensure_cc.sh; then
   if [ "${CI:-}" = "true" ]; then echo "CI: a C compiler is required for the C controller tests" >&2; exit 1; fi
 fi
 export NUMBA_CACHE_DIR="${NUMBA_CACHE_DIR:-$PWD/.numba_cache}"
-exec .venv/bin/python -m pytest "$@"
+if [ "$#" -gt 0 ]; then  # a selection: as given, in one process
+  exec .venv/bin/python -m pytest "$@"
+fi
+# The whole suite: the unit, engine and CLI tests on every core (pytest-xdist), then the browser tests one
+# at a time (their layout-steadiness and frame checks want the page's machine to themselves).
+rc=0
+.venv/bin/python -m pytest -n auto --ignore=tests/browser || rc=$?
+.venv/bin/python -m pytest tests/browser || rc=$?
+exit "$rc"
