@@ -20,7 +20,8 @@ needs torque headroom above J·α) and ω_v as a fraction of its ceiling (BANDWI
 loops pass the encoder's quantization less, faster ones track tighter). The search starts from the
 fastest move and loops and lets each failure choose the next step (:func:`next_step`): a limit or
 saturation lowers the acceleration, anything else (the sensors' ripple, the window, overshoot)
-lowers ω_v first — the worst case's cost checked before the first run.
+lowers ω_v first; each setting's cost is predicted before it runs and the search stops at the
+request budget.
 The first setting whose nominal run passes every check **and** that stays stable, within the
 drive's limits, unsaturated and free of chatter with the load inertia J_L at ×0.5 and ×2
 (ROBUST_J_L, the robustness margin) is the tuned one. A guided pass/fail search is what the checks
