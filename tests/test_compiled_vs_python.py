@@ -11,15 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
-import os
-import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+from tests.compiled_agreement import disagreements, plain_python_cases
+
 N_CASES = 200
 PRESETS = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_02a", "yaskawa_sgm7j_04a", "yaskawa_sgm7a_50a")
 CONTROLLERS = ("fdsmc", "conventional")
@@ -72,22 +69,13 @@ def run_cases(seed: int, n: int) -> list[dict]:
     return out
 
 
-def _same(a: object, b: object) -> bool:
-    if isinstance(a, float) and isinstance(b, float):
-        return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-9) or (math.isinf(a) and a == b)
-    return a == b
-
-
 def test_compiled_and_plain_python_agree_on_every_metric_and_flag():
     compiled = run_cases(2026, N_CASES)
-    env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, __file__, "2026", str(N_CASES)], capture_output=True, text=True,
-                       env=env, cwd=ROOT, check=True, timeout=1800)
-    plain = json.loads(r.stdout)
+    plain = plain_python_cases(__file__, 2026, N_CASES, timeout=1800)
     assert len(plain) == len(compiled) == N_CASES
     flags = {"chatter": 0, "saturated": 0, "over_i_max": 0, "in_position": 0}
     for i, (a, b) in enumerate(zip(compiled, plain, strict=True)):
-        bad = {k: (a[k], b.get(k)) for k in a if not _same(a[k], b.get(k))}
+        bad = disagreements(a, b, rel_tol=1e-6, abs_tol=1e-9)
         assert not bad, f"case {i}: {bad}"
         if "refused" in a:
             continue

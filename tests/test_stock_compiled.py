@@ -3,22 +3,19 @@
 Random cases (fixed seed): each drive's structure (ODrive's cascade with speed clamp and PLL snap,
 moteus' PID, the plain cascade), random speed-loop bandwidths — slow and fast enough to limit and
 saturate —, encoders, current noise and ADCs, a plant inertia the drive does not know, tight current
-limits. The plain-Python side runs in a subprocess (numba reads NUMBA_DISABLE_JIT at import).
+limits. The plain-Python side runs in a subprocess (tests/compiled_agreement.py).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
-import math
-import os
-import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+from tests.compiled_agreement import disagreements, plain_python_cases
+
 N_CASES = 16
 PRESETS = ("siemens_1ft7044_ak7", "yaskawa_sgm7j_04a", "odrive_d5065_belt")
 
@@ -61,21 +58,12 @@ def run_cases(seed: int, n: int) -> list[dict]:
     return out
 
 
-def _same(a: object, b: object) -> bool:
-    if isinstance(a, float) and isinstance(b, float):
-        return math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-12) or (math.isinf(a) and a == b)
-    return a == b
-
-
 def test_stock_loops_compiled_and_plain_python_agree():
     compiled = run_cases(35, N_CASES)
-    env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, __file__, "35", str(N_CASES)], capture_output=True, text=True,
-                       env=env, cwd=ROOT, check=True, timeout=900)
-    plain = json.loads(r.stdout)
+    plain = plain_python_cases(__file__, 35, N_CASES, timeout=900)
     assert len(plain) == len(compiled) == N_CASES
     for i, (a, b) in enumerate(zip(compiled, plain, strict=True)):
-        bad = {k: (a[k], b.get(k)) for k in a if not _same(a[k], b.get(k))}
+        bad = disagreements(a, b, rel_tol=1e-9, abs_tol=1e-12)
         assert not bad, f"case {i}: {bad}"
     saturated = sum(a["saturated_s"] > 0 for a in compiled if a["stable"])
     settled = sum(a["in_position_s"] is not None for a in compiled if a["stable"])
