@@ -102,7 +102,10 @@ def design_constants(params: DriveParams, d: Derived) -> list[tuple[str, float, 
 
 
 def _fields(params: DriveParams, d: Derived, K: float) -> dict[str, Any]:
-    """Field name → value (float, or a list for the observer arrays) of ``fdsmc_params`` (K: the law's gain)."""
+    """Field name → value of ``fdsmc_params`` in its declaration order (C++ needs designators in that order).
+
+    ``K``: the law's gain.
+    """
     c, ctrl, od = d.coefficients, params.controller, d.observer_discrete
     assert od is not None
     lim = {n: v for n, v, _, _ in design_constants(params, d)}
@@ -118,13 +121,13 @@ def _fields(params: DriveParams, d: Derived, K: float) -> dict[str, Any]:
         "g1": d.conventional.g1, "g2": d.conventional.g2, "f_s": f_s, "f_s2": f_s**2, "f_s3": f_s**3,
         "t_s2": od.T_s**2, "j_r": params.motor.J_r,
         "u_max": u_max, "u_max2": u_max**2, "i_max": i_lim, "i_max2": i_lim * i_lim,
-        "phi_d": phi_d, "gam_d": gam_d, "inv_gam_d": 1.0 / gam_d, "phi_q": phi_q, "gam_q": gam_q,
-        "inv_gam_q": 1.0 / gam_q, "beta_dv": mismatch_filter_factor(ctrl.T_dv, float(ctrl.f_s)),
+        "phi_d": phi_d, "inv_gam_d": 1.0 / gam_d, "gam_d": gam_d, "phi_q": phi_q, "inv_gam_q": 1.0 / gam_q,
+        "gam_q": gam_q, "beta_dv": mismatch_filter_factor(ctrl.T_dv, float(ctrl.f_s)),
         "gain_dv": gam_q * c.G, "inv_gain_dv": 1.0 / (gam_q * c.G),
         "i_fault2": lim["I_FAULT"] ** 2, "u_fault2": NON_FINITE_BOUND,
         "e_o_max_counts": lim["E_O_MAX"] * cpr / (2.0 * math.pi),
-        "rest_angle": lim["REST_ANGLE"], "rest_speed": lim["REST_SPEED"],
         "rad_per_count": 2.0 * math.pi / cpr, "counts_per_rad": cpr / (2.0 * math.pi),
+        "rest_angle": lim["REST_ANGLE"], "rest_speed": lim["REST_SPEED"],
     }
 
 
