@@ -53,6 +53,8 @@ ASPECT_MIN, ASPECT_MAX = 0.42, 0.85
 DEFAULT_WINDOW = (1280.0, 720.0)
 #: Window sizes accepted from the browser [px] (anything else is not a window and is ignored).
 WINDOW_LIMITS = (100.0, 20000.0)
+#: Longest page-address query the window report carries [characters].
+MAX_ADDRESS = 200
 
 
 @dataclass(frozen=True)
@@ -159,10 +161,13 @@ def window_report_js(probe_uuid: str) -> str:
     """Return a script reporting the window's CSS size ``"<width>x<height>"`` [px] to the server.
 
     It writes the size into the text field ``probe_uuid`` as if typed (so viser sends it), now and
-    after every resize of the window.
+    after every resize of the window, followed by the page address's query as the page opened with
+    it (``" ?demo=…"``, at most :data:`MAX_ADDRESS` characters; nothing when there is none), read
+    before any run rewrites the address (:func:`page_address`).
     """
     return """(() => {
   const uuid = UUID;
+  const search = location.search.slice(0, MAX_ADDRESS);  // as opened: before a run rewrites it
   const setValue = Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set;
   let frame = 0;
   const report = () => {
@@ -172,7 +177,7 @@ def window_report_js(probe_uuid: str) -> str:
       if (++frame < 3600) requestAnimationFrame(report);
       return;
     }
-    const size = `${window.innerWidth}x${window.innerHeight}`;
+    const size = `${window.innerWidth}x${window.innerHeight}` + (search ? ` ${search}` : '');
     if (input.value === size) return;
     setValue.call(input, size);
     input.dispatchEvent(new Event('input', {bubbles: true}));
@@ -181,17 +186,33 @@ def window_report_js(probe_uuid: str) -> str:
   window.__reportWindow = () => { frame = 0; report(); };
   window.addEventListener('resize', window.__reportWindow);
   report();
-})();""".replace("UUID", json.dumps(probe_uuid))
+})();""".replace("UUID", json.dumps(probe_uuid)).replace("MAX_ADDRESS", str(MAX_ADDRESS))
+
+
+#: The window report: ``"<width>x<height>"`` [px], then the page address's query (if any).
+_REPORT = re.compile(r"\s*(\d{1,6})x(\d{1,6})(?: (\?\S{0,MAX}))?\s*".replace("MAX", str(MAX_ADDRESS)))
 
 
 def parse_window(text: str) -> tuple[float, float] | None:
-    """Window size [px] from ``"<width>x<height>"``; None for anything else or out of :data:`WINDOW_LIMITS`."""
-    match = re.fullmatch(r"\s*(\d{1,6})x(\d{1,6})\s*", text)
+    """Window size [px] from ``"<width>x<height>[ ?query]"``; None for anything else or out of :data:`WINDOW_LIMITS`."""
+    match = _REPORT.fullmatch(text)
     if match is None:
         return None
     width, height = float(match.group(1)), float(match.group(2))
     lo, hi = WINDOW_LIMITS
     return (width, height) if lo <= width <= hi and lo <= height <= hi else None
+
+
+def page_address(text: str) -> str:
+    """Return the page address's query (``"?demo=…"``) the window report ``text`` carries; ``""`` if none.
+
+    The address rides in the window report's message, not in a hidden field of its own: viser's
+    page sends the value changes of a panel's widgets through one 50 ms throttle that keeps only
+    the first and the latest message of a burst, so a third field written with the two reports
+    at page open (window, page view) dropped the one in the middle — the window size.
+    """
+    match = _REPORT.fullmatch(text)
+    return (match.group(3) or "") if match is not None else ""
 
 
 class WindowFit:
@@ -231,4 +252,4 @@ class WindowFit:
 
 
 __all__ = ["PanelLayout", "WindowFit", "hide_field_js", "install_css_js", "layout_for_window", "page_css",
-           "page_marks_js", "parse_window", "window_report_js"]
+           "page_address", "page_marks_js", "parse_window", "window_report_js"]

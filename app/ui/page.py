@@ -21,6 +21,7 @@ from pmsm_commissioning.app.threads import limit_blas_threads, release_memory
 from pmsm_commissioning.app.ui.bldc_results import follow_tabs_js
 from pmsm_commissioning.app.ui.bldc_tab import add_bldc_tab, warm_bldc
 from pmsm_commissioning.app.ui.case import Case, CaseState
+from pmsm_commissioning.app.ui.demo_link import DemoLink
 from pmsm_commissioning.app.ui.demo_view import PageViewProbe
 from pmsm_commissioning.app.ui.figure_export import FigureExport
 from pmsm_commissioning.app.ui.files import FilesPanel
@@ -30,6 +31,7 @@ from pmsm_commissioning.app.ui.layout import (
     WindowFit,
     hide_field_js,
     install_css_js,
+    page_address,
     page_css,
     page_marks_js,
     window_report_js,
@@ -141,12 +143,19 @@ class Session:
             self.fit = WindowFit(self._apply_layout)
             self.tab.demo_files.probe = probe = PageViewProbe(gui)  # outside the mode tabs: in every mode
             run_script(gui, hide_field_js(widget_id(probe.field)))
+            self.tab.demo_link = link = DemoLink(self.client, self.tab.demo_files)  # a reload keeps the demo
+            probe.field.on_update(lambda _: link.remember())  # a tab chosen: the address names it too
             if scene is not None:
                 aim_camera(self.client.camera)
-        self._window_probe.on_update(lambda _: self.fit.window_reported(self._window_probe.value))
+        self._window_probe.on_update(lambda _: self._window_reported(self._window_probe.value))
         run_script(gui, window_report_js(widget_id(self._window_probe)))
         run_script(gui, follow_tabs_js())
         run_script(gui, install_css_js(SLIDER_CSS, "app-legibility-style"))
+
+    def _window_reported(self, text: str) -> None:
+        """Fit the panels to the window the page reported; open the demo its address names (first report)."""
+        self.fit.window_reported(text)
+        self.tab.demo_link.opened(page_address(text))
 
     def _figure_handles(self) -> list[viser.GuiPlotlyHandle]:
         r, b = self.results, self.bldc.results

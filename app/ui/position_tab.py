@@ -56,6 +56,7 @@ class PositionTab:
         self._recentre = True
         self._plant_J_L: float | None = None  # the J_L slider's plant [kg·m²]; None: the model's
         self.results: ResultsPanel | None = None  # the right-hand panel, given by the page once built
+        self.demo_link: Any = None  # the page's address (app.ui.demo_link.DemoLink), given by the page
         self.tuner = TuneRunner(worker, self._run_latest, self._tuned)
         self._controls(client.gui)
 
@@ -316,6 +317,8 @@ class PositionTab:
         if status:  # not during a drag: the sliders stand where the user's pointer holds them
             self.tuning.show(d, case.plant_J_L, recentre=self._recentre)
             self._recentre = False
+            if self.demo_link is not None:  # a reload of the page, or its address sent on, opens this demo
+                self.demo_link.remember()
             if self.results is not None:  # the K sweep of this run, after it (yields to the next job)
                 self.results.k_sweep.schedule(self._worker.submit_tail, self._worker.tail_checkpoint,
                                               case.comparison, case.plant_J_L)
