@@ -10,6 +10,7 @@ current limit included.
 from __future__ import annotations
 
 import ctypes
+import importlib.metadata
 import math
 import os
 import re
@@ -22,7 +23,8 @@ import numpy as np
 import pytest
 
 from pmsm_commissioning.app.exports.c_arm import arm_compiler, double_symbols
-from pmsm_commissioning.app.exports.c_module import HEADER_NAME
+from pmsm_commissioning.app.exports.c_module import HEADER_NAME, parameter_hash
+from pmsm_commissioning.app.exports.provenance import tool_version
 from pmsm_commissioning.app.exports.c_verify import (
     CFLAGS,
     CModule,
@@ -178,6 +180,26 @@ def test_accepting_by_the_macros_own_name_is_refused(tmp_path):
     run = subprocess.run([compiler() or "cc", *CFLAGS, "-DFDSMC_ACCEPT_UNCLEAN=FDSMC_PARAM_HASH", "-c",
                           "fdsmc_controller.c"], cwd=tmp_path, capture_output=True, text=True)
     assert run.returncode != 0 and "does not equal" in run.stderr
+
+
+def test_the_hash_covers_the_tool_version(tmp_path, monkeypatch):
+    """Another version of the tool (its code may differ) gives another FDSMC_PARAM_HASH: the old
+    acceptance no longer builds the new module, only the new literal does."""
+    _module(tmp_path)
+    params = count_params(load_preset("yaskawa_sgm7j_04a"))[0]
+    old_flag, h = accept_flag(tmp_path), parameter_hash(params)
+    assert h == parameter_hash(params, tool_version()) and f"0x{h}u" in old_flag
+    assert parameter_hash(params, tool_version() + ".post1") != h
+    monkeypatch.setattr(importlib.metadata, "version", lambda name: "99.0.0")
+    assert tool_version().endswith(" 99.0.0") and parameter_hash(params) != h
+    new = tmp_path / "new"
+    new.mkdir()
+    write_module(new, params)  # unverified: the gate needs the acceptance
+    assert "99.0.0" in _header(new)
+    for flag, ok in ((old_flag, False), (accept_flag(new), True)):
+        run = subprocess.run([compiler() or "cc", *CFLAGS, flag, "-c", "fdsmc_controller.c"], cwd=new,
+                             capture_output=True, text=True)
+        assert (run.returncode == 0) == ok, run.stderr
 
 
 def test_float32_is_the_default_on_a_single_precision_fpu(tmp_path):

@@ -89,7 +89,7 @@ def test_forced_files_carry_the_failed_checks_inside(paper_case):
     y = yaml.safe_load(texts["yaml"])
     assert any(c.startswith("chatter: 1000 s/rad") for c in y["verdicts"]["failed_checks"])
     assert json.loads(texts["json"])["verdicts"]["failed_checks"] == y["verdicts"]["failed_checks"]
-    assert texts["c"].startswith("/* verdict: NOT CLEAN — written with --force")
+    assert texts["c"].startswith("/* verdict: NOT CLEAN -- written with --force")  # ASCII, as the C files
     assert texts["csv"].startswith("# verdict: NOT CLEAN") and "\ncontroller,t [s]," in texts["csv"]
     assert '<body><div class="not-clean"><p>verdict: NOT CLEAN' in texts["html"]
     assert json.loads(texts["odrive"])["_comment"][3].startswith("verdict: NOT CLEAN — stock route")

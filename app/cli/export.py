@@ -24,9 +24,10 @@ from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
 from pmsm_commissioning.app.exports.c_module import LAWS
 from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions
 from pmsm_commissioning.app.exports.drive_units import ANGLE_UNITS
-from pmsm_commissioning.app.exports.model import FORMATS, c_law, export_files
+from pmsm_commissioning.app.exports.model import FORMATS, c_law, export_files, with_optimum_run
+from pmsm_commissioning.app.exports.provenance import ExportRefusedError, check_text, failed_checks
 from pmsm_commissioning.app.io import atomic
-from pmsm_commissioning.app.io.numbers import parse_number
+from pmsm_commissioning.app.io.numbers import one_line, parse_number
 from pmsm_commissioning.app.io.presets import load, load_with_plant
 from pmsm_commissioning.app.io.user_text import check_label, escaped
 from pmsm_commissioning.control.common.checks import ParameterError
@@ -111,17 +112,52 @@ def run(args: argparse.Namespace) -> int:
     if args.output and args.format != "c":
         check_writable(args.output, "-o")
     options = ExportOptions(args.force, args.angle_unit, cycle_seconds(args.cycle_ms), args.controller)
-    files = export_files(args.format, case(params, args.format, args.controller), options)
+    cmp = case(params, args.format, args.controller)
     if args.format == "c":
-        folder = Path(args.output or ".")
-        if folder.exists() and not folder.is_dir():
-            raise ParameterError(f"-o {str(folder)!r} is a file: --format c needs a folder")
-        folder.mkdir(parents=True, exist_ok=True)
-        targets = {folder / name: content for name, content in files.items()}
-    else:
-        ((name, content),) = files.items()
-        targets = {Path(args.output or name): content}
+        return _write_c(args, cmp, options)
+    ((name, content),) = export_files(args.format, cmp, options).items()
+    targets = {Path(args.output or name): content}
     write_files(targets)
+    _print_written(targets)
+    return 0
+
+
+def _print_written(targets: dict[Path, bytes]) -> None:
     for path, content in targets.items():
         sys.stdout.write(f"wrote {escaped(path)} ({len(content)} bytes)\n")
+
+
+def _check_lines(failed: list) -> str:
+    """One line per failed check, indented (each escaped and at most 300 characters)."""
+    return "".join(f"  {one_line(check_text(c), 298)}\n" for c in failed)
+
+
+def _write_c(args: argparse.Namespace, cmp: Comparison, options: ExportOptions) -> int:
+    """Write the C module's export; refuse it naming every failed check (one line each, exit 2).
+
+    Forced, the files are written and a warning on stderr names the failed checks.
+    """
+    if args.controller == "optimum":
+        cmp = with_optimum_run(cmp)
+    failed = failed_checks(cmp, args.controller)
+    names = ", ".join(c.name for c in failed)
+    try:
+        files = export_files("c", cmp, options)
+    except ExportRefusedError:
+        name = one_line(repr(cmp.derived.params.name), 80)
+        sys.stderr.write(f"error: export --format c refused: the design of {name} is not clean; "
+                         f"{len(failed)} failed check(s): {names}. Fix the design (pmsm-commission design ...) "
+                         "or export with --force to write it with these warnings inside:\n" + _check_lines(failed))
+        return 2
+    folder = Path(args.output or ".")
+    if folder.exists() and not folder.is_dir():
+        raise ParameterError(f"-o {str(folder)!r} is a file: --format c needs a folder")
+    folder.mkdir(parents=True, exist_ok=True)
+    targets = {folder / name: content for name, content in files.items()}
+    write_files(targets)
+    _print_written(targets)
+    if failed:
+        sys.stderr.write(f"warning: written with --force: the design is NOT CLEAN; {len(failed)} failed check(s): "
+                         f"{names} (the header stops the build unless FDSMC_ACCEPT_UNCLEAN is defined as its "
+                         "FDSMC_PARAM_HASH):\n" + _check_lines(failed))
     return 0

@@ -10,7 +10,8 @@ the step reads (with precomputed products and reciprocals). The C code is in
 :mod:`app.exports.c_template`; every text goes through :func:`app.exports.c_text.c_string`.
 
 The header carries the verdict (:class:`Verdict`): an unverified or not clean design stops the
-compiler with ``#error`` unless ``FDSMC_ACCEPT_UNCLEAN`` equals the design's :func:`parameter_hash`.
+compiler with ``#error`` unless ``FDSMC_ACCEPT_UNCLEAN`` equals the design's :func:`parameter_hash` (of the
+inputs and the tool's version) as a literal.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -245,14 +246,21 @@ def _define(k: CConstant) -> str:
     return f"#define FDSMC_{k.name:<15} {value:<32} /* [{_comment(k.unit)}] {_comment(k.ref)} */"
 
 
-def parameter_hash(params: DriveParams) -> str:
-    """Hash of a preset's inputs: 16 hex digits of SHA-256 over the canonical JSON of the preset.
+def parameter_hash(params: DriveParams, tool: str | None = None) -> str:
+    """Hash of a design: 16 hex digits of SHA-256 over the preset's canonical JSON and the tool's version.
 
-    The same inputs give the same hash whether exported as YAML, JSON or C (the loader reads
-    every format back to the same :class:`DriveParams`), so the hash ties a ``.h`` to its file.
+    ``tool``: ``"<tool> <version>"`` (default :func:`app.exports.provenance.tool_version`, the installed
+    package's). The same inputs give the same hash whether exported as YAML, JSON or C (the loader reads
+    every format back to the same :class:`DriveParams`), so the hash ties a ``.h`` to its file; another
+    version of the tool, whose generated code may differ, gives another hash (an accepted unclean
+    design must be accepted again).
     """
-    text = json.dumps(to_json(to_raw(params)), sort_keys=True, separators=(",", ":"), ensure_ascii=True,
-                      allow_nan=False)
+    if tool is None:
+        from pmsm_commissioning.app.exports.provenance import tool_version  # it imports this module
+
+        tool = tool_version()
+    data = {"inputs": to_json(to_raw(params)), "tool": tool}
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"), ensure_ascii=True, allow_nan=False)
     return hashlib.sha256(text.encode("ascii")).hexdigest()[:16]
 
 
@@ -290,11 +298,15 @@ def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Ver
     if table is not None:
         constants += [CConstant(*k) for k in optimum_constants(params, d, table)]
     defines = "\n".join(_define(k) for k in constants)
-    h = parameter_hash(params if inputs is None else inputs)
+    from pmsm_commissioning.app.exports.provenance import tool_version  # it imports this module
+
+    tool = tool_version()
+    h = parameter_hash(params if inputs is None else inputs, tool)
     optimum = table is not None
-    return HEADER.substitute(tool=TOOL, name=c_string(params.name), source=c_string(params.source), schema=schema,
-                             constants=defines, hash_text=h, hash_value=f"0x{h}u", law_text=LAW_TEXT[optimum],
-                             optimum=int(optimum), state_fields=STATE_FIELDS if optimum else "",
+    return HEADER.substitute(tool=c_string(tool)[1:-1], name=c_string(params.name), source=c_string(params.source),
+                             schema=schema, constants=defines, hash_text=h, hash_value=f"0x{h}u",
+                             law_text=LAW_TEXT[optimum], optimum=int(optimum),
+                             state_fields=STATE_FIELDS if optimum else "",
                              **_gate_texts(verdict, f"0x{h}u", "tracked optimum" if optimum else "FDSMC"))
 
 

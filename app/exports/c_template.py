@@ -19,8 +19,9 @@ HEADER = Template("""\
  * Drive:  $name
  * Outer law: $law_text
  * Source: $source
- * Parameter hash: $hash_text (FDSMC_PARAM_HASH; the YAML/JSON export of the same inputs carries
- * the same hash). Schema $schema. SI units (rad, s, A, V, N*m, kg*m^2) unless a name says otherwise.
+ * Parameter hash: $hash_text (FDSMC_PARAM_HASH: SHA-256 of the inputs' canonical JSON and the
+ * tool's version above; another version gives another hash). Schema $schema. SI units (rad, s, A,
+ * V, N*m, kg*m^2) unless a name says otherwise.
  *
  * VERDICT: $verdict
 $checks *

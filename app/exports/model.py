@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from pmsm_commissioning.app.exports.c_module import LAWS, TOOL
+from pmsm_commissioning.app.exports.c_text import c_comment
 from pmsm_commissioning.app.exports.c_vectors import c_files
 from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
 from pmsm_commissioning.app.exports.provenance import check_text, failed_checks, gate, verdict_lines
@@ -182,8 +183,8 @@ def _warned(fmt: str, text: str, failed: list) -> str:
     if not failed:
         return text
     lines = verdict_lines(failed)
-    if fmt == "c":
-        return "/* " + "\n * ".join(lines) + "\n */\n" + text
+    if fmt == "c":  # printable ASCII, as the generated C files
+        return c_comment(lines) + text
     if fmt == "csv":
         return "".join(f"# {line}\n" for line in lines) + text
     if fmt == "html":
