@@ -14,9 +14,11 @@ from pathlib import Path
 from typing import Any
 
 from pmsm_commissioning.app.cli.main import add_preset_arguments
+from pmsm_commissioning.app.io.bounded import ReadError, read_bounded
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.numbers import number_option, parse_number
 from pmsm_commissioning.app.io.presets import MAX_BYTES, load_preset, loads_raw
+from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.studies.duty import Move, duty_cycle
@@ -51,15 +53,10 @@ MAX_T_M_S, MAX_DWELL_S = 1e4, 86400.0
 
 def read_moves(path: str) -> str:
     """Return the moves file's UTF-8 text; one line naming the file when it cannot be read."""
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
-    except OSError as exc:
-        raise ParameterError(f"FILE = {path!r} cannot be read: {exc.strerror or exc}: allowed a readable "
-                             "YAML file") from None
-    if len(data) > MAX_BYTES:
-        raise ParameterError(f"FILE = {path!r} is larger than {MAX_BYTES // 1024} KiB: allowed ≤ "
-                             f"{MAX_BYTES // 1024} KiB")
+    try:  # never more than MAX_BYTES read (a sparse, /proc or device file); a FIFO refused
+        data = read_bounded(path, MAX_BYTES, f"FILE = {escaped(path)!r}")
+    except ReadError as exc:
+        raise ParameterError(str(exc)) from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError:

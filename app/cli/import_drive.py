@@ -21,6 +21,7 @@ from pmsm_commissioning.app.cli.export import write_atomic
 from pmsm_commissioning.app.cli.main import check_writable
 from pmsm_commissioning.app.exports.drive_import import IMPORT_FORMATS, import_drive
 from pmsm_commissioning.app.io.assumed import INHERITED, inherited_block
+from pmsm_commissioning.app.io.bounded import ReadError, read_bounded
 from pmsm_commissioning.app.io.presets import MAX_BYTES, dumps, load, to_raw
 from pmsm_commissioning.app.io.user_text import check_label, escaped
 from pmsm_commissioning.control.common.checks import ParameterError
@@ -38,12 +39,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def read_text(path: str) -> str:
     """Return the file's UTF-8 text; a one-line error naming the file when it cannot be read."""
-    try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        raise ParameterError(f"FILE {path!r} cannot be read: {exc.strerror or exc}") from None
-    if len(data) > MAX_BYTES:
-        raise ParameterError(f"FILE {path!r} is {len(data) // 1024} KiB: allowed ≤ {MAX_BYTES // 1024} KiB")
+    try:  # never more than MAX_BYTES read (a sparse, /proc or device file)
+        data = read_bounded(path, MAX_BYTES, f"FILE {escaped(path)!r}")
+    except ReadError as exc:
+        raise ParameterError(str(exc)) from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError:

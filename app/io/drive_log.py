@@ -28,14 +28,17 @@ from pathlib import Path
 import numpy as np
 
 from pmsm_commissioning.app.io import units
+from pmsm_commissioning.app.io.bounded import ReadError, read_bounded, too_large
+from pmsm_commissioning.app.io.log_rows import Rows, RowsError, check_widths, split_rows
 from pmsm_commissioning.app.io.numbers import FORMS, NumberFormatError, parse_number, shorten, shown
+from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.fdsmc.identification import Identification, identify
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc.kernel import CHANNELS
 
-#: Largest log file accepted [bytes]; checked before reading.
+#: Largest log file accepted [bytes]; checked before reading
 MAX_BYTES = 50 * 1024 * 1024
-#: Most data rows accepted [-].
+#: Most data rows accepted [-]; counted before any row is kept (:func:`app.io.log_rows.split_rows`).
 MAX_ROWS = 2_000_000
 #: Cell texts that mark a gap (refused by :func:`_check_finite`, which counts them).
 _GAPS = frozenset({"", "nan", "inf", "infinity"})
@@ -211,34 +214,21 @@ def _select(cols: list[_Column], run: str | None, mapped: bool) -> tuple[list[_C
     return used, notes
 
 
-def _body(text: str) -> tuple[list[str], list[str], str, list[int]]:
-    """(header, data lines, delimiter, line numbers) with comments and blank lines skipped."""
-    kept = [(n, ln) for n, ln in enumerate(text.splitlines(), 1) if ln.strip() and not ln.lstrip().startswith("#")]
-    if not kept:
-        raise LogError("the log is empty: expected a header row such as 't [s], theta_r [rad], i_q [A]'")
-    head = kept[0][1]
-    delim = max((",", ";", "\t"), key=head.count)
-    if len(kept) - 1 > MAX_ROWS + 1:
-        raise LogError(f"the log has {len(kept) - 1} rows: allowed ≤ {MAX_ROWS} (cut or decimate it)")
-    header = next(csv.reader([head], delimiter=delim))
-    return header, [ln for _, ln in kept[1:]], delim, [n for n, _ in kept[1:]]
-
-
-def _parse_rows(lines: list[str], line_no: list[int], delim: str, width: int, used: list[_Column]) -> np.ndarray:
+def _parse_rows(rows: Rows, delim: str, width: int, used: list[_Column]) -> np.ndarray:
     """Read the used columns as floats: numpy's fast reader, or a row-by-row scan naming the bad cell."""
-    if all(ln.count(delim) == width - 1 for ln in lines):
+    if check_widths(rows, delim, width):  # a short row is refused here, before any is parsed
         try:
-            return np.loadtxt(lines, delimiter=delim, usecols=[c.index for c in used], ndmin=2, dtype=float,
-                              comments=None)  # "#" lines are gone already; a "#" in a cell is no number
+            return np.loadtxt(rows.lines(), delimiter=delim, usecols=[c.index for c in used], ndmin=2,
+                              dtype=float, comments=None)  # "#" lines are gone already; a "#" in a cell is no number
         except ValueError:
             pass  # an empty or non-numeric cell: the scan names it
-    return _scan_rows(lines, line_no, delim, width, used)
+    return _scan_rows(rows, delim, width, used)
 
 
-def _scan_rows(lines: list[str], line_no: list[int], delim: str, width: int, used: list[_Column]) -> np.ndarray:
-    data, r = np.empty((len(lines), len(used))), 0
+def _scan_rows(rows: Rows, delim: str, width: int, used: list[_Column]) -> np.ndarray:
+    data, r, line_no = np.empty((len(rows), len(used))), 0, rows.line_no
     try:
-        for r, row in enumerate(csv.reader(lines, delimiter=delim)):
+        for r, row in enumerate(csv.reader(rows.lines(), delimiter=delim)):
             if len(row) != width:
                 raise LogError(f"line {line_no[r]}: {len(row)} fields, the header has {width}")
             for j, c in enumerate(used):
@@ -249,12 +239,12 @@ def _scan_rows(lines: list[str], line_no: list[int], delim: str, width: int, use
                     raise LogError(f"line {line_no[r]}, column {shown(c.header)}: {shown(cell)} is not a number: "
                                    f"allowed {FORMS}") from None
     except csv.Error as exc:  # e.g. an unterminated quote swallowing the rest of the file
-        raise LogError(f"line {line_no[min(r, len(line_no) - 1)] if line_no else 1}: not valid CSV "
+        raise LogError(f"line {line_no[min(r, len(line_no) - 1)] if len(line_no) else 1}: not valid CSV "
                        f"({shorten(exc, 80)}): allowed one row per line, quotes closed") from None
     return data
 
 
-def _check_finite(data: np.ndarray, used: list[_Column], line_no: list[int]) -> None:
+def _check_finite(data: np.ndarray, used: list[_Column], line_no: np.ndarray) -> None:
     for j, c in enumerate(used):
         bad = ~np.isfinite(data[:, j])
         if bad.any():
@@ -263,7 +253,7 @@ def _check_finite(data: np.ndarray, used: list[_Column], line_no: list[int]) -> 
                            f"{line_no[first]}: gaps are not filled in — repair or cut those rows")
 
 
-def _check_time(t: np.ndarray, line_no: list[int], header: str) -> float:
+def _check_time(t: np.ndarray, line_no: np.ndarray, header: str) -> float:
     dt = np.diff(t)
     if (dt <= 0).any():
         k = int(np.argmax(dt <= 0))
@@ -321,21 +311,30 @@ def _check_speed_units(sig: dict[str, np.ndarray], cols: dict[str, str]) -> None
                        "check their units (rpm vs rad/s, deg vs rad)")
 
 
-def _rows_of_run(lines: list[str], line_no: list[int], delim: str, header: list[str],
-                 run: str | None) -> tuple[list[str], list[int], str | None]:
+#: Most different run labels a row-label column may hold [-].
+MAX_RUN_LABELS = 16
+
+
+def _rows_of_run(rows: Rows, delim: str, header: list[str], run: str | None) -> tuple[Rows, str | None]:
     """Only the rows of one run when a column labels each row's run (the page's CSV export)."""
     idx = next((i for i, h in enumerate(header) if h.strip().lower() in _RUN_LABELS), None)
     if idx is None:
-        return lines, line_no, run
-    labels = [r[idx].strip() if len(r) > idx else "" for r in csv.reader(lines, delimiter=delim)]
-    found = sorted(set(labels))
+        return rows, run
+    found: set[str] = set()
+    for r in csv.reader(rows.lines(), delimiter=delim):
+        found.add(r[idx].strip() if len(r) > idx else "")
+        if len(found) > MAX_RUN_LABELS:
+            raise LogError(f"column {shown(header[idx])} holds more than {MAX_RUN_LABELS} different runs: "
+                           f"allowed ≤ {MAX_RUN_LABELS} (e.g. {', '.join(RUNS)})")
     if run is None and len(found) > 1:
-        raise LogError(f"the file holds the runs {', '.join(found)}: choose one (--run {'|'.join(found)})")
-    chosen = run if run is not None else found[0]
+        raise LogError(f"the file holds the runs {', '.join(sorted(found))}: choose one "
+                       f"(--run {'|'.join(sorted(found))})")
+    chosen = run if run is not None else min(found, default="")
     if chosen not in found:
-        raise LogError(f"run = {chosen!r} is not in the file: allowed {', '.join(found)}")
-    keep = [k for k, label in enumerate(labels) if label == chosen]
-    return [lines[k] for k in keep], [line_no[k] for k in keep], None
+        raise LogError(f"run = {chosen!r} is not in the file: allowed {', '.join(sorted(found))}")
+    keep = np.fromiter(((r[idx].strip() if len(r) > idx else "") == chosen
+                        for r in csv.reader(rows.lines(), delimiter=delim)), dtype=bool, count=len(rows))
+    return rows.take(keep), None
 
 
 def parse_log(text: str, name: str = "<log>", *, mapping: dict[str, str] | None = None, run: str | None = None,
@@ -351,19 +350,28 @@ def parse_log(text: str, name: str = "<log>", *, mapping: dict[str, str] | None 
 def _parse_log(text: str, name: str, *, mapping: dict[str, str] | None, run: str | None,
                p: int | None) -> DriveLog:
     if len(text) > MAX_BYTES:
-        raise LogError(f"{name} is {len(text) / 2**20:.1f} MB: allowed ≤ {MAX_BYTES // 2**20} MB")
-    header, lines, delim, line_no = _body(text)
+        raise LogError(too_large(escaped(name), len(text), MAX_BYTES))
+    try:
+        head, _, rows = split_rows(text, MAX_ROWS)
+    except RowsError as exc:
+        raise LogError(f"{shown(name)}: {exc}") from None
+    delim = max((",", ";", "\t"), key=head.count)
+    header = next(csv.reader([head], delimiter=delim))
     unit_row = None
-    if lines:
-        first = next(csv.reader([lines[0]], delimiter=delim))
+    if len(rows):
+        first = next(csv.reader([rows.line(0)], delimiter=delim))
         if len(first) == len(header) and not any(_is_number(x) for x in first if x.strip()):
-            unit_row, lines, line_no = first, lines[1:], line_no[1:]
-    lines, line_no, run = _rows_of_run(lines, line_no, delim, header, run)
+            unit_row, rows = first, rows.take(slice(1, None))
+    rows, run = _rows_of_run(rows, delim, header, run)
     cols = _columns_from_mapping(header, mapping) if mapping else _columns_from_header(header, unit_row)
     used, notes = _select(cols, run, mapping is not None)
-    if len(lines) < MIN_ROWS:
-        raise LogError(f"{name} has {len(lines)} data rows: allowed ≥ {MIN_ROWS}")
-    data = _parse_rows(lines, line_no, delim, len(header), used)
+    if len(rows) < MIN_ROWS:
+        raise LogError(f"{name} has {len(rows)} data rows: allowed ≥ {MIN_ROWS}")
+    try:
+        data = _parse_rows(rows, delim, len(header), used)
+    except RowsError as exc:
+        raise LogError(str(exc)) from None
+    line_no = rows.line_no
     _check_finite(data, used, line_no)
     sig = {c.signal: data[:, j] * UNITS[SIGNALS[c.signal]][c.unit] for j, c in enumerate(used)}  # type: ignore[index]
     src = {c.signal: c.header for c in used}
@@ -377,7 +385,7 @@ def _parse_log(text: str, name: str, *, mapping: dict[str, str] | None, run: str
 def read_bytes(data: bytes, name: str, **options: object) -> DriveLog:
     """Import an uploaded log (size checked before decoding)."""
     if len(data) > MAX_BYTES:
-        raise LogError(f"{name} is {len(data) / 2**20:.1f} MB: allowed ≤ {MAX_BYTES // 2**20} MB")
+        raise LogError(too_large(escaped(name), len(data), MAX_BYTES))
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -388,13 +396,10 @@ def read_bytes(data: bytes, name: str, **options: object) -> DriveLog:
 def read_log(path: str | Path, **options: object) -> DriveLog:
     """Import a log file (size checked before reading); options as :func:`parse_log`."""
     path = Path(path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_BYTES:
-            raise LogError(f"{path.name} is {size / 2**20:.1f} MB: allowed ≤ {MAX_BYTES // 2**20} MB")
-        data = path.read_bytes()
-    except OSError as exc:
-        raise LogError(f"cannot read log {str(path)!r}: {exc.strerror or exc}") from None
+    try:  # a sparse, /proc or device file: never more than MAX_BYTES read
+        data = read_bounded(path, MAX_BYTES, escaped(path.name))
+    except ReadError as exc:
+        raise LogError(str(exc)) from None
     return read_bytes(data, path.name, **options)
 
 

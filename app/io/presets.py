@@ -25,6 +25,7 @@ from typing import Any
 
 from pmsm_commissioning.app.io import units
 from pmsm_commissioning.app.io.atomic import write_atomic_text
+from pmsm_commissioning.app.io.bounded import ReadError, read_bounded
 from pmsm_commissioning.app.io.json_data import MAX_BYTES, MAX_DEPTH, loads_json_raw  # noqa: F401 - re-exported
 from pmsm_commissioning.app.io.modes import mode_for
 from pmsm_commissioning.app.io.numbers import shown
@@ -42,6 +43,7 @@ from pmsm_commissioning.app.io.preset_schema import (
     plant_raw,
 )
 from pmsm_commissioning.app.io.transmission_keys import as_aliases
+from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.app.io.yaml_text import dumps, loads_any_raw, loads_raw, plain_scalar
 from pmsm_commissioning.app.resources import preset_dir
 from pmsm_commissioning.control.common.checks import field_specs
@@ -112,13 +114,15 @@ def list_presets() -> list[str]:
 def load_raw(name_or_path: str) -> Any:
     """Read a preset file (by name or path) into raw data, without validating sections."""
     path = resolve(name_or_path)
-    try:
-        if path.stat().st_size > MAX_BYTES:  # before reading it
-            raise PresetError(f"{path.name} is too large ({path.stat().st_size // 1024} KiB): "
-                              f"allowed ≤ {MAX_BYTES // 1024} KiB")
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise PresetError(f"cannot read preset {str(path)!r}: {exc}") from None
+    try:  # never more than MAX_BYTES read (a sparse, /proc or device file)
+        text = read_bounded(path, MAX_BYTES, escaped(path.name)).decode("utf-8")
+    except ReadError as exc:
+        if exc.size is None:
+            raise PresetError(f"cannot read preset: {exc}") from None
+        raise PresetError(f"{escaped(path.name)} is too large ({'over ' if exc.size == MAX_BYTES + 1 else ''}"
+                          f"{exc.size // 1024} KiB): allowed ≤ {MAX_BYTES // 1024} KiB") from None
+    except UnicodeDecodeError as exc:
+        raise PresetError(f"cannot read preset {escaped(str(path))!r}: {exc}") from None
     return copy.deepcopy(_parsed_file(text, path.name))  # the caller may apply overrides to it
 
 
