@@ -131,11 +131,12 @@ def _leaves(node: Any, prefix: str = "", depth: int = 0) -> list[tuple[str, Any]
 
 
 def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    keys = [k for k, _ in pairs]
-    dup = next((k for k in keys if keys.count(k) > 1), None)
-    if dup is not None:
-        raise ParameterError(f"ODrive JSON key {dup!r} is given more than once: allowed once")
-    return dict(pairs)
+    data = dict(pairs)  # one pass: a key given twice leaves fewer entries than pairs
+    if len(data) < len(pairs):
+        seen: set[str] = set()
+        dup = next(k for k, _ in pairs if k in seen or seen.add(k))  # type: ignore[func-returns-value]
+        raise ParameterError(f"ODrive JSON key {escaped(dup)[:80]!r} is given more than once: allowed once")
+    return data
 
 
 def parse_odrive(text: str, origin: str = "<odrive>") -> VendorFile:
