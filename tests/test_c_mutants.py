@@ -1,9 +1,11 @@
 """The golden vectors kill mutants of the generated C: each mutation of the controller's source must
 make the export's host test program (fdsmc_test.c) fail, in the double and the float32 build.
 
-The vectors (app/exports/c_golden.py) cover the designed move and hold, the limits acting and two
-injected faults, so a wrong gain on the sloped segment, a sign error in the q-axis current limit, an
-innovation threshold 100 times too large and a sign flip of a gain are all caught.
+The vectors (app/exports/c_golden.py, c_targeted.py) cover the designed move and hold, the limits acting,
+two injected faults, calls at rest in which the d-axis current limit or the voltage limit acts, and
+fdsmc_set_move's refusals (busy, moving), so a wrong gain on the sloped segment, a sign error in the
+q-axis or d-axis current limit, a voltage limit off by 1 %, an innovation threshold 100 times too large,
+a move accepted while one is pending or running and a sign flip of a gain are all caught.
 """
 
 from __future__ import annotations
@@ -50,6 +52,14 @@ MUTANTS = {
                                           "!below(e_abs, R_(100) * p->e_o_max_counts)"),
     "NaN passes the current check": _replace("!below(i_d * i_d + i_q * i_q, p->i_fault2)",
                                              "i_d * i_d + i_q * i_q > p->i_fault2"),
+    "d-limit sign": _replace("i_d_end = i_d1 > R_(0) ? p->i_max : -p->i_max;",
+                             "i_d_end = i_d1 > R_(0) ? -p->i_max : p->i_max;"),
+    "d-limit left out": _replace("if (FDSMC_FABS(i_d1) > p->i_max) {", "if (0) {"),
+    "voltage limit x1.01": _replace("const fdsmc_real scale = p->u_max / FDSMC_SQRT(mag2);",
+                                    "const fdsmc_real scale = R_(1.01) * p->u_max / FDSMC_SQRT(mag2);"),
+    "voltage limit left out": _replace("if (p->u_max > R_(0) && mag2 > p->u_max2) {", "if (0) {"),
+    "set_move accepts while moving": _replace("return FDSMC_ERR_MOVING;", "(void)0;"),
+    "set_move accepts while busy": _replace("return FDSMC_ERR_BUSY;", "(void)0;"),
     **{f"sign of {f}": _flip(f) for f in ("k_bl", "alpha_max", "three_inv_t_si", "three_inv_t_salpha", "l")},
 }
 
@@ -87,7 +97,9 @@ def test_the_unmutated_module_passes(export):
     for build in BUILDS:
         run = _test_program(export, build)
         assert run.returncode == 0, run.stdout
-        assert "limits" in run.stdout and "fault_innovation" in run.stdout
+        assert all(f"segment {name} " in run.stdout for name in ("move", "limits", "fault_current",
+                                                                   "fault_innovation", "limit_i_d_pos",
+                                                                   "limit_i_d_neg", "limit_u"))
 
 
 @pytest.mark.parametrize("name", MUTANTS)

@@ -54,7 +54,7 @@ int main(void)
             continue; /* the fault path is short: not the budget's */
         }
         fdsmc_init(&s, &FDSMC_DESIGN, 0);
-        if (fdsmc_set_move(&s, seg->theta_dem, (fdsmc_real)seg->t_m) != FDSMC_OK) {
+        if (seg->t_m > 0.0 && fdsmc_set_move(&s, seg->theta_dem, (fdsmc_real)seg->t_m) != FDSMC_OK) {
             return 2;
         }
         for (k = seg->start; k < seg->start + seg->n; ++k) {

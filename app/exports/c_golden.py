@@ -12,7 +12,14 @@ an injected fault). :func:`segments` makes, within :data:`MAX_SAMPLES` samples i
   module's constants unchanged (the load is the plant's, not the controller's);
 - ``fault_current`` and ``fault_innovation``: the move's first :data:`FAULT_AT` samples, then a NaN
   i_q, or the encoder count jumping 1.5 × ``FDSMC_E_O_MAX``: zero voltage and the latched fault bit
-  from that sample on.
+  from that sample on;
+- ``limit_i_d_pos``, ``limit_i_d_neg``, ``limit_u`` (FDSMC module): one call at rest, without a move,
+  reading a current in which the d-axis current limit or the voltage limit acts
+  (:mod:`app.exports.c_targeted`).
+
+The ``move`` segment also checks ``fdsmc_set_move``'s refusals: called again right after the move was
+set it must return ``FDSMC_ERR_BUSY`` (not yet taken), and at :data:`REFUSE_AT` of T_m
+``FDSMC_ERR_MOVING`` -- and the move runs on unchanged.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pmsm_commissioning.app.exports.c_module import controller_source
+from pmsm_commissioning.app.exports.c_targeted import targeted_calls
 from pmsm_commissioning.app.exports.c_verify import count_params, readings
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import derive
@@ -33,10 +41,13 @@ from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.fdsmc.engine import simulate
 from pmsm_commissioning.sim.fdsmc.grid import time_grid
 
-#: Most samples of all segments together [-]: ≈ 110 bytes of text each (1.8 MB).
-MAX_SAMPLES = 16000
-#: Most samples of the ``move`` segment [-] (the rest is left to the others).
-MAX_MOVE = 12500
+#: Most samples of all segments together [-]: ≈ 110 bytes of text each (4 MB).
+MAX_SAMPLES = 36000
+#: Most samples of the ``move`` segment [-] (the rest is left to the others): the whole move and hold of
+#: every shipped preset (the paper drive's 1 s move and hold at 20 kHz: 26000).
+MAX_MOVE = 30000
+#: Fraction of T_m at which the ``move`` segment calls ``fdsmc_set_move`` mid-move (refused: moving) [-].
+REFUSE_AT = 0.25
 #: The load step of ``limits``: this multiple of Γ_max [-], from 10 % to 20 % of T_m.
 LOAD_STEP_FACTOR = 1.3
 #: Samples kept after the last sample in which a limit acted [-].
@@ -61,6 +72,8 @@ class Segment:
     u_dq : numpy.ndarray    (n, 2) voltages applied by the simulator [V] (0 from a fault on).
     fault : int             Fault bits latched at the end (0: none).
     fault_at : int          Sample of the fault (-1: none).
+    refuse_at : int         Sample before which ``fdsmc_set_move`` must refuse (moving), and right after the
+                            move was set (busy) (-1: not checked). ``T_m`` = 0: no move is set.
     """
 
     name: str
@@ -71,6 +84,7 @@ class Segment:
     u_dq: np.ndarray
     fault: int = 0
     fault_at: int = -1
+    refuse_at: int = -1
 
 
 def _run(params: DriveParams, controller: str, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -143,7 +157,21 @@ def segments(entered: DriveParams, controller: str = "fdsmc") -> list[Segment]:
     """
     params, count = count_params(entered)
     theta, i_dq, u_dq, _ = _run(params, controller, MAX_MOVE)
-    move = Segment("move", count, params.manoeuvre.T_m, theta, i_dq, u_dq)
+    refuse_at = round(REFUSE_AT * params.manoeuvre.T_m * float(params.controller.f_s))
+    move = Segment("move", count, params.manoeuvre.T_m, theta, i_dq, u_dq,
+                   refuse_at=refuse_at if 0 < refuse_at < theta.size else -1)
     faults = _faults(move, params)
-    room = MAX_SAMPLES - move.theta.size - sum(s.theta.size for s in faults)
-    return [move, *_limits(params, count, controller, room), *faults]
+    targeted = _targeted(params) if controller == "fdsmc" else []
+    room = MAX_SAMPLES - move.theta.size - sum(s.theta.size for s in faults + targeted)
+    return [move, *_limits(params, count, controller, room), *faults, *targeted]
+
+
+def _targeted(params: DriveParams) -> list[Segment]:
+    """Return the targeted limit segments (:func:`app.exports.c_targeted.targeted_calls`), at count 0, no move."""
+    segs = []
+    for name, call in targeted_calls(params, derive(params)).items():
+        n = 2 if params.controller.delay_samples == 1 else 1
+        u = np.zeros((n, 2))
+        u[-1] = (call.u_d, call.u_q)
+        segs.append(Segment(name, 0, 0.0, np.zeros(n, dtype=np.int64), np.tile([call.i_d, call.i_q], (n, 1)), u))
+    return segs

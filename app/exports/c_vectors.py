@@ -4,8 +4,9 @@
 and hold, the limits acting, injected faults -- as ``fdsmc_vectors.h``: per sample the inputs the
 simulator's controller saw (θ_r as encoder counts, i_d, i_q) and the voltages it applied (u_d, u_q).
 ``fdsmc_test.c`` (:data:`TEST_PROGRAM`) replays each segment through ``fdsmc_step`` and exits 0 when
-every voltage agrees within 1e-6 (double) or 1e-4 (float32) of the peak |u| and every fault is latched
-as recorded. :func:`c_files` is the whole C export of one simulated case, the verdict gate included.
+every voltage agrees within 1e-6 (double) or 1e-4 (float32) of the peak |u|, every fault is latched
+as recorded and ``fdsmc_set_move`` refuses where the segment says (busy, moving). :func:`c_files` is the
+whole C export of one simulated case, the verdict gate included.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ def _segment_table(segs: list[Segment]) -> str:
     rows, start = [], 0
     for s in segs:
         rows.append(f"    {{{c_string(s.name)}, {start}, {s.theta.size}, {s.theta_dem}, {c_literal(s.T_m)}, "
-                    f"{s.fault}u, {s.fault_at}}}")
+                    f"{s.fault}u, {s.fault_at}, {s.refuse_at}}}")
         start += s.theta.size
     return ",\n".join(rows)
 
@@ -64,9 +65,10 @@ typedef struct {
     const char *name;
     int32_t start, n;      /* first sample in the arrays, samples [-] */
     fdsmc_count theta_dem; /* the move set after fdsmc_init(&s, &FDSMC_DESIGN, 0) [counts] */
-    double t_m;            /* its T_m [s] */
+    double t_m;            /* its T_m [s]; 0: no move (at rest at count 0) */
     uint32_t fault;        /* fault bits latched at the end (0: none) */
     int32_t fault_at;      /* the sample that latches it (-1: none) */
+    int32_t refuse_at;     /* fdsmc_set_move refused: BUSY right after the move, MOVING before this sample */
 } fdsmc_vec_segment;
 """
 
