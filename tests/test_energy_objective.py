@@ -97,8 +97,9 @@ def test_minimum_friction_objective_is_the_papers_design_unchanged():
 
 
 def test_electrical_objective_draws_less_than_the_papers_and_the_conventional():
+    # a regenerative DC link: the objective is the net electrical input
     for name in ("siemens_1ft7044_ak7", "yaskawa_sgm7a_50a"):
-        p = load_preset(name)
+        p = load_preset(name, ["controller.dc_link=regenerative"])
         lean, paper = design_for(p, "electrical"), design_for(p, "friction")
         assert lean.design.clean and paper.design.clean
         e = {x.controller: x.net_electrical_J for x in lean.recommendation.energies}
@@ -109,3 +110,14 @@ def test_electrical_objective_draws_less_than_the_papers_and_the_conventional():
         rec = lean.recommendation.controller
         assert e[rec] <= e["conventional"]
         assert math.isfinite(e["optimum"]) and e["optimum"] < e["fdsmc"]  # the bound the FDSMC cannot reach
+
+
+def test_with_a_braking_resistor_the_design_kept_draws_least_from_the_supply():
+    # the default DC link burns the regenerated energy: the two α rules' designs are ranked by the energy drawn
+    od = design_for(load_preset("siemens_1ft7044_ak7"), "electrical")
+    assert od.design.params.controller.dc_link == "braking_resistor"
+    kept, other = od.design.comparison.fdsmc.metrics, od.rejected.comparison.fdsmc.metrics
+    assert od.design.clean and od.rejected.clean
+    assert kept.motoring_total_J <= other.motoring_total_J
+    e = {x.controller: x for x in od.recommendation.energies}
+    assert e["fdsmc"].dc_link_J == kept.motoring_total_J

@@ -16,6 +16,7 @@ from pmsm_commissioning.app.ui.savings import annual_savings
 from pmsm_commissioning.app.ui.text import derived_markdown, warnings_html
 from pmsm_commissioning.app.ui.worker import Worker
 from pmsm_commissioning.control.fdsmc.derivations import derive
+from pmsm_commissioning.sim.fdsmc import grid
 from pmsm_commissioning.sim.fdsmc.engine import compare
 from pmsm_commissioning.sim.fdsmc.verdicts import recommended_K, run_warnings
 
@@ -63,13 +64,17 @@ def test_run_warnings_and_savings(paper_params):
     c = compare(paper_params)
     warnings = run_warnings(c)
     assert any(w.startswith("Chatter (FDSMC)") and "Recommended K" in w for w in warnings)
-    s = annual_savings(c, 600.0, 4000.0, 0.25)
-    e_f = c.fdsmc.metrics.electrical_in_total_J
-    e_c = c.conventional.metrics.electrical_in_total_J
+    s = annual_savings(c, 600.0, 4000.0, 0.25)  # default DC link: a braking resistor, the supply gives the drawn energy
+    e_f = c.fdsmc.metrics.motoring_total_J
+    e_c = c.conventional.metrics.motoring_total_J
     assert s.per_cycle_J == pytest.approx(e_c - e_f)
     assert s.kWh_per_year == pytest.approx((e_c - e_f) * 600 * 4000 / 3.6e6)
     assert s.money_per_year == pytest.approx(0.25 * s.kWh_per_year)
     assert annual_savings(dataclasses.replace(c, fdsmc=None), 1, 1, 1) is None
+    regen = dataclasses.replace(c, derived=dataclasses.replace(
+        c.derived, params=grid.with_field(paper_params, "controller.dc_link", "regenerative")))
+    net = c.conventional.metrics.electrical_in_total_J - c.fdsmc.metrics.electrical_in_total_J
+    assert annual_savings(regen, 600.0, 4000.0, 0.25).per_cycle_J == pytest.approx(net)
 
 
 def test_parse_steps_and_T_m_list():

@@ -15,15 +15,14 @@ from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
 from pmsm_commissioning.app.io.assumed import INHERITED, Assumptions, assumptions
 from pmsm_commissioning.app.io.atomic import write_atomic_text
 from pmsm_commissioning.app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
+from pmsm_commissioning.app.io.dc_link_view import ENERGY_BASIS, choice_json, energy_lines, run_json
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.motor_defaults import DERIVED
 from pmsm_commissioning.app.io.presets import dumps, load_preset, load_raw, to_raw
 from pmsm_commissioning.app.io.user_text import check_label
 from pmsm_commissioning.sim.fdsmc.checks import run_checks
 from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
-from pmsm_commissioning.sim.fdsmc.engine import LABELS
 from pmsm_commissioning.sim.fdsmc.objective import OBJECTIVES, ObjectiveDesign, design_for
-from pmsm_commissioning.sim.fdsmc.recommend import least_drawn
 
 _VERIFIED_KEYS = ("torque_peak_Nm", "i_q_peak_A", "i_peak_A", "over_i_max_s", "u_peak_V", "omega_peak_rad_s",
                   "theta_error_at_Tm_rad", "overshoot_rad", "in_position_s", "hold_i_q_rms_A", "hold_u_q_ptp_V",
@@ -36,15 +35,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
     p.add_argument("-o", "--output", metavar="FILE", help="write the designed preset (YAML) to FILE")
     p.add_argument("--objective", choices=OBJECTIVES, default=OBJECTIVES[0],
-                   help="what the design minimises: net electrical input (default) or the paper's friction loss; "
+                   help="what the design minimises: the supply's energy under controller.dc_link (default) or the "
+                        "paper's friction loss; "
                         "in_position_by_T_m: the axis in position by T_m (the move ends earlier), least energy")
     p.add_argument("--name", help="name written in the designed preset (default: the preset's)")
     p.add_argument("--source", help="source written in the designed preset, e.g. the motor's data sheet")
-
-
-#: Which energy the recommendation and the savings use (said in every output).
-ENERGY_BASIS = ("net electrical input over the whole run (drawn − returned: a DC link that takes the regenerated "
-                "energy back); with a braking resistor the supply delivers drawn_J")
 
 
 def _axis_json(od: ObjectiveDesign, assumed: Assumptions) -> dict[str, Any]:
@@ -55,12 +50,6 @@ def _axis_json(od: ObjectiveDesign, assumed: Assumptions) -> dict[str, Any]:
         runs = [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock) if r is not None] if cmp else []
         out["transmission"] = tr | {"at_output": {r.controller: run_at_output(r.metrics, params) for r in runs}}
     return out
-
-
-def _least_drawn_json(rec: Any) -> dict[str, Any] | None:
-    """Return the clean run drawing least from the DC link (the supply's energy with a braking resistor)."""
-    low = least_drawn(rec.energies) if rec is not None else None
-    return None if low is None else {"controller": low.controller, "drawn_J": low.drawn_J}
 
 
 def _designed_preset(preset: dict[str, Any], assumed: Assumptions) -> dict[str, Any]:
@@ -92,13 +81,11 @@ def design_json(od: ObjectiveDesign) -> dict[str, Any]:
         "objective": od.objective,
         "alpha_max_rule": c.alpha_max_rule,
         "energies": {e.controller: {"net_electrical_J": e.net_electrical_J, "copper_J": e.copper_J,
-                                    "friction_J": e.friction_J, "checks_failed": list(e.failed),
-                                    "drawn_J": e.drawn_J, "returned_J": e.returned_J,
-                                    "braking_resistor_supply_J": e.drawn_J}
+                                    "friction_J": e.friction_J, "checks_failed": list(e.failed)} | run_json(e)
                      for e in (rec.energies if rec else ())},
         "energy_basis": ENERGY_BASIS,
-        "least_drawn": _least_drawn_json(rec),
-        "recommended": {"controller": rec.controller, "why": rec.why} if rec else None,
+        "dc_link": choice_json(c),
+        "recommended": {"controller": rec.controller, "why": rec.why, "dc_link": c.dc_link} if rec else None,
         "clean": dd.clean,
         "verdict": dd.verdict,
         "exit_status": dd.exit_status,
@@ -163,14 +150,8 @@ def run(args: argparse.Namespace) -> int:
     for n in dd.notes + dd.comparator:
         print(f"  note: {n}")
     if od.recommendation is not None:
-        print("  net electrical input: " + ", ".join(f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J"
-                                                    for e in od.recommendation.energies))
-        print("  drawn from the DC link (the supply's energy with a braking resistor) / returned: " + ", ".join(
-            f"{LABELS[e.controller]} {e.drawn_J:.4g} / {e.returned_J:.4g} J" for e in od.recommendation.energies))
-        low = least_drawn(od.recommendation.energies)
-        print("  the recommendation and the savings use the net electrical input (regenerative DC link)"
-              + (f"; with a braking resistor the clean run drawing least is {LABELS[low.controller]}, "
-                 f"{low.drawn_J:.4g} J" if low else ""))
+        for line in energy_lines(od.recommendation):
+            print(f"  {line}")
         print(f"  recommended: {od.recommendation.why}")
     for line in transmission_lines(dd.params):
         print(f"  {line}")

@@ -10,6 +10,7 @@ from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
 from pmsm_commissioning.app.io.assumed import assumptions
 from pmsm_commissioning.app.io.atomic import write_atomic_text
 from pmsm_commissioning.app.io.axis_view import run_at_output, run_line, transmission_json, transmission_lines
+from pmsm_commissioning.app.io.dc_link_view import ENERGY_BASIS, choice_json, energy_lines, run_json
 from pmsm_commissioning.app.io.derived_view import derived_json
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.numbers import format_metric
@@ -18,8 +19,8 @@ from pmsm_commissioning.app.io.presets import load_raw
 from pmsm_commissioning.app.io.stock_view import stock_json, stock_lines
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, LABELS, Comparison, compare
-from pmsm_commissioning.sim.fdsmc.optimum_gap import DRAWN_BASIS, saving_vs_optimum
-from pmsm_commissioning.sim.fdsmc.recommend import least_drawn, recommend, runs_of
+from pmsm_commissioning.sim.fdsmc.optimum_gap import DRAWN_BASIS, saving_vs_optimum, supply_saving_vs_optimum
+from pmsm_commissioning.sim.fdsmc.recommend import recommend, run_supply_J, runs_of
 from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes, run_warnings
 
 #: Rows of the terminal summary: (metric key, label, unit).
@@ -65,10 +66,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def comparison_json(cmp: Comparison) -> dict[str, Any]:
     """Return the stable JSON contract of ``simulate --json``.
 
-    Each run's entry holds its metrics; with the optimum run, the ``fdsmc`` and ``conventional``
-    entries gain ``saving_vs_optimum_pct`` (see :func:`saving_vs_optimum`).
+    Each run's entry holds its metrics, ``dc_link_J`` (the supply's energy under ``controller.dc_link``)
+    and its ``dc_link`` energies; with the optimum run, the other entries gain ``saving_vs_optimum_pct``
+    (net, :func:`saving_vs_optimum`), ``…_drawn_pct`` and ``…_dc_link_pct`` (the supply's energy).
     """
-    out: dict[str, Any] = {"derived": derived_json(cmp.derived)}
+    c = cmp.derived.params.controller
+    out: dict[str, Any] = {"derived": derived_json(cmp.derived), "dc_link": choice_json(c)}
     for run in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock):
         if run is not None:
             out[run.controller] = to_json(run.metrics)
@@ -77,18 +80,19 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
             if run is not None:
                 out[run.controller]["saving_vs_optimum_pct"] = saving_vs_optimum(run, cmp.optimum)
                 out[run.controller]["saving_vs_optimum_drawn_pct"] = saving_vs_optimum(run, cmp.optimum, DRAWN_BASIS)
+                out[run.controller]["saving_vs_optimum_dc_link_pct"] = supply_saving_vs_optimum(run, cmp.optimum, c)
     rec = recommend(cmp.derived.params, cmp)
     for e in rec.energies:
         out[e.controller]["net_electrical_J"] = e.net_electrical_J
         out[e.controller]["checks_failed"] = list(e.failed)
-        out[e.controller]["dc_link"] = dc_link_json(e)
-    out["recommended"] = {"controller": rec.controller, "why": rec.why}
+        out[e.controller]["dc_link_J"] = e.dc_link_J
+        out[e.controller]["dc_link"] = run_json(e)
+    out["recommended"] = {"controller": rec.controller, "why": rec.why, "dc_link": c.dc_link}
     out["energy_basis"] = ENERGY_BASIS
-    low = least_drawn(rec.energies)
-    out["least_drawn"] = None if low is None else {"controller": low.controller, "drawn_J": low.drawn_J}
     out["saving_friction_pct"] = cmp.saving_friction_pct
     out["saving_electrical_pct"] = cmp.saving_electrical_pct
     out["saving_electrical_drawn_pct"] = _drawn_saving(cmp)
+    out["saving_dc_link_pct"] = dc_link_saving(cmp)
     if (tr := transmission_json(cmp.derived.params)) is not None:
         out["transmission"] = tr
         for run in runs_of(cmp):
@@ -100,20 +104,11 @@ def comparison_json(cmp: Comparison) -> dict[str, Any]:
     return to_json(out)
 
 
-#: Which energy the savings, the optimum gap and the recommendation use (said in every output).
-ENERGY_BASIS = ("net electrical input over the whole run (drawn − returned: a DC link that takes the regenerated "
-                "energy back); with a braking resistor the supply delivers dc_link.drawn_J "
-                "(*_drawn_pct savings use it)")
-
-
-def dc_link_json(e: Any) -> dict[str, float]:
-    """Return a run's energies at the DC link [J].
-
-    Drawn ∫max(p, 0) dt, returned (regenerated), net, and the supply's energy with a braking resistor
-    (= drawn: the regenerated energy is burnt).
-    """
-    return {"drawn_J": e.drawn_J, "returned_J": e.returned_J, "net_J": e.net_electrical_J,
-            "braking_resistor_supply_J": e.drawn_J}
+def dc_link_saving(cmp: Comparison) -> float | None:
+    """Return the FDSMC's saving over the conventional on the supply's energy (``controller.dc_link``) [%]."""
+    c = cmp.derived.params.controller
+    a, b = run_supply_J(cmp.fdsmc, c), run_supply_J(cmp.conventional, c)
+    return None if a is None or b is None or b <= 0.0 else 100.0 * (1.0 - a / b)
 
 
 def _drawn_saving(cmp: Comparison) -> float | None:
@@ -141,15 +136,8 @@ def print_summary(cmp: Comparison) -> None:
     print(f"Preset: {p.name}  T_m = {p.manoeuvre.T_m:g} s, θ_dem = {p.manoeuvre.theta_dem:g} rad, "
           f"f_s = {p.controller.f_s}, K = {p.controller.K:g} s/rad\n")
     rec = recommend(p, cmp)
-    print("Net electrical input, whole run: " + ", ".join(
-        f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J (copper {e.copper_J:.3g}, friction {e.friction_J:.3g})"
-        for e in rec.energies))
-    print("Drawn from the DC link (the supply's energy with a braking resistor) / returned, whole run: " + ", ".join(
-        f"{LABELS[e.controller]} {e.drawn_J:.4g} / {e.returned_J:.4g} J" for e in rec.energies))
-    low = least_drawn(rec.energies)
-    print("Savings and the recommendation use the net electrical input (regenerative DC link)"
-          + (f"; with a braking resistor the clean run drawing least is {LABELS[low.controller]}, "
-             f"{low.drawn_J:.4g} J." if low else "."))
+    for line in energy_lines(rec):
+        print(line)
     print(f"Recommended: {LABELS.get(rec.controller or '', 'none')}. {rec.why}\n")
     print(f"{'':40s}" + "".join(f"{r.controller:>16s}" for r in runs))
     for key, label, unit in SUMMARY:
@@ -159,13 +147,14 @@ def print_summary(cmp: Comparison) -> None:
         e = cmp.derived.energy
         print(f"\nFriction saving over [0, T_m]: {cmp.saving_friction_pct:.2f} %  "
               f"(eq. (52) predicts {format_metric(e.saving_pct)} %, bound {e.bound_pct:.2f} %)")
-        print(f"Net electrical-energy saving, whole run: {cmp.saving_electrical_pct:.2f} %")
+        print(f"Supply-energy saving, whole run ({p.controller.dc_link}): {format_metric(dc_link_saving(cmp))} %; "
+              f"net electrical input {cmp.saving_electrical_pct:.2f} %")
     for run in (cmp.fdsmc, cmp.conventional):
-        gap = saving_vs_optimum(run, cmp.optimum)
-        drawn = saving_vs_optimum(run, cmp.optimum, DRAWN_BASIS)
+        gap = supply_saving_vs_optimum(run, cmp.optimum, p.controller)
+        net = saving_vs_optimum(run, cmp.optimum)
         if run is not None and gap is not None:
-            print(f"The tracked minimum-energy optimum would save {gap:.2f} % of the {run.controller}'s "
-                  f"net electrical input (whole run), {format_metric(drawn)} % of the energy it draws from the DC link")
+            print(f"The tracked minimum-energy optimum would save {gap:.2f} % of the {run.controller}'s energy "
+                  f"from the supply ({p.controller.dc_link}, whole run), {format_metric(net)} % of its net input")
     for line in transmission_lines(p):
         print(line)
     if transmission_lines(p):

@@ -91,14 +91,19 @@ def _table(rows: list[tuple[str, ...]], head: tuple[str, ...]) -> str:
 
 
 def energy_headline(cmp: Comparison) -> str:
-    """Return the report's headline: net electrical input per controller (copper, friction), the recommendation."""
+    """Return the report's headline: the supply's energy per controller under the DC-link choice, the recommendation.
+
+    Beside it the energy drawn from and returned to the DC link, the net electrical input, copper and friction.
+    """
     rec = recommend(cmp.derived.params, cmp)
     if not rec.energies:
         return "<p>No simulated run.</p>"
-    rows = [(LABELS[e.controller], f"{e.net_electrical_J:.5g}", f"{e.copper_J:.4g}", f"{e.friction_J:.4g}",
-             ", ".join(e.failed) or "none") for e in rec.energies]
-    table = _table(rows, ("controller", "net electrical input [J]", "copper [J]", "friction [J]", "failed checks"))
-    return f"{table}<p><b>Recommended:</b> {html_text(rec.why)}</p>"
+    rows = [(LABELS[e.controller], f"{e.dc_link_J:.5g}", f"{e.drawn_J:.5g}", f"{e.returned_J:.5g}",
+             f"{e.net_electrical_J:.5g}", f"{e.copper_J:.4g}", f"{e.friction_J:.4g}", ", ".join(e.failed) or "none")
+            for e in rec.energies]
+    table = _table(rows, ("controller", "from the supply [J]", "drawn [J]", "returned [J]", "net electrical input [J]",
+                          "copper [J]", "friction [J]", "failed checks"))
+    return f"<p><b>{html_text(rec.dc_link)}</b></p>{table}<p><b>Recommended:</b> {html_text(rec.why)}</p>"
 
 
 def report_figures(cmp: Comparison) -> list[go.Figure]:

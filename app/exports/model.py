@@ -42,6 +42,7 @@ from pmsm_commissioning.app.exports.c_text import c_comment
 from pmsm_commissioning.app.exports.c_vectors import c_files
 from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
 from pmsm_commissioning.app.exports.provenance import check_text, failed_checks, gate, verdict_lines
+from pmsm_commissioning.app.io.dc_link_view import choice_json
 from pmsm_commissioning.app.io.derived_view import derived_rows
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.presets import SCHEMA, annotate_units, dumps, to_raw
@@ -107,6 +108,7 @@ def verdicts(cmp: Comparison) -> dict[str, Any]:
             "run_warnings": run_warnings(cmp), "comparator_notes": comparator_notes(cmp),
             "saving_friction_pct": cmp.saving_friction_pct,
             "saving_electrical_pct": cmp.saving_electrical_pct,
+            "dc_link": choice_json(d.params.controller),
             "failed_checks": [check_text(c) for c in failed_checks(cmp)]}
 
 

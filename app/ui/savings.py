@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from pmsm_commissioning.sim.common.economics import cost_per_year, kwh_per_year
+from pmsm_commissioning.sim.fdsmc.recommend import run_supply_J
 
 
 @dataclass(frozen=True)
@@ -17,7 +18,7 @@ class AnnualSavings:
 
     Attributes
     ----------
-    per_cycle_J : float   Electrical input energy saved per manoeuvre [J] (negative = costs more).
+    per_cycle_J : float   Supply energy saved per manoeuvre [J] (negative = costs more), under the DC-link choice.
     kWh_per_year : float  Saved energy per year [kWh].
     money_per_year : float  Saved money per year [currency].
     """
@@ -29,7 +30,9 @@ class AnnualSavings:
 
 def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: float,
                    price_per_kWh: float) -> AnnualSavings | None:
-    """Return the savings on the net electrical input energy over the simulated horizon; None without both runs.
+    """Return the savings on the supply's energy over the simulated horizon; None without both runs.
+
+    The supply's energy is :func:`sim.fdsmc.recommend.run_supply_J` under the case's ``controller.dc_link``.
 
     Parameters
     ----------
@@ -41,7 +44,8 @@ def annual_savings(comparison: Any, cycles_per_hour: float, hours_per_year: floa
     f, c = comparison.fdsmc, comparison.conventional
     if f is None or c is None or not (f.metrics.stable and c.metrics.stable):
         return None
-    e_f, e_c = f.metrics.electrical_in_total_J, c.metrics.electrical_in_total_J
+    link = comparison.derived.params.controller
+    e_f, e_c = run_supply_J(f, link), run_supply_J(c, link)
     if e_f is None or e_c is None:
         return None
     per_cycle = e_c - e_f
@@ -54,7 +58,7 @@ def savings_markdown(s: AnnualSavings | None, currency: str = "€") -> str:
     if s is None:
         return "_Simulate both controllers (stable runs) to estimate the savings._"
     verb = "saves" if s.per_cycle_J >= 0 else "**costs more**:"
-    return (f"FDSMC {verb} **{abs(s.per_cycle_J):.4g} J** electrical input per cycle → "
+    return (f"FDSMC {verb} **{abs(s.per_cycle_J):.4g} J** from the supply per cycle → "
             f"**{s.kWh_per_year:.4g} kWh/year** and **{s.money_per_year:.4g} {currency}/year** per axis "
             "(negative = the conventional controller is cheaper).")
 

@@ -100,11 +100,12 @@ def pins_html(pins: Any) -> str:
 
 
 def key_numbers_html(comparison: Any) -> str:
-    """Render the key numbers above the overview figure: net electrical input first.
+    """Render the key numbers above the overview figure: the supply's energy first.
 
-    Net electrical input [J] (whole run) of every simulated controller with its copper and friction
-    parts, the recommended controller (:func:`sim.fdsmc.recommend.recommend`), then the paper's
-    friction saving and the peak torques [N·m] vs the drive's limit (red when above).
+    The energy the supply delivers [J] (whole run) under the DC-link choice ``controller.dc_link``
+    (named) of every simulated controller with its copper and friction losses, the recommended
+    controller (:func:`sim.fdsmc.recommend.recommend`), then the paper's friction saving and the
+    peak torques [N·m] vs the drive's limit (red when above).
     """
     f, c = comparison.fdsmc, comparison.conventional
     if f is None:
@@ -119,12 +120,15 @@ def key_numbers_html(comparison: Any) -> str:
         return f'<b style="color:{BAD_COLOUR}">{fmt(v, digits=3)} ⚠</b>' if v > g_max * 1.001 else fmt(v, digits=3)
 
     energies = " · ".join(
-        f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {fmt(e.net_electrical_J, 'J', 3)}"
+        f"{'<b>' if e.controller == rec.controller else ''}{LABELS[e.controller]} {fmt(e.dc_link_J, 'J', 3)}"
         f"{'</b>' if e.controller == rec.controller else ''} ({fmt(e.copper_J, digits=2)} Cu + "
         f"{fmt(e.friction_J, digits=2)} fr.)"
         for e in rec.energies)
     best = f"recommended: <b>{LABELS[rec.controller]}</b>" if rec.controller else "no controller passes every check"
-    parts = [f"<b>Net electrical input</b> {energies}", best,
+    ctrl = comparison.derived.params.controller
+    link = ctrl.dc_link.replace("_", " ") + (f" η_ch {ctrl.charge_efficiency:g}" if ctrl.dc_link == "battery" else "")
+    head = f'<b>From the supply</b> <span data-role="dc-link">(DC link: {html_text(link)})</span>'
+    parts = [f"{head} {energies}", best,
              f"FDSMC {_saves(comparison.saving_friction_pct)} friction vs conventional",
              f"peak Γ {peak(f)} / {peak(c)} N·m vs Γ_max {fmt(g_max, digits=3)} N·m"]
     return (f'<div data-role="key-numbers" style="font-size:{KEY_PX}px;line-height:1.3;padding:2px 2px 4px 2px">'

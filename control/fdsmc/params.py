@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 from pmsm_commissioning.control.common.checks import ParameterError, check_fields, spec_field
+from pmsm_commissioning.control.common.dc_link import DC_LINKS
 from pmsm_commissioning.control.fdsmc.transmission import Transmission
 
 ALPHA_MAX_RULES = ("paper", "torque_limit", "min_energy")
@@ -155,6 +156,12 @@ class Controller:
     T_dv : float
         Time constant of the q-axis voltage-mismatch estimate (:func:`control.fdsmc.fdc.voltage_mismatch`)
         [s]; 0 = none (the paper's FDC). Digital controllers only.
+    dc_link : str
+        What the DC link does with regenerated energy, one of :data:`control.common.dc_link.DC_LINKS`:
+        ``braking_resistor`` (default, a stock servo drive: burnt), ``regenerative`` (returned to the
+        supply) or ``battery`` (charged at ``charge_efficiency``); sets the supply's energy of every run.
+    charge_efficiency : float
+        Battery charge efficiency η_ch [-]; used only with ``dc_link = battery``.
     """
 
     T_si: float = spec_field("s", T_MIN_S, 10.0, low_open=False, label="T_si current settling", display="ms")
@@ -172,6 +179,9 @@ class Controller:
                               label="i_max inverter current (0 = none)")
     T_dv: float = spec_field("s", 0.0, 10.0, default=0.0, low_open=False, display="ms",
                              label="T_dv q-voltage mismatch estimate (0 = none)")
+    dc_link: str = DC_LINKS[0]
+    charge_efficiency: float = spec_field("-", 0.0, 1.0, default=0.9, low_open=False,
+                                          label="η_ch battery charge efficiency")
 
     def __post_init__(self) -> None:
         """Check every field's range: a ParameterError names the field, the value and the allowed range."""
@@ -185,6 +195,8 @@ class Controller:
                 f"controller.alpha_max_rule = {self.alpha_max_rule!r} is not allowed: "
                 f"one of {', '.join(ALPHA_MAX_RULES)}"
             )
+        if self.dc_link not in DC_LINKS:
+            raise ParameterError(f"controller.dc_link = {self.dc_link!r} is not allowed: one of {', '.join(DC_LINKS)}")
 
     @property
     def is_continuous(self) -> bool:

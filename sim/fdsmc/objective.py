@@ -1,10 +1,12 @@
-"""Design for the energy the user cares about: net electrical input (default) or the paper's friction.
+"""Design for the energy the user cares about: the supply's energy (default) or the paper's friction.
 
 The paper's profile (section 4 of [1]) minimises the friction loss and runs at the largest α the
 torque allows. On servo drives the copper loss dominates and falls with α, so for the objective
 ``electrical`` (and ``in_position_by_T_m``) the FDSMC is designed twice — at the torque limit's α
 and at the α that minimises the profile's friction + copper (``alpha_max_rule = min_energy``) — and
-the clean design that draws the least net electrical energy in its verification run is kept.
+the clean design whose verification run takes the least energy from the supply under the drive's
+DC-link choice (:func:`sim.fdsmc.recommend.run_supply_J`: drawn with a braking resistor, net with a
+regenerative link) is kept.
 ``friction`` is the paper's choice (``torque_limit``), unchanged. ``in_position_by_T_m`` reads the
 requested T_m as the time by which the axis must be in position (cycle time): the move ends early
 enough that the verified run is inside the window by then
@@ -25,7 +27,7 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc.design import DriveDesign, design_drive
 from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, Comparison, compare
-from pmsm_commissioning.sim.fdsmc.recommend import Recommendation, recommend
+from pmsm_commissioning.sim.fdsmc.recommend import Recommendation, recommend, run_supply_J
 
 #: Design objectives: the first is the default.
 OBJECTIVES = ("electrical", "friction", "in_position_by_T_m")
@@ -51,9 +53,10 @@ class ObjectiveDesign:
     recommendation: Recommendation | None
 
 
-def _net(dd: DriveDesign) -> float:
+def _supply(dd: DriveDesign) -> float:
+    """Return the supply's energy of the design's verification run [J] (inf: none)."""
     run = dd.comparison.fdsmc if dd.comparison is not None else None
-    e = run.metrics.electrical_in_total_J if run is not None else None
+    e = run_supply_J(run, dd.params.controller)
     return e if e is not None else float("inf")
 
 
@@ -71,7 +74,7 @@ def design_for(params: DriveParams, objective: str = OBJECTIVES[0]) -> Objective
     kept, rejected = paper, None
     if objective != "friction":
         lean = design_drive(params, "min_energy", cycle)
-        if (_rank(lean), -_net(lean)) > (_rank(paper), -_net(paper)):
+        if (_rank(lean), -_supply(lean)) > (_rank(paper), -_supply(paper)):
             kept, rejected = lean, paper
         else:
             rejected = lean

@@ -1,9 +1,11 @@
-"""Net electrical energy per controller, and the controller to recommend for the user's drive.
+"""The supply's energy per controller, and the controller to recommend for the user's drive.
 
-The headline figure of a comparison is the **net electrical input** of each simulated run over the
-whole move (rest to rest: what the drive draws from its DC link, friction + copper + the load's work,
-regeneration netted), not the paper's friction loss (eq. (47) in [1]): on servo drives the copper
-loss dominates. The recommended controller is the one that draws the least net electrical energy
+The headline figure of a comparison is the **energy the supply delivers** to the DC link over the
+whole run (rest to rest), under the drive's DC-link choice ``controller.dc_link``
+(:func:`control.common.dc_link.supply_energy`): the energy drawn with a braking resistor (the
+default, a stock servo drive), the net electrical input with a regenerative link, drawn minus
+η_ch × returned with a battery — not the paper's friction loss (eq. (47) in [1]): on servo drives
+the copper loss dominates. The recommended controller is the one whose supply energy is least
 among those whose run passes every check on the real drive (:func:`sim.fdsmc.checks.run_checks`:
 limits, sensors, in-position, overshoot, ripple).
 
@@ -15,7 +17,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.common.dc_link import dc_link_text, supply_energy
+from pmsm_commissioning.control.fdsmc.params import Controller, DriveParams
 from pmsm_commissioning.sim.fdsmc.checks import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison, RunResult
 
@@ -33,6 +36,7 @@ class ControllerEnergy:
     drawn_J : float             Energy drawn from the DC link, ∫max(p_el, 0) dt [J]: what the supply
                                 delivers when a braking resistor burns the regenerated energy.
     returned_J : float          Energy returned to the DC link (regenerated), drawn − net [J].
+    dc_link_J : float           Energy the supply delivers under the drive's DC-link choice [J].
     """
 
     controller: str
@@ -42,6 +46,7 @@ class ControllerEnergy:
     failed: tuple[str, ...]
     drawn_J: float = math.nan
     returned_J: float = math.nan
+    dc_link_J: float = math.nan
 
     @property
     def clean(self) -> bool:
@@ -58,11 +63,14 @@ class Recommendation:
     controller : str or None          The recommended controller; None when no run passes every check.
     why : str                         One sentence.
     energies : tuple of ControllerEnergy  Every stable run, in the comparison's order.
+    dc_link : str                     The DC-link choice the energies were ranked under, in words
+                                      (:func:`control.common.dc_link.dc_link_text`).
     """
 
     controller: str | None
     why: str
     energies: tuple[ControllerEnergy, ...]
+    dc_link: str = ""
 
 
 def runs_of(cmp: Comparison) -> list[RunResult]:
@@ -70,44 +78,56 @@ def runs_of(cmp: Comparison) -> list[RunResult]:
     return [r for r in (cmp.fdsmc, cmp.conventional, cmp.optimum, cmp.stock) if r is not None]
 
 
+def run_supply_J(run: RunResult | None, controller: Controller) -> float | None:
+    """Return the energy the supply delivers over ``run`` (whole run) under ``controller.dc_link`` [J].
+
+    None unless the run is stable with its drawn and net energies.
+    """
+    if run is None or not run.metrics.stable:
+        return None
+    drawn, net = run.metrics.motoring_total_J, run.metrics.electrical_in_total_J
+    if drawn is None or net is None:
+        return None
+    return supply_energy(drawn, drawn - net, controller.dc_link, controller.charge_efficiency)
+
+
 def controller_energies(params: DriveParams, cmp: Comparison) -> tuple[ControllerEnergy, ...]:
     """Return the energy headline of every stable run of ``cmp`` (whole run) with its failed checks."""
     out = []
+    c = params.controller
     for run in runs_of(cmp):
         m = run.metrics
         if m.stable and m.electrical_in_total_J is not None:
-            failed = tuple(c.name for c in run_checks(params, run))
+            failed = tuple(x.name for x in run_checks(params, run))
             drawn = m.motoring_total_J if m.motoring_total_J is not None else math.nan
+            returned = drawn - m.electrical_in_total_J
             out.append(ControllerEnergy(run.controller, m.electrical_in_total_J, m.copper_total_J or 0.0,
-                                        m.friction_total_J or 0.0, failed, drawn, drawn - m.electrical_in_total_J))
+                                        m.friction_total_J or 0.0, failed, drawn, returned,
+                                        supply_energy(drawn, returned, c.dc_link, c.charge_efficiency)))
     return tuple(out)
 
 
 def recommend(params: DriveParams, cmp: Comparison) -> Recommendation:
-    """Recommend the clean run with the least net electrical input (see the module doc)."""
-    energies = controller_energies(params, cmp)
-    clean = sorted((e for e in energies if e.clean), key=lambda e: e.net_electrical_J)
+    """Recommend the clean run whose supply energy is least under the DC-link choice (see the module doc)."""
+    return rank(controller_energies(params, cmp), params.controller)
+
+
+def rank(energies: tuple[ControllerEnergy, ...], controller: Controller) -> Recommendation:
+    """Recommend the clean run of ``energies`` with the least ``dc_link_J``, said under ``controller.dc_link``."""
+    link = dc_link_text(controller.dc_link, controller.charge_efficiency)
+    clean = sorted((e for e in energies if e.clean and e.dc_link_J == e.dc_link_J), key=lambda e: e.dc_link_J)
     if not clean:
         fails = "; ".join(f"{LABELS[e.controller]}: {', '.join(e.failed)}" for e in energies)
-        return Recommendation(None, f"No controller passes every check on this drive ({fails}).", energies)
+        return Recommendation(None, f"No controller passes every check on this drive ({fails}).", energies, link)
     best = clean[0]
     others = [e for e in energies if e.controller != best.controller]
-    beaten = ", ".join(f"{LABELS[e.controller]} {e.net_electrical_J:.4g} J"
+    beaten = ", ".join(f"{LABELS[e.controller]} {e.dc_link_J:.4g} J"
                        + ("" if e.clean else f" (fails {', '.join(e.failed)})") for e in others)
-    why = (f"{LABELS[best.controller]} draws the least net electrical energy, {best.net_electrical_J:.4g} J "
+    why = (f"{LABELS[best.controller]} takes the least energy from the supply, {best.dc_link_J:.4g} J "
            f"(copper {best.copper_J:.3g} J, friction {best.friction_J:.3g} J), of the controllers that pass "
-           f"every check" + (f"; {beaten}." if beaten else "."))
-    return Recommendation(best.controller, why, energies)
+           f"every check ({link})" + (f"; {beaten}." if beaten else "."))
+    return Recommendation(best.controller, why, energies, link)
 
 
-def least_drawn(energies: tuple[ControllerEnergy, ...]) -> ControllerEnergy | None:
-    """Return the clean run that draws the least from the DC link (None: no clean run).
-
-    With a braking resistor (no regeneration into the supply) the supply delivers the drawn energy,
-    not the net one, so this is the controller a drive without regeneration would be given.
-    """
-    clean = [e for e in energies if e.clean and e.drawn_J == e.drawn_J]  # NaN: no drawn figure
-    return min(clean, key=lambda e: e.drawn_J) if clean else None
-
-
-__all__ = ["ControllerEnergy", "Recommendation", "controller_energies", "least_drawn", "recommend", "runs_of"]
+__all__ = ["ControllerEnergy", "Recommendation", "controller_energies", "rank", "recommend", "run_supply_J",
+           "runs_of"]
