@@ -143,6 +143,8 @@ def _hint_bounds(hint: str) -> tuple[float | None, float | None, str]:
 def _check_hint(hint: str, spec: FieldSpec, unit: str, to_si: typing.Callable[[float], float]) -> None:
     low, high, shown = _hint_bounds(hint)
     assert shown == ("" if unit == "-" else unit), (hint, unit)
+    if low is not None and high is not None and to_si(low) > to_si(high):  # a decreasing unit (ω_c = 3/T_si)
+        low, high = high, low
     for got, want in ((low, spec.low), (high, spec.high)):
         assert (got is None) == (want is None), hint
         if got is not None:
@@ -167,13 +169,16 @@ def test_position_page_field_shows_spec_label_unit_and_range(field):
     to_si = (lambda x: choice.to_si(x, p)) if choice else (lambda x: units.to_si(x, spec.shown_unit))
     _check_hint(field.hint(choice, p), spec, unit, to_si)
     for alt in inputs.UNIT_GROUPS.get(field.group or "", ())[1:]:  # every other unit choice: same SI range
-        shown = alt.label.partition("[")[2].rstrip("]") if field.group == "flux" else field.unit_of(alt)
+        named = "[" in alt.label  # a quantity of its own (Kt [N·m/A peak], ω_c [Hz]) names the field
+        shown = alt.label.partition("[")[2].rstrip("]") if named else field.unit_of(alt)
+        assert field.text(alt) == (alt.label if named else f"{spec.label} [{shown}]")
         _check_hint(field.hint(alt, p), spec, shown, lambda x, u=alt: u.to_si(x, p))
 
 
 def test_position_page_covers_every_top_level_number_field():
     on_page = {f.key for f in PAGE_POSITION} | {"controller.delay_samples"}  # delay: a dropdown
-    spec_keys = {f"{sec}.{n}" for sec in ("motor", "load", "controller", "sensors", "limits", "manoeuvre")
+    spec_keys = {f"{sec}.{n}" for sec in ("motor", "load", "controller", "sensors", "limits", "manoeuvre",
+                                           "transmission")
                  for n in field_specs(units.SECTION_CLASSES[sec])}
     assert spec_keys == on_page
     spec = units.spec_of("controller.delay_samples")

@@ -108,6 +108,23 @@ def _listed_keys() -> list[str]:
     return keys
 
 
+def inherited_over(base: DriveParams, params: DriveParams) -> tuple[Assumed, ...]:
+    """Return the listed values ``params`` kept from ``base`` when a motor field differs (a motor typed over it).
+
+    The page's counterpart of :func:`assumptions`: what the engineer changed is what differs from the
+    opened preset ``base``; nothing is listed while the motor is the preset's own.
+    """
+    def value(p: DriveParams, key: str) -> Any:
+        section, _, name = key.partition(".")
+        return getattr(getattr(p, section), name)
+
+    keys = _listed_keys()
+    changed = {k for k in keys if value(base, k) != value(params, k)}
+    if not any(k.startswith("motor.") for k in changed):
+        return ()
+    return tuple(_value(params, k) for k in keys if k not in changed and not _default_none(params, k))
+
+
 def inherited_block(base: str, given: set[str]) -> dict[str, Any]:
     """Return the ``inherited`` entry of a preset built over ``base``: every listed field not in ``given``.
 
@@ -147,4 +164,4 @@ def assumptions(raw: Any, params: DriveParams, overrides: tuple[str, ...] = (), 
     return Assumptions(base, inherited, derived)
 
 
-__all__ = ["INHERITED", "Assumed", "Assumptions", "assumptions", "inherited_block"]
+__all__ = ["INHERITED", "Assumed", "Assumptions", "assumptions", "inherited_block", "inherited_over"]

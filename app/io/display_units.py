@@ -3,13 +3,14 @@
 Conversions are :mod:`app.io.units`'s (one table, driven by each field's
 :class:`~control.common.checks.FieldSpec`); this module adds what the page needs on top: the unit
 choices of a selector (inertia in kg·m² or kg·cm², R_s and L per phase or line-to-line, Ψ_PM or Ke,
-Kt, Kv), a field's label with its unit, and its allowed range written in the shown unit. The
-position tab's :class:`Field` and the BLDC tab's :func:`field_label`/:func:`shown_value`/
-:func:`si_value` are the same layer.
+Kt per A_rms or per A peak, Kv; T_si or the drive's current-loop bandwidth), a field's label with
+its unit, and its allowed range written in the shown unit. The position tab's :class:`Field` and the
+BLDC tab's :func:`field_label`/:func:`shown_value`/:func:`si_value` are the same layer.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -58,11 +59,19 @@ UNIT_GROUPS: dict[str, tuple[Unit, ...]] = {
                   lambda x, p: units.psi_pm_to_ke_vrms_krpm(x, p)),
              Unit("Kt [N·m/A_rms]", lambda x, p: units.kt_nm_per_arms_to_psi_pm(x, p),
                   lambda x, p: units.psi_pm_to_kt_nm_per_arms(x, p)),
+             Unit("Kt [N·m/A peak]", lambda x, p: units.kt_nm_per_apeak_to_psi_pm(x, p),
+                  lambda x, p: units.psi_pm_to_kt_nm_per_apeak(x, p)),
              Unit("Kv [rpm/V LL peak]", lambda x, p: units.kv_rpm_per_v_to_psi_pm(x, p),
                   lambda x, p: units.psi_pm_to_kv_rpm_per_v(x, p))),
     "current": (Unit("A peak"),
                 Unit("A_rms", lambda x, _p: units.to_si(x, "Arms"), lambda x, _p: units.from_si(x, "Arms"))),
     "resistance": (_winding("per phase", 1.0, "motor.R_s"), _winding("line-to-line", 2.0, "motor.R_s")),
+    # T_si, or the drive's current-loop bandwidth ω_c it follows from: T_si = 3/ω_c (eq. (8) of [1])
+    "settling": (_named(units.spec_of("controller.T_si").shown_unit),
+                 Unit("ω_c current-loop bandwidth [Hz]", lambda x, _p: units.bandwidth_to_T_si(2.0 * math.pi * x),
+                      lambda x, _p: units.bandwidth_to_T_si(x) / (2.0 * math.pi)),
+                 Unit("ω_c current-loop bandwidth [rad/s]", lambda x, _p: units.bandwidth_to_T_si(x),
+                      lambda x, _p: units.bandwidth_to_T_si(x))),
     "inductance": (_winding("per phase", 1.0, "motor.L_d"), _winding("line-to-line", 2.0, "motor.L_d")),
 }
 @dataclass(frozen=True)
@@ -109,8 +118,8 @@ class Field:
         return choice.label if choice is not None else self.unit
 
     def text(self, choice: Unit | None = None) -> str:
-        """Label with unit, as shown on the page."""
-        if self.group == "flux" and choice is not None:
+        """Label with unit, as shown on the page; a choice that names a quantity (``Kt [N·m/A peak]``) replaces it."""
+        if choice is not None and "[" in choice.label:
             return choice.label
         return f"{self.label} [{self.unit_of(choice)}]"
 
@@ -118,7 +127,8 @@ class Field:
         """Write the allowed range in the shown unit, e.g. ``"allowed 1e-06 ≤ value ≤ 10000 mH"``."""
         if choice is None:
             return units.shown_range(self.spec)
-        unit = choice.label.partition("[")[2].rstrip("]") if self.group == "flux" else self.unit_of(choice)
+        named = "[" in choice.label
+        unit = choice.label.partition("[")[2].rstrip("]") if named else self.unit_of(choice)
         return units.range_in(self.spec, lambda b: choice.from_si(b, p), unit)
 
 

@@ -191,7 +191,7 @@ def _bandwidth(factor: float, unit: str) -> Callable[[float], float]:
             raise ParameterError(f"controller.current_bandwidth_{unit.replace('/', '_')} = {x!r} {unit} is out of "
                                  f"range: allowed {0.3 / factor:.4g} ≤ value ≤ {3e6 / factor:.4g} {unit} "
                                  "(T_si = 3/ω_c, eq. (8))")
-        return 3.0 / omega_c
+        return bandwidth_to_T_si(omega_c)
     return convert
 
 
@@ -248,11 +248,14 @@ def spec_of(key: str) -> FieldSpec:
 
 
 def range_in(spec: FieldSpec, to_shown: Callable[[float], float], unit: str) -> str:
-    """Write the allowed range of ``spec`` in a shown unit; ``to_shown`` converts (linear, increasing).
+    """Write the allowed range of ``spec`` in a shown unit; ``to_shown`` converts (monotonic).
 
-    E.g. L_d's range 1e-09 ≤ value ≤ 10 H shown in mH: ``"allowed 1e-06 ≤ value ≤ 10000 mH"``.
+    E.g. L_d's range 1e-09 ≤ value ≤ 10 H shown in mH: ``"allowed 1e-06 ≤ value ≤ 10000 mH"``. A
+    decreasing conversion (T_si shown as the bandwidth 3/T_si) swaps the ends of a closed range.
     """
     lo, hi = (None if b is None else to_shown(b) for b in (spec.low, spec.high))
+    if lo is not None and hi is not None and lo > hi and not spec.low_open:
+        lo, hi = hi, lo
     return range_text(lo, hi, spec.low_open, unit, integer=spec.integer)
 
 
@@ -323,6 +326,16 @@ def kt_nm_per_apeak_to_psi_pm(Kt_Nm_Apk: float, p: int) -> float:
     """
     return Kt_Nm_Apk / (1.5 * p)
 
+
+
+def psi_pm_to_kt_nm_per_apeak(psi_pm: float, p: int) -> float:
+    """Ψ_PM [Wb] → Kt [N·m per A peak]; inverse of :func:`kt_nm_per_apeak_to_psi_pm`."""
+    return psi_pm * 1.5 * p
+
+
+def bandwidth_to_T_si(omega_c: float) -> float:
+    """Current-loop bandwidth ω_c [rad/s] → T_si = 3/ω_c [s] (eq. (8) of [1]: the d-current pole is 3/T_si)."""
+    return 3.0 / omega_c
 
 
 def kt_nm_per_arms_to_psi_pm(Kt_Nm_Arms: float, p: int) -> float:

@@ -21,14 +21,17 @@ from pmsm_commissioning.app.io import units
 from pmsm_commissioning.app.io.display_units import UNIT_GROUPS, Field, Unit
 from pmsm_commissioning.app.io.numbers import NumberFormatError
 from pmsm_commissioning.app.io.presets import to_raw
+from pmsm_commissioning.app.ui.axis_inputs import InputError, OutputSideInputs, rated_left_out, with_rated_derived
 from pmsm_commissioning.app.ui.choices import checked_choice
 from pmsm_commissioning.app.ui.number_fields import NumberInput
 from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.common.dc_link import DC_LINK_MEANING, DC_LINKS
 from pmsm_commissioning.control.fdsmc.nameplate import nameplate_consistency
 from pmsm_commissioning.control.fdsmc.params import ALPHA_MAX_RULES, DriveParams, LoadStep, Motor
+from pmsm_commissioning.control.fdsmc.transmission import Transmission
 
 SELECTORS = (("flux", "Flux given as"), ("resistance", "R_s, L_d, L_q given"), ("inertia", "Inertia unit"),
-             ("angle", "Move unit"), ("current", "i_max given as"))
+             ("angle", "Move unit"), ("current", "i_max given as"), ("settling", "T_si given as"))
 
 
 FIELDS: tuple[Field, ...] = (
@@ -36,8 +39,11 @@ FIELDS: tuple[Field, ...] = (
     Field("motor", "psi_pm", "flux"), Field("motor", "p"), Field("motor", "R_s", "resistance"),
     Field("motor", "L_d", "inductance"), Field("motor", "L_q", "inductance"), Field("motor", "J_r", "inertia"),
     Field("load", "J_L", "inertia"), Field("load", "F_v"), Field("load", "Gamma_Le"), Field("load", "Gamma_Le_ramp"),
-    Field("controller", "V_dc"), Field("controller", "i_max", "current"), Field("controller", "T_si"),
+    Field("transmission", "ratio"), Field("transmission", "efficiency"), Field("transmission", "lead"),
+    Field("transmission", "pulley_radius"),
+    Field("controller", "V_dc"), Field("controller", "i_max", "current"), Field("controller", "T_si", "settling"),
     Field("controller", "T_salpha"), Field("controller", "T_so"), Field("controller", "T_dv"), Field("controller", "K"),
+    Field("controller", "charge_efficiency"),
     Field("sensors", "encoder_cpr"), Field("sensors", "i_noise"), Field("sensors", "i_adc_bits"),
     Field("sensors", "i_adc_range"), Field("sensors", "seed"),
     Field("limits", "omega_max"), Field("limits", "in_position"), Field("limits", "overshoot"),
@@ -46,7 +52,8 @@ FIELDS: tuple[Field, ...] = (
 )
 #: Inputs with a keyword alternative (a dropdown beside them): T_c ('T_a' rule) and f_s ('continuous').
 T_C, F_S = Field("controller", "T_c"), Field("controller", "f_s")
-FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("controller", "Inverter and controller"),
+FOLDERS = (("motor", "Motor nameplate"), ("load", "Load"), ("transmission", "Transmission"),
+           ("controller", "Inverter and controller"),
            ("sensors", "Sensors"), ("limits", "Pass criteria"), ("manoeuvre", "Manoeuvre"))
 TC_RULES = ("T_c = T_a, eq. (59)", "T_c given below")
 FS_MODES = ("digital, sampled at f_s", "continuous")
@@ -54,10 +61,6 @@ ALPHA_RULES = ALPHA_MAX_RULES  # the parameter model's own list: every rule a pr
 DELAYS = ("0", "1")
 #: Optional datasheet values used only to cross-check the nameplate (label → key).
 CHECKS = (("Kt datasheet [N·m/A_rms] (optional check)", "Kt"), ("T_N rated torque [N·m] (optional check)", "T_N"))
-
-
-class InputError(ValueError):
-    """Invalid form input; the message names the field (with its page label) and the allowed range."""
 
 
 def format_steps(steps: tuple[Any, ...]) -> str:
@@ -102,7 +105,7 @@ class InputsPanel:
         self.populate(params)
 
     def _selectors(self, section: str) -> None:
-        wanted = {"motor": ("flux", "resistance", "inertia"), "controller": ("current",),
+        wanted = {"motor": ("flux", "resistance", "inertia"), "controller": ("current", "settling"),
                   "manoeuvre": ("angle",)}.get(section, ())
         for group, title in SELECTORS:
             if group in wanted:
@@ -118,7 +121,11 @@ class InputsPanel:
         elif section == "load":
             self.steps = gui.add_text("Γ_Le steps [t s : N·m, …]", "",
                                       hint="Later steps of the external load torque, e.g. 0.5:10, 1.2:0")
+        elif section == "transmission":
+            self.output_side = OutputSideInputs(gui)
         elif section == "controller":
+            self.dc_link = gui.add_dropdown("DC link", DC_LINKS, hint="; ".join(
+                f"{k}: {v}" for k, v in DC_LINK_MEANING.items()) + " (η_ch: the charge efficiency below)")
             self.tc_rule = gui.add_dropdown("T_c rule", TC_RULES)
             self.tc_ms = NumberInput(gui, T_C.text(), hint=T_C.hint(None, 0))
             self.alpha_rule = gui.add_dropdown("α_max rule", ALPHA_RULES,
@@ -177,6 +184,9 @@ class InputsPanel:
         if c.T_c != "T_a":
             self.tc_ms.show(units.from_si(float(c.T_c), T_C.unit), exact=float(c.T_c))
         self.alpha_rule.value = c.alpha_max_rule
+        self.dc_link.value = c.dc_link
+        self.output_side.clear()
+        self.rated_derived: tuple[str, ...] = ()
         self.fs_mode.value = FS_MODES[1] if c.is_continuous else FS_MODES[0]
         if not c.is_continuous:
             self.fs_khz.show(units.from_si(float(c.f_s), F_S.unit), exact=float(c.f_s))
@@ -245,11 +255,15 @@ class InputsPanel:
             Naming the page label, the SI field, the value and the allowed range.
         """
         values: dict[str, dict[str, Any]] = {}
+        left_out = rated_left_out(self.numbers)  # derived from the inverter below
         for f in FIELDS:
-            values.setdefault(f.section, {})[f.name] = self._read(f)
+            derived = f.section == "motor" and f.name in left_out
+            values.setdefault(f.section, {})[f.name] = 1.0 if derived else self._read(f)
         steps = parse_steps(self.steps.value)
         c = values["controller"]
         try:  # dropdown values are checked against the options offered (a client may send anything)
+            c["dc_link"] = checked_choice(self.dc_link.value, DC_LINKS, "DC link")
+            reflected = self.output_side.reflected(Transmission(**values["transmission"]))
             tc_rule = checked_choice(self.tc_rule.value, TC_RULES, "T_c rule")
             fs_mode = checked_choice(self.fs_mode.value, FS_MODES, "Controller")
             c["alpha_max_rule"] = checked_choice(self.alpha_rule.value, ALPHA_RULES, "α_max rule")
@@ -261,12 +275,21 @@ class InputsPanel:
             c["f_s"] = "continuous" if fs_mode == FS_MODES[1] else self.fs_khz.read(
                 f"Controller › {F_S.text()}", lambda x: units.to_si(x, F_S.unit))
         except (NumberFormatError, ParameterError) as exc:
-            raise InputError(str(exc)) from None
+            raise InputError(_with_label(str(exc))) from None
         self.nameplate_checks()
+        for section, given in reflected.items():
+            values[section].update(given)
         try:
-            return built(self._params, values, steps)
+            params = with_rated_derived(built(self._params, values, steps), left_out)
+        except InputError:
+            raise
         except ValueError as exc:
             raise InputError(_with_label(str(exc))) from None
+        for section, given in reflected.items():  # the rotor-side fields show what the output's values give
+            for name, si in given.items():
+                self.set_value(f"{section}.{name}", si)
+        self.rated_derived = left_out
+        return params
 
 
 def built(base: DriveParams, values: dict[str, dict[str, Any]], steps: list[dict[str, float]]) -> DriveParams:

@@ -18,6 +18,7 @@ from typing import Any
 import viser
 
 from pmsm_commissioning.app.io.presets import list_presets_of, load, require_mode
+from pmsm_commissioning.app.ui.axis_inputs import axis_markdown
 from pmsm_commissioning.app.ui.case import Case, CaseState
 from pmsm_commissioning.app.ui.choices import checked_choice
 from pmsm_commissioning.app.ui.files import ExportRefusedError, FilesPanel, uncommitted
@@ -160,7 +161,7 @@ class PositionTab:
                                                  "verified by simulation")
         self.design_button.on_click(lambda _: self.design())
         self.objective = gui.add_dropdown("Design objective", OBJECTIVE_LABELS,
-                                          hint="net electrical input (copper + friction): the α that draws least; "
+                                          hint="energy from the supply under the DC link: the α that takes least; "
                                                "friction: the paper's profile at the torque limit")
         self.design_note = gui.add_markdown("")
         self.optimum = OptimumToggle(gui, self.simulate)
@@ -170,6 +171,7 @@ class PositionTab:
         with gui.add_form(None) as form:
             self.inputs = InputsPanel(gui, case.params)
         form.on_submit(lambda _: self.simulate())
+        self.inputs.dc_link.on_update(lambda e: self.simulate() if e.client is not None else None)  # re-ranks
         with gui.add_folder("Derived values", expand_by_default=True):
             self.derived = gui.add_markdown("")
 
@@ -311,7 +313,8 @@ class PositionTab:
         """Show the derived values, verdicts and status of the current case."""
         case = self.case
         d = case.comparison.derived
-        assign(self.derived, content=derived_markdown(d))
+        axis = axis_markdown(case.params, self.inputs.rated_derived, case.origin)
+        assign(self.derived, content=derived_markdown(d) + (f"\n\n{axis}" if axis else ""))
         self.optimum.show(case.comparison)
         self.inputs.show_T_c_in_force(d.profile.T_c)
         if status:  # not during a drag: the sliders stand where the user's pointer holds them

@@ -12,7 +12,7 @@ from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, CONTROLLERS, Compar
 from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, table1_sweep
 
 #: The page's words for the design objectives (same order as :data:`sim.fdsmc.objective.OBJECTIVES`).
-OBJECTIVE_LABELS = ("minimum net electrical energy", "minimum friction (paper)")
+OBJECTIVE_LABELS = ("minimum energy from the supply", "minimum friction (paper)")
 
 
 def comparison_or_derived(params: DriveParams, optimum: bool = False, plant_J_L: float | None = None) -> Comparison:

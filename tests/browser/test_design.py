@@ -87,14 +87,14 @@ def test_design_button_turns_a_typed_catalogue_servo_clean(page, default_server)
     p = session.params
     assert p.motor.J_r == 4.86e-5 and p.motor.Gamma_max == 4.46  # exactly as typed
     assert p.motor.psi_pm == pytest.approx(0.544 / (1.5 * 2 ** 0.5 * 5), rel=1e-12)
-    # the default objective (net electrical input) takes the α that draws least copper + friction
+    # the default objective (energy from the supply) takes the α that draws least copper + friction
     assert p.controller.alpha_max_rule == "min_energy" and p.controller.K < 1.0
     m = session.comparison.fdsmc.metrics
     assert m.torque_peak_Nm <= 4.46 * 1.005 and not m.chatter
     assert m.i_q_peak_A <= 13.15 * 1.005
     assert field(page, "K boundary-layer gain [s/rad]").input_value() == shown_text(p.controller.K)  # rounded
     headline = page.inner_text('[data-role="key-numbers"]')
-    assert "Net electrical input" in headline and all(n in headline for n in ("FDSMC", "Conventional", "Optimum"))
+    assert "From the supply" in headline and all(n in headline for n in ("FDSMC", "Conventional", "Optimum"))
     lean = session.comparison.fdsmc.metrics.electrical_in_total_J
     # the paper's objective: the fastest profile the torque allows — another design, more energy drawn
     choose(page, "Design objective", "minimum friction (paper)")

@@ -103,7 +103,7 @@ def test_1280x720_shows_phase_plane_time_plot_numbers_and_scrub_without_scrollin
     assert boxes["phase"]["width"] >= 300 and boxes["phase"]["height"] >= 250  # legible on a projector
     assert boxes["omega"]["x"] > boxes["phase"]["x"] + boxes["phase"]["width"]  # side by side
     text = page.inner_text('[data-role="key-numbers"]')
-    assert "Net electrical input" in text and "Optimum" in text and "Γ_max" in text
+    assert "From the supply" in text and "Optimum" in text and "Γ_max" in text
     page.wait_for_timeout(300)  # let the last layout message settle before the picture
     ARTIFACTS.mkdir(exist_ok=True)
     out = ARTIFACTS / "projector_1280x720.png"  # copied by hand to docs/ for the README
@@ -245,6 +245,6 @@ def test_viser_software_webgl_notice_is_closed_while_no_3d_view_is_shown(browser
         page.wait_for_function(f"() => !({WEBGL_NOTICE_JS})()")
         page.wait_for_timeout(500)  # and it stays closed
         assert not page.evaluate(WEBGL_NOTICE_JS)
-        assert "Net electrical input" in page.inner_text('[data-role="key-numbers"]')
+        assert "From the supply" in page.inner_text('[data-role="key-numbers"]')
     finally:
         context.close()
