@@ -2,7 +2,8 @@
 
 The vendor files carry the motor's electrical data, not its nameplate, load or move, so an import
 replaces the motor data of a base preset: R_s, L_d, L_q, Ψ_PM (from the torque constant, Kv or flux
-linkage), the pole pairs p and the current limit (``controller.i_max``). Each value is checked
+linkage), the pole pairs p and the current limit (``controller.i_max``); a moteus file also gives the
+transmission ratio (``transmission.ratio`` = 1/``motor_position.rotor_to_output_ratio``). Each value is checked
 against the preset field's range; a bad value is reported naming the vendor key, its value and
 unit, and the allowed range. Every key of the file that is not imported is listed, never silently
 dropped; a preset field the file does not give (e.g. moteus without Kv) is kept and listed.
@@ -13,7 +14,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from pmsm_commissioning.app.exports.moteus import moteus_motor, parse_moteus
+from pmsm_commissioning.app.exports.moteus import moteus_motor, moteus_ratio, parse_moteus
 from pmsm_commissioning.app.exports.odrive import odrive_motor, parse_odrive
 from pmsm_commissioning.app.exports.vendor_keys import VendorFile
 from pmsm_commissioning.app.exports.vesc import parse_vesc, vesc_motor
@@ -34,7 +35,8 @@ SOURCES: dict[str, dict[str, tuple[str, str]]] = {
                "sensors.encoder_cpr": ("axis0.encoder.config.cpr", "counts/rev")},
     "moteus": {"motor.R_s": ("motor.resistance_ohm", "Ohm"), "motor.L_d": ("motor.inductance_d_H", "H"),
                "motor.L_q": ("motor.inductance_q_H", "H"), "motor.psi_pm": ("motor.Kv", "rpm/V"),
-               "motor.p": ("motor.poles", "poles"), "controller.i_max": ("servo.max_current_A", "A")},
+               "motor.p": ("motor.poles", "poles"), "controller.i_max": ("servo.max_current_A", "A"),
+               "transmission.ratio": ("motor_position.rotor_to_output_ratio", "output rev per rotor rev")},
     "vesc": {"motor.R_s": ("foc_motor_r", "Ohm"), "motor.L_d": ("foc_motor_l", "H"),
              "motor.L_q": ("foc_motor_l", "H"), "motor.psi_pm": ("foc_motor_flux_linkage", "Wb"),
              "motor.p": ("si_motor_poles", "poles"), "controller.i_max": ("l_current_max", "A")},
@@ -102,12 +104,18 @@ def import_drive(text: str, fmt: str, base: DriveParams, origin: str = "<drive f
         R, Ld, Lq, psi, p, i_max = motor
         values = {"motor.R_s": R, "motor.L_d": Ld, "motor.L_q": Lq, "motor.psi_pm": psi, "motor.p": p,
                   "controller.i_max": i_max}
+        if fmt == "moteus":
+            has_ratio = f.get("motor_position.rotor_to_output_ratio") is not None
+            values["transmission.ratio"] = moteus_ratio(f) if has_ratio else None
     given = {k: _checked(fmt, k, v, f) for k, v in values.items() if v is not None}
     motor_kw = {k.split(".")[1]: v for k, v in given.items() if k.startswith("motor.")}
     sensors = base.sensors if "sensors.encoder_cpr" not in given else dataclasses.replace(
         base.sensors, encoder_cpr=int(given["sensors.encoder_cpr"]))
+    transmission = base.transmission if "transmission.ratio" not in given else dataclasses.replace(
+        base.transmission, ratio=given["transmission.ratio"])
     params = dataclasses.replace(base, motor=dataclasses.replace(base.motor, **motor_kw), sensors=sensors,
-                                 controller=dataclasses.replace(base.controller, i_max=given["controller.i_max"]))
+                                 controller=dataclasses.replace(base.controller, i_max=given["controller.i_max"]),
+                                 transmission=transmission)
     used = {SOURCES[fmt][k][0] for k in given} | set(ALSO_USED.get(fmt, ()))
     imported = tuple(f"{k} = {v!r} (from {SOURCES[fmt][k][0]})" for k, v in given.items())
     kept = tuple(f"{k} (not in the file; {SOURCES[fmt][k][0]} absent)" for k in values if k not in given)

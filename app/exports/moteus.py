@@ -5,8 +5,16 @@ per line; ``--restore-config`` sends every non-empty line as ``conf set key valu
 units are those of moteus' ``docs/reference.md`` (configurable parameters) and the firmware's
 ``fw/bldc_servo_structs.h``: the position PID in N·m per output revolution (kp), N·m/s per
 revolution (ki), N·m per revolution/s (kd); the trajectory limits in rev/s and rev/s² at the
-output, after ``motor_position.rotor_to_output_ratio`` (written as 1: this tool's load is referred
-to the rotor); ``motor.poles`` counts poles, not pole pairs; ``servo.inertia_feedforward`` in kg·m².
+output; ``motor.poles`` counts poles, not pole pairs; ``servo.inertia_feedforward`` in kg·m².
+
+``motor_position.rotor_to_output_ratio`` is "the number of turns of the output for one turn of the
+rotor" (moteus docs/reference.md), so 1/N for this tool's ``transmission.ratio`` N (motor revolutions
+per output revolution). With it moteus reads positions, speeds and torques at the output shaft
+(reference.md: position "in rotations of the output shaft", torque "as measured at the output
+shaft"): an output revolution is N rotor revolutions and an output torque N rotor torques, so the
+rotor-side gains this tool tunes are written ×N² (kp, ki, kd, inertia: torque per angle, torque per
+acceleration), the integrator clamp ×N, the speed and acceleration limits ÷N; :func:`moteus_loop`
+reads them back the same way. moteus' ratio is kinematic only: the transmission's efficiency is not in it.
 
 moteus runs a parallel PID, not a cascade; its gains, the current PI (``servo.pid_dq``), the encoder
 PLL and the control rate are tuned on the simulated stock route (:mod:`sim.stock.tuning`: no
@@ -70,13 +78,32 @@ _LINE = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*) (\S+)$")
 
 
 def moteus_values(s: StockSettings) -> dict[str, float]:
-    """Every written key → value in moteus' units (the one conversion from SI)."""
-    g, tr, loop = s.gains, s.trapezoid, s.tuning.loop
-    values = [pole_pairs_to_poles(s.p), s.R_s, s.current_limit, per_rad_to_per_turn(g.kp),
-              per_rad_to_per_turn(g.ki), per_rad_to_per_turn(g.kd), loop.i_lim,
-              rad_to_turn(abs(tr.omega_c)), rad_to_turn(tr.alpha), g.inertia, 1.0, loop.current_kp,
-              loop.current_ki, s.pll_bandwidth / (2.0 * math.pi), s.f_loop]
+    """Every written key → value in moteus' units at the output (the one conversion from SI, see the module doc)."""
+    g, tr, loop, N = s.gains, s.trapezoid, s.tuning.loop, s.ratio
+    values = [pole_pairs_to_poles(s.p), s.R_s, s.current_limit, per_rad_to_per_turn(g.kp) * N**2,
+              per_rad_to_per_turn(g.ki) * N**2, per_rad_to_per_turn(g.kd) * N**2, loop.i_lim * N,
+              rad_to_turn(abs(tr.omega_c)) / N, rad_to_turn(tr.alpha) / N, g.inertia * N**2, 1.0 / N,
+              loop.current_kp, loop.current_ki, s.pll_bandwidth / (2.0 * math.pi), s.f_loop]
     return dict(zip(KEYS, values, strict=True))
+
+
+#: Relative mismatch of the file's ratio with the case's 1/N that float32 storage explains.
+RATIO_TOLERANCE = 1e-6
+
+
+def moteus_ratio(f: VendorFile) -> float:
+    """Return the transmission ratio N = 1/``motor_position.rotor_to_output_ratio`` (motor rev per output rev).
+
+    Raises
+    ------
+    ParameterError
+        Naming the key for a ratio that is missing, not > 0 or gives N outside ``transmission.ratio``'s range.
+    """
+    r = f.require("motor_position.rotor_to_output_ratio", "the ratio")
+    if not (math.isfinite(r) and r > 0.0):
+        raise ParameterError(f"motor_position.rotor_to_output_ratio = {r!r} is not allowed: allowed > 0 "
+                             "(output turns per rotor turn)")
+    return 1.0 / r
 
 
 def moteus_text(s: StockSettings, header: list[str]) -> str:
@@ -136,20 +163,21 @@ def moteus_loop(f: VendorFile, params: DriveParams) -> StockLoop:
     Raises
     ------
     ParameterError
-        Naming the key, for a missing setting or a rotor-to-output ratio other than 1.
+        Naming the key, for a missing setting or a rotor-to-output ratio that is not the case's 1/N.
     """
-    if f.require("motor_position.rotor_to_output_ratio", "the ratio") != 1.0:
-        raise ParameterError("motor_position.rotor_to_output_ratio is not allowed here: 1 (the simulated load "
-                             "is referred to the rotor)")
+    N = moteus_ratio(f)
+    if abs(N / params.transmission.ratio - 1.0) > RATIO_TOLERANCE:
+        raise ParameterError(f"motor_position.rotor_to_output_ratio = {1.0 / N!r} is not allowed here: "
+                             f"{1.0 / params.transmission.ratio!r} (1/transmission.ratio, the simulated axis)")
     tr = trapezoid_from_limits(params.manoeuvre.theta_dem,
-                               turn_to_rad(f.require("servo.default_velocity_limit", "the speed limit [rev/s]")),
-                               turn_to_rad(f.require("servo.default_accel_limit", "the acceleration [rev/s^2]")))
+                               turn_to_rad(f.require("servo.default_velocity_limit", "the speed limit [rev/s]")) * N,
+                               turn_to_rad(f.require("servo.default_accel_limit", "the acceleration [rev/s^2]")) * N)
     rate = f.require("servo.pwm_rate_hz", "the control rate [Hz]")
-    gains = [per_turn_to_per_rad(f.require(f"servo.pid_position.{k}", f"the position PID's {k}"))
+    gains = [per_turn_to_per_rad(f.require(f"servo.pid_position.{k}", f"the position PID's {k}")) / N**2
              for k in ("kp", "kd", "ki")]
     return StockLoop(
-        "moteus", rate, "pid", *gains, f.require("servo.pid_position.ilimit", "the integrator clamp [Nm]"),
-        math.inf, f.require("servo.inertia_feedforward", "the inertia [kg*m^2]"), torque_constant(params.motor),
+        "moteus", rate, "pid", *gains, f.require("servo.pid_position.ilimit", "the integrator clamp [Nm]") / N,
+        math.inf, f.require("servo.inertia_feedforward", "the inertia [kg*m^2]") / N**2, torque_constant(params.motor),
         f.require("servo.max_current_A", "the current limit [A]"),
         2.0 * math.pi * f.require("motor_position.sources.0.pll_filter_hz", "the PLL bandwidth [Hz]"), False,
         f.require("servo.pid_dq.kp", "the current kp [V/A]"), f.require("servo.pid_dq.ki", "the current ki"),

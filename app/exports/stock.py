@@ -51,6 +51,8 @@ class StockSettings:
     f_loop : float               The drive's loop rate [Hz].
     tuning : StockTuning         The tuned route (its verifying run and checks).
     encoder_cpr : int            Encoder counts per motor revolution (``sensors.encoder_cpr``; 0 = ideal).
+    ratio : float                Transmission ratio N, motor revolutions per output revolution
+                                 (``transmission.ratio``; a drive that works at the output divides by it).
     """
 
     trapezoid: TrapezoidTiming
@@ -68,6 +70,7 @@ class StockSettings:
     f_loop: float
     tuning: StockTuning
     encoder_cpr: int = 0
+    ratio: float = 1.0
 
 
 def loop_gains(loop: StockLoop) -> CascadeGains:
@@ -88,7 +91,7 @@ def stock_settings(cmp: Comparison, drive: str = "setpoints") -> StockSettings:
     cycle = CONTINUOUS_CYCLE_S if c.is_continuous else 1.0 / float(c.f_s)
     return StockSettings(tr, loop_gains(loop), m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, i_lim,
                          max(m.omega_b, abs(tr.omega_c)), 3.0 / c.T_si, cycle, loop.omega_e, loop.f_loop, tu,
-                         p.sensors.encoder_cpr)
+                         p.sensors.encoder_cpr, p.transmission.ratio)
 
 
 def with_stock_runs(cmp: Comparison) -> Comparison:
