@@ -21,17 +21,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pmsm_commissioning.control.common.arrays import FloatOrArray
+
 #: ε_λ [rad/s] without anti-windup: λ(ε) = λ_0 for every error, exactly (the integral of eq. (16)
 #: is never relieved).
 NO_ANTI_WINDUP = math.inf
 
 
-def lambda_of_error(eps: float, lambda_0: float, eps_lambda: float) -> float:
+def lambda_of_error(eps: FloatOrArray, lambda_0: float, eps_lambda: float) -> FloatOrArray:
     """λ(ε) = λ_0/(1 + (ε/ε_λ)²), the integral weight of eq. (16) in [2] [1/s].
 
     Parameters
     ----------
-    eps : float         Speed error ε_ω [rad/s].
+    eps : float or numpy.ndarray  Speed error ε_ω [rad/s] (an array gives λ at each error).
     lambda_0 : float    λ(0) [1/s].
     eps_lambda : float  Half-value error ε_λ [rad/s].
     """

@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import expm
 
+from pmsm_commissioning.control.common.arrays import FloatArray
+
 
 def block_exponential(M: np.ndarray) -> np.ndarray:
     """Return e^M of a square matrix [-] (one ``scipy.linalg.expm`` call).
@@ -32,7 +34,8 @@ def block_exponential(M: np.ndarray) -> np.ndarray:
     numpy.ndarray
         n×n matrix exponential.
     """
-    return expm(M)
+    e: FloatArray = expm(M)
+    return e
 
 
 def zoh(A: np.ndarray, B: np.ndarray, T_s: float) -> tuple[np.ndarray, np.ndarray]:

@@ -37,6 +37,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 from scipy.stats import t as student_t
 
+from pmsm_commissioning.control.common.arrays import FloatArray
 from pmsm_commissioning.control.fdsmc.model import electromagnetic_torque
 
 #: Largest relative standard error of a reported estimate [-]; above it the parameter is refused.
@@ -134,7 +135,8 @@ def _windows(n: int, w: int) -> tuple[np.ndarray, np.ndarray]:
 def _window_sums(per_interval: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Sum of a per-interval quantity over each window [a, b) of intervals."""
     c = np.concatenate([[0.0], np.cumsum(per_interval)])
-    return c[b] - c[a]
+    sums: FloatArray = c[b] - c[a]
+    return sums
 
 
 def _estimates(fit: _Fit | None, spec: tuple[tuple[str, str], ...], refused: dict[str, str],
@@ -182,8 +184,14 @@ def _electrical_rows(t: np.ndarray, th: np.ndarray, i_d: np.ndarray, i_q: np.nda
     dt, dth = np.diff(t), np.diff(th)
     md, mq = 0.5 * (i_d[1:] + i_d[:-1]), 0.5 * (i_q[1:] + i_q[:-1])
     a, b = _windows(n, w)
-    S = lambda v: _window_sums(v, a, b)  # noqa: E731
-    D = lambda x: x[b] - x[a]  # noqa: E731
+
+    def S(v: FloatArray) -> FloatArray:
+        return _window_sums(v, a, b)
+
+    def D(x: FloatArray) -> FloatArray:
+        change: FloatArray = x[b] - x[a]
+        return change
+
     zero = np.zeros(a.size)
     A_d = np.column_stack([S(md * dt), D(i_d), -p * S(mq * dth), zero])
     A_q = np.column_stack([S(mq * dt), p * S(md * dth), D(i_q), p * S(dth)])
@@ -240,9 +248,8 @@ def speed_from_angle(t: np.ndarray, theta_r: np.ndarray, span_s: float = 1e-2) -
     T_s = float(np.median(np.diff(t)))
     n = max(7, int(round(span_s / T_s)) | 1)
     n = min(n, theta_r.size - (1 - theta_r.size % 2))
-    if n < 5:
-        return np.gradient(theta_r, t)
-    return savgol_filter(theta_r, n, 3, deriv=1, delta=T_s)
+    omega_r: FloatArray = np.gradient(theta_r, t) if n < 5 else savgol_filter(theta_r, n, 3, deriv=1, delta=T_s)
+    return omega_r
 
 
 def identify_mechanical(t: np.ndarray, theta_r: np.ndarray, omega_r: np.ndarray, Gamma_em: np.ndarray,
@@ -324,8 +331,9 @@ def identify(
     else:
         i_q = signals["i_q"]
         i_d = signals.get("i_d")
-        known = i_d is not None and L_d is not None and L_q is not None  # else the reluctance term is 0
-        Gamma_em = electromagnetic_torque(p, psi, L_d if known else 0.0, L_q if known else 0.0,
-                                          i_d if known else 0.0, i_q)
+        if i_d is not None and L_d is not None and L_q is not None:
+            Gamma_em = electromagnetic_torque(p, psi, L_d, L_q, i_d, i_q)
+        else:  # the reluctance term is 0
+            Gamma_em = electromagnetic_torque(p, psi, 0.0, 0.0, np.zeros_like(i_q), i_q)
         mech, res_m, n_m = identify_mechanical(t, th, w, Gamma_em, window_mechanical_s)
     return Identification(tuple(el + mech), delay, res_el, res_m, n_el, n_m)

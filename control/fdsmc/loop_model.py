@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pmsm_commissioning.control.common.arrays import FloatArray
 from pmsm_commissioning.control.common.discrete import zoh
 from pmsm_commissioning.control.fdsmc.model import ModelCoefficients
 from pmsm_commissioning.control.fdsmc.observer import DiscreteObserver, ObserverGains, discrete_observer
@@ -247,7 +248,8 @@ def reduce_shift_mode(M: np.ndarray) -> np.ndarray:
     T_inv[1, 3] = 1.0
     Mt = T @ M @ T_inv
     keep = [i for i in range(n) if i != 3]
-    return Mt[np.ix_(keep, keep)]
+    reduced: FloatArray = Mt[np.ix_(keep, keep)]
+    return reduced
 
 
 def law_case(d: LoopCase, law: str) -> LoopCase:

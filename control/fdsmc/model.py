@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from pmsm_commissioning.control.common.arrays import FloatOrArray
 from pmsm_commissioning.control.common.jit import jitable
 from pmsm_commissioning.control.fdsmc.params import Motor
 
@@ -71,7 +72,8 @@ def model_coefficients(motor: Motor) -> ModelCoefficients:
 
 
 @jitable
-def electromagnetic_torque(p: float, psi_pm: float, L_d: float, L_q: float, i_d: float, i_q: float) -> float:
+def electromagnetic_torque(p: float, psi_pm: float, L_d: float, L_q: float, i_d: FloatOrArray,
+                          i_q: FloatOrArray) -> FloatOrArray:
     """Electromagnetic torque Γ_em = (3/2)·p·(Ψ_PM + (L_d − L_q)·i_d)·i_q, eq. (5) in [1] [N·m].
 
     The one implementation of eq. (5): the compiled kernel, the plain-Python reference, the
@@ -86,7 +88,7 @@ def electromagnetic_torque(p: float, psi_pm: float, L_d: float, L_q: float, i_d:
     L_d, L_q : float
         d- and q-axis inductances [H].
     i_d, i_q : float or numpy.ndarray
-        d- and q-axis currents [A] (amplitude-invariant dq).
+        d- and q-axis currents [A] (amplitude-invariant dq), both scalars or both arrays.
 
     Returns
     -------

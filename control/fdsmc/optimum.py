@@ -55,6 +55,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -62,6 +63,13 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import Derived
 from pmsm_commissioning.control.fdsmc.model import torque_constant
 from pmsm_commissioning.control.fdsmc.params import DriveParams
+
+if TYPE_CHECKING:  # cvxpy is imported where an optimum is asked for (a heavy import)
+    import cvxpy as cp
+
+    #: The convex problem of :func:`_problem`: (problem, g = Γ_em/G_s, v = ω/w_s, the speed parameter of u_d,
+    #: G_s [N·m], w_s [rad/s]).
+    ConvexMove = tuple[cp.Problem, cp.Variable, cp.Variable, cp.Parameter, float, float]
 
 #: Default number of QP intervals over [0, T_m] [-].
 N_INTERVALS = 2000
@@ -210,7 +218,7 @@ MAX_VOLTAGE_ITERATIONS = 12
 VOLTAGE_ITERATION_TOL = 1e-6
 
 
-def _problem(mm: MoveModel, n: int, voltage: bool) -> tuple:
+def _problem(mm: MoveModel, n: int, voltage: bool) -> ConvexMove:
     """Build the convex problem on n intervals.
 
     The QP of the module docstring, plus (``voltage``) the voltage cone with u_d's speed a
@@ -250,7 +258,7 @@ class OptimumSolverError(ParameterError):
     """Every solver of :data:`SOLVERS` failed on the optimum's problem (numerical trouble, not infeasibility)."""
 
 
-def _solve(mm: MoveModel, n: int, problem: tuple) -> OptimalMove:
+def _solve(mm: MoveModel, n: int, problem: ConvexMove) -> OptimalMove:
     """Solve ``problem`` of :func:`_problem`, naming the limits if it is infeasible.
 
     The solvers of :data:`SOLVERS` are tried in turn; when each one fails numerically,

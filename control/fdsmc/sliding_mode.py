@@ -10,6 +10,7 @@ Phase-plane state: position error θ_re = θ_r − θ_rdem and speed ω_r. The s
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from pmsm_commissioning.control.common.jit import jitable
 
@@ -41,7 +42,9 @@ def in_boundary_layer(theta_re: np.ndarray | float, omega_r: np.ndarray | float,
     T_c : float            Slope time constant [s].
     K : float              Boundary-layer gain [s/rad]: the layer is ±1/K wide.
     """
-    return np.abs(np.asarray(omega_r, dtype=float) - boundary_speed(theta_re, omega_p, T_c)) <= 1.0 / K
+    distance = np.abs(np.asarray(omega_r, dtype=float) - boundary_speed(theta_re, omega_p, T_c))
+    inside: npt.NDArray[np.bool_] = distance <= 1.0 / K
+    return inside
 
 
 @jitable

@@ -23,6 +23,7 @@ import numpy as np
 
 from pmsm_commissioning.control.bldc.dqx import trapezoid_unit
 from pmsm_commissioning.control.bldc.params import EMF_SAMPLES_MIN, BldcMachine
+from pmsm_commissioning.control.common.arrays import FloatArray
 from pmsm_commissioning.control.common.checks import ParameterError
 
 N_TABLE = 720  # 0.5° electrical per sample; a multiple of 12 keeps the trapezoid corners exact
@@ -51,7 +52,8 @@ def distorted_table(Phi_m: float, n: int = N_TABLE) -> np.ndarray:
     kernel = np.roll(kernel, -(width // 2))
     smooth = np.real(np.fft.ifft(np.fft.fft(ideal_table(Phi_m, n)) * np.fft.fft(kernel)))
     extra = sum(-a * Phi_m * np.sin(h * theta) for h, a in HARMONICS)
-    return smooth + extra
+    table: FloatArray = smooth + extra
+    return table
 
 
 def machine_table(machine: BldcMachine, n: int = N_TABLE) -> np.ndarray:
@@ -69,7 +71,8 @@ def periodic_resample(samples: np.ndarray, n: int) -> np.ndarray:
     if m == n:
         return samples.copy()
     x = np.arange(n) * m / n
-    return np.interp(x, np.arange(m + 1), np.append(samples, samples[0]))
+    resampled: FloatArray = np.interp(x, np.arange(m + 1), np.append(samples, samples[0]))
+    return resampled
 
 
 def table_phases(table: np.ndarray, theta_e: np.ndarray) -> np.ndarray:

@@ -74,7 +74,8 @@ def emf_lookup(table: np.ndarray, theta_e: float) -> float:
     f = x - i0
     i0 = i0 % n
     i1 = (i0 + 1) % n
-    return table[i0] + f * (table[i1] - table[i0])
+    phi: float = table[i0] + f * (table[i1] - table[i0])
+    return phi
 
 
 @njit(cache=True)
@@ -92,7 +93,7 @@ def plant_derivative(y: np.ndarray, v_a: float, v_b: float, v_c: float, T_L: flo
     v_n = (v_a + v_b + v_c - we * (fa + fb + fc)) / 3.0
     dy[0] = (v_a - v_n - prm[P_R] * i_a - we * fa) / prm[P_L]
     dy[1] = (v_b - v_n - prm[P_R] * i_b - we * fb) / prm[P_L]
-    T_el = npp * (fa * i_a + fb * i_b + fc * i_c)
+    T_el: float = npp * (fa * i_a + fb * i_b + fc * i_c)
     dy[2] = (T_el - prm[P_B] * w - T_L) / prm[P_J]
     dy[3] = w
     dy[4] = v_a * i_a + v_b * i_b + v_c * i_c

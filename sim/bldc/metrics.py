@@ -121,6 +121,12 @@ def _window_stats(params: BldcParams, tr: BldcTrace, t_reach: float | None
     return err_max, ripple, best
 
 
+def _slowest(rec: list[float | None]) -> float | None:
+    """Return the longest recovery time [s]; None when there is no load step or one never recovers."""
+    times = [r for r in rec if r is not None]
+    return max(times) if times and len(times) == len(rec) else None
+
+
 def _overshoot(params: BldcParams, tr: BldcTrace, t_reach: float | None) -> float:
     """Overshoot [rad/s] within the constant-load segment in which ω first reaches ω*."""
     case = params.case
@@ -155,7 +161,7 @@ def run_metrics(params: BldcParams, tr: BldcTrace, diverged: bool = False) -> Bl
         overshoot_rad_s=_overshoot(params, tr, t_reach) if stable else None,
         torque_ripple_pct=ripple if stable else None,
         ripple_window_s=list(window) if window else None,
-        recovery_time_s=None if (not stable or not rec or any(r is None for r in rec)) else max(rec),
+        recovery_time_s=_slowest(rec) if stable else None,
         recovery_times_s=rec,
         reach_time_s=t_reach,
         i_peak_A=signals.peak_abs(tr.i_abc),

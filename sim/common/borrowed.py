@@ -44,6 +44,6 @@ def _compiled() -> Any:
 
 
 #: ``borrowed(a)`` inside a compiled kernel: ``a`` without reference counting (see the module docstring).
-borrowed = _identity if numba.config.DISABLE_JIT else _compiled()
+borrowed = _identity if numba.config.DISABLE_JIT else _compiled()  # type: ignore[attr-defined]
 
 __all__ = ["borrowed"]

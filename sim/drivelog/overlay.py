@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pmsm_commissioning.control.fdsmc.identification import speed_from_angle
-from pmsm_commissioning.sim.fdsmc.engine import Trace
+from pmsm_commissioning.sim.fdsmc.trace import Trace
 
 #: Signals compared: name → SI unit.
 OVERLAY_SIGNALS = {"theta_r": "rad", "omega_r": "rad/s", "i_d": "A", "i_q": "A", "u_d": "V", "u_q": "V"}

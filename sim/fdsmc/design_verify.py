@@ -184,7 +184,7 @@ def _scan_T_c(p: DriveParams, best: Verified, n_best: int, step: float) -> Verif
         got = simulate(_with_T_c(p, T_a * step**k))
         n = n_best if got is None or got[2].fdsmc is None else len(run_checks(got[0], got[2].fdsmc))
         since = 0 if n < n_best else since + 1
-        if n < n_best:
+        if got is not None and n < n_best:
             best, n_best = got, n
         if n == 0 or since > T_C_PATIENCE:
             break

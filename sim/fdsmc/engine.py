@@ -14,7 +14,6 @@ Energies without suffix are integrals over [0, T_m] (the paper's W_L, eq. (47) i
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 import threading
@@ -57,6 +56,7 @@ from pmsm_commissioning.sim.fdsmc.metrics import (
     run_metrics,
 )
 from pmsm_commissioning.sim.fdsmc.summary import decode_info
+from pmsm_commissioning.sim.fdsmc.trace import Trace as Trace  # re-exported: RunResult.trace
 
 CONTROLLERS = ("fdsmc", "conventional")
 #: Every simulated outer loop: the two controllers and the tracked minimum-energy optimum
@@ -86,19 +86,6 @@ def start_run_threads() -> None:
     gate = threading.Barrier(RUN_THREADS)  # each task waits until all threads run one
     for f in [_RUNS.submit(gate.wait, 10.0) for _ in range(RUN_THREADS)]:
         f.result()
-
-
-#: Time series of one run on a common grid (SI units; energies cumulative from t = 0), one field per
-#: channel of the compiled kernel (:data:`sim.fdsmc.kernel.CHANNELS`, in its order):
-#: t [s]; theta_r [rad]; omega_r [rad/s]; i_d, i_q [A]; u_d, u_q [V] (applied);
-#: alpha [rad/s²] true rotor acceleration dω_r/dt; alpha_dem [rad/s²] outer-loop demand;
-#: Gamma_L [N·m] true total load torque, eq. (4a)/(6); Gamma_L_hat [N·m] observer's L̂0;
-#: theta_hat [rad]; omega_hat [rad/s]; S [rad/s] switching function (0 for the conventional law);
-#: E_friction, E_copper, E_electrical [J]; alpha_hat [rad/s²] eq. (7) with Γ̂_L; E_motoring, E_load [J].
-Trace = dataclasses.make_dataclass(
-    "Trace", [(name, np.ndarray) for name in kn.CHANNELS], frozen=True,
-    namespace={"__module__": __name__, "__doc__": "Time series of one run: one array per kernel channel "
-               "(:data:`sim.fdsmc.kernel.CHANNELS`), SI units; energies cumulative from t = 0."})
 
 
 @dataclass(frozen=True)

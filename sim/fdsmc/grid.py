@@ -139,8 +139,16 @@ def _cost_drivers(params: DriveParams, request: Callable[[DriveParams], budget.C
         fields.append(("controller.f_s", float(ctrl.f_s), "Hz", 100.0, False))
         if plant_substeps(params) > 1:
             fields += [("motor.omega_b", m.omega_b, "rad/s", 1e-3, False), ("motor.p", m.p, "", 1, True)]
-    return [budget.Driver(name, value, unit, lambda v, n=name: request(with_field(params, n, v)), limit, integer)
+    return [budget.Driver(name, value, unit, _field_cost(request, params, name), limit, integer)
             for name, value, unit, limit, integer in fields]
+
+
+def _field_cost(request: Callable[[DriveParams], budget.Cost], params: DriveParams,
+                field: str) -> Callable[[float], budget.Cost]:
+    """Return the cost of ``params`` as a function of the value of ``field`` (``"section.name"``)."""
+    def cost(value: float) -> budget.Cost:
+        return request(with_field(params, field, value))
+    return cost
 
 
 def check_budget(params: DriveParams, n_runs: int = 1, **options: Any) -> budget.Cost:

@@ -34,6 +34,7 @@ from numba import njit
 from pmsm_commissioning.control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
 from pmsm_commissioning.control.stock import loops
 from pmsm_commissioning.sim.common import sensors
+from pmsm_commissioning.sim.fdsmc.trace import CHANNELS as CHANNELS  # re-exported: the kernel's channel order
 
 # ---- prm indices -------------------------------------------------------------------------
 (P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
@@ -64,9 +65,7 @@ LAW_DRIVE = 4.0
 N_X = 13
 
 # ---- trace channels ----------------------------------------------------------------------
-CHANNELS = ("t", "theta_r", "omega_r", "i_d", "i_q", "u_d", "u_q", "alpha", "alpha_dem",
-            "Gamma_L", "Gamma_L_hat", "theta_hat", "omega_hat", "S", "E_friction", "E_copper",
-            "E_electrical", "alpha_hat", "E_motoring", "E_load")
+# the fields of sim.fdsmc.trace.Trace, in order: record() writes a sample's row in it
 N_CH = len(CHANNELS)
 
 # ---- info indices ------------------------------------------------------------------------
@@ -77,6 +76,11 @@ I_END = I_SNAP + N_X  # then N_X values of the final state
 # (−1: never); largest overshoot beyond θ_dem [rad].
 (I_PIDQ, I_TOVER, I_TOUT, I_OVS) = range(I_END + N_X, I_END + N_X + 4)
 N_INFO = I_OVS + 1
+#: A tuple of float states or values (the plant's first X_THH states, the observer's four, the memory ``hold``).
+Floats = tuple[float, ...]
+#: What :func:`step_sample` returns: the voltages applied over the step (u_d, u_q) [V], the new observer
+#: state, the new controller memory ``hold``, the recorded outputs (u_d, u_q, α_dem, α̂, S), the limited flag.
+SampleStep = tuple[tuple[float, float], Floats, Floats, Floats, bool]
 #: The controller's memory ``hold`` of :func:`step_sample` at rest.
 HOLD0 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 #: Rows of ``win`` per chatter window: α_dem [rad/s²], ω_r [rad/s], i_q [A], u_q [V] (applied).
@@ -98,11 +102,12 @@ inlined = njit(cache=True, error_model="numpy", inline="always")
 @inlined
 def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) -> float:
     """External load torque Γ_Le(t) [N·m]: last step value (or Γ_Le0) plus the ramp."""
-    g = prm[P_GLE0]
+    g: float = prm[P_GLE0]
     for j in range(step_t.size):
         if t >= step_t[j]:
             g = step_v[j]
-    return g + prm[P_GRAMP] * t
+    ramp: float = prm[P_GRAMP]
+    return g + ramp * t
 
 
 @inlined
@@ -157,7 +162,8 @@ def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0:
 
 
 @inlined
-def predict_currents(i_d: float, i_q: float, omega_hat: float, u: tuple, prm: np.ndarray) -> tuple[float, float]:
+def predict_currents(i_d: float, i_q: float, omega_hat: float, u: tuple[float, float],
+                     prm: np.ndarray) -> tuple[float, float]:
     """Currents [A] one sample on with the voltages u held: :func:`control.fdsmc.inverter.predict_currents`."""
     return inverter.predict_currents(i_d, i_q, omega_hat, u[0], u[1], prm[P_PHID], prm[P_GMID], prm[P_PHIQ],
                                      prm[P_GMIQ], prm[P_B], prm[P_C], prm[P_E], prm[P_F], prm[P_G])
@@ -173,7 +179,7 @@ def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: flo
 
 
 @inlined
-def measure(k: int, p: tuple, prm: np.ndarray, noise: np.ndarray) -> tuple[float, float, float]:
+def measure(k: int, p: Floats, prm: np.ndarray, noise: np.ndarray) -> tuple[float, float, float]:
     """Return what the controller reads at sample k: (θ_r [rad], i_d, i_q [A]) through :mod:`sim.common.sensors`."""
     j = k % noise.shape[1]
     return (sensors.encoder_angle(p[X_TH], prm[P_ENC]),
@@ -182,7 +188,7 @@ def measure(k: int, p: tuple, prm: np.ndarray, noise: np.ndarray) -> tuple[float
 
 
 @inlined
-def control_output(t: float, y: tuple, i0: tuple, o: tuple, prm: np.ndarray,
+def control_output(t: float, y: Floats, i0: Floats, o: Floats, prm: np.ndarray,
                    ref: np.ndarray, dv: float) -> tuple[float, float, float, float, float, bool]:
     """u_d, u_q [V], α_dem, α [rad/s²], S [rad/s], limited, from the readings y and the estimates o.
 
@@ -203,8 +209,8 @@ def electromagnetic_torque(i_d: float, i_q: float, prm: np.ndarray) -> float:
 
 
 @inlined
-def plant_rhs(t: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray, step_t: np.ndarray,
-              step_v: np.ndarray) -> tuple:
+def plant_rhs(t: float, p: Floats, u_d: float, u_q: float, prm: np.ndarray, step_t: np.ndarray,
+              step_v: np.ndarray) -> Floats:
     """Return the derivatives of the plant and energy states p (eqs. 1–3, 4b, 5) [SI/s]."""
     i_d, i_q, w = p[X_ID], p[X_IQ], p[X_W]
     g_le = gamma_le(t, prm, step_t, step_v)
@@ -222,7 +228,7 @@ def plant_rhs(t: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray, step_
 
 
 @inlined
-def observer_rhs(p: tuple, o: tuple, prm: np.ndarray) -> tuple[float, float, float, float]:
+def observer_rhs(p: Floats, o: Floats, prm: np.ndarray) -> tuple[float, float, float, float]:
     """Corrected continuous observer, eq. (15) with e_o = θ_r − θ̂_r [rad/s, rad/s², …]."""
     e_o = p[X_TH] - o[0]
     a_em = (prm[P_H] + prm[P_K] * p[X_ID]) * p[X_IQ]
@@ -231,33 +237,33 @@ def observer_rhs(p: tuple, o: tuple, prm: np.ndarray) -> tuple[float, float, flo
 
 
 @inlined
-def axpy9(x: tuple, a: float, k: tuple) -> tuple:
+def axpy9(x: Floats, a: float, k: Floats) -> Floats:
     """Return x + a·k for 9-tuples."""
     return (x[0] + a * k[0], x[1] + a * k[1], x[2] + a * k[2], x[3] + a * k[3], x[4] + a * k[4],
             x[5] + a * k[5], x[6] + a * k[6], x[7] + a * k[7], x[8] + a * k[8])
 
 
 @inlined
-def axpy4(x: tuple, a: float, k: tuple) -> tuple:
+def axpy4(x: Floats, a: float, k: Floats) -> Floats:
     """Return x + a·k for 4-tuples."""
     return (x[0] + a * k[0], x[1] + a * k[1], x[2] + a * k[2], x[3] + a * k[3])
 
 
 @inlined
-def rk4_sum9(x: tuple, h: float, k1: tuple, k2: tuple, k3: tuple, k4: tuple) -> tuple:
+def rk4_sum9(x: Floats, h: float, k1: Floats, k2: Floats, k3: Floats, k4: Floats) -> Floats:
     """Return x + h/6·(k1 + 2k2 + 2k3 + k4) for 9-tuples."""
     return axpy9(x, h / 6.0, axpy9(axpy9(k1, 2.0, axpy9(k2, 1.0, k3)), 1.0, k4))
 
 
 @inlined
-def rk4_sum4(x: tuple, h: float, k1: tuple, k2: tuple, k3: tuple, k4: tuple) -> tuple:
+def rk4_sum4(x: Floats, h: float, k1: Floats, k2: Floats, k3: Floats, k4: Floats) -> Floats:
     """Return x + h/6·(k1 + 2k2 + 2k3 + k4) for 4-tuples."""
     return axpy4(x, h / 6.0, axpy4(axpy4(k1, 2.0, axpy4(k2, 1.0, k3)), 1.0, k4))
 
 
 @inlined
-def rk4_plant(t: float, h: float, p: tuple, u_d: float, u_q: float, prm: np.ndarray,
-              step_t: np.ndarray, step_v: np.ndarray) -> tuple:
+def rk4_plant(t: float, h: float, p: Floats, u_d: float, u_q: float, prm: np.ndarray,
+              step_t: np.ndarray, step_v: np.ndarray) -> Floats:
     """One classical Runge–Kutta step [s] of the plant with held voltages (digital mode)."""
     k1 = plant_rhs(t, p, u_d, u_q, prm, step_t, step_v)
     k2 = plant_rhs(t + 0.5 * h, axpy9(p, 0.5 * h, k1), u_d, u_q, prm, step_t, step_v)
@@ -267,8 +273,8 @@ def rk4_plant(t: float, h: float, p: tuple, u_d: float, u_q: float, prm: np.ndar
 
 
 @inlined
-def full_rhs(t: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
-             step_v: np.ndarray, ref: np.ndarray) -> tuple:
+def full_rhs(t: float, p: Floats, o: Floats, prm: np.ndarray, step_t: np.ndarray,
+             step_v: np.ndarray, ref: np.ndarray) -> tuple[Floats, Floats]:
     """Continuous mode: plant and observer derivatives with the controller inside (ideal sensors)."""
     i = (p[X_ID], p[X_IQ])
     u_d, u_q, _, _, _, _ = control_output(t, (p[X_TH], p[X_ID], p[X_IQ]), i, o, prm, ref, 0.0)
@@ -276,8 +282,8 @@ def full_rhs(t: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
 
 
 @inlined
-def rk4_continuous(t: float, h: float, p: tuple, o: tuple, prm: np.ndarray, step_t: np.ndarray,
-                   step_v: np.ndarray, ref: np.ndarray) -> tuple:
+def rk4_continuous(t: float, h: float, p: Floats, o: Floats, prm: np.ndarray, step_t: np.ndarray,
+                   step_v: np.ndarray, ref: np.ndarray) -> tuple[Floats, Floats]:
     """One RK4 step [s] of plant + observer with the controller evaluated in every stage."""
     a1, b1 = full_rhs(t, p, o, prm, step_t, step_v, ref)
     a2, b2 = full_rhs(t + 0.5 * h, axpy9(p, 0.5 * h, a1), axpy4(o, 0.5 * h, b1), prm, step_t, step_v, ref)
@@ -287,13 +293,14 @@ def rk4_continuous(t: float, h: float, p: tuple, o: tuple, prm: np.ndarray, step
 
 
 @inlined
-def _row4(M: np.ndarray, i: int, o: tuple) -> float:
+def _row4(M: np.ndarray, i: int, o: Floats) -> float:
     """Row i of the 4×4 matrix M times the 4-tuple o."""
-    return M[i, 0] * o[0] + M[i, 1] * o[1] + M[i, 2] * o[2] + M[i, 3] * o[3]
+    row: float = M[i, 0] * o[0] + M[i, 1] * o[1] + M[i, 2] * o[2] + M[i, 3] * o[3]
+    return row
 
 
 @inlined
-def observer_update(theta_m: float, o: tuple, a_em: float, Phi: np.ndarray, Gam: np.ndarray,
+def observer_update(theta_m: float, o: Floats, a_em: float, Phi: np.ndarray, Gam: np.ndarray,
                     Lo: np.ndarray) -> tuple[float, float, float, float]:
     """Discrete observer x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·(θ_r,meas[k] − θ̂_r[k])."""
     e_o = theta_m - o[0]
@@ -304,9 +311,9 @@ def observer_update(theta_m: float, o: tuple, a_em: float, Phi: np.ndarray, Gam:
 
 
 @inlined
-def step_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, continuous: bool, delay: int,
+def step_sample(k: int, t: float, p: Floats, o: Floats, hold: Floats, continuous: bool, delay: int,
                 prm: np.ndarray, Phi: np.ndarray, Gam: np.ndarray, Lo: np.ndarray, ref: np.ndarray,
-                noise: np.ndarray):
+                noise: np.ndarray) -> SampleStep:
     """Run the controller (and, digital, the observer update) at sample k or one continuous step.
 
     Returns (voltages applied over the step, new observer state, new controller memory ``hold``, the
@@ -355,8 +362,8 @@ def table_at(t: float, ref: np.ndarray, dt: float) -> tuple[float, float, float]
 
 
 @inlined
-def drive_sample(k: int, t: float, p: tuple, o: tuple, hold: tuple, delay: int, prm: np.ndarray,
-                 ref: np.ndarray, noise: np.ndarray):
+def drive_sample(k: int, t: float, p: Floats, o: Floats, hold: Floats, delay: int, prm: np.ndarray,
+                 ref: np.ndarray, noise: np.ndarray) -> SampleStep:
     """One cycle of a stock drive's own loops (:mod:`control.stock.loops`); returns as :func:`step_sample`.
 
     ``o`` = (PLL θ̂ [rad], ω̂ [rad/s], the position/speed law's integrator [N·m], 0); ``hold`` = (held

@@ -53,6 +53,7 @@ from pmsm_commissioning.sim.fdsmc.kernel import (
     X_TH,
     X_THH,
     X_W,
+    Floats,
     electromagnetic_torque,
     inlined,
     plant_rhs,
@@ -63,7 +64,7 @@ from pmsm_commissioning.sim.fdsmc.kernel import (
 
 
 @inlined
-def record(row: np.ndarray, t: float, p: tuple, o: tuple, u: tuple, prm: np.ndarray,
+def record(row: np.ndarray, t: float, p: Floats, o: Floats, u: Floats, prm: np.ndarray,
            step_t: np.ndarray, step_v: np.ndarray) -> None:
     """Write one trace sample (channels in CHANNELS order); u = (u_d, u_q, α_dem, α̂, S)."""
     dp = plant_rhs(t, p, u[0], u[1], prm, step_t, step_v)
@@ -77,7 +78,7 @@ def record(row: np.ndarray, t: float, p: tuple, o: tuple, u: tuple, prm: np.ndar
 
 
 @inlined
-def peaks(pk: tuple, p: tuple, u_d: float, u_q: float, prm: np.ndarray) -> tuple:
+def peaks(pk: Floats, p: Floats, u_d: float, u_q: float, prm: np.ndarray) -> Floats:
     """Return the running peaks updated with this step (|ω_r|, |i_q|, |u_dq|, |Γ_em|, |i_d|, |i_dq|)."""
     return (max(pk[0], abs(p[X_W])), max(pk[1], abs(p[X_IQ])),
             max(pk[2], math.sqrt(u_d * u_d + u_q * u_q)),
@@ -86,7 +87,7 @@ def peaks(pk: tuple, p: tuple, u_d: float, u_q: float, prm: np.ndarray) -> tuple
 
 
 @inlined
-def position_checks(pc: tuple, t: float, p: tuple, dt: float, prm: np.ndarray) -> tuple:
+def position_checks(pc: Floats, t: float, p: Floats, dt: float, prm: np.ndarray) -> Floats:
     """Update (time over i_max [s], last time outside the in-position window [s], overshoot [rad]) at t."""
     i_dq = math.sqrt(p[X_ID] * p[X_ID] + p[X_IQ] * p[X_IQ])
     over = prm[P_IMAX] > 0.0 and i_dq > prm[P_IMAX]
@@ -97,7 +98,7 @@ def position_checks(pc: tuple, t: float, p: tuple, dt: float, prm: np.ndarray) -
 
 
 @inlined
-def diverged(p: tuple, o: tuple, prm: np.ndarray) -> bool:
+def diverged(p: Floats, o: Floats, prm: np.ndarray) -> bool:
     """Return True when a state is not finite or beyond the divergence limits."""
     total = 0.0
     for v in p:
@@ -105,12 +106,13 @@ def diverged(p: tuple, o: tuple, prm: np.ndarray) -> bool:
     total += o[0] + o[1] + o[2] + o[3]
     if not math.isfinite(total):  # one NaN/inf anywhere makes the sum non-finite
         return True
-    return (abs(p[X_W]) > prm[P_WLIM] or abs(p[X_IQ]) > prm[P_ILIM]
-            or abs(p[X_ID]) > prm[P_ILIM] or abs(o[1]) > 10.0 * prm[P_WLIM])
+    beyond: bool = (abs(p[X_W]) > prm[P_WLIM] or abs(p[X_IQ]) > prm[P_ILIM]
+                    or abs(p[X_ID]) > prm[P_ILIM] or abs(o[1]) > 10.0 * prm[P_WLIM])
+    return beyond
 
 
 @inlined
-def store_state(info: np.ndarray, at: int, p: tuple, o: tuple, w: float, p0: tuple) -> None:
+def store_state(info: np.ndarray, at: int, p: Floats, o: Floats, w: float, p0: Floats) -> None:
     """info[at:at+N_X] = (1 − w)·p0 + w·p (plant, linear interpolation) followed by o."""
     for i in range(X_THH):
         info[at + i] = (1.0 - w) * p0[i] + w * p[i]
@@ -142,9 +144,11 @@ def run_kernel(prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray, Phi: np.
                                          borrowed(Gam), borrowed(Lo))  # no reference counts in the loop
     out, info, k_win, win, ref, noise = (borrowed(out), borrowed(info), borrowed(k_win), borrowed(win),
                                          borrowed(ref), borrowed(noise))
-    p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    o, hold, pk = (0.0, 0.0, 0.0, 0.0), HOLD0, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    pc = (0.0, -1.0, 0.0)
+    p: Floats = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    o: Floats = (0.0, 0.0, 0.0, 0.0)
+    hold: Floats = HOLD0
+    pk: Floats = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    pc: Floats = (0.0, -1.0, 0.0)
     n_out, t, t_sat, T_m, hit = 0, 0.0, 0.0, prm[P_TM], False
     info[:] = 0.0
     for k in range(n_steps):

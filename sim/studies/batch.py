@@ -23,6 +23,7 @@ from typing import Any
 
 import numba
 import numpy as np
+import numpy.typing as npt
 from numba import njit, prange
 
 from pmsm_commissioning.control.fdsmc.derivations import Derived
@@ -70,7 +71,7 @@ class Setup:
 
     controller: str
     grid: TimeGrid
-    arrays: tuple[np.ndarray, ...]  # step_t, step_v, Phi, Gam, Lo
+    arrays: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # step_t, step_v, Phi, Gam, Lo
     ref: np.ndarray
     noise: np.ndarray  # the sensors' noise table (the model's sensors, as simulate())
     windows: tuple[tuple[float, float], ...]  # cruise, hold [s]
@@ -128,7 +129,9 @@ def chatter_rows(t: np.ndarray, alpha_dem: np.ndarray, window: tuple[float, floa
     rows = np.ascontiguousarray(alpha_dem[:, sel])
     hyst, ptp_min = CHATTER_HYSTERESIS_FRACTION * alpha_max, CHATTER_PTP_FRACTION * alpha_max
     ptp, changes = chatter_stats(rows, n, hyst)
-    return ((ptp > ptp_min) & (changes >= CHATTER_MIN_SIGN_CHANGES)) | limit_cycles(rows, t[sel], hyst, ptp_min)[0]
+    verdict: npt.NDArray[np.bool_] = ((ptp > ptp_min) & (changes >= CHATTER_MIN_SIGN_CHANGES)
+                                      | limit_cycles(rows, t[sel], hyst, ptp_min)[0])
+    return verdict
 
 
 def _buffers(s: Setup, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -182,7 +185,8 @@ def _saving(f: dict[str, Any], c: dict[str, Any]) -> float | None:
     """FDSMC's friction saving [%] (eq. (47) in [1]); None unless both runs reached the 2 % band."""
     if f["t_2pct_first_s"] is None or c["t_2pct_first_s"] is None or not c["friction_J"]:
         return None
-    return 100.0 * (1.0 - f["friction_J"] / c["friction_J"])
+    saving: float = 100.0 * (1.0 - f["friction_J"] / c["friction_J"])
+    return saving
 
 
 def simulate_batch(params: DriveParams, d: Derived, plants: list[DriveParams], max_points: int,
@@ -202,7 +206,7 @@ def simulate_batch(params: DriveParams, d: Derived, plants: list[DriveParams], m
     """
     if not plants:
         return []
-    numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+    numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))  # type: ignore[attr-defined]
     per: dict[str, list[dict[str, Any]]] = {}
     for ctrl in controllers:
         s = setup(params, d, ctrl, plants[0], max_points)

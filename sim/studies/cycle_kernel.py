@@ -40,8 +40,9 @@ def run_cycle(prm_all: np.ndarray, seg_steps: np.ndarray, ref_all: np.ndarray, r
     prm_all, seg_steps, ref_all, ref_off = borrowed(prm_all), borrowed(seg_steps), borrowed(ref_all), borrowed(ref_off)
     step_t, step_v, Phi, Gam, Lo = borrowed(step_t), borrowed(step_v), borrowed(Phi), borrowed(Gam), borrowed(Lo)
     out, seg_info, noise = borrowed(out), borrowed(seg_info), borrowed(noise)  # no reference counts in the loop
-    p = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-    o, hold = (0.0, 0.0, 0.0, 0.0), kn.HOLD0
+    p: kn.Floats = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    o: kn.Floats = (0.0, 0.0, 0.0, 0.0)
+    hold: kn.Floats = kn.HOLD0
     t, k_all, n_out = 0.0, 0, 0
     for j in range(seg_steps.size):
         prm = prm_all[j]

@@ -164,8 +164,7 @@ class DaskChunk:
 
     def result(self) -> Any:
         """Return the chunk's result; ExecutorError for no workers, KilledWorker, a lost scheduler, other source."""
-        from distributed import KilledWorker
-        from distributed.client import CancelledError
+        from distributed import CancelledError, KilledWorker
 
         box: dict[str, Any] = {}
         self._watch(box)
@@ -266,7 +265,7 @@ def connect(address: str, no_worker_s: float = NO_WORKER_S, tuned: bool = True) 
     except (OSError, TimeoutError) as exc:
         raise ExecutorError(f"cannot reach the Dask scheduler at {address!r} ({_line(exc)}): allowed the address "
                             "tcp://HOST:PORT of a running `dask scheduler`") from None
-    from distributed.client import CancelledError
+    from distributed import CancelledError
 
     ex = DaskExecutor(client, address, no_worker_s, 0)
     try:

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.sim.fdsmc.checks import TARGET_BAND
 from pmsm_commissioning.sim.fdsmc.design import DriveDesign, design_drive
-from pmsm_commissioning.sim.fdsmc.verdicts import TARGET_BAND
 
 #: Requested T_m [s] that makes the design return the axis's shortest feasible time.
 SHORTEST_REQUEST_S = 1e-3
