@@ -310,10 +310,15 @@ def test_float_build_for_cortex_m4f_has_no_double_operation(tmp_path, preset):
 
 
 def test_float_build_fits_300_instructions_per_step(tmp_path):
-    """Counted under qemu-arm over the golden vectors (scripts/c_bench.py prints the figures)."""
+    """Counted under qemu-arm over the golden vectors (scripts/c_bench.py prints the figures): -cpu cortex-m4
+    where qemu-arm's user mode runs it, else the Thumb-2/VFPv4 Cortex-A15 running the same binary.
+    """
     extra = _arm_export(tmp_path, "yaskawa_sgm7j_04a")
     if shutil.which("qemu-arm") is None and CI:
         pytest.fail("qemu-arm missing: scripts/ensure_cc.sh installs qemu-user (CI needs it)")
     n = count_instructions(tmp_path, extra)
-    assert n.max <= 300, n
-    assert n.method != "qemu-arm" or n.calls >= 1000
+    assert n.max <= 300, n  # the worst path: measured 300 (the sample that takes a move; all limits at once)
+    if n.method.startswith("qemu-arm"):  # per path: the move and hold, the limits, each targeted limit
+        assert n.calls >= 10000 and n.method in ("qemu-arm -cpu cortex-m4", "qemu-arm -cpu cortex-a15")
+        assert [p.name for p in n.paths] == ["move", "limits", "limit_i_d_pos", "limit_i_d_neg", "limit_u"]
+        assert all(p.worst <= 300 and p.median <= p.worst for p in n.paths) and n.median <= n.max

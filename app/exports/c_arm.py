@@ -2,20 +2,25 @@
 
 Uses Debian's ``gcc-arm-none-eabi`` (installed by ``scripts/ensure_cc.sh``). The float32 build is
 compiled with :data:`ARM_FLAGS`; :func:`double_symbols` lists every soft-float double helper
-(``__aeabi_d*``, ``__*df*``) the object needs — none when the build is float-only — and
-:func:`helper_symbols` adds the 64-bit integer helpers (``__aeabi_ldivmod``, ``__aeabi_uldivmod`` …).
+(``__aeabi_d*``, ``__*df*``) the object needs -- none when the build is float-only -- and
+:func:`helper_symbols` adds the 64-bit integer helpers (``__aeabi_ldivmod``, ``__aeabi_uldivmod`` ...).
 :func:`count_instructions` links the module with a tiny bench program (Linux ``exit`` syscall, no C
 library) that replays the golden vectors, runs it under ``qemu-arm`` (``qemu-user``) with one
-instruction per translation block and ``-d exec``, and counts the instructions executed between
-two calls of a marker function: every instruction of one ``fdsmc_step`` call (prologue, inlined
-helpers, libgcc calls, epilogue). Without qemu it counts statically: the instructions of the step's
-code in the disassembly (each instruction once, whatever the path).
+instruction per translation block and ``-d exec`` (the log read as it is written, never stored),
+and counts the instructions executed between two calls of a marker function: every instruction of
+one ``fdsmc_step`` call (prologue, inlined helpers, libgcc calls, epilogue), per segment of the
+vectors. The CPU is ``-cpu cortex-m4`` where qemu-arm's user mode runs it; Debian's qemu 7.2 aborts
+on M-profile CPUs in user mode, so then the Cortex-M4 binary runs unchanged on the Thumb-2/VFPv4
+Cortex-A15 model (:data:`STAND_IN_CPU`): the instructions executed are the binary's own, the same on
+either. Without qemu it counts statically: the instructions of the step's code in the disassembly
+(each instruction once, whatever the path).
 """
 
 from __future__ import annotations
 
 import re
 import shutil
+import statistics
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +30,8 @@ from pathlib import Path
 ARM_FLAGS = ("-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard", "-O2", "-fno-math-errno",
              "-ffp-contract=fast",
              "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wdouble-promotion", "-DFDSMC_USE_FLOAT")
+#: qemu-arm CPU models tried in turn: the Cortex-M4 itself, then a Thumb-2/VFPv4 stand-in.
+TARGET_CPU, STAND_IN_CPU = "cortex-m4", "cortex-a15"
 #: Soft-float double helpers of the ARM EABI and libgcc.
 DOUBLE_SYMBOL = re.compile(r"__aeabi_(d|l2d|ul2d|i2d|ui2d|f2d)\w*|__\w*df\w*")
 #: 64-bit integer helpers of the ARM EABI and libgcc (division, modulo, shifts, compares, conversions).
@@ -72,21 +79,43 @@ int main(void)
 
 
 @dataclass(frozen=True)
+class PathCount:
+    """Instructions per ``fdsmc_step`` call over one segment of the golden vectors (one path of the step).
+
+    Attributes
+    ----------
+    name : str      The segment (``move``, ``limits``, ``limit_u`` ...).
+    median : float  Median per call [-].
+    worst : int     Largest per call [-].
+    calls : int     Calls counted [-].
+    """
+
+    name: str
+    median: float
+    worst: int
+    calls: int
+
+
+@dataclass(frozen=True)
 class InstructionCount:
     """Instructions per ``fdsmc_step`` call on Cortex-M4F.
 
     Attributes
     ----------
-    method : str   ``"qemu-arm"`` (executed, over the golden vectors) or ``"static"`` (disassembly).
+    method : str   ``"qemu-arm -cpu <model>"`` (executed, over the golden vectors) or ``"static"`` (disassembly).
     mean : float   Mean per call [-] (static: the code's instruction count).
-    max : int      Largest per call [-].
+    median : float Median per call [-].
+    max : int      Largest per call: the worst path [-].
     calls : int    Calls counted [-].
+    paths : tuple of PathCount  Per segment of the vectors (empty when static).
     """
 
     method: str
     mean: float
+    median: float
     max: int
     calls: int
+    paths: tuple[PathCount, ...] = ()
 
 
 def arm_compiler() -> str | None:
@@ -127,14 +156,29 @@ def code_size(obj: Path) -> dict[str, int]:
     return {"text": int(line[0]), "data": int(line[1]), "bss": int(line[2])}
 
 
-def _executed(folder: Path, elf: Path) -> InstructionCount:
-    log = folder / "qemu_exec.log"
-    _run(["qemu-arm", "-cpu", "max", "-singlestep", "-d", "exec,nochain", "-D", str(log), str(elf)], folder)
+def _segments(folder: Path) -> list[tuple[str, int]]:
+    """(name, calls) of each segment the bench replays: those of ``fdsmc_vectors.h`` without a fault."""
+    text = (folder / "fdsmc_vectors.h").read_text(encoding="utf-8")
+    rows = re.findall(r'\{"([^"]*)", -?\d+, (\d+), -?\d+, [^,]+, (\d+)u,', text)
+    return [(name, int(n)) for name, n, fault in rows if fault == "0"]
+
+
+def qemu_cpu(folder: Path, elf: Path) -> str:
+    """Return the qemu-arm CPU model that runs ``elf`` to its end: :data:`TARGET_CPU`, else :data:`STAND_IN_CPU`."""
+    run = subprocess.run(["qemu-arm", "-cpu", TARGET_CPU, str(elf)], cwd=folder, capture_output=True, timeout=600)
+    return TARGET_CPU if run.returncode == 0 else STAND_IN_CPU
+
+
+def _step_counts(folder: Path, elf: Path, cpu: str) -> list[int]:
+    """Instructions of each fdsmc_step call, from qemu-arm's exec log read as a stream (stderr)."""
+    args = ["qemu-arm", "-cpu", cpu, "-singlestep", "-d", "exec,nochain", str(elf)]
     counts: list[int] = []
     n, prev = -1, ""  # n: -1 outside a step, else the instructions since the mark before it
-    with log.open(encoding="utf-8", errors="replace") as fh:
-        for line in fh:
-            name = line.rsplit(None, 1)[-1]
+    with subprocess.Popen(args, cwd=folder, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                          errors="replace") as proc:
+        assert proc.stderr is not None
+        for line in proc.stderr:
+            name = line.rsplit(None, 1)[-1] if line.strip() else ""
             if name == "fdsmc_bench_mark" and prev != name:  # a call of the mark: a step starts or ends
                 if n > 0:
                     counts.append(n)
@@ -142,8 +186,22 @@ def _executed(folder: Path, elf: Path) -> InstructionCount:
             elif n >= 0 and name not in ("main", "fdsmc_bench_mark"):
                 n += 1
             prev = name
-    log.unlink()
-    return InstructionCount("qemu-arm", sum(counts) / len(counts), max(counts), len(counts))
+    if proc.returncode != 0:
+        raise RuntimeError(f"the bench program failed under qemu-arm -cpu {cpu} (exit {proc.returncode})")
+    return counts
+
+
+def _executed(folder: Path, elf: Path) -> InstructionCount:
+    cpu = qemu_cpu(folder, elf)
+    counts = _step_counts(folder, elf, cpu)
+    paths, start = [], 0
+    for name, n in _segments(folder):
+        part = counts[start:start + n]
+        start += n
+        if part:
+            paths.append(PathCount(name, statistics.median(part), max(part), len(part)))
+    return InstructionCount(f"qemu-arm -cpu {cpu}", sum(counts) / len(counts), statistics.median(counts),
+                            max(counts), len(counts), tuple(paths))
 
 
 def _static(folder: Path, elf: Path) -> InstructionCount:
@@ -155,7 +213,7 @@ def _static(folder: Path, elf: Path) -> InstructionCount:
             inside = head.group(1) in ("fdsmc_step", "step")
         elif inside and re.match(r"^\s+[0-9a-f]+:\s+\w", line):
             n += 1
-    return InstructionCount("static", float(n), n, 1)
+    return InstructionCount("static", float(n), float(n), n, 1)
 
 
 def count_instructions(folder: Path, extra: tuple[str, ...] = ()) -> InstructionCount:
