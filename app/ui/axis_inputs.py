@@ -24,6 +24,7 @@ from pmsm_commissioning.app.io.numbers import NumberFormatError
 from pmsm_commissioning.app.io.presets import list_presets_of, load
 from pmsm_commissioning.app.io.transmission_keys import OUTPUT_KEYS, to_motor_side
 from pmsm_commissioning.app.ui.number_fields import NumberInput
+from pmsm_commissioning.app.ui.props import assign
 from pmsm_commissioning.app.ui.text import md_text
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.params import DriveParams
@@ -56,7 +57,7 @@ class OutputSideInputs:
     def clear(self) -> None:
         """Empty every load-side field (a new case opened)."""
         for n in self.numbers.values():
-            n.handle.value = ""
+            assign(n.handle, value="")
 
     def reflected(self, tr: Transmission) -> dict[str, dict[str, float]]:
         """Return the rotor-side values [SI] of the load-side fields typed, per section.
