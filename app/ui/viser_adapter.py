@@ -19,7 +19,9 @@ The page needs four things viser's public API does not offer:
 * **checks in front of viser's message handlers** (:func:`wrap_gui_handler`, used by
   :mod:`app.ui.web_guard`: widget values type-checked, uploads bounded) and what they read: a
   widget by uuid (:func:`input_widget`), its state (:func:`widget_state`), the uploads in flight
-  (:func:`upload_states`), the client of a message (:func:`resolve_client`);
+  (:func:`upload_states`), the client of a message (:func:`resolve_client`), and in front of its
+  loop reading each client's websocket frames (:func:`wrap_frame_reader`: a frame that is no message
+  of the protocol is refused in one line, never a traceback in the server's log);
 * **viser's icons read at server start** (:func:`warm_icons`: its cached ``svg_from_icon``).
 
 A viser upgrade is checked here and in ``tests/test_viser_adapter.py`` only.
@@ -32,6 +34,7 @@ from typing import Any, Protocol
 
 import viser
 import viser._gui_api as _viser_gui
+import viser.infra._infra as _viser_infra
 from viser import _icons, _messages
 
 from pmsm_commissioning.app.figures.plain import blank_json
@@ -120,6 +123,17 @@ def wrap_gui_handler(name: str, wrap: Any) -> None:
     current = getattr(_viser_gui.GuiApi, name)
     if not hasattr(current, "__wrapped__"):
         setattr(_viser_gui.GuiApi, name, wrap(current))
+
+
+def wrap_frame_reader(wrap: Any) -> None:
+    """Replace viser's loop reading a client's frames by ``wrap(loop)``, once.
+
+    The loop is ``async (connection, handle_message, message_class) -> None``: it receives each frame,
+    decodes it with ``message_class.deserialize`` and hands the message to ``handle_message``.
+    """
+    current = _viser_infra._message_consumer
+    if not hasattr(current, "__wrapped__"):
+        _viser_infra._message_consumer = wrap(current)
 
 
 def input_widget(gui: Any, uuid: Any) -> Any | None:

@@ -21,9 +21,14 @@ puts :meth:`Guard.check` in front of viser's own ``process_request``:
   bool, a vector a list of the same length — so a hand-made client cannot raise in the server's
   message handler or slip NaN into a field; a refused update is dropped and recorded in
   :data:`REFUSED_UPDATES`.
+* **Frames**: a websocket frame that is not a message of viser's protocol (not MessagePack, a text
+  frame, no or an unknown type, fields missing or of the wrong type, nested too deeply) closes its
+  connection with code 1007 and one line in :data:`REFUSED_UPDATES`, never a traceback in the log.
 * **Uploads** (checked while streaming): refused by their declared size before any part is kept
-  (:func:`upload_limit`: 50 MB for a drive log, 512 KiB for preset and waveform files), a part that
-  would overrun the declared size ends the transfer, and one client's unfinished uploads together
+  (:func:`upload_limit`: 50 MB for a drive log, 512 KiB for preset and waveform files) and by their
+  part count (≤ one part per :data:`MIN_PART_BYTES` declared: the page sends 512 KiB parts, so a
+  transfer of millions of one-byte parts is never started), a part over :data:`MAX_PART_BYTES` or one
+  that would overrun the declared size ends the transfer, and one client's unfinished uploads together
   may hold ≤ :data:`CLIENT_INFLIGHT_BYTES`, the server's ≤ :data:`SERVER_INFLIGHT_BYTES`.
 """
 
@@ -38,6 +43,7 @@ import math
 import secrets
 import socket
 import threading
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -54,6 +60,7 @@ from pmsm_commissioning.app.ui.viser_adapter import (
     resolve_client,
     upload_states,
     widget_state,
+    wrap_frame_reader,
     wrap_gui_handler,
 )
 
@@ -232,6 +239,8 @@ def _checked_gui_updates(original: Callable[..., Any]) -> Callable[..., Any]:
 
 #: Largest drive-log upload [B] (as :data:`app.io.drive_log.MAX_BYTES`), and any other upload [B].
 LOG_UPLOAD_BYTES, FILE_UPLOAD_BYTES = 50 * 2**20, 512 * 2**10
+#: Smallest average part an upload may declare (parts ≤ size / this, rounded up), largest single part [B].
+MIN_PART_BYTES, MAX_PART_BYTES = 64 * 2**10, 2**20
 #: Most bytes one client's unfinished uploads may declare together, and all clients' [B].
 CLIENT_INFLIGHT_BYTES, SERVER_INFLIGHT_BYTES = 60 * 2**20, 200 * 2**20
 
@@ -249,8 +258,11 @@ def upload_problem(gui: Any, client_id: Any, message: Any) -> str | None:
         return None  # viser ignores it
     size, parts = message.size_bytes, message.part_count
     limit = upload_limit(getattr(widget_state(widget).props, "mime_type", ""))
-    if not isinstance(size, int) or not isinstance(parts, int) or size < 0 or parts < 0 or parts > size + 1:
+    if not isinstance(size, int) or not isinstance(parts, int) or size < 0 or parts < 0:
         return f"{shorten(message.filename, 60)!r}: malformed upload (size {size!r}, {parts!r} parts)"
+    if parts > -(-size // MIN_PART_BYTES):
+        return (f"{shorten(message.filename, 60)!r}: {parts} parts for {size} bytes: allowed ≤ "
+                f"{-(-size // MIN_PART_BYTES)} (one part per {MIN_PART_BYTES // 1024} KiB)")
     if size > limit:
         return (f"{shorten(message.filename, 60)!r} is {size / 2**20:.1f} MB: allowed ≤ {limit / 2**20:.3g} MB "
                 "for this button")
@@ -282,15 +294,40 @@ def _checked_upload_part(original: Callable[..., Any]) -> Callable[..., Any]:
     def handle(self: Any, client_id: Any, message: Any) -> None:
         state = upload_states(self).get(message.transfer_uuid)
         if state is not None and (state["client_id"] != client_id or not isinstance(message.content, bytes)
+                                  or len(message.content) > MAX_PART_BYTES
                                   or state["transferred_bytes"] + len(message.content) > state["total_bytes"]):
             upload_states(self).pop(message.transfer_uuid, None)  # the parts kept are freed
             REFUSED_UPDATES.append(f"client {client_id}: upload {shorten(state['filename'], 60)!r} ended: "
-                                   "its parts overrun the declared size")
+                                   f"its parts overrun the declared size or {MAX_PART_BYTES // 2**20} MiB a part")
             return
         original(self, client_id, message)
 
     handle.__wrapped__ = original  # type: ignore[attr-defined]
     return handle
+
+
+#: Close code of a connection whose frame is not a message of the protocol (RFC 6455: invalid payload).
+INVALID_FRAME = 1007
+
+
+def _checked_frames(original: Callable[..., Any]) -> Callable[..., Any]:
+    async def consume(connection: Any, handle_message: Callable[[Any], None], message_class: Any) -> None:
+        while True:
+            raw = await connection.recv()
+            try:
+                if not isinstance(raw, bytes):
+                    raise TypeError("a text frame (allowed: binary MessagePack)")
+                message = message_class.deserialize(raw)
+            except Exception as exc:  # noqa: BLE001 - whatever the decoder raises, the frame is refused
+                REFUSED_UPDATES.append(f"connection {getattr(connection, 'id', '?')}: frame of {len(raw)} bytes "
+                                       f"refused, connection closed: {type(exc).__name__}: {shorten(exc, 120)}")
+                await connection.close(INVALID_FRAME, "not a message of the protocol")
+                await connection.recv()  # raises ConnectionClosed: viser ends the connection as a disconnect
+                return
+            handle_message(message)
+
+    consume.__wrapped__ = original  # type: ignore[attr-defined]
+    return consume
 
 
 _WRAPPERS = {GUI_UPDATES: _checked_gui_updates, UPLOAD_START: _checked_upload_start, UPLOAD_PART: _checked_upload_part}
@@ -300,6 +337,9 @@ def check_widget_updates() -> None:
     """Put the widget-value and upload checks in front of viser's handlers (once, for every GUI created after)."""
     for name, wrap in _WRAPPERS.items():
         wrap_gui_handler(name, wrap)
+    wrap_frame_reader(_checked_frames)
+    # viser warns with the client's value when a field does not match its type: hostile text, raw, in the log
+    warnings.filterwarnings("ignore", message=r"\[viser\] .* does not match annotation", category=UserWarning)
 
 
 @contextlib.contextmanager
