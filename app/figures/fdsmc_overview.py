@@ -146,9 +146,17 @@ def _with_trail(comparison: Any, data: list[dict[str, Any]]) -> list[dict[str, A
             return {**tr, "showlegend": False}
         return tr
     rest = [kept(tr) for tr in data[2:] if "sliding phase" not in str(tr.get("name", ""))]
-    # the layer's legend entry short enough for a third of the legend's width (three entries a row)
-    layer = {**data[0], "name": data[0]["name"].replace("Boundary layer", "Layer").replace(", eq. (45)", " (45)")}
-    return [layer, data[1]] + piece_traces(pieces(comparison)) + rest
+    return [short_layer(data[0]), data[1]] + piece_traces(pieces(comparison)) + rest
+
+
+def short_layer(layer: dict[str, Any]) -> dict[str, Any]:
+    """Return the boundary layer's trace with its legend entry short enough for a third of the legend's width.
+
+    The overview's legend has three entries a row (``entrywidth`` 0.3): "Boundary layer ±1/K = …,
+    eq. (45)" ran into its neighbour; "Layer ±1/K = … (45)" fits.
+    """
+    name = str(layer.get("name", ""))
+    return {**layer, "name": name.replace("Boundary layer", "Layer").replace(", eq. (45)", " (45)")}
 
 
 def keeper(xaxis: str, yaxis: str) -> dict[str, Any]:
@@ -202,8 +210,8 @@ def overview_spec(comparison: Any, pins: tuple[Pin, ...] = (), plant_J_L: float 
     layout["legend"] = {"orientation": "h", "x": 0.0, "y": 1.01, "yanchor": "bottom", "font": {"size": FONT_PX},
                         "entrywidth": 0.3, "entrywidthmode": "fraction"}
     layout["margin"] = {"l": 56, "r": 12, "t": 124, "b": 84, "autoexpand": False}  # title and a 3-row legend at 14 px
-    if not runs(comparison):
-        return {**spec, "data": ghost_traces(pins, time_row=False) + spec["data"]}
+    if not runs(comparison):  # not simulated: the boundary and its layer (same legend as a run's)
+        return {**spec, "data": ghost_traces(pins, time_row=False) + [short_layer(spec["data"][0])] + spec["data"][1:]}
     spec["data"] = _with_trail(comparison, spec["data"])
     traces, ranges, t_end = _row_traces(comparison)
     phase_notes = list(layout.get("annotations", []))

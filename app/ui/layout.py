@@ -38,12 +38,16 @@ RAIL = 36.0
 CONTROL_WIDTH, CONTROL_WIDTH_WIDE, WIDE_WINDOW = 400.0, 440.0, 1600.0
 #: Least width of the results panel [px] (narrow windows scroll rather than squash it).
 RESULTS_MIN = 320.0
+#: The compact tab row (:func:`page_css`): a tab's padding each side and the gap from its 14 px icon to
+#: its label [em of the tab's 14 px text]. With viser's 0.9 em and 0.5 em the results panel's nine tabs
+#: took 966 px, two lines in the 860 px of a 1280 px window; compact they take ≈ 822 px, one line.
+TAB_PAD_EM, TAB_GAP_EM = 0.45, 0.25
 #: Vertical space of the results panel not available to the overview plot [px]: panel header and
-#: tab strip at 14 px (≈ 80; nine tabs wrap to two lines at 1280 px), the key numbers (16 px, three
-#: lines at 1280×720 with the stock drive ≈ 68), the "Replay t" slider below the plot (≈ 40),
-#: paddings. The folded "Paper errata for this figure" header (≈ 35 px) is left below the fold: 270
-#: would show it too, at the cost of 35 px of the phase plane (measured; tests/browser/test_first_screen.py).
-CHROME_HEIGHT = 235.0
+#: the tab strip at 14 px (≈ 46: one line, :data:`TAB_PAD_EM`), the key numbers (16 px, three lines at
+#: 1280×720 with the stock drive ≈ 68), the "Replay t" slider below the plot (≈ 40), the folded "Paper
+#: errata for this figure" header (≈ 35), paddings: nothing in the results panel scrolls at 1280×720
+#: (235 left it 1 px too tall; measured, tests/browser/test_results_fit.py).
+CHROME_HEIGHT = 240.0
 #: Horizontal padding of the results panel around a plot [px] (measured: the plot box is the results
 #: panel less 18.5 px at 1280 and at 1920 px; the page fits the height to the same rule from the first draw).
 PLOT_PADDING = 18.5
@@ -85,7 +89,7 @@ def layout_for_window(width: float, height: float, show_3d: bool = False) -> Pan
 
 
 def page_css(show_3d: bool = False) -> str:
-    """Return the page's CSS: panel widths, hidden window-size field, no 3D canvas in the BLDC tabs.
+    """Return the page's CSS: panel widths, hidden window-size field, no 3D canvas in the BLDC tabs, compact tabs.
 
     The docked regions, their shadows and the canvas between them get the widths of
     :func:`layout_for_window` for the window's width (``100%``: viser's dock root, the window).
@@ -103,6 +107,8 @@ def page_css(show_3d: bool = False) -> str:
     return (
         "[data-app-bldc] canvas {visibility: hidden} "
         "[data-app-hidden] {display: none !important} "
+        f"[role='tab'] {{padding: 0 {TAB_PAD_EM:g}em !important}} "
+        f"[role='tab'] > div:first-child:not(:last-child) {{margin-right: {TAB_GAP_EM:g}em !important}} "
         f"{root} {{--fit-left: {CONTROL_WIDTH + gutters:g}px; --fit-canvas: {canvas}; "
         f"--fit-right: max({RESULTS_MIN + gutters:g}px, calc(100% - var(--fit-left) - var(--fit-canvas)))}} "
         f"@media (min-width: {WIDE_WINDOW + 1:g}px) {{ {root} {{--fit-left: {CONTROL_WIDTH_WIDE + gutters:g}px}} }} "
