@@ -11,10 +11,12 @@ import json
 from pathlib import Path
 from typing import Any
 
+from pmsm_commissioning.app.io.bounded import ReadError, read_utf8
 from pmsm_commissioning.app.io.drive_log import DriveLog, read_log, run_identification
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.numbers import number_option
-from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset, loads_log_mapping
+from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, MAX_BYTES, load_preset, loads_log_mapping
+from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.identification import Identification
 from pmsm_commissioning.control.fdsmc.params import DriveParams
@@ -45,9 +47,9 @@ def load(args: argparse.Namespace) -> tuple[DriveParams, DriveLog]:
     mapping = None
     if args.mapping:
         try:
-            text = Path(args.mapping).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ParameterError(f"cannot read mapping {args.mapping!r}: {exc}") from None
+            text = read_utf8(args.mapping, MAX_BYTES, f"--mapping {escaped(args.mapping)!r}")
+        except ReadError as exc:
+            raise ParameterError(str(exc)) from None
         mapping = loads_log_mapping(text, Path(args.mapping).name)
     return params, read_log(args.file, mapping=mapping, run=args.run, p=params.motor.p)
 

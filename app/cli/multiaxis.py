@@ -14,10 +14,12 @@ import json
 from pathlib import Path
 from typing import Any
 
+from pmsm_commissioning.app.io.bounded import ReadError, read_utf8
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.numbers import number_option
-from pmsm_commissioning.app.io.presets import loads_raw
+from pmsm_commissioning.app.io.presets import MAX_BYTES, loads_raw
 from pmsm_commissioning.app.io.study_inputs import parse_axes
+from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.sim.studies.multiaxis import MultiAxisResult, coordinate
 
@@ -50,11 +52,13 @@ def multiaxis_json(res: MultiAxisResult) -> dict[str, Any]:
 def run(args: argparse.Namespace) -> int:
     """Coordinate the axes and print the result."""
     path = Path(args.file)
-    if not path.is_file():
-        raise ParameterError(f"FILE = {args.file!r} is not a readable file")
+    try:
+        text = read_utf8(path, MAX_BYTES, f"FILE = {escaped(args.file)!r}")
+    except ReadError as exc:
+        raise ParameterError(str(exc)) from None
     if args.T_m is not None and not 0.0 < args.T_m <= 1e4:
         raise ParameterError(f"--T-m = {args.T_m:g} s is not allowed: 0 < T_m ≤ 1e4 s")
-    axes = parse_axes(loads_raw(path.read_text(encoding="utf-8"), str(path)), str(path))
+    axes = parse_axes(loads_raw(text, str(path)), str(path))
     out = multiaxis_json(coordinate(axes, args.T_m))
     if args.json:
         print(json.dumps(out, indent=2, ensure_ascii=False))

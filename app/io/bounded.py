@@ -71,4 +71,14 @@ def read_bounded(path: str | os.PathLike[str], limit: int, what: str | None = No
     return data
 
 
-__all__ = ["ReadError", "limit_text", "read_bounded", "size_text", "too_large"]
+def read_utf8(path: str | os.PathLike[str], limit: int, what: str | None = None) -> str:
+    """Return the UTF-8 text of ``path``, read as :func:`read_bounded`; :class:`ReadError` if it is not UTF-8."""
+    data = read_bounded(path, limit, what)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ReadError(f"{what or repr(escaped(str(path)))} is not UTF-8 text (byte {exc.start}): allowed a "
+                        "UTF-8 text file") from None
+
+
+__all__ = ["ReadError", "limit_text", "read_bounded", "read_utf8", "size_text", "too_large"]
