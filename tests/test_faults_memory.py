@@ -114,7 +114,7 @@ def test_odrive_duplicate_key_found_among_many():
     keys = {f"k{i}": 1 for i in range(28_000)}
     text = json.dumps({"axis0": {"motor": {"config": keys}}})
     assert len(parse_odrive(text).unknown) >= 28_000  # read in one pass; every key listed
-    dup = text[:-3] + ', "k27999": 2}}}'
+    dup = text[:-4] + ', "k27999": 2}}}'
     with pytest.raises(ParameterError, match="'k27999' is given more than once"):
         parse_odrive(dup)
 
