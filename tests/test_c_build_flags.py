@@ -24,7 +24,6 @@ import pytest
 
 from pmsm_commissioning.app.exports.c_arm import arm_compiler, double_symbols
 from pmsm_commissioning.app.exports.c_module import HEADER_NAME, parameter_hash
-from pmsm_commissioning.app.exports.provenance import tool_version
 from pmsm_commissioning.app.exports.c_verify import (
     CFLAGS,
     CModule,
@@ -37,6 +36,7 @@ from pmsm_commissioning.app.exports.c_verify import (
     readings,
     write_module,
 )
+from pmsm_commissioning.app.exports.provenance import tool_version
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.fdsmc.feasibility import current_limit
 from pmsm_commissioning.sim.common import sensors
@@ -184,7 +184,8 @@ def test_accepting_by_the_macros_own_name_is_refused(tmp_path):
 
 def test_the_hash_covers_the_tool_version(tmp_path, monkeypatch):
     """Another version of the tool (its code may differ) gives another FDSMC_PARAM_HASH: the old
-    acceptance no longer builds the new module, only the new literal does."""
+    acceptance no longer builds the new module, only the new literal does.
+    """
     _module(tmp_path)
     params = count_params(load_preset("yaskawa_sgm7j_04a"))[0]
     old_flag, h = accept_flag(tmp_path), parameter_hash(params)
