@@ -24,19 +24,24 @@ from pmsm_commissioning.app.cli.bldc import bench_figure
 from pmsm_commissioning.app.cli.main import add_preset_arguments
 from pmsm_commissioning.app.io.numbers import integer_option
 from pmsm_commissioning.app.io.presets import load, load_preset
+from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import clear_caches, derive
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc.engine import compare, run_steps
 from pmsm_commissioning.sim.fdsmc.grid import CONTINUOUS_STEP_S
 from pmsm_commissioning.sim.fdsmc.reference import run_reference
 from pmsm_commissioning.sim.fdsmc.table1 import TABLE1_T_M, table1_sweep
+from pmsm_commissioning.sim.studies.runner import exit_with_parent
+
+#: Most repetitions of each figure [-]: a figure takes up to ≈ 5 s a repetition, so 100 is ≈ 10 min of work.
+MAX_REPEAT = 100
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     """Arguments of ``bench``."""
     add_preset_arguments(p, default="paper_12kw_pmsm")
     p.add_argument("--repeat", type=integer_option("--repeat"), default=7,
-                   help="repetitions of each figure (median; at least 5)")
+                   help=f"repetitions of each figure (median; 5 … {MAX_REPEAT}, fewer count as 5)")
     p.add_argument("--smoke", action="store_true",
                    help="one repetition of each figure: checks that every figure runs (not figures of record)")
 
@@ -65,6 +70,9 @@ def _ms(wall_cpu: tuple[float, float]) -> str:
 def run(args: argparse.Namespace) -> int:
     """Print the speed figures."""
     base = args.overrides
+    if not 1 <= args.repeat <= MAX_REPEAT:  # before any work: the loops run that many times
+        raise ParameterError(f"--repeat = {args.repeat} is not allowed: 1 … {MAX_REPEAT} (each figure is timed "
+                             "that many times)")
     rep = 1 if args.smoke else max(5, args.repeat)
     if args.smoke:
         print("smoke run: one repetition of each figure, so these are single timings, not medians")
@@ -167,7 +175,8 @@ def concurrency_figure(p: object, repeat: int) -> str:
     n = 4 * cores
     serial = _medians(repeat, lambda: [compare(p) for _ in range(n)])  # type: ignore[arg-type]
     threads = _medians(repeat, _parallel, n, compare, p)
-    with ProcessPoolExecutor(cores, mp_context=multiprocessing.get_context("forkserver")) as pool:
+    with ProcessPoolExecutor(cores, mp_context=multiprocessing.get_context("forkserver"),
+                             initializer=exit_with_parent) as pool:
         list(pool.map(_compare_in_process, [p] * cores))  # imports + kernel cache load in each worker
         procs = _medians(repeat, lambda: list(pool.map(_compare_in_process, [p] * n)))
     return (f"{n} comparisons (derive included): one after the other {_ms(serial)}; on {n} threads "

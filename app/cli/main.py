@@ -161,10 +161,15 @@ def _end_child_processes() -> None:
 
 
 def _install_handlers() -> dict[int, Any]:
-    """Route SIGTERM, and SIGINT unless it is ignored (a background job), to :func:`_raise_interrupt`."""
+    """Route SIGTERM, SIGINT and SIGHUP (a closed terminal) to :func:`_raise_interrupt`.
+
+    SIGINT and SIGHUP keep an ignored disposition (a background job, ``nohup``).
+    """
     previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _raise_interrupt)}
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         previous[signal.SIGINT] = signal.signal(signal.SIGINT, _raise_interrupt)
+    if signal.getsignal(signal.SIGHUP) is signal.SIG_DFL:
+        previous[signal.SIGHUP] = signal.signal(signal.SIGHUP, _raise_interrupt)
     return previous
 
 
@@ -192,6 +197,7 @@ def _stop_interrupted() -> NoReturn:
     from pmsm_commissioning.app.io.atomic import discard_partial
 
     discard_partial()
+    _end_child_processes()  # a pool's workers (they would also end themselves, a moment later)
     try:
         sys.stdout.flush()
         # \r: over a progress line a command may have left open (table1's "simulated 2/5"), as a terminal shows it

@@ -8,8 +8,14 @@ chunk that the pool loses a second time raises :class:`ExecutorError` (one line:
 happened, what is allowed). Workers are started with ``spawn`` (no fork of a threaded parent) and
 each runs its chunks on one numba thread: the processes are the parallelism. ``nice`` lowers the
 workers' scheduling priority (so that a server's interactive work comes first). Workers start
-with SIGINT blocked (:class:`_QuietSpawn`): a Ctrl-C typed as the pool starts reaches the whole
-process group, and the parent alone answers it (ending the workers), so no worker prints a traceback.
+with SIGINT and SIGHUP blocked (:class:`_QuietSpawn`): a Ctrl-C typed as the pool starts, or a closed
+terminal's hang-up, reaches the whole process group, and the parent alone answers it (ending the
+workers), so no worker prints a traceback. Every worker ends itself once its parent is gone
+(:func:`exit_with_parent`): a parent killed with SIGKILL (the OOM killer, a CI timeout) leaves no
+worker behind, nor the resource tracker (which ends when the last process holding its pipe does).
+The resource tracker is started with SIGHUP blocked too (:func:`_start_resource_tracker`): it ignores
+SIGINT and SIGTERM itself, and a hang-up that killed it made the parent start a new one, which then
+printed a KeyError traceback for every semaphore the pool released.
 """
 
 from __future__ import annotations
@@ -18,9 +24,11 @@ import contextlib
 import os
 import signal
 import threading
+import time
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
+from multiprocessing import resource_tracker
 from multiprocessing.context import SpawnContext, SpawnProcess
 from typing import Any
 
@@ -30,18 +38,34 @@ RETRIES = 1
 #: signal to any of its threads; Python's handler then only sets a flag, which the main thread reads when it
 #: wakes: a wait in slices keeps Ctrl-C and SIGTERM prompt however long the chunk runs.
 WAIT_SLICE_S = 0.2
+#: How often a worker looks whether its parent process is still there [s].
+PARENT_POLL_S = 0.25
+#: Signals a worker starts with blocked: the parent answers them for the whole pool.
+BLOCKED_IN_WORKERS = frozenset({signal.SIGINT, signal.SIGHUP})
 
 
 class _QuietProcess(SpawnProcess):
-    """A spawned process that inherits SIGINT blocked (the mask survives fork and exec)."""
+    """A spawned process that inherits SIGINT and SIGHUP blocked (the mask survives fork and exec)."""
 
     def start(self) -> None:
-        """Start the process with SIGINT blocked in this thread meanwhile (a pending one is then delivered)."""
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        """Start the process with those signals blocked in this thread meanwhile (a pending one is then delivered)."""
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, BLOCKED_IN_WORKERS)
         try:
             super().start()
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _start_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker (if not running) with the workers' signals blocked.
+
+    The tracker unblocks only SIGINT and SIGTERM (which it ignores): SIGHUP stays blocked in it.
+    """
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, BLOCKED_IN_WORKERS)
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 class _QuietSpawn(SpawnContext):
@@ -113,6 +137,34 @@ def lower_priority(increment: int) -> None:
             os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + increment)
 
 
+def _watch_parent(parent: int) -> None:
+    """End this process once its parent ``parent`` is gone (it is then reparented: init or a subreaper)."""
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_S)
+    os._exit(1)  # nothing of the worker's is kept: its chunk's result would have no reader
+
+
+def exit_with_parent(parent: int | None = None) -> None:
+    """Make the calling process (a pool worker) exit within :data:`PARENT_POLL_S` of its parent's death.
+
+    ``parent``: the process id the worker's parent must have (the pool's process for ``spawn``; None:
+    the parent it has now, e.g. a forkserver). A watchdog thread compares ``os.getppid()`` with it.
+    (Linux's parent-death signal, ``prctl(PR_SET_PDEATHSIG)``, fires when the parent's *thread* that
+    started the worker ends, and a pool starts workers from whichever thread submits first: it could
+    end a worker of a living parent.)
+    """
+    now = os.getppid()
+    if parent is not None and now != parent:  # the parent died before this worker got here
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(now,), name="parent-watchdog", daemon=True).start()
+
+
+def start_worker(nice: int, parent: int) -> None:
+    """Start a pool worker: exit with the parent ``parent`` (:func:`exit_with_parent`), lowered priority."""
+    exit_with_parent(parent)
+    lower_priority(nice)
+
+
 class RetryingPool:
     """A spawn-context process pool of ``workers`` processes that survives one lost worker per chunk.
 
@@ -128,8 +180,9 @@ class RetryingPool:
         self._futures: list[RetryingFuture] = []
 
     def _new_pool(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(self.workers, mp_context=_QuietSpawn(), initializer=lower_priority,
-                                   initargs=(self.nice,))
+        _start_resource_tracker()
+        return ProcessPoolExecutor(self.workers, mp_context=_QuietSpawn(), initializer=start_worker,
+                                   initargs=(self.nice, os.getpid()))
 
     def raw_submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
         """Submit to the current process pool (no retry)."""
