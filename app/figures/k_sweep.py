@@ -11,9 +11,11 @@ the display's frame rate.
 
 Per frame only what K changes: the layer ±1/K (eq. (45) in [1]), the FDSMC trajectory in the phase
 plane, its ω_r and motor torque Γ against t, and the verdict of that very run
-(:func:`app.figures.fdsmc_verdict.chatter_verdict`) as a text trace on an overlaid [0, 1] axis
-(a layout annotation would need ``redraw: true``). The axes hold every run of the grid, so nothing
-rescales while dragging. Frames are written as text with 4 significant digits (:func:`_frame_json`).
+(:func:`app.figures.fdsmc_verdict.chatter_verdict`) as a text trace in the phase plane's own axes
+(a layout annotation would need ``redraw: true``; a hidden overlaid axis of its own was one more
+subplot for Plotly to lay out and draw at every frame). The axes hold every run of the grid, so
+nothing rescales while dragging, and the verdict stays where it was put. Frames are written as
+text with 4 significant digits (:func:`_frame_json`).
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -133,8 +135,13 @@ def _step_label(K: float) -> str:
     return f"{K:.0f}" if K >= 100.0 else f"{K:.2g}"
 
 
-def _static_traces(points: list[Any], active: Any, boundary: tuple[np.ndarray, np.ndarray]) -> list[dict[str, Any]]:
-    """Return the figure's traces as they show the ``active`` run (the frames change :data:`DYNAMIC` of them)."""
+def _static_traces(points: list[Any], active: Any, boundary: tuple[np.ndarray, np.ndarray],
+                   ranges: tuple[list[float], list[float]]) -> list[dict[str, Any]]:
+    """Return the figure's traces as they show the ``active`` run (the frames change :data:`DYNAMIC` of them).
+
+    ``ranges`` are the phase plane's fixed θ_re [rad] and ω_r [rad/s] ranges: the verdict stands in
+    their empty half.
+    """
     d = active.derived
     bx, by = _band(*boundary, d.params.controller.K)
     tr = active.fdsmc.trace
@@ -160,17 +167,21 @@ def _static_traces(points: list[Any], active: Any, boundary: tuple[np.ndarray, n
         {**line, "x": [0.0, t_end, None, 0.0, t_end], "y": [g_max, g_max, None, -g_max, -g_max],
          "name": "±Γ_max", "xaxis": "x3", "yaxis": "y3", "line": REF_LINE},
         # in the phase plane's empty half (below the cruise for a positive move): not on the trajectory
-        {"type": "scatter", "mode": "text", "x": [0.5], "y": [0.3 if sign > 0 else 0.7], "text": [text],
-         "xaxis": "x4", "yaxis": "y4", "textposition": "middle center",
+        {"type": "scatter", "mode": "text", "x": [_at(ranges[0], 0.5)], "y": [_at(ranges[1], 0.3 if sign > 0 else 0.7)],
+         "text": [text], "textposition": "middle center", "cliponaxis": False,
          "textfont": {"color": colour, "size": VERDICT_FONT_PX},
          "hoverinfo": "skip", "showlegend": False, "name": "verdict"},
     ]
 
 
+def _at(span: list[float], share: float) -> float:
+    """Return the point ``share`` of the way along the axis range ``span``."""
+    return span[0] + share * (span[1] - span[0])
+
+
 def _layout(points: list[Any], t_end: float) -> dict[str, Any]:
-    """Axes of the phase plane (left), the ω_r and Γ rows (right) and the verdict's overlay."""
+    """Axes of the phase plane (left) and of the ω_r and Γ rows (right)."""
     x_r, y_r, w_r, g_r = _extent(points)
-    hidden = {"visible": False, "range": [0.0, 1.0], "fixedrange": True}
     return {
         "xaxis": {"domain": list(PHASE_X), "range": x_r, "title": {"text": "θ_re = θ_r − θ_rdem [rad]"}},
         "yaxis": {"range": y_r, "title": {"text": "ω_r [rad/s]"}},
@@ -179,8 +190,6 @@ def _layout(points: list[Any], t_end: float) -> dict[str, Any]:
         "xaxis3": {"domain": list(TIME_X), "anchor": "y3", "range": [0.0, t_end], "matches": "x2",
                    "title": {"text": "t [s]", "standoff": 4}},
         "yaxis3": {"domain": list(ROW_Y[1]), "anchor": "x3", "range": g_r, "title": {"text": "Γ [N·m]"}},
-        "xaxis4": {**hidden, "domain": list(PHASE_X), "anchor": "y4", "overlaying": "x"},
-        "yaxis4": {**hidden, "anchor": "x4", "overlaying": "y"},
     }
 
 
@@ -208,11 +217,11 @@ def k_sweep_spec(points: list[Any], K_now: float, marks: dict[str, float],
     Ks = [c.derived.params.controller.K for c in points]
     active = int(np.argmin([abs(math.log(K / K_now)) for K in Ks]))
     d = points[active].derived
-    lo, hi = _extent(points)[0]
+    x_r, y_r = _extent(points)[:2]
     knee = d.profile.T_c * d.profile.omega_p
-    bx = np.unique(np.array([lo, -knee, 0.0, knee, hi]))
+    bx = np.unique(np.array([x_r[0], -knee, 0.0, knee, x_r[1]]))
     boundary = (bx, boundary_speed(bx, d.profile.omega_p, d.profile.T_c))
-    data = _static_traces(points, points[active], boundary)
+    data = _static_traces(points, points[active], boundary, (x_r, y_r))
     if plant_J_L is not None:  # the active frame's verdict says so too
         data[7]["text"] = [_verdict_text(points[active], plant_J_L)[0]]
     raw = {f"__k_frame_{k}__": "[" + _frame_json(c, boundary, plant_J_L) + "]" for k, c in enumerate(points)}
