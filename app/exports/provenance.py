@@ -23,8 +23,10 @@ from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.presets import to_raw
 from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.common.checks import ParameterError
+from pmsm_commissioning.control.fdsmc.params import Controller
 from pmsm_commissioning.sim.fdsmc.design import Constraint, run_checks
 from pmsm_commissioning.sim.fdsmc.engine import Comparison, RunResult
+from pmsm_commissioning.sim.fdsmc.recommend import run_supply_J
 
 
 class ExportRefusedError(ParameterError):
@@ -85,13 +87,15 @@ def verdict_lines(failed: Sequence[Constraint]) -> list[str]:
     return ["verdict: NOT CLEAN — written with --force; failed checks:"] + [f"  {check_text(c)}" for c in failed]
 
 
-def _energy(run: RunResult | None) -> str:
+def _energy(run: RunResult | None, controller: Controller) -> str:
+    """One run's energies: from the supply under the DC-link choice (named), net, friction, copper."""
     if run is None:
         return "not simulated"
     m = run.metrics
     if not m.stable:
         return f"unstable ({m.reason})"
-    return (f"net electrical {m.electrical_in_total_J:.5g} J (friction {m.friction_total_J:.5g} J, "
+    return (f"from the supply {run_supply_J(run, controller):.5g} J (DC link {controller.dc_link}), "
+            f"net electrical {m.electrical_in_total_J:.5g} J (friction {m.friction_total_J:.5g} J, "
             f"copper {m.copper_total_J:.5g} J), peak torque {m.torque_peak_Nm:.4g} N·m")
 
 
@@ -121,6 +125,6 @@ def header_lines(cmp: Comparison, failed: Sequence[Constraint], route: tuple[str
     lines += [f"FDSMC design (C module, not this file): {'clean' if not failed else 'NOT CLEAN'}"]
     lines += [f"design warning: {w}" for w in cmp.derived.warnings]
     stock = None if route is None else route[1]
-    lines += [f"simulated whole-run energy, {name}: {_energy(run)}" for name, run in
+    lines += [f"simulated whole-run energy, {name}: {_energy(run, p.controller)}" for name, run in
               (("FDSMC", cmp.fdsmc), ("tracked optimum", cmp.optimum), ("stock route (this file)", stock))]
     return lines
