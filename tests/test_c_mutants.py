@@ -37,6 +37,16 @@ def _flip(field: str):
     return mutate
 
 
+def _flip_element(field: str, index: int):
+    """Mutation: the sign of element ``index`` of the design's array ``field`` flipped (both builds' rows)."""
+    def mutate(text: str) -> str:
+        pattern = rf"(\.{field} = \{{(?:R_\([^)]*\), ){{{index}}}R_\()(-?)"
+        out, n = re.subn(pattern, lambda m: m.group(1) + ("" if m.group(2) else "-"), text)
+        assert n == 2, (field, index, n)
+        return out
+    return mutate
+
+
 def _replace(old: str, new: str):
     def mutate(text: str) -> str:
         assert text.count(old) == 1, old
@@ -61,6 +71,7 @@ MUTANTS = {
     "set_move accepts while moving": _replace("return FDSMC_ERR_MOVING;", "(void)0;"),
     "set_move accepts while busy": _replace("return FDSMC_ERR_BUSY;", "(void)0;"),
     **{f"sign of {f}": _flip(f) for f in ("k_bl", "alpha_max", "three_inv_t_si", "three_inv_t_salpha", "l")},
+    **{f"sign of l[{i}]": _flip_element("l", i) for i in (1, 2, 3)},
 }
 
 
