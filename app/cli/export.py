@@ -8,9 +8,9 @@ the tracked optimum with its designed move's reference table); otherwise PATH is
 naming the failed checks, when the simulated design is not clean; ``--force`` writes it with the
 failed checks inside. For ``c`` the refusal names every failed check (their names on the first line,
 then one line each) and a forced export warns on stderr naming them the same way. Files are written
-whole (a temporary file, then ``os.replace``); the C
-module's files are all written to temporary files first and renamed only when every one is complete
-(:func:`app.io.atomic.write_all`: a full disk leaves the old files). ``-o`` a device node, FIFO,
+whole (a temporary file, then ``os.replace``); the C module's files are all written to temporary files
+first and renamed only when every one is complete (:func:`app.io.atomic.write_all`: a full disk leaves
+the old files). ``-o`` a device node, FIFO,
 folder, read-only file or symbolic-link loop is refused before any simulation
 (:func:`app.io.atomic.target_problem`).
 """
