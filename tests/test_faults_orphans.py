@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.sim.studies.runner import PARENT_POLL_S, RetryingPool, exit_with_parent
+from pmsm_commissioning.sim.studies.runner import PARENT_POLL_S, ExecutorError, RetryingPool, exit_with_parent
 from tests.child_signals import default_signals
 from tests.test_faults_signals import _no_part_files, _pool_workers, _running, _wait_until, interrupt
 
@@ -154,3 +154,14 @@ def test_a_worker_whose_parent_is_gone_ends_itself():
     exit_with_parent(os.getppid())  # this process's own parent is alive: nothing happens
     with RetryingPool(1) as pool:
         assert pool.submit(os.getppid).result() == os.getpid()  # a worker's parent is the pool's process
+
+
+def test_a_pool_ended_before_its_first_chunk_starts_no_worker():
+    # a study cancelled (or its page closed) before its first chunk: the chunks used to start the
+    # workers anyway and the study ran on without a page
+    pool = RetryingPool(2)
+    pool.terminate()
+    with pytest.raises(ExecutorError, match="no chunk started: the local pool was ended"):
+        pool.submit(os.getpid)
+    assert pool.processes() == []
+    pool.shutdown()

@@ -175,7 +175,7 @@ class RetryingPool:
         self.workers, self.nice = int(workers), int(nice)
         self.generation = 0
         self.ended = False
-        self._lock = threading.Lock()
+        self._lock = threading.RLock()  # renew() submits again while holding it
         self._pool = self._new_pool()
         self._futures: list[RetryingFuture] = []
 
@@ -185,8 +185,17 @@ class RetryingPool:
                                    initargs=(self.nice, os.getpid()))
 
     def raw_submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
-        """Submit to the current process pool (no retry)."""
-        return self._pool.submit(fn, *args)
+        """Submit to the current process pool (no retry); :class:`ExecutorError` once the pool was ended.
+
+        Under the lock :meth:`terminate` takes: a worker is never started after the pool was ended
+        (the pool starts its workers as chunks are submitted, so a study cancelled before its first
+        chunk, or its page closed then, would otherwise start them and run on without a page).
+        """
+        with self._lock:
+            if self.ended:
+                raise ExecutorError("no chunk started: the local pool was ended (the run was cancelled); "
+                                    "allowed: a pool left running")
+            return self._pool.submit(fn, *args)
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> RetryingFuture:
         """Submit one chunk; its index is the order of submission."""
@@ -212,6 +221,7 @@ class RetryingPool:
             self.ended = True
             for proc in list((self._pool._processes or {}).values()):
                 proc.terminate()
+            self._pool.shutdown(wait=False, cancel_futures=True)  # nothing more starts
 
     def processes(self) -> list[int]:
         """Process ids of the current workers (for tests and diagnostics)."""
