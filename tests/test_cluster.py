@@ -31,6 +31,8 @@ from pmsm_commissioning.control.fdsmc.derivations import derive
 from pmsm_commissioning.sim.studies.robustness import METRICS, draw, simulate_chunk
 from tests.child_signals import default_signals
 
+pytestmark = pytest.mark.cluster  # every test here starts a scheduler (or checks one is refused)
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PRESET = "paper_12kw_pmsm"
 SPREAD = "plant.J_L=0:0.3,plant.R_s=±20%,plant.psi_pm=±10%"

@@ -107,6 +107,7 @@ print(json.dumps({"same": remote.runs == local.runs, "summary": remote.summary["
 """
 
 
+@pytest.mark.cluster
 def test_dask_cluster_gives_the_local_results():
     """Run in a fresh interpreter: the cluster's event loop must not outlive it in the test process."""
     r = subprocess.run([sys.executable, "-c", _DASK_SCRIPT], capture_output=True, text=True, check=False,
