@@ -26,7 +26,7 @@ from pmsm_commissioning.app.ui.text import md_text
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
 from pmsm_commissioning.sim.common.budget import BudgetError
-from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, CONTROLLERS, compare
+from pmsm_commissioning.sim.fdsmc.engine import COMPARATORS, CONTROLLERS, LABELS, compare
 from pmsm_commissioning.sim.fdsmc.grid import check_budget
 from pmsm_commissioning.sim.fdsmc.optimum_gap import saving_vs_optimum
 from pmsm_commissioning.sim.fdsmc.verdicts import TARGET_BAND
@@ -79,6 +79,19 @@ def test_gap_to_the_optimum_in_the_numbers(with_optimum):
     assert f"{gaps['fdsmc']:.1f} %" in spec["layout"]["title"]["text"]
     assert f"{gaps['fdsmc']:.1f} %" in optimum_markdown(with_optimum)
     to_figure(spec)  # a valid Plotly figure
+
+
+def test_the_supplys_energy_is_a_bar_and_a_gap_under_the_dc_link(with_optimum):
+    """Default DC link (braking resistor): the fourth bar is the energy drawn, its gap the drawn basis."""
+    bars = {t["name"]: t for t in energy_bars_spec(with_optimum)["data"]}
+    assert bars["FDSMC"]["x"][3] == "from the supply (braking resistor)"
+    for key in ("fdsmc", "conventional", "optimum"):
+        run = getattr(with_optimum, key)
+        assert bars[LABELS[key]]["y"][3] == run.metrics.motoring_total_J
+    drawn = {k: getattr(with_optimum, k).metrics.motoring_total_J for k in COMPARATORS}
+    gaps = energy_bars_spec(with_optimum)["layout"]["meta"]["gap_to_optimum_supply_pct"]
+    assert gaps["fdsmc"] == pytest.approx(100.0 * (1.0 - drawn["optimum"] / drawn["fdsmc"]))
+    assert f"{gaps['fdsmc']:.1f} %" in optimum_markdown(with_optimum).split("From the supply")[1]
 
 
 def test_no_optimum_numbers_without_the_optimum_run():

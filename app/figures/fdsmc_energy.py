@@ -14,7 +14,8 @@ from pmsm_commissioning.app.figures.decimate import f32, time_axis
 from pmsm_commissioning.app.figures.fdsmc_comparison import COLOURS, MAX_POINTS_TIME, runs, stride_index
 from pmsm_commissioning.app.figures.style import BAD_COLOUR, GOOD_COLOUR
 from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison, RunResult
-from pmsm_commissioning.sim.fdsmc.optimum_gap import saving_vs_optimum
+from pmsm_commissioning.sim.fdsmc.optimum_gap import saving_vs_optimum, supply_saving_vs_optimum
+from pmsm_commissioning.sim.fdsmc.recommend import run_supply_J
 from pmsm_commissioning.sim.fdsmc.table1 import Table1Row, printed_reversed
 
 #: Energy kinds: (trace attribute, metric key of the horizon total, label, dash).
@@ -55,15 +56,19 @@ def energy_spec(comparison: Comparison) -> dict[str, Any]:
 
 def energy_bars_spec(comparison: Comparison) -> dict[str, Any]:
     """Energy totals as a plain-dict figure (see :func:`make_energy_bars_figure`)."""
-    kinds = [label for _, _, label, _ in ENERGIES]
+    c = comparison.derived.params.controller
+    kinds = [label for _, _, label, _ in ENERGIES] + [f"from the supply ({c.dc_link.replace('_', ' ')})"]
     data = []
     for key, run in runs(comparison):
-        totals = [energy_total(run, attr, metric) for attr, metric, _, _ in ENERGIES]
+        supply = run_supply_J(run, c)
+        totals = [energy_total(run, attr, metric) for attr, metric, _, _ in ENERGIES] + [
+            float("nan") if supply is None else supply]
         data.append({"type": "bar", "x": kinds, "y": totals, "name": LABELS[key], "marker": {"color": COLOURS[key]},
                      "text": [f"{v:.4g} J" for v in totals], "textposition": "outside"})
     title = (f"Totals — FDSMC saves {_pct(comparison.saving_friction_pct)} friction, "
              f"{_pct(comparison.saving_electrical_pct)} electrical input")
     gaps = optimum_gaps(comparison)
+    supply_gaps = optimum_gaps(comparison, supply=True)
     extra: dict[str, Any] = {}
     if gaps:
         title += ("<br>the optimum would save " + ", ".join(f"{_pct(v)} of {LABELS[k]}'s" for k, v in gaps.items())
@@ -71,17 +76,22 @@ def energy_bars_spec(comparison: Comparison) -> dict[str, Any]:
         extra["margin"] = {"l": 60, "r": 16, "t": 64, "b": 40}
     return {"data": data, "layout": _layout("energy_bars", title, -0.15, barmode="group",
                                             yaxis={"title": {"text": "energy [J]"}},
-                                            meta={"id": "energy_bars", "gap_to_optimum_pct": gaps}, **extra)}
+                                            meta={"id": "energy_bars", "gap_to_optimum_pct": gaps,
+                                                  "gap_to_optimum_supply_pct": supply_gaps}, **extra)}
 
 
-def optimum_gaps(comparison: Any) -> dict[str, float | None]:
+def optimum_gaps(comparison: Any, supply: bool = False) -> dict[str, float | None]:
     """Return, per controller, the share of its net electrical input [%] the optimum would save.
 
-    See (:func:`sim.fdsmc.optimum_gap.saving_vs_optimum`); empty without an optimum run.
+    See (:func:`sim.fdsmc.optimum_gap.saving_vs_optimum`); with ``supply`` the share of the energy the
+    supply delivers under the DC-link choice (:func:`~sim.fdsmc.optimum_gap.supply_saving_vs_optimum`).
+    Empty without an optimum run.
     """
     if getattr(comparison, "optimum", None) is None:
         return {}
-    return {key: saving_vs_optimum(run, comparison.optimum) for key, run in runs(comparison) if key != "optimum"}
+    c = comparison.derived.params.controller
+    return {key: supply_saving_vs_optimum(run, comparison.optimum, c) if supply else
+            saving_vs_optimum(run, comparison.optimum) for key, run in runs(comparison) if key != "optimum"}
 
 
 def make_energy_figure(comparison: Comparison) -> go.Figure:

@@ -37,7 +37,10 @@ def optimum_markdown(comparison: Any) -> str:
     gaps = optimum_gaps(comparison)
     parts = [f"{LABELS[k]}'s by **{v:.1f} %**" for k, v in gaps.items() if v is not None]
     head = f"Optimum (tracked): **{w:.4g} J** net electrical input" if isinstance(w, float) else "Optimum (tracked)"
-    return head + ("; it undercuts " + ", ".join(parts) + "." if parts else " (no stable comparison).")
+    supply = [f"{LABELS[k]}'s by {v:.1f} %" for k, v in optimum_gaps(comparison, supply=True).items() if v is not None]
+    link = md_text(comparison.derived.params.controller.dc_link)
+    return head + ("; it undercuts " + ", ".join(parts) + "." if parts else " (no stable comparison).") + (
+        f" From the supply (DC link {link}): " + ", ".join(supply) + "." if supply else "")
 
 
 class OptimumToggle:
