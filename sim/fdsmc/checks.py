@@ -20,8 +20,8 @@ from pmsm_commissioning.control.fdsmc.feasibility import (
 )
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
-from pmsm_commissioning.sim.fdsmc.engine import LABELS, RunResult
 from pmsm_commissioning.sim.fdsmc.metrics import RunMetrics
+from pmsm_commissioning.sim.fdsmc.run import LABELS, RunResult
 
 #: Position error at T_m, as a fraction of |θ_dem|, beyond which a run is said to miss T_m [-]:
 #: the FDSMC is designed to arrive by T_m (2 % band); the comparator's Dodds formula (eq. (61) in

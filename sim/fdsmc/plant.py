@@ -18,8 +18,8 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc import kernel as kn
-from pmsm_commissioning.sim.fdsmc.engine import pack_parameters
 from pmsm_commissioning.sim.fdsmc.grid import load_steps, time_grid
+from pmsm_commissioning.sim.fdsmc.run import pack_parameters
 
 
 class PlantInTheLoop:

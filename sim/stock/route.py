@@ -25,8 +25,8 @@ from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.control.stock.loops import LAW_CASCADE, LAW_PID
 from pmsm_commissioning.sim.fdsmc import kernel as kn
-from pmsm_commissioning.sim.fdsmc.engine import RunResult, pack_parameters, run_packed
 from pmsm_commissioning.sim.fdsmc.grid import MAX_POINTS, check_budget, time_grid
+from pmsm_commissioning.sim.fdsmc.run import RunResult, pack_parameters, run_packed
 
 #: Position/speed laws by name.
 LAWS = {"cascade": LAW_CASCADE, "pid": LAW_PID}

@@ -46,8 +46,8 @@ from pmsm_commissioning.control.fdsmc.trapezoid import TrapezoidTiming, trapezoi
 from pmsm_commissioning.sim.common.budget import MAX_CPU_S
 from pmsm_commissioning.sim.fdsmc.checks import Constraint, run_checks
 from pmsm_commissioning.sim.fdsmc.criteria import drive_current
-from pmsm_commissioning.sim.fdsmc.engine import RunResult
 from pmsm_commissioning.sim.fdsmc.grid import check_budget
+from pmsm_commissioning.sim.fdsmc.run import RunResult
 from pmsm_commissioning.sim.stock.route import StockLoop, at_loop_rate, simulate_stock
 
 #: pos_gain = ω_v/POSITION_RATIO [-].

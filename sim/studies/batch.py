@@ -33,7 +33,7 @@ from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.common import sensors, signals
 from pmsm_commissioning.sim.fdsmc import kernel as kn
 from pmsm_commissioning.sim.fdsmc import kernel_run
-from pmsm_commissioning.sim.fdsmc.engine import CONTROLLERS, _observer_arrays, _reference, pack_parameters
+from pmsm_commissioning.sim.fdsmc.engine import CONTROLLERS
 from pmsm_commissioning.sim.fdsmc.grid import CONTINUOUS_STEP_S, TimeGrid, load_steps, time_grid
 from pmsm_commissioning.sim.fdsmc.limit_cycle import limit_cycles
 from pmsm_commissioning.sim.fdsmc.metrics import (
@@ -43,6 +43,7 @@ from pmsm_commissioning.sim.fdsmc.metrics import (
     chatter_window_steps,
     chatter_windows,
 )
+from pmsm_commissioning.sim.fdsmc.run import observer_arrays, pack_parameters, reference_rows
 
 #: Samples per compiled call [-]: bounds the trace buffers; ≥ 8 keeps two threads busy.
 BATCH = 16
@@ -84,7 +85,7 @@ def setup(params: DriveParams, d: Derived, controller: str, plant: DriveParams, 
     T_step = g.h * g.n_sub
     windows = tuple(chatter_windows(params, d, controller, g.n_steps * T_step).values())
     steps = tuple(chatter_window_steps(w, T_step, g.n_steps) for w in windows)
-    return Setup(controller, g, (*load_steps(plant), *_observer_arrays(d)), _reference(d, controller),
+    return Setup(controller, g, (*load_steps(plant), *observer_arrays(d)), reference_rows(d, controller),
                  sensors.noise_table(params.sensors), windows, steps)
 
 

@@ -28,9 +28,10 @@ from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.common.economics import J_PER_KWH, cost_per_year, kwh_per_year  # noqa: F401 - J_PER_KWH re-exported
 from pmsm_commissioning.sim.fdsmc import kernel as kn
-from pmsm_commissioning.sim.fdsmc.engine import optimum_omitted, pack_parameters
+from pmsm_commissioning.sim.fdsmc.engine import optimum_omitted
 from pmsm_commissioning.sim.fdsmc.grid import continuous_step, plant_substeps
 from pmsm_commissioning.sim.fdsmc.metrics import kinetic_energy, magnetic_energy
+from pmsm_commissioning.sim.fdsmc.run import pack_parameters
 from pmsm_commissioning.sim.fdsmc.summary import decode_state
 from pmsm_commissioning.sim.studies.cycle_kernel import run_cycle
 
