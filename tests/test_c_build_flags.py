@@ -36,7 +36,7 @@ from pmsm_commissioning.app.exports.c_verify import (
     readings,
     write_module,
 )
-from pmsm_commissioning.app.exports.provenance import tool_version
+from pmsm_commissioning.app.exports.tool_id import tool_version
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.fdsmc.feasibility import current_limit
 from pmsm_commissioning.sim.common import sensors

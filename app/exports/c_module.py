@@ -39,8 +39,9 @@ from pmsm_commissioning.control.fdsmc.tracking import slide_gain
 from .c_optimum import STATE_FIELDS, ReferenceTable, law_parts, optimum_constants, reference_table
 from .c_source import FDSMC_MOVE, LIMIT_CODE, SOURCE
 from .c_template import HEADER
+from .tool_id import TOOL as TOOL  # the tool's name, imported from here by the other exports
+from .tool_id import tool_version
 
-TOOL = "pmsm-commissioning (FDSMC)"
 #: File names of the generated module.
 HEADER_NAME, SOURCE_NAME = "fdsmc_controller.h", "fdsmc_controller.c"
 
@@ -249,17 +250,13 @@ def _define(k: CConstant) -> str:
 def parameter_hash(params: DriveParams, tool: str | None = None) -> str:
     """Hash of a design: 16 hex digits of SHA-256 over the preset's canonical JSON and the tool's version.
 
-    ``tool``: ``"<tool> <version>"`` (default :func:`app.exports.provenance.tool_version`, the installed
+    ``tool``: ``"<tool> <version>"`` (default :func:`app.exports.tool_id.tool_version`, the installed
     package's). The same inputs give the same hash whether exported as YAML, JSON or C (the loader reads
     every format back to the same :class:`DriveParams`), so the hash ties a ``.h`` to its file; another
     version of the tool, whose generated code may differ, gives another hash (an accepted unclean
     design must be accepted again).
     """
-    if tool is None:
-        from pmsm_commissioning.app.exports.provenance import tool_version  # it imports this module
-
-        tool = tool_version()
-    data = {"inputs": to_json(to_raw(params)), "tool": tool}
+    data = {"inputs": to_json(to_raw(params)), "tool": tool_version() if tool is None else tool}
     text = json.dumps(data, sort_keys=True, separators=(",", ":"), ensure_ascii=True, allow_nan=False)
     return hashlib.sha256(text.encode("ascii")).hexdigest()[:16]
 
@@ -298,8 +295,6 @@ def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Ver
     if table is not None:
         constants += [CConstant(*k) for k in optimum_constants(params, d, table)]
     defines = "\n".join(_define(k) for k in constants)
-    from pmsm_commissioning.app.exports.provenance import tool_version  # it imports this module
-
     tool = tool_version()
     h = parameter_hash(params if inputs is None else inputs, tool)
     optimum = table is not None
