@@ -5,7 +5,7 @@ rad/s are about ten pixels tall. The inset (own axes ``x4``/``y5``, in the empty
 the phase plane) shows a short stretch of the cruise, where the FDSMC slides on — or chatters about
 — ω_r = ω_p: the layer, the switching boundary of eq. (41) and the FDSMC's samples there at full
 resolution. The window (:func:`zoom_window`) is chosen from the run, so it always holds the
-layer and the run's excursions from it; a grey rectangle on the phase plane marks where it is.
+layer and the run's excursions from it; a grey bracket under the path on the phase plane marks where it is.
 
 [1] Dodds, Sooriyakumar, Perryman, the FDSMC paper.
 """
@@ -53,7 +53,7 @@ def zoom_window(theta_re: np.ndarray, omega_r: np.ndarray, omega_p: float, knee:
 
 def zoom_parts(comparison: Any) -> tuple[list[dict[str, Any]], dict[str, Any], list[dict[str, Any]],
                                          list[dict[str, Any]]] | None:
-    """Inset traces, its axes, shapes (ground, marking rectangle) and title for ``comparison``'s FDSMC run.
+    """Inset traces, its axes, shapes (ground, marking bracket) and title for ``comparison``'s FDSMC run.
 
     None without a cruise. For a move to a negative θ_dem the inset sits in the upper half (the
     lower one holds the trajectory).
@@ -85,21 +85,26 @@ def zoom_parts(comparison: Any) -> tuple[list[dict[str, Any]], dict[str, Any], l
 
 def _inset_frame(win: tuple[float, float, float, float], upward: bool,
                  K: float) -> tuple[dict[str, Any], list[dict[str, Any]], list[dict[str, Any]]]:
-    """Return the inset's axes over window ``win``, its white ground and marking rectangle, and its title."""
+    """Return the inset's axes over window ``win``, its white ground, the bracket marking it, and its title."""
     x0, x1, y0, y1 = win
     frame = {"showgrid": False, "zeroline": False, "mirror": True, "showline": True, "linecolor": ZOOM_COLOUR,
              "tickfont": {"size": FONT_PX}}
     y_dom = INSET_Y if upward else (1.0 - INSET_Y[1] - 0.1, 1.0 - INSET_Y[0] - 0.1)
     layout = {"xaxis4": {**frame, "domain": list(INSET_X), "anchor": "y5", "range": [x0, x1], "nticks": 3},
               "yaxis5": {**frame, "domain": list(y_dom), "anchor": "x4", "range": [y0, y1], "nticks": 4}}
-    box = {"type": "rect", "xref": "x", "yref": "y", "x0": x0, "x1": x1, "y0": y0, "y1": y1,
-           "line": {"color": ZOOM_COLOUR, "width": 1.5}}
+    # the window marked in the phase plane by a bracket under the path (its sides up to the path's
+    # middle), not a box around it: the replay's time label, above the moving marker, would sit on
+    # a box's top edge while the marker crosses it
+    w_mid = 0.5 * (y0 + y1)
+    bracket = {"type": "path", "xref": "x", "yref": "y", "path": f"M{x0},{w_mid} L{x0},{y0} L{x1},{y0} L{x1},{w_mid}",
+               "line": {"color": ZOOM_COLOUR, "width": 1.5}, "name": "zoom window"}
     # the inset's own white ground, under its traces, over the phase plane's grid
-    ground = {**box, "xref": "x4", "yref": "y5", "layer": "below", "fillcolor": "white", "line": {"width": 0}}
+    ground = {"type": "rect", "xref": "x4", "yref": "y5", "x0": x0, "x1": x1, "y0": y0, "y1": y1, "layer": "below",
+              "fillcolor": "white", "line": {"width": 0}}
     title = {"text": f"zoom: sliding region, layer ±1/K = ±{1 / K:.3g} rad/s", "x": INSET_X[0],
              "y": y_dom[1], "xref": "paper", "yref": "paper", "xanchor": "left", "yanchor": "bottom",
              "showarrow": False, "font": {"size": FONT_PX, "color": ZOOM_COLOUR}, "bgcolor": "rgba(255,255,255,0.8)"}
-    return layout, [ground, box], [title]
+    return layout, [ground, bracket], [title]
 
 
 __all__ = ["INSET_X", "INSET_Y", "zoom_parts", "zoom_window"]

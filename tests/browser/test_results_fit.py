@@ -114,3 +114,50 @@ def test_the_overview_legend_entries_never_overlap(browser, ui_server):
         assert any(n.startswith("Layer ±1/K") for n in names), names
     finally:
         context.close()
+
+
+#: Plays the overview's replay at ``label`` and, in each of ``n`` animation frames, records whether the
+#: FDSMC marker's time label meets the verdict box, the zoom window's mark in the phase plane or the
+#: zoom inset; resolves with {labelled frames, hits by what, first hits, [verdict and zoom mark found]}.
+REPLAY_HITS_JS = """([label, n]) => new Promise(resolve => {
+  const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
+  const now = () => [...el.querySelectorAll('g.trace.scatter')].find(g => g.__data__[0].trace.name === 'FDSMC now');
+  const box = e => { if (!e) return null; const r = e.getBoundingClientRect();
+    return r.width ? [r.left, r.top, r.right, r.bottom] : null; };
+  const meet = (a, b) => a && b && a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+  const L = el.layout, v = L.annotations.findIndex(a => a.name === 'verdict');
+  const z = (L.shapes || []).findIndex(s => s.xref === 'x' && s.yref === 'y');
+  const b = L.updatemenus[0].buttons.find(x => x.label === label);
+  window.Plotly.animate(el, ...b.args);
+  const out = {frames: 0, hits: {verdict: 0, zoom: 0, inset: 0}, first: [], marks: [v >= 0, z >= 0]};
+  const f = () => {
+    const t = now() && now().querySelector('text'), tb = t && t.textContent ? box(t) : null;
+    const others = {verdict: box(el.querySelector(`g.annotation[data-index="${v}"] rect.bg`)),
+                    zoom: z >= 0 ? box(el.querySelector(`.shapelayer path[data-index="${z}"]`)) : null,
+                    inset: box(el.querySelector('.subplot.x4y5 .nsewdrag'))};
+    if (tb) { out.frames += 1;
+      for (const [k, o] of Object.entries(others)) if (meet(tb, o)) { out.hits[k] += 1;
+        if (out.first.length < 4) out.first.push([k, t.textContent, tb, o]); } }
+    if (--n > 0) requestAnimationFrame(f); else resolve(out);
+  };
+  requestAnimationFrame(f);
+})"""
+
+
+def test_the_replay_time_label_keeps_clear_of_the_verdict_and_the_zoom(browser, ui_server):
+    context, page = open_page(browser, ui_server, viewport=VIEW)
+    try:
+        for clean in (False, True):  # the paper's K = 1000 (chatter), then the recommended K (a wide layer)
+            if clean:
+                page.get_by_role("button", name=re.compile("^Use recommended K")).click()
+                _wait_ready(page, 1)
+                page.wait_for_function("() => [...document.querySelectorAll('.js-plotly-plot')].some(e => e.layout"
+                                       " && e.layout.meta && e.layout.meta.id === 'phase_plane'"
+                                       " && (e.layout.updatemenus || []).length > 0"
+                                       " && e.layout.annotations.some(a => a.name === 'verdict'"
+                                       " && a.text.includes('no chatter')))", timeout=3 * TIMEOUT_MS)
+            seen = page.evaluate(REPLAY_HITS_JS, ["▶ 0.25×", 240])
+            assert seen["frames"] >= 30 and seen["marks"] == [True, True], seen
+            assert seen["hits"] == {"verdict": 0, "zoom": 0, "inset": 0}, seen
+    finally:
+        context.close()
