@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from pmsm_commissioning.app.figures.fdsmc_comparison import runs
+from pmsm_commissioning.app.figures.fdsmc_comparison import phase_plane_extent, runs
 from pmsm_commissioning.app.figures.style import FONT_PX
 from pmsm_commissioning.sim.fdsmc.engine import Comparison
 
@@ -44,6 +44,9 @@ from pmsm_commissioning.sim.fdsmc.engine import Comparison
 SPEEDS = {"1×": 1.0, "0.25×": 0.25, "0.1×": 0.1, "0.01×": 0.01}
 #: Key frames per wall-clock second, and the most key frames per speed (bounds the figure size).
 KEY_RATE, MAX_FRAMES = 10.0, 150
+#: Share of the phase plane's width, at its right edge, where the time label stands left of the
+#: marker [-] (right of it, the label was cut at the plot's edge at the end of a replay).
+LABEL_LEFT_SHARE = 0.2
 
 
 @dataclass(frozen=True)
@@ -113,23 +116,35 @@ def _marker_positions(comparison: Comparison, t_grid: np.ndarray) -> list[tuple[
             for _, run in runs(comparison)]
 
 
+def label_sides(comparison: Comparison, x: Any) -> list[str]:
+    """Return the ``textposition`` of the time label for the FDSMC marker at each θ_re of ``x`` [rad].
+
+    Above the marker; left of it in the right :data:`LABEL_LEFT_SHARE` of the phase plane.
+    """
+    lo, hi = phase_plane_extent(comparison)
+    edge = hi - LABEL_LEFT_SHARE * (hi - lo)
+    return ["top left" if v > edge else "top right" for v in np.atleast_1d(np.asarray(x, dtype=float)).tolist()]
+
+
 def _frames_json(comparison: Comparison, targets: ScrubTargets, t_grid: np.ndarray) -> str:
     """Write the JSON list of frames at the times ``t_grid`` [s].
 
-    Per time t: the x/y of each "now" marker (and a time label), ``x = [t, t]`` of each
-    time-cursor trace, the trail pieces the frame shows (:func:`_trail_frames`) and each subplot's
-    *keeper* as it is (``meta.keep``: Plotly's transitions clear a subplot none of whose traces
+    Per time t: the x/y of each "now" marker (and a time label on the side of :func:`label_sides`),
+    ``x = [t, t]`` of each time-cursor trace, the trail pieces the frame shows (:func:`_trail_frames`)
+    and each subplot's *keeper* as it is (``meta.keep``: Plotly's transitions clear a subplot none of whose traces
     is in the frame).
 
     Written as text directly: a few thousand small frames are ~10× faster this way than as dicts.
     """
-    cols = [([f"{v:.5g}" for v in x.tolist()], [f"{v:.5g}" for v in y.tolist()])
-            for x, y in _marker_positions(comparison, t_grid)]
+    marks = _marker_positions(comparison, t_grid)
+    cols = [([f"{v:.5g}" for v in x.tolist()], [f"{v:.5g}" for v in y.tolist()]) for x, y in marks]
+    sides = label_sides(comparison, marks[0][0]) if marks else []
     frames, cursors = [], targets.cursors
     keep = [i for i, _ in targets.keep], [points for _, points in targets.keep]
     for k, (t, (pieces, points)) in enumerate(zip(t_grid.tolist(), _trail_frames(targets.trail, t_grid),
                                                   strict=True)):
-        parts = [f'{{"x":[{x[k]}],"y":[{y[k]}]' + (f',"text":["t = {t:.3f} s"]}}' if j == 0 else "}")
+        parts = [f'{{"x":[{x[k]}],"y":[{y[k]}]'
+                 + (f',"text":["t = {t:.3f} s"],"textposition":["{sides[k]}"]}}' if j == 0 else "}")
                  for j, (x, y) in enumerate(cols)]
         parts += [f'{{"x":[{t:.6g},{t:.6g}]}}'] * len(cursors) + points + keep[1]
         traces = ",".join(map(str, [*targets.now, *cursors, *pieces, *keep[0]]))
@@ -197,7 +212,8 @@ def scrub_update(comparison: Comparison, targets: ScrubTargets, t: float) -> tup
 
     The markers go to (θ_r(t) − θ_dem, ω_r(t)) of each run (linear between samples, as the key
     frames), the cursors to ``x = [t, t]`` with their vertical extent kept; the first marker's
-    text gives the time. (The trail follows in the page: :data:`app.ui.replay.BUTTONS_JS`.)
+    text gives the time, on the side :func:`label_sides` picks. (The trail follows in the page:
+    :data:`app.ui.replay.BUTTONS_JS`.)
 
     Returns
     -------
@@ -207,9 +223,13 @@ def scrub_update(comparison: Comparison, targets: ScrubTargets, t: float) -> tup
     t = float(t)
     marks = [(float(x[0]), float(y[0])) for x, y in _marker_positions(comparison, np.array([t]))]
     texts = [[f"t = {t:.3f} s"]] + [[""]] * (len(marks) - 1 + len(targets.cursors))
+    sides = [label_sides(comparison, marks[0][0]) if marks else ["top right"]]
+    sides += [["top right"]] * (len(marks) - 1 + len(targets.cursors))
     return ({"x": [[x] for x, _ in marks] + [[t, t]] * len(targets.cursors),
-             "y": [[y] for _, y in marks] + [list(y) for y in targets.cursor_y], "text": texts},
+             "y": [[y] for _, y in marks] + [list(y) for y in targets.cursor_y], "text": texts,
+             "textposition": sides},
             [*targets.now, *targets.cursors])
 
 
-__all__ = ["KEY_RATE", "MAX_FRAMES", "PAUSE", "SPEEDS", "ScrubTargets", "end_time", "replay_layout", "scrub_update"]
+__all__ = ["KEY_RATE", "LABEL_LEFT_SHARE", "MAX_FRAMES", "PAUSE", "SPEEDS", "ScrubTargets", "end_time",
+           "label_sides", "replay_layout", "scrub_update"]

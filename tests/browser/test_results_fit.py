@@ -118,7 +118,8 @@ def test_the_overview_legend_entries_never_overlap(browser, ui_server):
 
 #: Plays the overview's replay at ``label`` and, in each of ``n`` animation frames, records whether the
 #: FDSMC marker's time label meets the verdict box, the zoom window's mark in the phase plane or the
-#: zoom inset; resolves with {labelled frames, hits by what, first hits, [verdict and zoom mark found]}.
+#: zoom inset; resolves with {labelled frames, hits by what, first hits, [verdict, zoom mark, inset found],
+#: the last frame's [label text, label box, phase-plane plot area box]}.
 REPLAY_HITS_JS = """([label, n]) => new Promise(resolve => {
   const el = [...document.querySelectorAll('.js-plotly-plot')].find(e => e.layout.meta.id === 'phase_plane');
   const now = () => [...el.querySelectorAll('g.trace.scatter')].find(g => g.__data__[0].trace.name === 'FDSMC now');
@@ -129,13 +130,14 @@ REPLAY_HITS_JS = """([label, n]) => new Promise(resolve => {
   const z = (L.shapes || []).findIndex(s => s.xref === 'x' && s.yref === 'y');
   const b = L.updatemenus[0].buttons.find(x => x.label === label);
   window.Plotly.animate(el, ...b.args);
-  const out = {frames: 0, hits: {verdict: 0, zoom: 0, inset: 0}, first: [], marks: [v >= 0, z >= 0]};
+  const out = {frames: 0, hits: {verdict: 0, zoom: 0, inset: 0}, first: [], marks: [v >= 0, z >= 0, false]};
   const f = () => {
     const t = now() && now().querySelector('text'), tb = t && t.textContent ? box(t) : null;
     const others = {verdict: box(el.querySelector(`g.annotation[data-index="${v}"] rect.bg`)),
                     zoom: z >= 0 ? box(el.querySelector(`.shapelayer path[data-index="${z}"]`)) : null,
-                    inset: box(el.querySelector('.subplot.x4y5 .nsewdrag'))};
-    if (tb) { out.frames += 1;
+                    inset: box(el.querySelector('g.x4y5 > rect.nsewdrag'))};
+    out.marks[2] = !!others.inset;
+    if (tb) { out.frames += 1; out.last = [t.textContent, tb, box(el.querySelector('g.xy > rect.nsewdrag'))];
       for (const [k, o] of Object.entries(others)) if (meet(tb, o)) { out.hits[k] += 1;
         if (out.first.length < 4) out.first.push([k, t.textContent, tb, o]); } }
     if (--n > 0) requestAnimationFrame(f); else resolve(out);
@@ -157,7 +159,9 @@ def test_the_replay_time_label_keeps_clear_of_the_verdict_and_the_zoom(browser, 
                                        " && e.layout.annotations.some(a => a.name === 'verdict'"
                                        " && a.text.includes('no chatter')))", timeout=3 * TIMEOUT_MS)
             seen = page.evaluate(REPLAY_HITS_JS, ["▶ 0.25×", 240])
-            assert seen["frames"] >= 30 and seen["marks"] == [True, True], seen
+            assert seen["frames"] >= 30 and seen["marks"] == [True, True, True], seen
             assert seen["hits"] == {"verdict": 0, "zoom": 0, "inset": 0}, seen
+            text, label, plane = seen["last"]  # the replay's end: the marker at the plot's right edge
+            assert text.startswith("t = ") and plane[0] - 1 <= label[0] and label[2] <= plane[2] + 1, seen["last"]
     finally:
         context.close()
