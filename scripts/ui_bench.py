@@ -17,6 +17,8 @@
   pages share the same two cores, which is the concurrency figure's business, not these);
 * server memory (RSS) idle and with the pages connected.
 
+Bytes per Simulate by message kind (which figure takes what): ``scripts/ui_bench_bytes.py``.
+
 **What a user gets** comes first: ``--runs`` rounds, each on a NEW server process with ONE new
 page (fresh browser context, nothing else open): page open → usable, the first Simulate → drawn,
 and K-slider redraws per second, each printed per round with the load average, then their
