@@ -154,7 +154,13 @@ def _compiling_here() -> bool:
 
 
 def _end_child_processes() -> None:
-    """Terminate this process's multiprocessing children (a pool's workers), which would outlive it."""
+    """Terminate this process's multiprocessing children (a pool's workers), which would outlive it.
+
+    The study pools are ended first (:func:`sim.studies.runner.end_all_pools`): none starts anew.
+    """
+    runner = sys.modules.get("pmsm_commissioning.sim.studies.runner")
+    if runner is not None:
+        runner.end_all_pools()
     mp = sys.modules.get("multiprocessing")
     for child in mp.active_children() if mp is not None else []:
         child.terminate()

@@ -15,7 +15,8 @@ workers), so no worker prints a traceback. Every worker ends itself once its par
 worker behind, nor the resource tracker (which ends when the last process holding its pipe does).
 The resource tracker is started with SIGHUP blocked too (:func:`_start_resource_tracker`): it ignores
 SIGINT and SIGTERM itself, and a hang-up that killed it made the parent start a new one, which then
-printed a KeyError traceback for every semaphore the pool released.
+printed a KeyError traceback for every semaphore the pool released. Its warning about the
+semaphores of a parent that exited at once (an interrupted run: they are removed all the same) is off.
 """
 
 from __future__ import annotations
@@ -23,9 +24,11 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import sys
 import threading
 import time
-from collections.abc import Callable
+import weakref
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import resource_tracker
@@ -44,6 +47,32 @@ PARENT_POLL_S = 0.25
 BLOCKED_IN_WORKERS = frozenset({signal.SIGINT, signal.SIGHUP})
 
 
+#: Signals whose Python handlers wait while a worker is started on the main thread.
+HELD_WHILE_STARTING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+@contextlib.contextmanager
+def _handlers_held() -> Iterator[None]:
+    """On the main thread, hold the stop signals' Python handlers until the block ends, then run them.
+
+    A handler that raises (Ctrl-C's KeyboardInterrupt) between the start of a spawned worker and
+    the writing of its start data left the worker reading an empty pipe: an EOFError traceback.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield  # handlers run on the main thread only: this thread is not interrupted
+        return
+    caught: list[int] = []
+    held = {sig: signal.signal(sig, lambda signum, _: caught.append(signum))
+            for sig in HELD_WHILE_STARTING if callable(signal.getsignal(sig))}
+    try:
+        yield
+    finally:
+        for sig, handler in held.items():
+            signal.signal(sig, handler)
+        if caught:
+            signal.raise_signal(caught[0])  # now its own handler runs
+
+
 class _QuietProcess(SpawnProcess):
     """A spawned process that inherits SIGINT and SIGHUP blocked (the mask survives fork and exec)."""
 
@@ -51,20 +80,29 @@ class _QuietProcess(SpawnProcess):
         """Start the process with those signals blocked in this thread meanwhile (a pending one is then delivered)."""
         old = signal.pthread_sigmask(signal.SIG_BLOCK, BLOCKED_IN_WORKERS)
         try:
-            super().start()
+            with _handlers_held():
+                super().start()
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+#: Warning filter of the resource tracker (its ``-W`` option): no "leaked semaphore objects" after a
+#: parent that exited at once on Ctrl-C or SIGTERM (the tracker removes them all the same).
+QUIET_TRACKER = "ignore:resource_tracker:UserWarning"
 
 
 def _start_resource_tracker() -> None:
     """Start multiprocessing's resource tracker (if not running) with the workers' signals blocked.
 
-    The tracker unblocks only SIGINT and SIGTERM (which it ignores): SIGHUP stays blocked in it.
+    The tracker unblocks only SIGINT and SIGTERM (which it ignores): SIGHUP stays blocked in it. It is
+    started with the interpreter's ``-W`` options, and :data:`QUIET_TRACKER` among them.
     """
     old = signal.pthread_sigmask(signal.SIG_BLOCK, BLOCKED_IN_WORKERS)
+    sys.warnoptions.append(QUIET_TRACKER)
     try:
         resource_tracker.ensure_running()
     finally:
+        sys.warnoptions.remove(QUIET_TRACKER)
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
@@ -165,6 +203,21 @@ def start_worker(nice: int, parent: int) -> None:
     lower_priority(nice)
 
 
+#: Every pool of this process not yet garbage (for :func:`end_all_pools`).
+_POOLS: weakref.WeakSet[RetryingPool] = weakref.WeakSet()
+
+
+def end_all_pools() -> None:
+    """End every :class:`RetryingPool` of this process now (a command stopped by a signal exits next).
+
+    Each is marked ended under its lock before its workers are terminated, so a chunk that sees its
+    worker gone does not start a new pool (a worker half-started as the process exits prints an
+    EOFError traceback).
+    """
+    for pool in list(_POOLS):
+        pool.terminate()
+
+
 class RetryingPool:
     """A spawn-context process pool of ``workers`` processes that survives one lost worker per chunk.
 
@@ -178,6 +231,7 @@ class RetryingPool:
         self._lock = threading.RLock()  # renew() submits again while holding it
         self._pool = self._new_pool()
         self._futures: list[RetryingFuture] = []
+        _POOLS.add(self)
 
     def _new_pool(self) -> ProcessPoolExecutor:
         _start_resource_tracker()
