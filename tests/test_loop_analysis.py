@@ -112,7 +112,8 @@ def test_stability_measure_sign_convention():
 
 def test_derived_carries_verdicts_and_warning():
     d = derive(_params())
-    assert d.gain == recommend_K(d.loop) and d.sample_rate == sample_rate_check(d.loop)  # one construction
+    assert d.gain == recommend_K(d.loop, T_dv=d.params.controller.T_dv)  # one construction
+    assert d.sample_rate == sample_rate_check(d.loop)
     assert any("Recommended K" in w for w in d.warnings)
     ok = derive(dataclasses.replace(d.params, controller=dataclasses.replace(d.params.controller, K=0.3)))
     assert not any("Boundary-layer gain" in w for w in ok.warnings)

@@ -72,14 +72,18 @@ def test_standstill_ripple_matches_the_closed_form_noise_gain(overrides, what):
 
 
 def test_quantization_ripple_scales_with_the_count_and_sets_the_encoder_needed():
-    p = load_preset("siemens_1ft7044_ak7", IDEAL + SIEMENS_LOOPS)
+    p = load_preset("siemens_1ft7044_ak7", IDEAL + SIEMENS_LOOPS + ["sensors.i_noise=0.05"])
     d = derive(p)
-    g17, g20 = (noise_gain(d.loop, "slope", p.controller.K, 2 * math.pi / 2**b, 0.0) for b in (17, 20))
+    # white quantization error (Δ²/12): the ripple is linear in the count
+    g17, g20 = (noise_gain(d.loop, "slope", p.controller.K, 2 * math.pi / 2**b, 0.0, coloured=False) for b in (17, 20))
     assert g17.i_q_rms == pytest.approx(8 * g20.i_q_rms, rel=1e-9)
-    assert g17.i_q_rms == pytest.approx(g17.i_q_per_rad * 2 * math.pi / 2**17, rel=1e-9)
-    need = encoder_needed(g17, 0.1)
+    assert g17.i_q_current_rms == 0.0 and g17.i_q_quant_rms == g17.i_q_rms
+    crit = 0.1
+    need = encoder_needed(p, d, crit)
     assert need is not None and need & (need - 1) == 0  # a power of two
-    assert g17.i_q_per_rad * 2 * math.pi / need <= 0.1 < g17.i_q_per_rad * 2 * math.pi / (need // 2)
+    assert predicted_noise(p, d, need).i_q_rms <= crit < predicted_noise(p, d, need // 2).i_q_rms
+    # the current noise alone above the criterion: no encoder helps
+    assert encoder_needed(p, d, 0.5 * predicted_noise(p, d, 0).i_q_rms) is None
 
 
 def test_the_design_slows_the_observer_for_a_coarse_encoder_and_verifies_it_with_the_sensors():

@@ -118,7 +118,7 @@ def derive(params: DriveParams) -> Derived:
     conv = conventional_gains(params.manoeuvre.T_m)
     loop = LoopCase.of_case(lm, params, alpha.alpha_max, prof.T_c, conv.g1, conv.g2)
     se = params.sensors
-    gain = recommend_K(loop, count=se.encoder_step, i_noise_rms=se.reading_noise)
+    gain = recommend_K(loop, count=se.encoder_step, i_noise_rms=se.reading_noise, T_dv=ctrl.T_dv)
     rate = sample_rate_check(loop)
     return Derived(
         params=params,

@@ -148,8 +148,9 @@ def voltage_mismatch(dv_hat: float, i_q: float, i_q_model: float, gain: float, b
     γ_q·G [A/V] and low-pass filters it, d̂ ← d̂ + β·((i_q − i_q,model)/(γ_q·G) − d̂); the FDC subtracts
     d̂ from its u_q. With the exact model the difference is only the sensors' noise (and the speed's change
     within a sample, which the prediction holds constant), so the linearised loop of
-    :mod:`control.fdsmc.loop_analysis` (K limit) and the noise gain of :mod:`control.fdsmc.noise` leave it
-    out; the design's verification by simulation includes it.
+    :mod:`control.fdsmc.loop_analysis` (K limit) leaves it out; the noise gain of
+    :mod:`control.fdsmc.noise` (standstill ripple, K_noise) includes it, since the estimate feeds the
+    current noise back against itself, and so does the design's verification by simulation.
 
     Parameters
     ----------

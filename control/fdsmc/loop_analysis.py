@@ -241,7 +241,7 @@ def slope_damping(alpha_max: float, K: float, T_c: float) -> float:
 
 
 def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
-                i_noise_rms: float = 0.0) -> GainRecommendation:
+                i_noise_rms: float = 0.0, T_dv: float = 0.0) -> GainRecommendation:
     """Recommended boundary-layer gain K for the preset's implementation and sensors.
 
     K_limit/margin, or less where the sensors' noise would swing α_dem by more than the chatter
@@ -257,6 +257,8 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
         Encoder count Δ = 2π/cpr [rad]; 0 for an ideal encoder.
     i_noise_rms : float
         RMS of the current-measurement error [A].
+    T_dv : float
+        Filter time of the q-axis voltage-mismatch estimate (``controller.T_dv``) [s]; 0: none.
 
     Returns
     -------
@@ -271,8 +273,8 @@ def recommend_K(d: LoopCase, margin: float = GAIN_MARGIN, count: float = 0.0,
     K, a_max = d.K, d.alpha_max
     mode = "continuous" if f_s is None else f"f_s = {f_s:g} Hz"
     k_ok = k_lim > K
-    K_noise = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION, k_lim)
-    k_quiet = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION / margin, k_lim / margin)
+    K_noise = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION, k_lim, T_dv)
+    k_quiet = noise_gain_limit(d, count, i_noise_rms, CHATTER_PTP_FRACTION / margin, k_lim / margin, T_dv)
     k_rec = min(k_lim / margin, k_quiet) if k_lim > 0.0 else 0.0
     zeta = slope_damping(a_max, K if k_ok else k_rec, d.T_c)
     zeta_rec = slope_damping(a_max, k_rec, d.T_c)

@@ -13,10 +13,11 @@ at two places:
   q-axis voltage-mismatch estimate (``controller.T_dv``, not in [1]), that estimate's comparison of
   the measured i_q with its one-sample prediction (:func:`sampled_noise_loop`).
 
-With n_θ modelled as white, uniform over one count (variance Δ²/12, the usual model once the
-rotor jitters over several counts) and n_i white (σ² + q²/12), the steady-state covariance P of
-the loop's state solves the discrete Lyapunov equation P = Z·P·Zᵀ + B·W·Bᵀ; the rms ripple of i_q
-is √P[i_q, i_q] and that of the applied u_q follows from the control row.
+With n_i white (σ² + q²/12), the steady-state covariance of the loop's state from it solves the
+discrete Lyapunov equation P = Z·P·Zᵀ + b·σ²·bᵀ. n_θ is uniform over one count (variance Δ²/12) and
+coloured by the rotor's own motion (:mod:`control.fdsmc.quantization`); white where the rotor
+crosses many counts per sample. The rms ripple of i_q is √P[i_q, i_q] of the sum and that of the
+applied u_q follows from the control row.
 
 The same covariance gives the rms of the demanded acceleration, α_dem = a_θ·θ̂ + a_ω·ω̂ of the
 outer law; its expected swing over a chatter window is :data:`PTP_PER_RMS` times the rms. Where
@@ -50,6 +51,7 @@ from pmsm_commissioning.control.fdsmc.loop_model import (
     outer_gains,
     sampled_parts,
 )
+from pmsm_commissioning.control.fdsmc.quantization import quantization_covariance
 
 #: Peak-to-peak of the sampled noise of α_dem over a chatter window per rms [-]. A few thousand
 #: Gaussian samples span ≈ 2 × 3.5 rms; the high-passed α_dem of the chatter criterion spans
@@ -65,21 +67,24 @@ class NoiseGain:
 
     Attributes
     ----------
-    i_q_rms : float           RMS ripple of i_q [A] (inf when the linear loop is unstable).
-    u_q_rms : float           RMS ripple of the applied u_q [V].
-    i_q_per_rad : float       i_q rms from quantization alone per radian of encoder count [A/rad]:
-                              the quantization ripple is i_q_per_rad·Δ for a count Δ = 2π/cpr.
-    alpha_dem_rms : float     RMS of the demanded acceleration α_dem of the outer law [rad/s²].
+    i_q_rms : float            RMS ripple of i_q [A], both parts (inf when the linear loop is unstable).
+    u_q_rms : float            RMS ripple of the applied u_q [V].
+    i_q_quant_rms : float      Part of ``i_q_rms`` from the encoder's quantization [A].
+    i_q_current_rms : float    Part of ``i_q_rms`` from the current noise and the ADC [A].
+    jitter_counts : float      RMS of the rotor angle θ_r in encoder counts [-] (0 for an ideal encoder).
+    alpha_dem_rms : float      RMS of the demanded acceleration α_dem of the outer law [rad/s²].
     """
 
     i_q_rms: float
     u_q_rms: float
-    i_q_per_rad: float
+    i_q_quant_rms: float
+    i_q_current_rms: float
+    jitter_counts: float
     alpha_dem_rms: float
 
 
 def noise_gain(loop: LoopCase, law: str, K: float, count: float, i_noise_rms: float,
-               T_dv: float = 0.0) -> NoiseGain:
+               T_dv: float = 0.0, coloured: bool = True) -> NoiseGain:
     """Predict the standstill ripple of i_q and u_q from encoder quantization and current noise.
 
     Parameters
@@ -91,6 +96,8 @@ def noise_gain(loop: LoopCase, law: str, K: float, count: float, i_noise_rms: fl
     i_noise_rms : float   RMS of the current-measurement error, noise and ADC step [A].
     T_dv : float          Filter time of the q-axis voltage-mismatch estimate (``controller.T_dv``,
                           :func:`control.fdsmc.fdc.voltage_mismatch`; not in [1]) [s]; 0: none.
+    coloured : bool       Quantization error coloured by the rotor's motion
+                          (:func:`control.fdsmc.quantization.quantization_covariance`); False: white, Δ²/12.
 
     Returns
     -------
@@ -101,16 +108,29 @@ def noise_gain(loop: LoopCase, law: str, K: float, count: float, i_noise_rms: fl
     beta = mismatch_filter_factor(T_dv, float(loop.f_s))
     Z, B, u = sampled_noise_loop(loop, control_row(loop, law, K), beta)
     if not np.all(np.isfinite(Z)) or np.max(np.abs(np.linalg.eigvals(Z))) >= 1.0:
-        return NoiseGain(math.inf, math.inf, math.inf, math.inf)
-    W = np.diag([count**2 / 12.0, i_noise_rms**2])
-    P_theta, P_i = (_covariance(Z, B[:, j]) for j in (0, 1))
-    P = W[0, 0] * P_theta + W[1, 1] * P_i
+        return NoiseGain(math.inf, math.inf, math.inf, math.inf, math.inf, math.inf)
+    P_i = i_noise_rms**2 * _covariance(Z, B[:, 1])
+    P_q, jitter = _quantization(Z, B[:, 0], P_i, count, coloured)
+    P = P_q + P_i
     n = Z.shape[0]
-    u_rms = math.sqrt(max(float(u[:n] @ P @ u[:n] + u[n:] @ W @ u[n:]), 0.0))
-    per_rad = math.sqrt(max(P_theta[0, 0], 0.0) / 12.0)
+    feed = u[n] ** 2 * count**2 / 12.0 + u[n + 1] ** 2 * i_noise_rms**2  # 0 for n_θ: it enters the observer only
+    u_rms = math.sqrt(max(float(u[:n] @ P @ u[:n] + feed), 0.0))
     a = np.array(outer_gains(loop, law, K))  # α_dem = a_θ·θ̂ + a_ω·ω̂ (states 3 and 4)
     alpha_rms = math.sqrt(max(float(a @ P[3:5, 3:5] @ a), 0.0))
-    return NoiseGain(math.sqrt(max(P[0, 0], 0.0)), u_rms, per_rad, alpha_rms)
+    rms = [math.sqrt(max(float(X[0, 0]), 0.0)) for X in (P, P_q, P_i)]
+    return NoiseGain(rms[0], u_rms, rms[1], rms[2], jitter, alpha_rms)
+
+
+def _quantization(Z: np.ndarray, b: np.ndarray, P_i: np.ndarray, count: float,
+                  coloured: bool) -> tuple[np.ndarray, float]:
+    """Covariance of the state from the encoder's quantization [state units²] and the rotor's jitter [counts]."""
+    if count == 0.0:
+        return np.zeros_like(P_i), 0.0
+    if coloured:
+        q = quantization_covariance(Z, b, P_i, count)
+        return q.P, q.jitter_counts
+    P = count**2 / 12.0 * _covariance(Z, b)
+    return P, math.sqrt(max(float((P + P_i)[1, 1]), 0.0)) / count
 
 
 def sampled_noise_loop(loop: LoopCase, row: np.ndarray, beta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -177,7 +197,7 @@ def _covariance(Z: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: float,
-                     K_max: float) -> float:
+                     K_max: float, T_dv: float = 0.0) -> float:
     """Smallest K ≤ K_max [s/rad] at which the sensors' noise swings α_dem by ``fraction``·α_max.
 
     The predicted swing of α_dem holding θ_dem is PTP_PER_RMS × its rms
@@ -192,6 +212,7 @@ def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: fl
     i_noise_rms : float   RMS of the current-measurement error [A].
     fraction : float      Allowed swing of α_dem [fraction of α_max].
     K_max : float         Upper end of the search [s/rad], e.g. the stability limit.
+    T_dv : float          Filter time of the q-axis voltage-mismatch estimate [s]; 0: none.
 
     Returns
     -------
@@ -204,17 +225,17 @@ def noise_gain_limit(d: LoopCase, count: float, i_noise_rms: float, fraction: fl
     if d.f_s is None or (count == 0.0 and i_noise_rms == 0.0) or not K_max > 0.0:
         return math.inf
     return _noise_gain_limit(law_case(d, "slope"), float(d.f_s), int(d.delay), float(count),
-                             float(i_noise_rms), float(fraction), float(K_max))
+                             float(i_noise_rms), float(fraction), float(K_max), float(T_dv))
 
 
 @functools.lru_cache(maxsize=512)
 def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_noise_rms: float,
-                      fraction: float, K_max: float) -> float:
+                      fraction: float, K_max: float, T_dv: float) -> float:
     loop = dataclasses.replace(case, f_s=f_s, delay=delay)
     target = fraction * loop.alpha_max / PTP_PER_RMS
 
     def rms(K: float) -> float:
-        return _alpha_dem_rms(loop, K, count, i_noise_rms)
+        return _alpha_dem_rms(loop, K, count, i_noise_rms, T_dv)
 
     def swings(K: float) -> bool:
         return not rms(K) < target
@@ -233,11 +254,15 @@ def _noise_gain_limit(case: LoopCase, f_s: float, delay: int, count: float, i_no
 
 
 @functools.lru_cache(maxsize=2048)
-def _alpha_dem_rms(loop: LoopCase, K: float, count: float, i_noise_rms: float) -> float:
-    """α_dem rms of :func:`noise_gain` on the sloped law [rad/s²] (inf where the loop is unstable)."""
+def _alpha_dem_rms(loop: LoopCase, K: float, count: float, i_noise_rms: float, T_dv: float) -> float:
+    """α_dem rms of :func:`noise_gain` on the sloped law [rad/s²] (inf where the loop is unstable).
+
+    The quantization error is taken as white here: :data:`PTP_PER_RMS` was measured against that
+    model, and the search evaluates it at every K of its grid.
+    """
     with warnings.catch_warnings():  # ill-conditioned only next to the stability limit
         warnings.simplefilter("ignore", LinAlgWarning)
-        return noise_gain(loop, "slope", K, count, i_noise_rms).alpha_dem_rms
+        return noise_gain(loop, "slope", K, count, i_noise_rms, T_dv, coloured=False).alpha_dem_rms
 
 
 __all__ = ["PTP_PER_RMS", "NoiseGain", "noise_gain", "noise_gain_limit", "sampled_noise_loop"]

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
 from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
 from pmsm_commissioning.control.fdsmc.noise import NoiseGain, noise_gain
-from pmsm_commissioning.control.fdsmc.params import DriveParams
+from pmsm_commissioning.control.fdsmc.params import ENCODER_CPR_MAX, DriveParams
 from pmsm_commissioning.sim.fdsmc.checks import Constraint, run_checks
-from pmsm_commissioning.sim.fdsmc.criteria import encoder_cpr_for, pass_criteria
+from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
 from pmsm_commissioning.sim.fdsmc.engine import Comparison, RunResult
 from pmsm_commissioning.sim.fdsmc.verdicts import comparator_notes, flux_warnings
 
@@ -127,19 +127,42 @@ def round_down(x: float, digits: int = 3) -> float:
     return float(round(math.floor(x * scale + 1e-9) / scale, 12))
 
 
-def predicted_noise(p: DriveParams, d: Derived) -> NoiseGain | None:
-    """Standstill ripple of ``p``'s FDSMC loop from its sensors (None for a continuous controller)."""
+def predicted_noise(p: DriveParams, d: Derived, encoder_cpr: int | None = None) -> NoiseGain | None:
+    """Standstill ripple of ``p``'s FDSMC loop from its sensors (None for a continuous controller).
+
+    ``encoder_cpr`` replaces the preset's encoder resolution [counts/rev] (0: an ideal encoder).
+    """
     if d.loop.f_s is None:
         return None
-    se = p.sensors
-    return noise_gain(d.loop, "slope", p.controller.K, se.encoder_step, se.reading_noise, p.controller.T_dv)
+    se, c = p.sensors, p.controller
+    count = se.encoder_step if encoder_cpr is None else (2.0 * math.pi / encoder_cpr if encoder_cpr else 0.0)
+    return noise_gain(d.loop, "slope", c.K, count, se.reading_noise, c.T_dv)
 
 
-def encoder_needed(noise: NoiseGain | None, criterion: float) -> int | None:
-    """Smallest power-of-two counts per rev whose quantization alone gives ≤ ``criterion`` [A] of ripple."""
-    if noise is None or not math.isfinite(noise.i_q_per_rad) or noise.i_q_per_rad <= 0.0:
+def encoder_needed(p: DriveParams, d: Derived, criterion: float) -> int | None:
+    """Smallest power-of-two counts per rev at which the predicted standstill ripple is ≤ ``criterion`` [A].
+
+    None for a continuous controller, or where the current noise alone (an ideal encoder) exceeds the
+    criterion. The ripple falls as the count shrinks (:func:`control.fdsmc.noise.noise_gain`), so the
+    exponent is bisected between 2⁴ and :data:`control.fdsmc.params.ENCODER_CPR_MAX`.
+    """
+    ideal = predicted_noise(p, d, 0)
+    if ideal is None or not ideal.i_q_rms <= criterion:
         return None
-    return encoder_cpr_for(2.0 * math.pi * noise.i_q_per_rad / criterion)
+
+    def passes(bits: int) -> bool:
+        g = predicted_noise(p, d, 2**bits)
+        return g is not None and g.i_q_rms <= criterion
+
+    lo, hi = 4, int(math.log2(ENCODER_CPR_MAX))
+    if passes(lo):
+        return 2**lo
+    if not passes(hi):
+        return None
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if passes(mid) else (mid, hi)
+    return 2**hi
 
 
 def refused(p: DriveParams, limiting: list[Constraint], asked: DriveParams | None = None) -> DriveDesign:
@@ -154,7 +177,7 @@ def verified(p: DriveParams, d: Derived, cmp: Comparison, asked: DriveParams) ->
     limiting = [torque_binding(p, d, cmp.fdsmc)] + run_checks(p, cmp.fdsmc)
     ng = predicted_noise(p, d)
     crit = pass_criteria(p).hold_i_rms
-    need = encoder_needed(ng, crit)
+    need = encoder_needed(p, d, crit)
     as_asked = p.manoeuvre.T_m == asked.manoeuvre.T_m
     clean = as_asked and not any(c.violated for c in limiting)
     notes = _notes(d) + _sensor_notes(p, asked, ng, crit, need)
