@@ -14,11 +14,10 @@
 from __future__ import annotations
 
 import hashlib
-import importlib.metadata
 import json
 from collections.abc import Sequence
 
-from pmsm_commissioning.app.exports.c_module import TOOL
+from pmsm_commissioning.app.exports.tool_id import tool_version
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.presets import to_raw
 from pmsm_commissioning.app.io.user_text import escaped
@@ -31,15 +30,6 @@ from pmsm_commissioning.sim.fdsmc.recommend import run_supply_J
 
 class ExportRefusedError(ParameterError):
     """An export of a design that is not clean (``--force`` writes it with the warnings inside)."""
-
-
-def tool_version() -> str:
-    """Return ``"<tool> <version>"`` (the installed package's version, else ``unknown``)."""
-    try:
-        version = importlib.metadata.version("pmsm-commissioning")
-    except importlib.metadata.PackageNotFoundError:
-        version = "unknown"
-    return f"{TOOL} {version}"
 
 
 def parameter_hash(params: object) -> str:
