@@ -103,7 +103,9 @@ def test_recommended_K_with_a_coarse_encoder_is_the_one_the_sensors_allow(page):
     page.get_by_role("button", name="Simulate").click()
     verdict = _wait_verdict(page, "CHATTER")
     assert "K_noise" in verdict and "(sensors)" in verdict
-    assert "noise" in page.locator(".mantine-Slider-markLabel").all_inner_texts()
+    # the sliders follow the run's derived values after its figures: waited for, not read at once
+    page.wait_for_function("() => [...document.querySelectorAll('.mantine-Slider-markLabel')]"
+                           ".some(l => l.textContent.trim() === 'noise')")
     page.get_by_text("sensors' noise limit K_noise").first.wait_for()  # the warning says why
     page.get_by_role("button", name="Use recommended K").click()
     verdict = _wait_verdict(page, "no chatter")
