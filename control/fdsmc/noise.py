@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import LinAlgWarning, matrix_balance, solve_discrete_lyapunov
 
+from pmsm_commissioning.control.common.arrays import FloatArray
 from pmsm_commissioning.control.fdsmc.fdc import mismatch_filter_factor
 from pmsm_commissioning.control.fdsmc.inverter import decay_factors
 from pmsm_commissioning.control.fdsmc.loop_model import (
@@ -159,7 +160,10 @@ def sampled_noise_loop(loop: LoopCase, row: np.ndarray, beta: float) -> tuple[np
     tuple of numpy.ndarray
         Z (n × n), B (n × 2) and the applied u_q as a row over [s, n_θ, n_i] (n + 2) [V per state].
     """
-    sp, c = sampled_parts(loop, float(loop.f_s)), loop.coefficients
+    if loop.f_s is None:
+        raise ValueError("sampled_noise_loop needs a sampled loop: loop.f_s is None")
+    f_s = float(loop.f_s)
+    sp, c = sampled_parts(loop, f_s), loop.coefficients
     n0 = N_STATES + loop.delay
     n = n0 + (4 if beta > 0.0 else 0)
     e = np.eye(n + 2)  # rows: the states, then n_θ, n_i (a row of e picks one of them)
@@ -168,7 +172,7 @@ def sampled_noise_loop(loop: LoopCase, row: np.ndarray, beta: float) -> tuple[np
     M = np.zeros((n, n + 2))
     if beta > 0.0:
         dv, y_prev, w_prev, u_prev = n0, n0 + 1, n0 + 2, n0 + 3
-        phi_q, gam_q = decay_factors(c.D, 1.0 / float(loop.f_s))
+        phi_q, gam_q = decay_factors(c.D, 1.0 / f_s)
         i_model = phi_q * e[y_prev] + gam_q * (c.G * e[u_prev] - c.E * e[w_prev])
         M[dv] = (1.0 - beta) * e[dv] + beta * (y_i - i_model) / (gam_q * c.G)
         u_c = u_c - M[dv]
@@ -192,7 +196,7 @@ def _covariance(Z: np.ndarray, b: np.ndarray) -> np.ndarray:
     """
     Z_b, D = matrix_balance(Z, permute=False, separate=True)
     s = D[0]
-    P_b = solve_discrete_lyapunov(Z_b, np.outer(b / s, b / s))
+    P_b: FloatArray = solve_discrete_lyapunov(Z_b, np.outer(b / s, b / s))
     return P_b * np.outer(s, s)
 
 

@@ -156,13 +156,13 @@ def encoder_needed(p: DriveParams, d: Derived, criterion: float) -> int | None:
 
     lo, hi = 4, int(math.log2(ENCODER_CPR_MAX))
     if passes(lo):
-        return 2**lo
+        return 1 << lo
     if not passes(hi):
         return None
     while hi - lo > 1:
         mid = (lo + hi) // 2
         lo, hi = (lo, mid) if passes(mid) else (mid, hi)
-    return 2**hi
+    return 1 << hi
 
 
 def refused(p: DriveParams, limiting: list[Constraint], asked: DriveParams | None = None) -> DriveDesign:
