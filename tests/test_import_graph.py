@@ -28,13 +28,9 @@ PKG = "pmsm_commissioning"
 #: app's parts and their level from the bottom; a part imports only parts of a lower level (and itself).
 APP_LEVEL = {"resources": 0, "threads": 0, "io": 1, "figures": 2, "exports": 3, "ui": 4, "cli": 5, "__main__": 6}
 
-# Temporary: circles and sideways imports inside folders being reorganised now (app/exports is being split
-# into firmware/ and drives/, app/ui's adapters reworked); remove an entry once it is gone. Anything else fails.
-KNOWN_CIRCLES = frozenset({
-    frozenset({"app.exports.c_golden", "app.exports.c_vectors", "app.exports.c_verify"}),
-    frozenset({"app.ui.studies_queue", "app.ui.worker"}),
-})
-KNOWN_SIDEWAYS = frozenset({("app.exports.html", "app.ui.text")})
+#: No exception: every circle and every sideways import fails the tests.
+KNOWN_CIRCLES: frozenset[frozenset[str]] = frozenset()
+KNOWN_SIDEWAYS: frozenset[tuple[str, str]] = frozenset()
 
 
 def _module_name(path: pathlib.Path) -> str:

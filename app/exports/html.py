@@ -19,7 +19,7 @@ from pmsm_commissioning.app.figures.style import BAD_COLOUR
 from pmsm_commissioning.app.io.derived_view import derived_rows
 from pmsm_commissioning.app.io.numbers import format_metric
 from pmsm_commissioning.app.io.presets import to_raw
-from pmsm_commissioning.app.ui.text import html_text
+from pmsm_commissioning.app.io.user_text import html_text
 from pmsm_commissioning.control.fdsmc.model import available_voltage
 from pmsm_commissioning.sim.fdsmc.engine import LABELS, Comparison
 from pmsm_commissioning.sim.fdsmc.recommend import recommend

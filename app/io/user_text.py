@@ -18,6 +18,7 @@ One policy, used by every writer and every message:
 
 from __future__ import annotations
 
+import html
 import re
 import unicodedata
 
@@ -104,10 +105,19 @@ def xml_comment(line: str) -> str:
     return text + " " if text.endswith("-") else text
 
 
+def html_text(text: object) -> str:
+    """Make user-provided text safe inside HTML or a Plotly label: ``& < > " '`` become entities.
+
+    The escaping of every user string (file name, column header, note, preset name or source, log
+    mapping) that goes into HTML: the page's HTML boxes, Plotly titles and legends, the HTML report.
+    """
+    return html.escape(str(text), quote=True)
+
+
 def terminal(text: object) -> str:
     """Return ``text`` for a terminal: escape sequences, BEL, C1 and bidi characters shown escaped."""
     return escaped(text)
 
 
 __all__ = ["ALLOWED", "FORBIDDEN_CATEGORIES", "LABEL_MAX", "check_label", "csv_comment", "escaped", "forbidden",
-           "terminal", "xml_comment"]
+           "html_text", "terminal", "xml_comment"]

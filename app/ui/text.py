@@ -15,6 +15,7 @@ from typing import Any
 from pmsm_commissioning.app.figures.fdsmc_pins import pins_note
 from pmsm_commissioning.app.figures.style import BAD_COLOUR, GOOD_COLOUR, KEY_PX, fmt
 from pmsm_commissioning.app.io.derived_view import derived_rows
+from pmsm_commissioning.app.io.user_text import html_text
 from pmsm_commissioning.control.fdsmc.derivations import Derived
 from pmsm_commissioning.control.fdsmc.feasibility import torque_limit
 from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
@@ -22,15 +23,6 @@ from pmsm_commissioning.sim.fdsmc.engine import LABELS
 from pmsm_commissioning.sim.fdsmc.recommend import recommend
 
 _MARKDOWN_SPECIAL = re.compile(r"([\\`*_{}\[\]()#+\-.!|~>=:])")
-
-
-def html_text(text: object) -> str:
-    """Make user-provided text safe inside HTML or a Plotly label: ``& < > " '`` become entities.
-
-    The escaping of every user string (file name, column header, note, preset name or source, log
-    mapping) that goes into HTML: the page's HTML boxes, Plotly titles and legends, the HTML report.
-    """
-    return html.escape(str(text), quote=True)
 
 
 def md_text(text: object) -> str:

@@ -23,10 +23,15 @@ import contextlib
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
-if TYPE_CHECKING:
-    from pmsm_commissioning.app.ui.studies_queue import StudySlots
+
+class StudySlots(Protocol):
+    """What the worker needs of :class:`app.ui.studies_queue.StudySlots`: run a study once a slot is free."""
+
+    def run(self, label: str, fn: Callable[[], Any], on_queued: Callable[[str, int], None],
+            cancelled: Callable[[], bool]) -> None:
+        """Run ``fn`` once a slot is free, telling ``on_queued(label, ahead)`` while it waits."""
 
 
 class Cancelled(Exception):  # noqa: N818 - an outcome, not an error
