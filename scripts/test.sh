@@ -17,6 +17,6 @@ fi
 # The whole suite: the unit, engine and CLI tests on every core (pytest-xdist), then the browser tests one
 # at a time (their layout-steadiness and frame checks want the page's machine to themselves).
 rc=0
-.venv/bin/python -m pytest -n auto --ignore=tests/browser || rc=$?
-.venv/bin/python -m pytest tests/browser || rc=$?
+.venv/bin/python -m pytest -n auto --durations=25 --ignore=tests/browser || rc=$?
+.venv/bin/python -m pytest --durations=25 tests/browser || rc=$?
 exit "$rc"

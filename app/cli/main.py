@@ -127,6 +127,8 @@ THREADED = frozenset({"derive", "design", "simulate", "export", "import-drive", 
                       "multiaxis", "dutycycle"})
 #: Exit code after Ctrl-C or SIGTERM (128 + SIGINT, as a shell reports it).
 INTERRUPTED = 130
+#: Exit code when the output's reader went away (128 + SIGPIPE, as a shell reports a process it ended).
+BROKEN_PIPE = 141
 
 
 #: True while :func:`main` runs as the process itself (``pmsm-commission``, the console script).
@@ -225,6 +227,10 @@ def main(argv: list[str] | None = None, prog: str = MODULE_PROG) -> int:
         if argv is None:  # ``pmsm-commission``: end the process now, whatever threads still run
             _stop_interrupted()
         return INTERRUPTED
+    except BrokenPipeError:  # the reader of the output went away (``… | head``): nothing more to say
+        if argv is None:  # the interpreter's last flush of stdout would fail again: point it at /dev/null
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return BROKEN_PIPE
     finally:
         _AS_PROCESS = False
         for signum, handler in previous.items():
