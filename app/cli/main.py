@@ -205,6 +205,8 @@ def _stop_interrupted() -> NoReturn:
     from pmsm_commissioning.app.io.atomic import discard_partial
 
     discard_partial()
+    # the pool's own threads fail as its workers go (broken pipes): a consequence of stopping, not news
+    threading.excepthook = lambda _args: None
     _end_child_processes()  # a pool's workers (they would also end themselves, a moment later)
     try:
         sys.stdout.flush()
