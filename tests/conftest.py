@@ -8,11 +8,27 @@ is the fast run for development; the README's command and CI run every test.
 from __future__ import annotations
 
 import pathlib
+import socket
+from collections.abc import Iterator
 
 import pytest
+import viser
 
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.fdsmc.params import DriveParams
+
+
+@pytest.fixture(scope="module")
+def gui() -> Iterator[viser.GuiApi]:
+    """A viser server's GUI API on a free local port, for the page's panels without a browser."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = int(s.getsockname()[1])
+    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    try:
+        yield server.gui
+    finally:
+        server.stop()
 
 
 @pytest.fixture(scope="session")

@@ -6,11 +6,8 @@ from __future__ import annotations
 
 import math
 import re
-import socket
-from collections.abc import Iterator
 
 import pytest
-import viser
 
 from pmsm_commissioning.app.io.display_units import UNIT_GROUPS
 from pmsm_commissioning.app.io.presets import load
@@ -20,17 +17,6 @@ from pmsm_commissioning.control.fdsmc.nameplate import rated_from_inverter
 
 PRESET = "odrive_d5065_belt"
 
-
-@pytest.fixture(scope="module")
-def gui() -> Iterator[viser.GuiApi]:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = int(s.getsockname()[1])
-    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
-    try:
-        yield server.gui
-    finally:
-        server.stop()
 
 
 @pytest.fixture

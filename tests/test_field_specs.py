@@ -225,22 +225,6 @@ def test_messages_of_list_sections_name_their_dotted_path():
         parse_preset(bad)
 
 
-@pytest.fixture(scope="module")
-def gui():
-    import socket
-
-    import viser
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = int(s.getsockname()[1])
-    server = viser.ViserServer(host="127.0.0.1", port=port)
-    try:
-        yield server.gui
-    finally:
-        server.stop()
-
-
 @pytest.mark.parametrize(("group", "key"), [("inertia", "motor.J_r"), ("angle", "manoeuvre.theta_dem"),
                                             ("resistance", "motor.L_d"), ("flux", "motor.psi_pm")])
 def test_unit_choice_relabels_and_rehints_the_field_and_keeps_the_si_value(gui, group, key):

@@ -5,27 +5,11 @@ out-of-range or unknown value is refused with the message a preset file with tha
 
 from __future__ import annotations
 
-import socket
-from collections.abc import Iterator
-
 import pytest
-import viser
 
 from pmsm_commissioning.app.io.preset_schema import parse_preset
 from pmsm_commissioning.app.io.presets import list_presets_of, load, to_raw
 from pmsm_commissioning.app.ui.inputs import FIELDS, InputError, InputsPanel, _with_label
-
-
-@pytest.fixture(scope="module")
-def gui() -> Iterator[viser.GuiApi]:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = int(s.getsockname()[1])
-    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
-    try:
-        yield server.gui
-    finally:
-        server.stop()
 
 
 @pytest.mark.parametrize("name", list_presets_of("position"))

@@ -8,11 +8,8 @@ name of viser.
 from __future__ import annotations
 
 import re
-import socket
-from collections.abc import Iterator
 from pathlib import Path
 
-import pytest
 import viser
 from viser import _icons
 
@@ -26,17 +23,6 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_viser_is_the_release_the_adapter_was_written_for():
     assert viser.__version__ == va.WRITTEN_FOR
 
-
-@pytest.fixture(scope="module")
-def gui() -> Iterator[viser.GuiApi]:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = int(s.getsockname()[1])
-    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
-    try:
-        yield server.gui
-    finally:
-        server.stop()
 
 
 def test_a_figure_is_shown_and_an_unchanged_one_not_sent_again(gui, monkeypatch):
