@@ -10,6 +10,7 @@ from __future__ import annotations
 import pathlib
 import socket
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
 import viser
@@ -27,6 +28,20 @@ def gui() -> Iterator[viser.GuiApi]:
     server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
     try:
         yield server.gui
+    finally:
+        server.stop()
+
+
+@pytest.fixture(scope="module")
+def served() -> Iterator[tuple[str, Any, Any]]:
+    """The page's server on the default preset (no 3D scene) on a free port: ("127.0.0.1:port", server, config)."""
+    from pmsm_commissioning.app.io.presets import DEFAULT_PRESET
+    from pmsm_commissioning.app.ui.page import create_server
+    from tests.net import free_port
+
+    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(), scene_3d=False)
+    try:
+        yield f"127.0.0.1:{server.get_port()}", server, config
     finally:
         server.stop()
 

@@ -9,7 +9,6 @@ import threading
 import time
 import urllib.error
 import urllib.request
-from collections.abc import Iterator
 from pathlib import Path
 
 import msgspec
@@ -24,27 +23,11 @@ from pmsm_commissioning.app.ui.text import md_text
 from pmsm_commissioning.app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
 from pmsm_commissioning.app.ui.worker import Cancelled, Worker
 from pmsm_commissioning.control.common.checks import ParameterError
-from tests.net import free_port
+from tests.net import free_port, run_coroutine
 
 PROTOCOL = f"viser-v{viser.__version__}"
 
 
-@pytest.fixture(scope="module")
-def served() -> Iterator[tuple[str, object, object]]:
-    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(), scene_3d=False)
-    try:
-        yield f"127.0.0.1:{server.get_port()}", server, config
-    finally:
-        server.stop()
-
-
-def _run(coro_fn) -> object:
-    """Run a coroutine on its own thread (the browser tests leave an event loop on the main one)."""
-    box: list[object] = []
-    t = threading.Thread(target=lambda: box.append(asyncio.run(coro_fn())))
-    t.start()
-    t.join(120)
-    return box[0] if box else None
 
 
 def _ws_status(hostport: str, origin: str | None, headers: dict[str, str] | None = None,
@@ -57,7 +40,7 @@ def _ws_status(hostport: str, origin: str | None, headers: dict[str, str] | None
         except websockets.exceptions.InvalidStatus as exc:
             return str(exc.response.status_code)
 
-    return _run(go)
+    return run_coroutine(go)
 
 
 def _http_status(url: str, headers: dict[str, str] | None = None) -> tuple[int, str]:
@@ -189,7 +172,7 @@ def _send_update(hostport: str, config: object, handle_of: str, value: str, wait
                     await asyncio.sleep(0.05)
             done.set()
 
-    _run(go)
+    run_coroutine(go)
     assert done.is_set()
     return session_box[0]
 
@@ -226,7 +209,7 @@ def test_widget_values_are_type_checked_before_viser_casts_them(served):
                     break
                 await asyncio.sleep(0.05)
 
-    _run(go)
+    run_coroutine(go)
     session = box[0]
     assert session.results.cycles.value == 601.0 and session.inputs.alpha_rule.value != 5
     refused = list(REFUSED_UPDATES)[before:]
@@ -269,7 +252,7 @@ def test_uploads_are_refused_by_declared_size_and_overrun_while_streaming(served
                 await asyncio.sleep(0.05)
             box.append(dict(box[0].client.gui._current_file_upload_states))
 
-    _run(go)
+    run_coroutine(go)
     refused = list(REFUSED_UPDATES)[before:]
     assert len(refused) == 4, refused
     assert "huge.csv" in refused[0] and "allowed ≤ 50 MB" in refused[0]
@@ -376,7 +359,7 @@ def test_page_open_sends_each_figure_once(served):
                     if meta:
                         figures.append((m["uuid"], meta["id"]))
 
-    _run(go)
+    run_coroutine(go)
     ids = [fid for _, fid in figures]
     assert {"phase_plane", "time_plots", "energy_time", "energy_bars", "bldc_emf"} <= set(ids)
     assert len(figures) == len(set(figures)), sorted(f for f in ids if ids.count(f) > 1)

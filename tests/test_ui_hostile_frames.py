@@ -7,17 +7,13 @@ from __future__ import annotations
 
 import asyncio
 import logging
-import threading
-from collections.abc import Iterator
 
 import msgspec
 import pytest
 import websockets
 
-from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset
-from pmsm_commissioning.app.ui.page import create_server
 from pmsm_commissioning.app.ui.web_guard import INVALID_FRAME, MAX_PART_BYTES, MIN_PART_BYTES, REFUSED_UPDATES
-from tests.net import free_port
+from tests.net import run_coroutine
 from tests.test_ui_hostile import CAMERA, PROTOCOL
 
 enc = msgspec.msgpack.encode
@@ -44,22 +40,6 @@ HOSTILE_FRAMES = {
 }
 
 
-@pytest.fixture(scope="module")
-def served() -> Iterator[tuple[str, object]]:
-    server, config = create_server(load_preset(DEFAULT_PRESET), DEFAULT_PRESET, port=free_port(), scene_3d=False)
-    try:
-        yield f"127.0.0.1:{server.get_port()}", config
-    finally:
-        server.stop()
-
-
-def _run(coro_fn) -> object:
-    """Run a coroutine on its own thread (the browser tests leave an event loop on the main one)."""
-    box: list[object] = []
-    t = threading.Thread(target=lambda: box.append(asyncio.run(coro_fn())))
-    t.start()
-    t.join(120)
-    return box[0] if box else None
 
 
 class _Records(logging.Handler):
@@ -87,12 +67,12 @@ def _send(hostport: str, frame: bytes | str, wait_s: float = 10.0) -> int | None
             except TimeoutError:
                 return None
 
-    return _run(go)
+    return run_coroutine(go)
 
 
 @pytest.mark.parametrize("name", list(HOSTILE_FRAMES))
 def test_a_hostile_frame_closes_its_connection_with_one_line_and_no_traceback(served, name):
-    hostport, _ = served
+    hostport, _, _ = served
     records, root = _Records(), logging.getLogger()
     root.addHandler(records)
     before = len(REFUSED_UPDATES)
@@ -108,7 +88,7 @@ def test_a_hostile_frame_closes_its_connection_with_one_line_and_no_traceback(se
 
 
 def test_the_server_still_serves_after_hostile_frames(served):
-    hostport, _ = served
+    hostport, _, _ = served
     for frame in list(HOSTILE_FRAMES.values())[:3]:
         assert _send(hostport, frame) == INVALID_FRAME
     assert _send(hostport, enc(CAMERA), wait_s=3.0) is None  # a good page opens and stays open
@@ -120,7 +100,7 @@ def _start(uuid: str, name: str, size: int, parts: int) -> dict:
 
 
 def test_uploads_are_bounded_by_part_count_and_part_size(served):
-    hostport, config = served
+    hostport, _, config = served
     known, before = set(config.sessions), len(REFUSED_UPDATES)
     box: list[object] = []
 
@@ -147,7 +127,7 @@ def test_uploads_are_bounded_by_part_count_and_part_size(served):
                 await asyncio.sleep(0.05)
             box.append(dict(box[0].client.gui._current_file_upload_states))
 
-    _run(go)
+    run_coroutine(go)
     refused = list(REFUSED_UPDATES)[before:]
     allowed = -(-300_000 // MIN_PART_BYTES)
     assert len(refused) == 2, refused
