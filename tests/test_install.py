@@ -59,8 +59,11 @@ def base(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("install")
 
 
-@pytest.fixture(scope="module")
-def wheel(base: Path) -> Path:
+def build_wheel(base: Path, no_isolation: bool) -> Path:
+    """Copy the project's :data:`SOURCES` below ``base`` and build its wheel there; the wheel's path.
+
+    ``no_isolation``: build with this interpreter's setuptools (no download of a build environment).
+    """
     src = base / "src"
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".numba_cache")
     for name in SOURCES:
@@ -70,11 +73,16 @@ def wheel(base: Path) -> Path:
             shutil.copy(ROOT / name, src / name)
     dist = base / "dist"
     build = [sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(dist), str(src)]
-    r = _run(build + (["--no-build-isolation"] if _offline_build() else []), cwd=base)
+    r = _run(build + (["--no-build-isolation"] if no_isolation else []), cwd=base)
     assert r.returncode == 0, r.stderr
     wheels = list(dist.glob("pmsm_commissioning-*.whl"))
     assert len(wheels) == 1, wheels
     return wheels[0]
+
+
+@pytest.fixture(scope="module")
+def wheel(base: Path) -> Path:
+    return build_wheel(base, _offline_build())
 
 
 def _new_env(env_dir: Path, user_site: bool = False) -> Path:

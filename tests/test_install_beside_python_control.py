@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 import sysconfig
@@ -21,8 +20,9 @@ from pathlib import Path
 
 import pytest
 
+from tests.test_install import build_wheel
+
 ROOT = Path(__file__).resolve().parents[1]
-SOURCES = ("app", "control", "sim", "presets", "pyproject.toml", "setup.py", "README.md", "LICENSE")
 STUB = ('"""Stand-in for python-control."""\n\n__version__ = "0.10.1"\n\n\n'
         'def tf(num, den):\n    return ("tf", num, den)\n')
 
@@ -33,19 +33,7 @@ def _run(cmd: list[str], cwd: Path, env: dict[str, str] | None = None) -> subpro
 
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    base = tmp_path_factory.mktemp("neighbour_build")
-    src = base / "src"
-    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".numba_cache")
-    for name in SOURCES:
-        if (ROOT / name).is_dir():
-            shutil.copytree(ROOT / name, src / name, ignore=ignore)
-        else:
-            shutil.copy(ROOT / name, src / name)
-    r = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--quiet", "-w",
-              str(base / "dist"), str(src)], cwd=base)
-    assert r.returncode == 0, r.stderr
-    (whl,) = (base / "dist").glob("pmsm_commissioning-*.whl")
-    return whl
+    return build_wheel(tmp_path_factory.mktemp("neighbour_build"), no_isolation=True)
 
 
 def _venv_with_python_control(env_dir: Path) -> tuple[Path, Path]:
