@@ -41,17 +41,14 @@ from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.fdsmc.feasibility import current_limit
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.fdsmc.plant import PlantInTheLoop
+from tests.toolchain import need
 
-CI = os.environ.get("CI") == "true"
 ROOT = Path(__file__).resolve().parent.parent
 FAST_MATH = [("-ffast-math",), ("-Ofast",), ("-O2", "-ffinite-math-only")]
 
 
 def _module(folder: Path, preset: str = "yaskawa_sgm7j_04a", sets: tuple[str, ...] = ()) -> None:
-    if compiler() is None:
-        if CI:
-            pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip("no C compiler (run scripts/ensure_cc.sh)")
+    need(compiler(), "C compiler")
     params, _ = count_params(load_preset(preset, list(sets)))
     write_module(folder, params)
 
@@ -59,12 +56,7 @@ def _module(folder: Path, preset: str = "yaskawa_sgm7j_04a", sets: tuple[str, ..
 @pytest.fixture(params=["gcc", "clang"])
 def cc(request) -> str:
     """Path of the host compiler (gcc, clang); a failure under CI=true, else a skip, when it is missing."""
-    path = shutil.which(request.param)
-    if path is None:
-        if CI:
-            pytest.fail(f"{request.param} missing: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip(f"{request.param} missing (run scripts/ensure_cc.sh)")
-    return path
+    return need(shutil.which(request.param), request.param)
 
 
 def _compile(folder: Path, cc: str, *flags: str) -> subprocess.CompletedProcess:
@@ -205,10 +197,7 @@ def test_the_hash_covers_the_tool_version(tmp_path, monkeypatch):
 
 def test_float32_is_the_default_on_a_single_precision_fpu(tmp_path):
     """Cortex-M4F without -DFDSMC_USE_FLOAT: the float build (no double helper); -DFDSMC_USE_DOUBLE opts out."""
-    if arm_compiler() is None:
-        if CI:
-            pytest.fail("arm-none-eabi-gcc missing: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip("arm-none-eabi-gcc missing (run scripts/ensure_cc.sh)")
+    need(arm_compiler(), "arm-none-eabi-gcc")
     _module(tmp_path)
     base = ["arm-none-eabi-gcc", "-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard", "-O2",
             "-std=c99", accept_flag(tmp_path), "-c", "fdsmc_controller.c"]

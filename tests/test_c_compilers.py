@@ -8,7 +8,6 @@ missing compiler fails (``scripts/ensure_cc.sh`` installs gcc, g++, clang and cl
 
 from __future__ import annotations
 
-import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -20,6 +19,7 @@ from pmsm_commissioning.app.exports.c_verify import CFLAGS, accept_flag
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare
+from tests.toolchain import need
 
 CXXFLAGS = ("-x", "c++", "-std=c++17", "-Wall", "-Wextra", "-Werror")
 BUILDS = {"double": (), "float": ("-DFDSMC_USE_FLOAT",)}
@@ -27,12 +27,7 @@ BUILDS = {"double": (), "float": ("-DFDSMC_USE_FLOAT",)}
 
 def tool(name: str) -> str:
     """Path of the compiler ``name``; a failure under CI=true, else a skip, when it is missing."""
-    path = shutil.which(name)
-    if path is None:
-        if os.environ.get("CI") == "true":
-            pytest.fail(f"{name} missing: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip(f"{name} missing (run scripts/ensure_cc.sh)")
-    return path
+    return need(shutil.which(name), name)
 
 
 def _export(folder: Path, law: str) -> Path:

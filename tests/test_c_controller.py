@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import ctypes
 import dataclasses
-import os
 import subprocess
 from pathlib import Path
 
@@ -39,15 +38,11 @@ from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.control.fdsmc.profile import velocity_profile
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
+from tests.toolchain import need
 
 
 def _compiler() -> str:
-    cc = compiler()
-    if cc is None:
-        if os.environ.get("CI") == "true":
-            pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip("no C compiler (run scripts/ensure_cc.sh)")
-    return cc
+    return need(compiler(), "C compiler")
 
 
 def _run_closed_loop(tmp_path: Path, params: DriveParams, single: bool, controller: str = "fdsmc") -> dict:

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import ctypes
 import math
-import os
 from pathlib import Path
 
 import pytest
 
 from pmsm_commissioning.app.exports.c_verify import CModule, build, compiler, count_params, write_module
 from pmsm_commissioning.app.io.presets import load_preset
+from tests.toolchain import need
 
 PRESET = "yaskawa_sgm7j_04a"
 #: Poison bytes: 0x7f.. is a large finite float/double and int, 0xff.. a NaN and -1.
@@ -26,10 +26,7 @@ POISONS = (0x7F, 0xFF)
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory) -> Path:
     """The preset's module (unverified: built with its acceptance)."""
-    if compiler() is None:
-        if os.environ.get("CI") == "true":
-            pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip("no C compiler (run scripts/ensure_cc.sh)")
+    need(compiler(), "C compiler")
     path = tmp_path_factory.mktemp("fault_outputs")
     write_module(path, count_params(load_preset(PRESET))[0])
     return path

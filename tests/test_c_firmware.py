@@ -42,6 +42,7 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import derive
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare
+from tests.toolchain import need
 
 ROOT = Path(__file__).resolve().parent.parent
 #: The designed move of yaskawa_sgm7j_04a (10 rev in 0.5 s) in counts of its module.
@@ -50,12 +51,7 @@ CI = os.environ.get("CI") == "true"
 
 
 def _tool(name: str) -> str:
-    path = shutil.which(name)
-    if path is None:
-        if CI:
-            pytest.fail(f"{name} missing: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip(f"{name} missing (run scripts/ensure_cc.sh)")
-    return path
+    return need(shutil.which(name), name)
 
 
 def _cc(folder: Path, *args: str) -> subprocess.CompletedProcess:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import ctypes
 import math
-import os
 import re
 import subprocess
 from pathlib import Path
@@ -29,21 +28,14 @@ from pmsm_commissioning.app.exports.c_verify import (
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.fdsmc.plant import PlantInTheLoop
+from tests.toolchain import need
 
-CI = os.environ.get("CI") == "true"
 PRESET = "yaskawa_sgm7j_04a"
-
-
-def _need(tool: str | None, name: str) -> None:
-    if tool is None:
-        if CI:
-            pytest.fail(f"{name} missing: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip(f"{name} missing (run scripts/ensure_cc.sh)")
 
 
 def _module(folder: Path, cpr: int) -> int:
     """Write the module of the preset with ``cpr`` counts/rev into ``folder``; returns its pole pairs."""
-    _need(compiler(), "cc")
+    need(compiler(), "cc")
     params, _ = count_params(load_preset(PRESET, [f"sensors.encoder_cpr={cpr}"]))
     write_module(folder, params)
     return params.motor.p
@@ -105,7 +97,7 @@ def test_helper_check_knows_the_64_bit_division_helpers():
 @pytest.mark.parametrize("cpr", [10000, 2**14])
 def test_no_64_bit_or_double_helper_in_the_float_object_for_any_encoder(tmp_path, cpr):
     """arm-none-eabi-gcc, Cortex-M4F: the object calls no helper at all, 64-bit division included."""
-    _need(arm_compiler(), "arm-none-eabi-gcc")
+    need(arm_compiler(), "arm-none-eabi-gcc")
     _module(tmp_path, cpr)
     obj = cross_compile(tmp_path, (accept_flag(tmp_path),))
     assert helper_symbols(obj) == [] and symbols(obj) == []

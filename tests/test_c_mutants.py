@@ -10,7 +10,6 @@ a move accepted while one is pending or running and a sign flip of a gain are al
 
 from __future__ import annotations
 
-import os
 import re
 import shutil
 import subprocess
@@ -23,6 +22,7 @@ from pmsm_commissioning.app.exports.c_verify import CFLAGS, accept_flag, compile
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare
+from tests.toolchain import need
 
 PRESET = "yaskawa_sgm7j_04a"
 BUILDS = {"double": (), "float": ("-DFDSMC_USE_FLOAT",)}
@@ -78,10 +78,7 @@ MUTANTS = {
 @pytest.fixture(scope="module")
 def export(tmp_path_factory) -> Path:
     """The preset's export with the test program's object compiled once per build (the vectors are large)."""
-    if compiler() is None:
-        if os.environ.get("CI") == "true":
-            pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip("no C compiler (run scripts/ensure_cc.sh)")
+    need(compiler(), "C compiler")
     folder = tmp_path_factory.mktemp("mutants")
     params = load_preset(PRESET)
     cmp = compare(params)

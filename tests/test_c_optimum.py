@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import ctypes
 import io
-import os
 import subprocess
 import zipfile
 from pathlib import Path
@@ -40,18 +39,13 @@ from pmsm_commissioning.control.fdsmc.optimum import tracked_move
 from pmsm_commissioning.control.fdsmc.tracking import slide_time_constant
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
+from tests.toolchain import need
 
-CI = os.environ.get("CI") == "true"
 OPTIMUM = ExportOptions(force=True, controller="optimum")
 
 
 def _compiler() -> str:
-    cc = cv.compiler()
-    if cc is None:
-        if CI:
-            pytest.fail("no C compiler: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip("no C compiler (run scripts/ensure_cc.sh)")
-    return cc
+    return need(cv.compiler(), "C compiler")
 
 
 def _closed_loop(folder: Path, preset: str, single: bool) -> dict[str, float]:
@@ -178,10 +172,7 @@ def test_the_page_offers_the_optimum_module_as_its_own_zip():
 
 def test_float_build_for_cortex_m4f(tmp_path):
     """No double operation; the table is in .text (flash); instructions per step under qemu-arm."""
-    if arm_compiler() is None:
-        if CI:
-            pytest.fail("arm-none-eabi-gcc missing: scripts/ensure_cc.sh installs it (CI needs it)")
-        pytest.skip("arm-none-eabi-gcc missing (run scripts/ensure_cc.sh)")
+    need(arm_compiler(), "arm-none-eabi-gcc")
     _export(tmp_path, "yaskawa_sgm7j_04a")
     obj = cross_compile(tmp_path)
     assert double_symbols(obj) == []
