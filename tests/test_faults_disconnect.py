@@ -14,8 +14,8 @@ import websockets
 from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset
 from pmsm_commissioning.app.ui.page import create_server
 from pmsm_commissioning.app.ui.worker import Cancelled, Worker
-from tests.net import free_port
-from tests.test_ui_hostile import CAMERA, PROTOCOL, _run
+from tests.net import free_port, run_coroutine
+from tests.test_ui_hostile import CAMERA, PROTOCOL
 
 #: The promise: a disconnected page's work is gone within this time [s].
 GONE_S = 2.0
@@ -78,7 +78,7 @@ def test_disconnected_page_ends_its_robustness_pool():
         # leaving the block closes the websocket: the page is gone
 
     try:
-        _run(page)
+        run_coroutine(page)
         assert _wait(lambda: not pool_children(), GONE_S + 3.0), pool_children()
         assert _wait(lambda: not box[0].worker.busy, GONE_S)
     finally:

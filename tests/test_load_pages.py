@@ -13,9 +13,8 @@ import time
 from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, load_preset
 from pmsm_commissioning.app.ui.page import create_server
 from pmsm_commissioning.app.ui.studies_queue import StudySlots
-from tests.net import free_port
+from tests.net import free_port, run_coroutine
 from tests.page_client import PageClient
-from tests.test_ui_hostile import _run
 
 #: Generous bound on a closed page's processes and study slot being gone [s] (the promise is 2 s).
 GONE_S = 5.0
@@ -57,7 +56,7 @@ def test_three_pages_queue_their_studies_and_leave_no_process_behind():
         await pages[2].close()
 
     try:
-        _run(go)
+        run_coroutine(go)
         gone = _wait_gone(lambda: children() or config.slots.running or config.slots.queued)
         assert seen == {"pool": True, "queued": True, "third runs": True}
         assert gone, (children(), config.slots.running, config.slots.queued)
@@ -96,7 +95,7 @@ def test_a_table1_sweep_is_a_study_it_waits_for_a_slot_and_then_runs():
         await page.close()
 
     try:
-        _run(go)
+        run_coroutine(go)
         assert seen == {"queued": True, "waiting": True, "ran": True}
         assert config.slots.running == config.slots.queued == 0
     finally:
