@@ -14,7 +14,7 @@ from setuptools import find_namespace_packages, setup
 NAME = "pmsm_commissioning"
 PARTS = ("app", "control", "sim")
 
-# namespace packages too: the data folders app/examples, app/ui/assets, app/exports/c
+# namespace packages too: the data folders app/examples, app/ui/assets, app/exports/firmware/c
 found = find_namespace_packages(include=[p for part in PARTS for p in (part, f"{part}.*")], exclude=["*__pycache__*"])
 
 setup(

@@ -121,7 +121,7 @@ def _vendor_cases() -> dict[str, tuple[str, str]]:
 
 def vendor_files() -> Tally:
     """Vendor texts through import-drive's parser and mapping onto a base preset."""
-    from pmsm_commissioning.app.exports.drive_import import import_drive
+    from pmsm_commissioning.app.exports.drives.import_drive import import_drive
     from pmsm_commissioning.app.io.presets import load
 
     base, tally = load("odrive_d5065_belt", (), mode="position"), Tally()
@@ -184,7 +184,7 @@ def written_files() -> Tally:
 
     from pmsm_commissioning.app.cli.export import case
     from pmsm_commissioning.app.exports import moteus, odrive, setpoints, vesc
-    from pmsm_commissioning.app.exports.stock import stock_settings
+    from pmsm_commissioning.app.exports.drives.stock import stock_settings
     from tests.test_hostile_round3 import _files, corpus
 
     cmp = case(load_preset("yaskawa_sgm7j_04a"), "odrive")

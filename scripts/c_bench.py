@@ -26,19 +26,19 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from pmsm_commissioning.app.exports.c_arm import (  # noqa: E402
+from pmsm_commissioning.app.exports.firmware.vectors import c_files  # noqa: E402
+from pmsm_commissioning.app.exports.firmware.verify import accept_flag  # noqa: E402
+from pmsm_commissioning.app.io.presets import list_presets, load_preset  # noqa: E402
+from pmsm_commissioning.control.fdsmc.params import DriveParams  # noqa: E402
+from pmsm_commissioning.sim.fdsmc.design import run_checks  # noqa: E402
+from pmsm_commissioning.sim.fdsmc.engine import compare  # noqa: E402
+from scripts.c_arm import (  # noqa: E402
     arm_compiler,
     code_size,
     count_instructions,
     cross_compile,
     double_symbols,
 )
-from pmsm_commissioning.app.exports.c_vectors import c_files  # noqa: E402
-from pmsm_commissioning.app.exports.c_verify import accept_flag  # noqa: E402
-from pmsm_commissioning.app.io.presets import list_presets, load_preset  # noqa: E402
-from pmsm_commissioning.control.fdsmc.params import DriveParams  # noqa: E402
-from pmsm_commissioning.sim.fdsmc.design import run_checks  # noqa: E402
-from pmsm_commissioning.sim.fdsmc.engine import compare  # noqa: E402
 
 #: Instructions per step the float32 build must stay within on Cortex-M4F [-].
 BUDGET = 300

@@ -12,8 +12,8 @@ import argparse
 import tempfile
 from pathlib import Path
 
-from pmsm_commissioning.app.exports.c_vectors import c_files
-from pmsm_commissioning.app.exports.c_verify import measure, replay
+from pmsm_commissioning.app.exports.firmware.vectors import c_files
+from pmsm_commissioning.app.exports.firmware.verify import measure, replay
 from pmsm_commissioning.app.io.presets import list_presets, load_preset
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc.design import run_checks

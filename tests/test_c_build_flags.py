@@ -22,9 +22,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pmsm_commissioning.app.exports.c_arm import arm_compiler, double_symbols
-from pmsm_commissioning.app.exports.c_module import HEADER_NAME, parameter_hash
-from pmsm_commissioning.app.exports.c_verify import (
+from pmsm_commissioning.app.exports.firmware.module import HEADER_NAME, parameter_hash
+from pmsm_commissioning.app.exports.firmware.verify import (
     CFLAGS,
     CModule,
     accept_flag,
@@ -41,6 +40,7 @@ from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.fdsmc.feasibility import current_limit
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.fdsmc.plant import PlantInTheLoop
+from scripts.c_arm import arm_compiler, double_symbols
 from tests.toolchain import need
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from pmsm_commissioning.app.exports.c_vectors import c_files
-from pmsm_commissioning.app.exports.c_verify import CFLAGS, accept_flag
+from pmsm_commissioning.app.exports.firmware.vectors import c_files
+from pmsm_commissioning.app.exports.firmware.verify import CFLAGS, accept_flag
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare

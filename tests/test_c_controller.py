@@ -1,7 +1,7 @@
 """The generated C controller runs in closed loop against the simulator's plant and reproduces the
 simulator's digital mode, sensors included: what the drive will run is what was simulated.
 
-The module is compiled with the system C compiler and loaded with :mod:`ctypes` (app/exports/c_verify.py):
+The module is compiled with the system C compiler and loaded with :mod:`ctypes` (app/exports/firmware/verify.py):
 called sample by sample between RK4 steps of :class:`sim.fdsmc.plant.PlantInTheLoop`, it reads what the
 simulator's controller reads (encoder counts, noisy ADC currents). The double build is the simulator's
 arithmetic operation for operation, so the closed loop is bit-identical even though a quantized encoder
@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from pmsm_commissioning.app.exports.c_vectors import c_files
-from pmsm_commissioning.app.exports.c_verify import (
+from pmsm_commissioning.app.exports.firmware.vectors import c_files
+from pmsm_commissioning.app.exports.firmware.verify import (
     CFLAGS,
     CModule,
     accept_flag,

@@ -10,8 +10,8 @@ from __future__ import annotations
 import pytest
 
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.app.exports.c_module import HEADER_NAME, SOURCE_NAME
-from pmsm_commissioning.app.exports.c_vectors import TEST_NAME, VECTORS_NAME
+from pmsm_commissioning.app.exports.firmware.module import HEADER_NAME, SOURCE_NAME
+from pmsm_commissioning.app.exports.firmware.vectors import TEST_NAME, VECTORS_NAME
 from pmsm_commissioning.app.exports.provenance import failed_checks
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.sim.fdsmc.engine import compare

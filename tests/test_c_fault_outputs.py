@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from pmsm_commissioning.app.exports.c_verify import CModule, build, compiler, count_params, write_module
+from pmsm_commissioning.app.exports.firmware.verify import CModule, build, compiler, count_params, write_module
 from pmsm_commissioning.app.io.presets import load_preset
 from tests.toolchain import need
 

@@ -17,17 +17,10 @@ from pathlib import Path
 
 import pytest
 
-from pmsm_commissioning.app.exports.c_arm import (
-    arm_compiler,
-    count_instructions,
-    cross_compile,
-    double_symbols,
-    symbols,
-)
-from pmsm_commissioning.app.exports.c_module import HEADER_NAME, Verdict, controller_files, parameter_hash
-from pmsm_commissioning.app.exports.c_text import MAX_CHARS, c_string
-from pmsm_commissioning.app.exports.c_vectors import c_files
-from pmsm_commissioning.app.exports.c_verify import (
+from pmsm_commissioning.app.exports.firmware.module import HEADER_NAME, Verdict, controller_files, parameter_hash
+from pmsm_commissioning.app.exports.firmware.text import MAX_CHARS, c_string
+from pmsm_commissioning.app.exports.firmware.vectors import c_files
+from pmsm_commissioning.app.exports.firmware.verify import (
     CFLAGS,
     CModule,
     accept_flag,
@@ -42,6 +35,13 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import derive
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare
+from scripts.c_arm import (
+    arm_compiler,
+    count_instructions,
+    cross_compile,
+    double_symbols,
+    symbols,
+)
 from tests.toolchain import need
 
 ROOT = Path(__file__).resolve().parent.parent

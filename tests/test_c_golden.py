@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from pmsm_commissioning.app.exports.c_golden import REFUSE_AT, segments
-from pmsm_commissioning.app.exports.c_targeted import call_at_rest, targeted_calls
-from pmsm_commissioning.app.exports.c_verify import count_params
+from pmsm_commissioning.app.exports.firmware.golden import REFUSE_AT, segments
+from pmsm_commissioning.app.exports.firmware.targeted import call_at_rest, targeted_calls
+from pmsm_commissioning.app.exports.firmware.verify import count_params
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.fdsmc.derivations import derive
 from pmsm_commissioning.control.fdsmc.feasibility import current_limit

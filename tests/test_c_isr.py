@@ -14,8 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pmsm_commissioning.app.exports.c_arm import LONG_SYMBOL, arm_compiler, cross_compile, helper_symbols, symbols
-from pmsm_commissioning.app.exports.c_verify import (
+from pmsm_commissioning.app.exports.firmware.verify import (
     CFLAGS,
     CModule,
     accept_flag,
@@ -28,6 +27,7 @@ from pmsm_commissioning.app.exports.c_verify import (
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.fdsmc.plant import PlantInTheLoop
+from scripts.c_arm import LONG_SYMBOL, arm_compiler, cross_compile, helper_symbols, symbols
 from tests.toolchain import need
 
 PRESET = "yaskawa_sgm7j_04a"

@@ -20,16 +20,9 @@ import pytest
 
 from pmsm_commissioning.app.cli.main import main
 from pmsm_commissioning.app.exports import c_verify as cv
-from pmsm_commissioning.app.exports.c_arm import (
-    arm_compiler,
-    code_size,
-    count_instructions,
-    cross_compile,
-    double_symbols,
-)
-from pmsm_commissioning.app.exports.c_module import HEADER_NAME
-from pmsm_commissioning.app.exports.c_optimum import NODE_BYTES_FLOAT, reference_table
-from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.drives.files import ExportOptions
+from pmsm_commissioning.app.exports.firmware.module import HEADER_NAME
+from pmsm_commissioning.app.exports.firmware.optimum import NODE_BYTES_FLOAT, reference_table
 from pmsm_commissioning.app.exports.model import export_download, export_files
 from pmsm_commissioning.app.exports.provenance import ExportRefusedError
 from pmsm_commissioning.app.io.presets import load_preset
@@ -39,6 +32,13 @@ from pmsm_commissioning.control.fdsmc.optimum import tracked_move
 from pmsm_commissioning.control.fdsmc.tracking import slide_time_constant
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 from pmsm_commissioning.sim.fdsmc.engine import compare, simulate
+from scripts.c_arm import (
+    arm_compiler,
+    code_size,
+    count_instructions,
+    cross_compile,
+    double_symbols,
+)
 from tests.toolchain import need
 
 OPTIMUM = ExportOptions(force=True, controller="optimum")

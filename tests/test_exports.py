@@ -16,7 +16,7 @@ import yaml
 
 from pmsm_commissioning.app.cli.export import case as export_case
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.drives.files import ExportOptions
 from pmsm_commissioning.app.exports.html import ROW_HEIGHT_PX, html_report
 from pmsm_commissioning.app.exports.model import (
     FORMATS,

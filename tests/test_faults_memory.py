@@ -14,7 +14,7 @@ import threading
 import pytest
 
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.app.exports.odrive import parse_odrive
+from pmsm_commissioning.app.exports.drives.odrive import parse_odrive
 from pmsm_commissioning.app.io.bounded import ReadError, read_bounded
 from pmsm_commissioning.app.io.drive_log import MAX_ROWS, LogError, parse_log, read_log
 from pmsm_commissioning.control.common.checks import ParameterError

@@ -16,7 +16,7 @@ import typing
 
 import pytest
 
-from pmsm_commissioning.app.exports.c_module import INPUT_KEYS, c_unit, controller_header
+from pmsm_commissioning.app.exports.firmware.module import INPUT_KEYS, c_unit, controller_header
 from pmsm_commissioning.app.io import units
 from pmsm_commissioning.app.io.presets import (
     SCHEMA,

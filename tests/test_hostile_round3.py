@@ -22,8 +22,8 @@ import pytest
 from pmsm_commissioning.app.cli.export import case
 from pmsm_commissioning.app.cli.main import main
 from pmsm_commissioning.app.exports import moteus, odrive, setpoints, vesc
+from pmsm_commissioning.app.exports.drives.stock import stock_settings
 from pmsm_commissioning.app.exports.provenance import header_lines
-from pmsm_commissioning.app.exports.stock import stock_settings
 from pmsm_commissioning.app.io import atomic
 from pmsm_commissioning.app.io.numbers import one_line, parse_number
 from pmsm_commissioning.app.io.presets import load_preset

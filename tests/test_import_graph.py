@@ -13,7 +13,9 @@ each part imports only the parts below it, from the bottom:
 * ``app/cli`` — the commands (``serve`` starts the page); ``app/__main__.py`` runs them.
 
 A part importing one at its own level or above (``figures`` → ``ui``, ``exports`` → ``ui``) is a sideways or
-upward import: what both need belongs in the lower part.
+upward import: what both need belongs in the lower part. Inside ``app/exports``, ``firmware`` (the C module and
+its checks) and ``drives`` (the stock drives' files and the stock route) import neither the other: what both
+use (``provenance``, ``tool_id``) is in ``app/exports`` itself, and ``model`` dispatches to both.
 """
 
 from __future__ import annotations
@@ -145,3 +147,16 @@ def test_control_and_sim_import_nothing_above_them():
           if (m.startswith("control") and not d.startswith("control"))
           or (m.startswith("sim") and d.startswith("app"))]
     assert not up, "\n".join(sorted(up))
+
+
+#: Sub-packages of app/exports that import neither the other.
+EXPORT_SIBLINGS = ("app.exports.firmware", "app.exports.drives")
+
+
+def test_firmware_and_drives_import_neither_the_other():
+    graph = _graph()
+    assert all(any(m.startswith(s + ".") for m in graph) for s in EXPORT_SIBLINGS), "a sub-package is gone"
+    wrong = [f"{m} imports {d}" for m, deps in graph.items() for d in deps
+             for a, b in (EXPORT_SIBLINGS, EXPORT_SIBLINGS[::-1])
+             if (m == a or m.startswith(a + ".")) and (d == b or d.startswith(b + "."))]
+    assert not wrong, "\n".join(sorted(wrong))

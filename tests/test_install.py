@@ -155,7 +155,7 @@ def test_console_entry_point_designs_a_shipped_preset(installed: dict[str, Path]
 
 def test_the_installed_package_writes_the_c_controller_and_has_the_pages_scripts(installed: dict[str, Path],
                                                                                  tmp_path: Path) -> None:
-    """The C texts (app/exports/c) and the page's scripts (app/ui/assets) are package data of the wheel."""
+    """The C texts (app/exports/firmware/c) and the page's scripts (app/ui/assets) are package data of the wheel."""
     out = tmp_path / "c"
     r = _run([str(installed["script"]), "export", "yaskawa_sgm7j_04a", "--format", "c", "-o", str(out)],
              cwd=installed["cwd"], env=_env(installed))

@@ -10,10 +10,10 @@ import yaml
 
 from pmsm_commissioning.app.cli.export import case
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions
+from pmsm_commissioning.app.exports.drives.files import DRIVE_FORMATS, ExportOptions
+from pmsm_commissioning.app.exports.drives.stock_route import file_verdict
 from pmsm_commissioning.app.exports.model import FORMATS, export_download, export_files
 from pmsm_commissioning.app.exports.provenance import ExportRefusedError, failed_checks, parameter_hash
-from pmsm_commissioning.app.exports.stock_route import file_verdict
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.sim.fdsmc.design import run_checks
 

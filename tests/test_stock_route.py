@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from pmsm_commissioning.app.cli.export import case
-from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS
+from pmsm_commissioning.app.exports.drives.files import DRIVE_FORMATS
+from pmsm_commissioning.app.exports.drives.stock_route import file_loop, file_verdict
 from pmsm_commissioning.app.exports.model import export_files
 from pmsm_commissioning.app.exports.provenance import ExportRefusedError
-from pmsm_commissioning.app.exports.stock_route import file_loop, file_verdict
 from pmsm_commissioning.app.io.presets import load
 from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_from_limits, trapezoid_timing
 from pmsm_commissioning.control.stock import loops
@@ -110,7 +110,7 @@ def test_the_stock_route_of_the_paper_case_is_refused_naming_its_checks():
 
 def test_the_file_runs_the_tuned_route():
     """The 9-digit file and the tuned settings give the same run (the file is the tuning, written)."""
-    from pmsm_commissioning.app.exports.stock import stock_settings
+    from pmsm_commissioning.app.exports.drives.stock import stock_settings
 
     cmp = _case("yaskawa_sgm7j_04a")
     p = cmp.derived.params

@@ -9,10 +9,10 @@ import pytest
 
 from pmsm_commissioning.app.cli.export import case
 from pmsm_commissioning.app.exports import odrive, vesc
-from pmsm_commissioning.app.exports.drive_files import ExportOptions
-from pmsm_commissioning.app.exports.drive_import import import_drive
+from pmsm_commissioning.app.exports.drives.files import ExportOptions
+from pmsm_commissioning.app.exports.drives.import_drive import import_drive
+from pmsm_commissioning.app.exports.drives.stock import stock_settings
 from pmsm_commissioning.app.exports.model import export_files
-from pmsm_commissioning.app.exports.stock import stock_settings
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.common.checks import ParameterError
 

@@ -23,9 +23,9 @@ import sys
 from pathlib import Path
 
 from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
-from pmsm_commissioning.app.exports.c_module import LAWS
-from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions
-from pmsm_commissioning.app.exports.drive_units import ANGLE_UNITS
+from pmsm_commissioning.app.exports.drives.files import DRIVE_FORMATS, ExportOptions
+from pmsm_commissioning.app.exports.drives.units import ANGLE_UNITS
+from pmsm_commissioning.app.exports.firmware.module import LAWS
 from pmsm_commissioning.app.exports.model import FORMATS, c_law, export_files, with_optimum_run
 from pmsm_commissioning.app.exports.provenance import ExportRefusedError, check_text, failed_checks
 from pmsm_commissioning.app.io import atomic

@@ -1,7 +1,7 @@
 """``pmsm-commission import-drive FILE --format odrive|moteus|vesc --base PRESET -o preset.yaml``.
 
 Reads a stock drive's own file (ODrive backup JSON, moteus configuration dump, VESC mcconf XML) and
-writes a preset: the base preset with the file's motor data (:func:`app.exports.drive_import.import_drive`).
+writes a preset: the base preset with the file's motor data (:func:`app.exports.drives.import_drive.import_drive`).
 Every key of the file that is not imported is listed (on the terminal and in the preset's header
 comment). The preset is written whole (a temporary file, then ``os.replace``).
 
@@ -19,7 +19,7 @@ from pathlib import Path
 
 from pmsm_commissioning.app.cli.export import write_atomic
 from pmsm_commissioning.app.cli.main import check_writable
-from pmsm_commissioning.app.exports.drive_import import IMPORT_FORMATS, import_drive
+from pmsm_commissioning.app.exports.drives.import_drive import IMPORT_FORMATS, import_drive
 from pmsm_commissioning.app.io.assumed import INHERITED, inherited_block
 from pmsm_commissioning.app.io.bounded import ReadError, read_bounded
 from pmsm_commissioning.app.io.presets import MAX_BYTES, dumps, load, to_raw

@@ -12,7 +12,7 @@ import math
 import plotly.graph_objects as go
 import plotly.io as pio
 
-from pmsm_commissioning.app.exports.c_module import TOOL
+from pmsm_commissioning.app.exports.tool_id import TOOL
 from pmsm_commissioning.app.figures.fdsmc_comparison import TIME_ROWS, make_phase_plane_figure, make_time_plots_figure
 from pmsm_commissioning.app.figures.fdsmc_energy import make_energy_bars_figure, make_energy_figure
 from pmsm_commissioning.app.figures.style import BAD_COLOUR

@@ -8,11 +8,11 @@
   (feasibility, warnings, run warnings, savings) and ``results`` (each run's metrics, the unit in
   each key's suffix). The loader ignores the informational sections and recomputes them, so
   export → import → export gives identical bytes;
-* ``c``: the C99 controller module (:mod:`app.exports.c_module`);
+* ``c``: the C99 controller module (:mod:`app.exports.firmware.module`);
 * ``csv``: the time series of both runs (:func:`trace_csv`);
 * ``html``: the offline report (:mod:`app.exports.html`);
 * ``odrive`` / ``moteus`` / ``vesc`` / ``setpoints``: the files a stock drive loads
-  (:mod:`app.exports.drive_files`): the same move as a trapezoid and the comparator's gains as the
+  (:mod:`app.exports.drives.files`): the same move as a trapezoid and the comparator's gains as the
   drive's cascade, each with a header naming the preset, the tool's version, the verdicts, a hash of
   the parameters and the simulated energy of the stock route next to FDSMC and the optimum.
 
@@ -37,11 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from pmsm_commissioning.app.exports.c_module import LAWS, TOOL
-from pmsm_commissioning.app.exports.c_text import c_comment
-from pmsm_commissioning.app.exports.c_vectors import c_files
-from pmsm_commissioning.app.exports.drive_files import DRIVE_FORMATS, ExportOptions, drive_file
+from pmsm_commissioning.app.exports.drives.files import DRIVE_FORMATS, ExportOptions, drive_file
+from pmsm_commissioning.app.exports.firmware.module import LAWS
+from pmsm_commissioning.app.exports.firmware.text import c_comment
+from pmsm_commissioning.app.exports.firmware.vectors import c_files
 from pmsm_commissioning.app.exports.provenance import check_text, failed_checks, gate, verdict_lines
+from pmsm_commissioning.app.exports.tool_id import TOOL
 from pmsm_commissioning.app.io.dc_link_view import choice_json
 from pmsm_commissioning.app.io.derived_view import derived_rows
 from pmsm_commissioning.app.io.json_data import to_json

@@ -1,7 +1,7 @@
 """The tool's name and version as the exported files state them (the C header, the drive files' headers).
 
 :func:`tool_version` reads the installed package's version, so a generated file names the code that
-wrote it; the C module's parameter hash covers it (:func:`app.exports.c_module.parameter_hash`).
+wrote it; the C module's parameter hash covers it (:func:`app.exports.firmware.module.parameter_hash`).
 """
 
 from __future__ import annotations

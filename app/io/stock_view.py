@@ -3,7 +3,7 @@
 The engine's ``stock`` run is a setpoint-table drive's own loops (:mod:`sim.stock.route`), tuned on the
 simulated checks (:mod:`sim.stock.tuning`); each vendor drive's tuned route is reported beside it, with
 the settings its file carries. The verdict a written drive file carries is the one simulated from that
-file's own numbers (:mod:`app.exports.stock_route`); it equals these to the files' 9 digits.
+file's own numbers (:mod:`app.exports.drives.stock_route`); it equals these to the files' 9 digits.
 """
 
 from __future__ import annotations

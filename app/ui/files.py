@@ -19,7 +19,7 @@ from typing import Any
 
 import viser
 
-from pmsm_commissioning.app.exports.drive_files import ExportOptions
+from pmsm_commissioning.app.exports.drives.files import ExportOptions
 from pmsm_commissioning.app.exports.model import export_download, safe_stem
 from pmsm_commissioning.app.io.modes import REGISTRY
 from pmsm_commissioning.app.io.preset_schema import PresetError

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from playwright.sync_api import expect
 
-from pmsm_commissioning.app.exports.c_verify import count_params
+from pmsm_commissioning.app.exports.firmware.verify import count_params
 from pmsm_commissioning.app.io.presets import PAPER_PRESET, dumps_preset, load_preset, loads_preset
 from pmsm_commissioning.control.fdsmc.derivations import derive
 from tests.browser.conftest import ARTIFACTS, field, figure, open_page, set_number

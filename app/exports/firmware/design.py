@@ -132,7 +132,7 @@ def _fields(params: DriveParams, d: Derived, K: float) -> dict[str, Any]:
 
 
 def design_initializer(params: DriveParams, d: Derived, so: Any, literal: Callable[[float], str], K: float) -> str:
-    """Designated initializer of ``FDSMC_DESIGN`` (``so``: the :class:`~app.exports.c_module.ScaledObserver`).
+    """Designated initializer of ``FDSMC_DESIGN`` (``so``: the :class:`~app.exports.firmware.module.ScaledObserver`).
 
     ``K`` is the boundary-layer gain of the module's law: the case's for the FDSMC, the tracked optimum's
     (:func:`control.fdsmc.tracking.slide_gain`) for its module.

@@ -1,7 +1,7 @@
-"""C99 text of the generated controller's header ``fdsmc_controller.h`` (the source is in :mod:`app.exports.c_source`).
+"""C99 text of the generated controller's header ``fdsmc_controller.h`` (source: :mod:`app.exports.firmware.source`).
 
-The templates use :class:`string.Template` placeholders (``$name``); :mod:`app.exports.c_module` fills in
-the constants of one derived design (every user string through :func:`app.exports.c_text.c_string`).
+The templates use :class:`string.Template` placeholders (``$name``); :mod:`app.exports.firmware.module` fills in
+the constants of one derived design (every user string through :func:`app.exports.firmware.text.c_string`).
 The C code mirrors the controller of the simulator's digital mode, :func:`sim.fdsmc.kernel.step_sample`
 (outer law, FDC voltages, inverter limits, computation delay, observer update): the same formulas, in
 the same order, with the observer's angle kept as integer encoder counts plus a fraction so that the

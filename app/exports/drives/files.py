@@ -1,8 +1,8 @@
 """The stock-drive export formats of the one export model: ODrive, moteus, VESC and the setpoint table.
 
 :func:`drive_file` writes the format from the drive's tuned SI settings
-(:func:`app.exports.stock.stock_settings`), reads the draft back with the strict parser and simulates
-the drive's own loops from it (:func:`app.exports.stock_route.file_verdict`): **that** verdict gates
+(:func:`app.exports.drives.stock.stock_settings`), reads the draft back with the strict parser and simulates
+the drive's own loops from it (:func:`app.exports.drives.stock_route.file_verdict`): **that** verdict gates
 the export (refused unless ``force`` when a check fails) and heads the file, next to the energies of
 the FDSMC and the tracked optimum (:func:`app.exports.provenance.header_lines`).
 """
@@ -12,13 +12,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from pmsm_commissioning.app.exports.moteus import moteus_text
-from pmsm_commissioning.app.exports.odrive import odrive_json
+from pmsm_commissioning.app.exports.drives.moteus import moteus_text
+from pmsm_commissioning.app.exports.drives.odrive import odrive_json
+from pmsm_commissioning.app.exports.drives.setpoints import setpoints_csv
+from pmsm_commissioning.app.exports.drives.stock import StockSettings, stock_settings, with_stock_runs
+from pmsm_commissioning.app.exports.drives.stock_route import ROUTE_NAMES, file_verdict
+from pmsm_commissioning.app.exports.drives.vesc import vesc_xml
 from pmsm_commissioning.app.exports.provenance import ExportRefusedError, check_text, header_lines
-from pmsm_commissioning.app.exports.setpoints import setpoints_csv
-from pmsm_commissioning.app.exports.stock import StockSettings, stock_settings, with_stock_runs
-from pmsm_commissioning.app.exports.stock_route import ROUTE_NAMES, file_verdict
-from pmsm_commissioning.app.exports.vesc import vesc_xml
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.sim.fdsmc.design import Constraint
 from pmsm_commissioning.sim.fdsmc.engine import Comparison

@@ -7,7 +7,7 @@ and the discrete observer at the drive's f_s in a scaled state-space form (:func
 that float32 firmware is accurate. They are written twice: as ``#define FDSMC_<NAME>`` with unit and
 reference (documentation, and for the integrator's code) and as the ``const fdsmc_params FDSMC_DESIGN``
 the step reads (with precomputed products and reciprocals). The C code is in
-:mod:`app.exports.c_template`; every text goes through :func:`app.exports.c_text.c_string`.
+:mod:`app.exports.firmware.template`; every text goes through :func:`app.exports.firmware.text.c_string`.
 
 The header carries the verdict (:class:`Verdict`): an unverified or not clean design stops the
 compiler with ``#error`` unless ``FDSMC_ACCEPT_UNCLEAN`` equals the design's :func:`parameter_hash` (of the
@@ -26,8 +26,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pmsm_commissioning.app.exports.c_design import design_constants, design_initializer, encoder_counts_per_rev
-from pmsm_commissioning.app.exports.c_text import c_string
+from pmsm_commissioning.app.exports.firmware.design import design_constants, design_initializer, encoder_counts_per_rev
+from pmsm_commissioning.app.exports.firmware.optimum import (
+    STATE_FIELDS,
+    ReferenceTable,
+    law_parts,
+    optimum_constants,
+    reference_table,
+)
+from pmsm_commissioning.app.exports.firmware.source import FDSMC_MOVE, LIMIT_CODE, SOURCE
+from pmsm_commissioning.app.exports.firmware.template import HEADER
+from pmsm_commissioning.app.exports.firmware.text import c_string
+from pmsm_commissioning.app.exports.tool_id import tool_version
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.presets import to_raw
 from pmsm_commissioning.app.io.units import spec_of
@@ -35,12 +45,6 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import Derived
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.control.fdsmc.tracking import slide_gain
-
-from .c_optimum import STATE_FIELDS, ReferenceTable, law_parts, optimum_constants, reference_table
-from .c_source import FDSMC_MOVE, LIMIT_CODE, SOURCE
-from .c_template import HEADER
-from .tool_id import TOOL as TOOL  # the tool's name, imported from here by the other exports
-from .tool_id import tool_version
 
 #: File names of the generated module.
 HEADER_NAME, SOURCE_NAME = "fdsmc_controller.h", "fdsmc_controller.c"
@@ -289,7 +293,7 @@ def controller_header(params: DriveParams, d: Derived, schema: int, verdict: Ver
 
     ``inputs``: the preset as entered, whose :func:`parameter_hash` the header carries (default ``params``;
     the export passes the entered preset when ``params`` has θ_dem rounded to a count). ``table``: the
-    tracked optimum's reference (:func:`app.exports.c_optimum.reference_table`) for its module; None: FDSMC.
+    tracked optimum's reference (:func:`app.exports.firmware.optimum.reference_table`) for its module; None: FDSMC.
     """
     constants = controller_constants(params, d)
     if table is not None:

@@ -1,6 +1,6 @@
 """The tracked optimum's C module: the designed move's reference table and the law that tracks it.
 
-The module is the FDSMC's (:mod:`app.exports.c_source`) with another outer law: the simulator's
+The module is the FDSMC's (:mod:`app.exports.firmware.source`) with another outer law: the simulator's
 ``optimum`` (kernel law 3, :func:`control.fdsmc.terminal_slide.slide_in_demand`). Its reference is the
 minimum-energy move of :func:`control.fdsmc.optimum.tracked_move` — the very table the simulator
 reads — written as a ``const`` table of its N nodes and read as :func:`sim.fdsmc.kernel.reference_at`
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pmsm_commissioning.app.exports.c_design import encoder_counts_per_rev
+from pmsm_commissioning.app.exports.firmware.design import encoder_counts_per_rev
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import Derived
 from pmsm_commissioning.control.fdsmc.optimum import tracked_move
@@ -263,6 +263,6 @@ static fdsmc_real tracked_optimum(fdsmc_state *s, fdsmc_real theta_re, fdsmc_rea
 
 
 def law_parts(table: ReferenceTable, literal: Callable[[float], str]) -> dict[str, str]:
-    """Placeholders of :data:`app.exports.c_source.SOURCE` and the header for the tracked optimum."""
+    """Placeholders of :data:`app.exports.firmware.source.SOURCE` and the header for the tracked optimum."""
     return {"set_move": SET_MOVE, "outer_law": OUTER_LAW.replace("$table", table_initializer(table, literal)),
             "outer_call": "tracked_optimum(s, th_re, w, &S)", "law_init": LAW_INIT, "take_law": TAKE_LAW}

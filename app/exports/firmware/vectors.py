@@ -1,6 +1,6 @@
 """Golden test vectors and the host test program of the C module, and the export's C file set.
 
-:func:`vector_header` writes the segments of :func:`app.exports.c_golden.segments` -- the designed move
+:func:`vector_header` writes the segments of :func:`app.exports.firmware.golden.segments` -- the designed move
 and hold, the limits acting, injected faults -- as ``fdsmc_vectors.h``: per sample the inputs the
 simulator's controller saw (θ_r as encoder counts, i_d, i_q) and the voltages it applied (u_d, u_q).
 ``fdsmc_test.c`` (:data:`TEST_PROGRAM`) replays each segment through ``fdsmc_step`` and exits 0 when
@@ -16,8 +16,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from pmsm_commissioning.app.exports.c_golden import Segment, segments
-from pmsm_commissioning.app.exports.c_module import (
+from pmsm_commissioning.app.exports.firmware.golden import Segment, segments
+from pmsm_commissioning.app.exports.firmware.module import (
     CONTINUOUS_REFUSED,
     HEADER_NAME,
     Verdict,
@@ -26,9 +26,9 @@ from pmsm_commissioning.app.exports.c_module import (
     parameter_hash,
     verdict_of,
 )
-from pmsm_commissioning.app.exports.c_source import c_text
-from pmsm_commissioning.app.exports.c_text import c_string
-from pmsm_commissioning.app.exports.c_verify import count_params
+from pmsm_commissioning.app.exports.firmware.source import c_text
+from pmsm_commissioning.app.exports.firmware.text import c_string
+from pmsm_commissioning.app.exports.firmware.verify import count_params
 from pmsm_commissioning.app.io.presets import SCHEMA
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import derive
@@ -76,8 +76,8 @@ typedef struct {
 def vector_header(params: DriveParams, controller: str = "fdsmc") -> str:
     """Return the text of ``fdsmc_vectors.h``: the simulator's controller inputs and outputs per segment.
 
-    The segments are :func:`app.exports.c_golden.segments` (at most
-    :data:`app.exports.c_golden.MAX_SAMPLES` samples); ``controller``: the module's outer law
+    The segments are :func:`app.exports.firmware.golden.segments` (at most
+    :data:`app.exports.firmware.golden.MAX_SAMPLES` samples); ``controller``: the module's outer law
     (``"fdsmc"`` or ``"optimum"``), whose runs are recorded.
 
     Raises
@@ -118,7 +118,7 @@ def c_files(cmp: Comparison, checks: Sequence | None, force: bool = False,
         Export a design that is not clean (the header still stops the build unless accepted).
     controller : str
         The module's outer law: ``"fdsmc"`` (its run ``cmp.fdsmc``) or ``"optimum"`` (``cmp.optimum``,
-        the tracked optimum's module, :mod:`app.exports.c_optimum`).
+        the tracked optimum's module, :mod:`app.exports.firmware.optimum`).
 
     Raises
     ------

@@ -3,8 +3,8 @@
 Stock drives count in turns (ODrive: turn, turn/s, turn/s², N·m/(turn/s)), revolutions at the output
 (moteus: rev, rev/s, rev/s², N·m/rev), poles rather than pole pairs (moteus, VESC) and a torque
 constant per ampere of q-axis current (ODrive). Every conversion is a pure function here; the
-writers and the strict parsers of :mod:`app.exports.odrive`, :mod:`app.exports.moteus`,
-:mod:`app.exports.vesc` and :mod:`app.exports.setpoints` use nothing else.
+writers and the strict parsers of :mod:`app.exports.drives.odrive`, :mod:`app.exports.drives.moteus`,
+:mod:`app.exports.drives.vesc` and :mod:`app.exports.drives.setpoints` use nothing else.
 
 Currents are the amplitude of the phase current (amplitude-invariant dq, |i_q| as in the
 controller's ``i_max``), the convention of ODrive's ``current_lim``/``torque_constant``, moteus'

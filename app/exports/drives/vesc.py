@@ -10,7 +10,7 @@ amplitude-invariant Ψ_PM), ``l_current_max``/``l_current_min`` [A] (motor curre
 bandwidth 3/T_si: kp = L·ω_c, ki = R·ω_c, VESC Tool's own rule).
 
 VESC has no position trajectory planner: the file writes the motor part and, as ``cascade.*`` comment
-lines (:mod:`app.exports.stock_lines`), the trapezoid and the position/speed cascade that a VESC app or
+lines (:mod:`app.exports.drives.stock_lines`), the trapezoid and the position/speed cascade that a VESC app or
 the host runs on VESC's current loop; :func:`vesc_loop` reads all of it back for the stock route.
 """
 
@@ -19,10 +19,10 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
-from pmsm_commissioning.app.exports.drive_units import pole_pairs_to_poles, poles_to_pole_pairs
-from pmsm_commissioning.app.exports.stock import StockSettings
-from pmsm_commissioning.app.exports.stock_lines import cascade_lines, parse_cascade
-from pmsm_commissioning.app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from pmsm_commissioning.app.exports.drives.stock import StockSettings
+from pmsm_commissioning.app.exports.drives.stock_lines import cascade_lines, parse_cascade
+from pmsm_commissioning.app.exports.drives.units import pole_pairs_to_poles, poles_to_pole_pairs
+from pmsm_commissioning.app.exports.drives.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
 from pmsm_commissioning.app.io.user_text import xml_comment
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.params import DriveParams

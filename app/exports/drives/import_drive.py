@@ -14,10 +14,10 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from pmsm_commissioning.app.exports.moteus import moteus_motor, moteus_ratio, parse_moteus
-from pmsm_commissioning.app.exports.odrive import odrive_motor, parse_odrive
-from pmsm_commissioning.app.exports.vendor_keys import VendorFile
-from pmsm_commissioning.app.exports.vesc import parse_vesc, vesc_motor
+from pmsm_commissioning.app.exports.drives.moteus import moteus_motor, moteus_ratio, parse_moteus
+from pmsm_commissioning.app.exports.drives.odrive import odrive_motor, parse_odrive
+from pmsm_commissioning.app.exports.drives.vendor_keys import VendorFile
+from pmsm_commissioning.app.exports.drives.vesc import parse_vesc, vesc_motor
 from pmsm_commissioning.app.io.units import spec_of
 from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.common.checks import ParameterError

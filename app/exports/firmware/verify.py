@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pmsm_commissioning.app.exports.c_design import encoder_counts_per_rev
-from pmsm_commissioning.app.exports.c_module import Verdict, controller_files
+from pmsm_commissioning.app.exports.firmware.design import encoder_counts_per_rev
+from pmsm_commissioning.app.exports.firmware.module import Verdict, controller_files
 from pmsm_commissioning.app.io.presets import SCHEMA
 from pmsm_commissioning.control.fdsmc.derivations import derive
 from pmsm_commissioning.control.fdsmc.params import DriveParams
@@ -50,7 +50,7 @@ def count_params(params: DriveParams) -> tuple[DriveParams, int]:
     """Return the case as the firmware runs it, and the demand in counts.
 
     θ_dem is rounded to a whole encoder count; an ideal encoder becomes the module's resolution
-    (:data:`app.exports.c_design.IDEAL_COUNTS_PER_REV`), so that the simulator reads the same counts.
+    (:data:`app.exports.firmware.design.IDEAL_COUNTS_PER_REV`), so that the simulator reads the same counts.
     """
     cpr = encoder_counts_per_rev(params)
     se = dataclasses.replace(params.sensors, encoder_cpr=cpr)

@@ -29,7 +29,8 @@ from __future__ import annotations
 import math
 import re
 
-from pmsm_commissioning.app.exports.drive_units import (
+from pmsm_commissioning.app.exports.drives.stock import StockSettings
+from pmsm_commissioning.app.exports.drives.units import (
     per_rad_to_per_turn,
     per_turn_to_per_rad,
     pole_pairs_to_poles,
@@ -38,8 +39,7 @@ from pmsm_commissioning.app.exports.drive_units import (
     rad_to_turn,
     turn_to_rad,
 )
-from pmsm_commissioning.app.exports.stock import StockSettings
-from pmsm_commissioning.app.exports.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
+from pmsm_commissioning.app.exports.drives.vendor_keys import VendorFile, VendorKey, fmt_float, vendor_file
 from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.model import torque_constant

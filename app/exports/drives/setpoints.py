@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pmsm_commissioning.app.exports.drive_units import ANGLE_UNITS, rad_to_angle_unit
-from pmsm_commissioning.app.exports.stock import StockSettings
-from pmsm_commissioning.app.exports.stock_lines import CASCADE_UNITS, cascade_lines, parse_cascade
+from pmsm_commissioning.app.exports.drives.stock import StockSettings
+from pmsm_commissioning.app.exports.drives.stock_lines import CASCADE_UNITS, cascade_lines, parse_cascade
+from pmsm_commissioning.app.exports.drives.units import ANGLE_UNITS, rad_to_angle_unit
 from pmsm_commissioning.app.io.user_text import csv_comment
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.trapezoid import trapezoid_samples

@@ -22,7 +22,8 @@ import json
 import math
 from typing import Any
 
-from pmsm_commissioning.app.exports.drive_units import (
+from pmsm_commissioning.app.exports.drives.stock import StockSettings
+from pmsm_commissioning.app.exports.drives.units import (
     per_rad_to_per_turn,
     per_turn_to_per_rad,
     psi_from_torque_constant,
@@ -30,8 +31,7 @@ from pmsm_commissioning.app.exports.drive_units import (
     torque_constant,
     turn_to_rad,
 )
-from pmsm_commissioning.app.exports.stock import StockSettings
-from pmsm_commissioning.app.exports.vendor_keys import VendorFile, VendorKey, vendor_file
+from pmsm_commissioning.app.exports.drives.vendor_keys import VendorFile, VendorKey, vendor_file
 from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.params import DriveParams

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pmsm_commissioning.app.exports.moteus import moteus_loop, parse_moteus
-from pmsm_commissioning.app.exports.odrive import odrive_loop, parse_odrive
-from pmsm_commissioning.app.exports.setpoints import setpoints_loop
-from pmsm_commissioning.app.exports.vesc import parse_vesc, vesc_loop
+from pmsm_commissioning.app.exports.drives.moteus import moteus_loop, parse_moteus
+from pmsm_commissioning.app.exports.drives.odrive import odrive_loop, parse_odrive
+from pmsm_commissioning.app.exports.drives.setpoints import setpoints_loop
+from pmsm_commissioning.app.exports.drives.vesc import parse_vesc, vesc_loop
 from pmsm_commissioning.control.fdsmc.derivations import Derived
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc.checks import Constraint, run_checks

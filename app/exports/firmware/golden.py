@@ -15,7 +15,7 @@ an injected fault). :func:`segments` makes, within :data:`MAX_SAMPLES` samples i
   from that sample on;
 - ``limit_i_d_pos``, ``limit_i_d_neg``, ``limit_u`` (FDSMC module): one call at rest, without a move,
   reading a current in which the d-axis current limit or the voltage limit acts
-  (:mod:`app.exports.c_targeted`).
+  (:mod:`app.exports.firmware.targeted`).
 
 The ``move`` segment also checks ``fdsmc_set_move``'s refusals: called again right after the move was
 set it must return ``FDSMC_ERR_BUSY`` (not yet taken), and at :data:`REFUSE_AT` of T_m
@@ -30,9 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pmsm_commissioning.app.exports.c_module import controller_source
-from pmsm_commissioning.app.exports.c_targeted import targeted_calls
-from pmsm_commissioning.app.exports.c_verify import count_params, readings
+from pmsm_commissioning.app.exports.firmware.module import controller_source
+from pmsm_commissioning.app.exports.firmware.targeted import targeted_calls
+from pmsm_commissioning.app.exports.firmware.verify import count_params, readings
 from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import derive
 from pmsm_commissioning.control.fdsmc.feasibility import current_limit
@@ -167,7 +167,7 @@ def segments(entered: DriveParams, controller: str = "fdsmc") -> list[Segment]:
 
 
 def _targeted(params: DriveParams) -> list[Segment]:
-    """Return the targeted limit segments (:func:`app.exports.c_targeted.targeted_calls`), at count 0, no move."""
+    """Return the targeted limit segments (:func:`app.exports.firmware.targeted.targeted_calls`), count 0, no move."""
     segs = []
     for name, call in targeted_calls(params, derive(params)).items():
         n = 2 if params.controller.delay_samples == 1 else 1

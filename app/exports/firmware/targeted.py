@@ -1,7 +1,7 @@
 """Targeted golden vectors: single controller calls at rest in which a chosen inverter limit acts.
 
 A closed-loop run hardly ever drives i_d to its limit, nor (on every drive) |u_dq| to V_dc/√3, so the
-segments of :mod:`app.exports.c_golden` alone would let a wrong d-axis limit or voltage limit pass. Each
+segments of :mod:`app.exports.firmware.golden` alone would let a wrong d-axis limit or voltage limit pass. Each
 targeted segment starts from ``fdsmc_init`` at count 0 with no move (the estimates at rest: θ_re = 0,
 ω̂ = 0, Γ̂_L = 0, so the outer law demands 0) and reads one implausible-but-allowed current: the
 voltages the simulator's controller computes from it are those of :mod:`control` -- the FDC of
