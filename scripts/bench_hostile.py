@@ -183,7 +183,7 @@ def written_files() -> Tally:
     import xml.etree.ElementTree as ET
 
     from pmsm_commissioning.app.cli.export import case
-    from pmsm_commissioning.app.exports import moteus, odrive, setpoints, vesc
+    from pmsm_commissioning.app.exports.drives import moteus, odrive, setpoints, vesc
     from pmsm_commissioning.app.exports.drives.stock import stock_settings
     from tests.test_hostile_round3 import _files, corpus
 

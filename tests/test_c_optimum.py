@@ -19,8 +19,8 @@ from pathlib import Path
 import pytest
 
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.app.exports import c_verify as cv
 from pmsm_commissioning.app.exports.drives.files import ExportOptions
+from pmsm_commissioning.app.exports.firmware import verify as cv
 from pmsm_commissioning.app.exports.firmware.module import HEADER_NAME
 from pmsm_commissioning.app.exports.firmware.optimum import NODE_BYTES_FLOAT, reference_table
 from pmsm_commissioning.app.exports.model import export_download, export_files

@@ -21,7 +21,7 @@ import pytest
 
 from pmsm_commissioning.app.cli.export import case
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.app.exports import moteus, odrive, setpoints, vesc
+from pmsm_commissioning.app.exports.drives import moteus, odrive, setpoints, vesc
 from pmsm_commissioning.app.exports.drives.stock import stock_settings
 from pmsm_commissioning.app.exports.provenance import header_lines
 from pmsm_commissioning.app.io import atomic

@@ -11,7 +11,7 @@ from __future__ import annotations
 import pytest
 
 from pmsm_commissioning.app.cli.export import case
-from pmsm_commissioning.app.exports import moteus
+from pmsm_commissioning.app.exports.drives import moteus
 from pmsm_commissioning.app.exports.drives.import_drive import import_drive
 from pmsm_commissioning.app.exports.drives.stock import stock_settings
 from pmsm_commissioning.app.exports.drives.stock_route import file_verdict

@@ -13,7 +13,7 @@ import pytest
 
 from pmsm_commissioning.app.cli.export import case
 from pmsm_commissioning.app.cli.main import main
-from pmsm_commissioning.app.exports import moteus, odrive, setpoints, vesc
+from pmsm_commissioning.app.exports.drives import moteus, odrive, setpoints, vesc
 from pmsm_commissioning.app.exports.drives.files import ExportOptions
 from pmsm_commissioning.app.exports.drives.import_drive import import_drive
 from pmsm_commissioning.app.exports.drives.stock import stock_settings

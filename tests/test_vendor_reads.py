@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from pmsm_commissioning.app.cli.export import case
-from pmsm_commissioning.app.exports import odrive, vesc
+from pmsm_commissioning.app.exports.drives import odrive, vesc
 from pmsm_commissioning.app.exports.drives.files import ExportOptions
 from pmsm_commissioning.app.exports.drives.import_drive import import_drive
 from pmsm_commissioning.app.exports.drives.stock import stock_settings
