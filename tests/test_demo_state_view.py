@@ -76,15 +76,19 @@ def test_the_pages_report_is_read_with_the_files_checks():
             loads_view(bad)
 
 
-def test_the_probe_keeps_the_last_valid_report():
+def test_the_probe_keeps_the_last_valid_report_and_tells_its_listeners_of_it():
     probe = PageViewProbe.__new__(PageViewProbe)  # its logic only: no page to report into
-    probe.view = PageView()
+    probe.view, probe._listeners = PageView(), []
+    heard: list[tuple[PageView, PageView]] = []
+    probe.on_view(lambda view: heard.append((view, probe.view)))
     probe._reported(json.dumps({"tab": {"mode": None, "results": "Energy"}, "zoom": {}}))
     assert probe.view == PageView(None, "Energy", {})
+    assert heard == [(probe.view, probe.view)]  # told after the probe holds the view
     long_text = json.dumps({"tab": {"mode": None, "results": None}, "zoom": {}}) + " " * 5000
     for bad in ("", long_text, '{"tab": 1, "zoom": {}}', "[" * 100, '{"tab": {"mode": null, "results": "Nope"}}'):
         probe._reported(bad)
         assert probe.view == PageView(None, "Energy", {})
+    assert len(heard) == 1  # nothing told of a report that is no view
 
 
 def test_the_overview_is_sent_again_with_the_zoomed_axes_only():

@@ -42,7 +42,8 @@ KEYS_V1 = ("demo_state", "preset", "origin", "ranges", "pins")
 KEYS = (*KEYS_V1, "tab", "zoom")
 #: The page's tabs a demo state may show: the control panel's mode tabs, the results panel's tabs.
 MODE_TABS = ("Position drive (FDSMC)", "BLDC speed SMC")
-RESULTS_TABS = ("Overview", "K sweep", "Time plots", "Energy", "Table 1 sweep", "Studies", "BLDC figures", "Share")
+RESULTS_TABS = ("Overview", "K sweep", "Time plots", "Energy", "Stock drive", "Table 1 sweep", "Studies",
+                "BLDC figures", "Share")
 #: The overview's axis names (Plotly's ``xaxis``, ``yaxis2``, …) a zoom may name.
 AXIS_NAME = re.compile(r"[xy]axis[2-9]?")
 #: Most points per pinned array.

@@ -13,6 +13,7 @@ them as the zoom shown until the user changes it or a new run draws a new figure
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import viser
@@ -66,22 +67,34 @@ def zoomed_json(figure_json: str, zoom: dict[str, tuple[float, float]]) -> str:
 
 
 class PageViewProbe:
-    """The hidden field the page reports its view into; :attr:`view` is the last valid report."""
+    """The hidden field the page reports its view into; :attr:`view` is the last valid report.
+
+    Listeners added with :meth:`on_view` get each valid report after :attr:`view` holds it (viser
+    runs each callback of a field as its own task: one added to the field itself could read the
+    view before it changed).
+    """
 
     def __init__(self, gui: viser.GuiApi) -> None:
         self._gui = gui
         self.view = PageView()
+        self._listeners: list[Callable[[PageView], None]] = []
         self.field = gui.add_text("page view", "")
         self.field.on_update(lambda _: self._reported(self.field.value))
         run_script(gui, view_report_js(widget_id(self.field)))
+
+    def on_view(self, listener: Callable[[PageView], None]) -> None:
+        """Call ``listener(view)`` after each valid report of the page's view."""
+        self._listeners.append(listener)
 
     def _reported(self, text: str) -> None:
         if len(text) > MAX_REPORT:
             return
         try:
-            self.view = loads_view(text, "page view")
+            self.view = view = loads_view(text, "page view")
         except ValueError:
             return  # not a view (the page writes only views): the last one stays
+        for listener in self._listeners:
+            listener(view)
 
     def select_tabs(self, view: PageView) -> None:
         """Select ``view``'s tabs in the page."""

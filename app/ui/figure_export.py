@@ -4,7 +4,8 @@ Both are laid out at 1280×720 (a 720p slide); the PNG is drawn at scale 1.5, so
 carry the page's 14 px text as 21 px, 14 px again on a 720p slide (at scale 1 it was 9 px there).
 
 The modebar's camera button writes the plot as it is on screen (≈ 840×540 px, replay buttons
-included). Here the server takes the figure it last sent, removes the interactive parts
+included). Here the server takes the figure of the run in force (the one it last sent, or for a
+tab not shown yet the one it would send: :mod:`app.ui.tab_figures`), removes the interactive parts
 (:data:`UI_KEYS`: the replay buttons and their inline frames, sliders) and sends it with the
 image options to the page, where ``Plotly.toImage`` draws it off screen and the browser saves
 it — no image library on the server. The figure need not be on screen (a folded tab works).
@@ -20,7 +21,7 @@ from typing import Any
 import viser
 
 from pmsm_commissioning.app.figures.style import EXPORT_SCALE, EXPORT_SIZE
-from pmsm_commissioning.app.ui.viser_adapter import figure_json_shown, run_script
+from pmsm_commissioning.app.ui.viser_adapter import run_script
 
 #: Layout keys of the interactive UI a figure carries in the page, left out of an export.
 UI_KEYS: tuple[str, ...] = ("updatemenus", "sliders")
@@ -74,10 +75,13 @@ def export_js(figure: dict[str, Any], options: dict[str, Any]) -> str:
 
 
 class FigureExport:
-    """Dropdown of the page's figures and one button per format, in the current GUI container."""
+    """Dropdown of the page's figures and one button per format, in the current GUI container.
 
-    def __init__(self, gui: viser.GuiApi, handles: Callable[[], Iterable[viser.GuiPlotlyHandle]]) -> None:
-        self.gui, self._handles = gui, handles
+    ``figures`` returns the Plotly JSON of each figure the page offers, of the run in force.
+    """
+
+    def __init__(self, gui: viser.GuiApi, figures: Callable[[], Iterable[str]]) -> None:
+        self.gui, self._figures = gui, figures
         gui.add_markdown("Export a figure for slides: drawn again at full size, without the replay buttons.")
         self.choice = gui.add_dropdown("Figure", tuple(self.figures()) or ("—",))
         self.buttons = {}
@@ -88,8 +92,7 @@ class FigureExport:
 
     def figures(self) -> dict[str, str]:
         """Map figure id → JSON of every figure of the page that has one (placeholders included)."""
-        shown = (figure_json_shown(h) for h in self._handles())
-        return {fid: j for j in shown if (fid := figure_id(j)) is not None}
+        return {fid: j for j in self._figures() if (fid := figure_id(j)) is not None}
 
     def export(self, fmt: str) -> bool:
         """Send the chosen figure to the page to be saved as ``fmt``; False if it is not there."""

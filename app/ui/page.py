@@ -46,7 +46,7 @@ from pmsm_commissioning.app.ui.scene import RotorScene, aim_camera
 from pmsm_commissioning.app.ui.studies import StudiesSection
 from pmsm_commissioning.app.ui.studies_queue import StudySlots
 from pmsm_commissioning.app.ui.text import md_text
-from pmsm_commissioning.app.ui.viser_adapter import run_script, warm_icons, widget_id
+from pmsm_commissioning.app.ui.viser_adapter import figure_json_shown, run_script, warm_icons, widget_id
 from pmsm_commissioning.app.ui.web_guard import Guard, guarded
 from pmsm_commissioning.app.ui.worker import Worker
 from pmsm_commissioning.control.fdsmc.params import DriveParams
@@ -139,12 +139,13 @@ class Session:
             self.studies = StudiesSection(self.tab, self.worker.as_study, self.slots.processes_per_study)
             self.bldc = add_bldc_tab(self.client, tabs, self.tab.submit, self.results.panel, self.worker)
             with self.results.panel.add_tab("Share", viser.Icon.SHARE):
-                self.export = FigureExport(gui, self._figure_handles)
+                self.export = FigureExport(gui, self._figure_jsons)
             self.fit = WindowFit(self._apply_layout)
             self.tab.demo_files.probe = probe = PageViewProbe(gui)  # outside the mode tabs: in every mode
             run_script(gui, hide_field_js(widget_id(probe.field)))
             self.tab.demo_link = link = DemoLink(self.client, self.tab.demo_files)  # a reload keeps the demo
-            probe.field.on_update(lambda _: link.remember())  # a tab chosen: the address names it too
+            probe.on_view(lambda view: self.results.tab_shown(view.results_tab))  # its figures, if not sent
+            probe.on_view(lambda _: link.remember())  # a tab chosen: the address names it too
             if scene is not None:
                 aim_camera(self.client.camera)
         self._window_probe.on_update(lambda _: self._window_reported(self._window_probe.value))
@@ -157,10 +158,11 @@ class Session:
         self.fit.window_reported(text)
         self.tab.demo_link.opened(page_address(text))
 
-    def _figure_handles(self) -> list[viser.GuiPlotlyHandle]:
-        r, b = self.results, self.bldc.results
-        return [r.phase, r.time_plots, r.energy, r.bars, r.table1, b.speed, b.torque, b.antiwindup, b.sigma,
-                b.currents, b.emf, b.dqx, b.reach]
+    def _figure_jsons(self) -> list[str]:
+        """Return the JSON of every figure the Share tab offers (the results panel's: of the run in force)."""
+        b = self.bldc.results
+        return [*self.results.figure_jsons(), *(figure_json_shown(h) for h in (
+            b.speed, b.torque, b.antiwindup, b.sigma, b.currents, b.emf, b.dqx, b.reach))]
 
     def _sweep(self, T_m_values: list[float]) -> None:
         """Start the Table-1 sweep as a study (it waits for a server-wide slot)."""

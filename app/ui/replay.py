@@ -158,14 +158,13 @@ def time_plots_json(comparison: Any) -> str:
 
 
 class Replay:
-    """Sends the figures of a comparison; the "Replay t" scrub; Play/Pause for the 3D rotors."""
+    """Sends the overview of a comparison; the "Replay t" scrub; Play/Pause for the 3D rotors."""
 
-    def __init__(self, gui: viser.GuiApi, phase: viser.GuiPlotlyHandle,
-                 time_plots: viser.GuiPlotlyHandle | None, scene: RotorScene | None,
+    def __init__(self, gui: viser.GuiApi, phase: viser.GuiPlotlyHandle, scene: RotorScene | None,
                  shown: tuple[Any, ScrubTargets] | None = None,
                  flush: Any = lambda: None, on_3d: Callable[[bool], None] = lambda _: None) -> None:
-        """``shown``: the comparison the figure widgets already show, and the traces a scrub moves."""
-        self._phase, self._time_plots, self._scene, self._flush = phase, time_plots, scene, flush
+        """``shown``: the comparison the overview widget already shows, and the traces a scrub moves."""
+        self._phase, self._scene, self._flush = phase, scene, flush
         self._on_3d = on_3d
         self._lock = threading.Lock()
         # One overview sent at a time, whole: a pin cleared while a run's figures go out waits for
@@ -203,10 +202,10 @@ class Replay:
         self._on_3d(shown)
 
     def load(self, comparison: Any, autoplay: bool = True, light: bool = False) -> None:
-        """Show a new comparison: the phase plane first, then the time plots; rotors to the end.
+        """Show a new comparison in the overview; rotors to the end.
 
-        ``light`` (a slider being dragged): the overview without its replay controls and no time
-        plots, until :meth:`complete`. Otherwise the light overview goes out first (the browser
+        ``light`` (a slider being dragged): the overview without its replay controls, until
+        :meth:`complete`. Otherwise the light overview goes out first (the browser
         draws its 22 traces in a third of the time of the replay's 150) and the overview with its
         replay right after it.
         """
@@ -219,8 +218,6 @@ class Replay:
             figure, targets = overview_json(comparison, replay=not light, pins=self.pins, plant_J_L=self.plant_J_L)
             set_figure_json(self._phase, figure)
             self._flush()  # the phase plane goes out before the larger figure is even built
-            if not light:
-                self.show_time_plots(comparison)
             with self._lock:
                 self._comparison, self._targets = comparison, targets
                 rs = runs(comparison)
@@ -233,10 +230,9 @@ class Replay:
             self.seek(self._t_end, scrub=False)
 
     def complete(self, comparison: Any) -> None:
-        """Send what a light :meth:`load` left out: the overview's replay and the time plots."""
+        """Send what a light :meth:`load` left out: the overview's replay."""
         with self._sending:
             set_figure_json(self._phase, phase_plane_json(comparison, pins=self.pins, plant_J_L=self.plant_J_L))
-            self.show_time_plots(comparison)
 
     def show_pins(self, pins: tuple[Pin, ...]) -> None:
         """Draw the overview of the comparison shown again with ``pins`` as its ghosts."""
@@ -248,11 +244,6 @@ class Replay:
                 set_figure_json(self._phase, figure)
                 with self._lock:
                     self._targets = targets
-
-    def show_time_plots(self, comparison: Any) -> None:
-        """Send the time-plots figure of ``comparison`` (if this panel has one)."""
-        if self._time_plots is not None:
-            set_figure_json(self._time_plots, time_plots_json(comparison))
 
     def seek(self, t_now: float, scrub: bool = True) -> None:
         """Turn the 3D rotors to their angles at ``t_now`` [s]; with ``scrub`` move the overview's markers too."""

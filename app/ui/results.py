@@ -4,7 +4,9 @@ The *Overview* tab is what a projector shows: one line of key numbers above one 
 the phase plane and a compact time plot (ω_r and Γ vs t), replayed together in the browser.
 
 Only builds widgets and pushes figures made by the pure ``make_*_figure`` functions; the
-simulations themselves run on the session's worker.
+simulations themselves run on the session's worker. The figures of the *Time plots*, *Energy* and
+*Stock drive* tabs go out only while their tab is shown (:mod:`app.ui.tab_figures`); the overview,
+its key numbers and the K sweep (the K demo) go out with every run.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from typing import Any
 
 import viser
 
-from pmsm_commissioning.app.figures.fdsmc_comparison import runs
+from pmsm_commissioning.app.figures.fdsmc_comparison import runs, time_plots_spec
 from pmsm_commissioning.app.figures.fdsmc_energy import energy_bars_spec, energy_spec, make_table1_figure
 from pmsm_commissioning.app.figures.plain import figure_json
 from pmsm_commissioning.app.figures.stock_route import stock_route_spec
@@ -27,8 +29,9 @@ from pmsm_commissioning.app.ui.props import assign
 from pmsm_commissioning.app.ui.replay import Replay, overview_json, time_plots_json
 from pmsm_commissioning.app.ui.savings import annual_savings, savings_markdown
 from pmsm_commissioning.app.ui.scene import RotorScene
+from pmsm_commissioning.app.ui.tab_figures import Build, TabFigures
 from pmsm_commissioning.app.ui.text import key_numbers_html, stock_html
-from pmsm_commissioning.app.ui.viser_adapter import add_figure, set_figure_json
+from pmsm_commissioning.app.ui.viser_adapter import add_figure, figure_json_shown, set_figure_json
 from pmsm_commissioning.sim.fdsmc.table1 import PAPER_TABLE1, TABLE1_T_M
 
 #: Plot height / width per figure [-].
@@ -44,6 +47,16 @@ def empty_table1_json() -> str:
     return make_table1_figure([], PAPER_TABLE1).to_json()
 
 
+def _when_simulated(spec: Callable[[Any], dict[str, Any]]) -> Build:
+    """Return the builder of ``spec``'s figure JSON: None (the figure shown stays) for a comparison without runs."""
+    return lambda comparison: figure_json(spec(comparison)) if runs(comparison) else None
+
+
+def _time_plots_of(comparison: Any) -> str:
+    """JSON of the time plots of a run (the start-up comparison's stay in :func:`time_plots_json`'s cache)."""
+    return figure_json(time_plots_spec(comparison))
+
+
 class ResultsPanel:
     """Right-hand panel with the result tabs of one client."""
 
@@ -54,6 +67,7 @@ class ResultsPanel:
         self._on_sweep = on_sweep
         self._comparison = comparison
         self._rest_pending = False
+        self.tab_figures = TabFigures(comparison)
         self.panel = gui.add_panel()
         phase_tab = self.panel.add_tab("Overview", viser.Icon.CHART_DOTS)
         time_tab = self.panel.add_tab("Time plots", viser.Icon.CHART_LINE)
@@ -67,22 +81,20 @@ class ResultsPanel:
         with time_tab:
             self.time_plots = add_figure(gui, time_plots_json(comparison), ASPECT_TIME)
         with phase_tab:
-            self.replay = Replay(gui, self.phase, self.time_plots, scene, (comparison, targets),
+            self.replay = Replay(gui, self.phase, scene, (comparison, targets),
                                  flush=client.flush, on_3d=on_3d)
             with gui.add_folder("Paper errata for this figure", expand_by_default=False):
                 gui.add_html(errata_html("overview"))
         with time_tab:
             gui.add_html(errata_html("time_plots"))
-        simulated = bool(runs(comparison))
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
-            self.energy = add_figure(gui, figure_json(energy_spec(comparison)) if simulated else None, ASPECT_SMALL)
-            self.bars = add_figure(gui, figure_json(energy_bars_spec(comparison)) if simulated else None,
-                                   ASPECT_SMALL)
+            self.energy = self._tab_figure(gui, "Energy", _when_simulated(energy_spec), ASPECT_SMALL)
+            self.bars = self._tab_figure(gui, "Energy", _when_simulated(energy_bars_spec), ASPECT_SMALL)
             self._build_savings(gui)
         with self.panel.add_tab("Stock drive", viser.Icon.ROUTE):
-            self.stock_text = gui.add_html(stock_html(comparison) if simulated else "")
-            self.stock = add_figure(gui, figure_json(stock_route_spec(comparison)) if simulated else None,
-                                    ASPECT_STOCK)
+            self.stock_text = gui.add_html(stock_html(comparison) if runs(comparison) else "")
+            self.stock = self._tab_figure(gui, "Stock drive", _when_simulated(stock_route_spec), ASPECT_STOCK)
+        self.tab_figures.add("Time plots", self.time_plots, _time_plots_of, figure_json_shown(self.time_plots))
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
             self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
@@ -91,6 +103,13 @@ class ResultsPanel:
             self.table1 = add_figure(gui, empty_table1_json(), ASPECT_SMALL)
             gui.add_html(errata_html("table1"))
         self.sweep_button.on_click(lambda _: self._sweep_clicked(client))
+
+    def _tab_figure(self, gui: viser.GuiApi, tab: str, build: Build, aspect: float) -> viser.GuiPlotlyHandle:
+        """Add a figure of ``tab``, showing the comparison in force, sent from now on only while ``tab`` is shown."""
+        shown = build(self._comparison)
+        handle = add_figure(gui, shown, aspect)
+        self.tab_figures.add(tab, handle, build, shown)
+        return handle
 
     def _build_savings(self, gui: viser.GuiApi) -> None:
         with gui.add_folder("Savings estimate (electrical input, per axis)"):
@@ -131,21 +150,33 @@ class ResultsPanel:
             self.show_rest()
 
     def show_rest(self) -> None:
-        """Draw the time plots, energy figures and savings of the comparison last shown."""
+        """Draw the rest of the comparison last shown: the overview's replay if pending, texts, the tabs' figures.
+
+        The time plots, energy and stock-route figures go out now only if their tab is shown
+        (:meth:`tab_shown` sends them when it is chosen).
+        """
         comparison = self._comparison
         if self._rest_pending:
             self.replay.complete(comparison)
         self._rest_pending = False
-        set_figure_json(self.energy, figure_json(energy_spec(comparison)))
-        set_figure_json(self.bars, figure_json(energy_bars_spec(comparison)))
         assign(self.stock_text, content=stock_html(comparison))
-        set_figure_json(self.stock, figure_json(stock_route_spec(comparison)))
         self._update_savings()
+        self.tab_figures.show(comparison)
 
     def show_derived_only(self, comparison: Any) -> None:
         """Show an infeasible case (no runs): the key numbers say so, the overview shows the boundary."""
         self.key_numbers.content = key_numbers_html(comparison)
         self.replay.load(comparison, autoplay=False)
+        self.tab_figures.show(comparison)  # the time plots empty; the energy and stock figures stay
+
+    def tab_shown(self, tab: str | None) -> None:
+        """Send the figures of the results tab ``tab`` the page shows (None: unknown) for the comparison in force."""
+        self.tab_figures.tab_shown(tab)
+
+    def figure_jsons(self) -> list[str]:
+        """Return the JSON of each figure of the panel for the comparison in force (not shown yet: built, not sent)."""
+        deferred = [self.tab_figures.figure_json(h) for h in (self.time_plots, self.energy, self.bars)]
+        return [figure_json_shown(self.phase), *deferred, figure_json_shown(self.table1)]
 
     def _sweep_clicked(self, client: viser.ClientHandle) -> None:
         try:
