@@ -14,6 +14,7 @@ from pmsm_commissioning.app.ui.demo_link import state_of
 from pmsm_commissioning.app.ui.demo_state import DemoState, PageView, dumps_state, loads_state
 from tests.browser.conftest import TIMEOUT_MS, click_tab, field, open_page, session_of, set_number, wait_for_layout
 from tests.browser.test_design import choose
+from tests.browser.test_tab_figures import shows_the_time_plots_of
 
 K_FIELD, T_M_FIELD = "K boundary-layer gain [s/rad]", "T_m manoeuvre time [s]"
 #: A preset other than the server's start-up one, and the K, T_m typed over it [s/rad], [s].
@@ -58,6 +59,7 @@ def _shows_the_demo(page: Any, ui: Any, before: set[int]) -> None:
                            "e => e.getAttribute('title') === t && e.getAttribute('aria-selected') === 'true')",
                            arg=RESULTS_TAB)
     page.get_by_text("Ready — ").wait_for(timeout=3 * TIMEOUT_MS)  # its run ends before the page closes
+    shows_the_time_plots_of(page, session)  # the restored tab shows the demo's run (sent once it is chosen)
 
 
 def test_a_reload_and_the_sent_link_restore_the_demo(browser, ui_server):

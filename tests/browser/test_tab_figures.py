@@ -88,7 +88,7 @@ def _omega_p_drawn(page: Any) -> float | None:
     return abs(refs[0][0]) if refs and refs[0] else None
 
 
-def _shows_the_time_plots_of(page: Any, session: Any) -> None:
+def shows_the_time_plots_of(page: Any, session: Any) -> None:
     """Wait until the time plots drawn are those of the session's run in force (its ω_p, eq. (60))."""
     omega_p = session.comparison.derived.profile.omega_p
     page.wait_for_function("""(w) => { const el = [...document.querySelectorAll('.js-plotly-plot')]
@@ -108,12 +108,12 @@ def test_the_time_plots_go_out_when_their_tab_is_chosen_and_with_each_run_while_
         assert not set(WAITING) & set(sent), sent  # nothing of the tabs not shown
         n = len(figures.ids)
         click_tab(page, "Time plots")
-        _shows_the_time_plots_of(page, session)  # the run just simulated, not the start-up one
+        shows_the_time_plots_of(page, session)  # the run just simulated, not the start-up one
         assert figures.since(n) == ["time_plots"]
         click_tab(page, "Overview")
         click_tab(page, "Time plots")  # chosen again: the same figure, not sent again
         n = _simulate(page, session, figures, T_M[1])  # while the time plots are shown
-        _shows_the_time_plots_of(page, session)
+        shows_the_time_plots_of(page, session)
         sent = figures.since(n)
         assert sent.count("time_plots") == 1, sent  # this run's only: the tab chosen again sent nothing
         assert sent.index("time_plots") < sent.index("k_sweep")  # with the run, not after a tab choice
@@ -136,6 +136,6 @@ def test_a_demo_state_restoring_the_time_plots_tab_shows_its_run_there(browser, 
         assert session.params.manoeuvre.T_m == T_M[2]
         page.wait_for_function("() => [...document.querySelectorAll('[role=\"tab\"][aria-selected=\"true\"]')]"
                                ".some(t => t.title === 'Time plots')")
-        _shows_the_time_plots_of(page, session)
+        shows_the_time_plots_of(page, session)
     finally:
         context.close()
