@@ -1,11 +1,13 @@
 """Websocket bytes per Simulate, by message kind (prints; no assertions; a measurement, never a test).
 
 One ``pmsm-commission serve`` process (paper preset, no 3D view), one page in Debian's Chromium: after
-the page has settled, ``--runs`` Simulates (T_m alternated, so each gives a new run), each followed by
-``--replay-wait`` seconds (the replay's and the K sweep's messages arrive then). Per Simulate: the bytes
-as the page receives them (viser's zstd-compressed frames) and the messages, median (min, max); then,
-for the last Simulate, where they go — per kind of viser message (each figure by its ``layout.meta.id``),
-bytes as sent and decoded (:func:`ui_bench.breakdown`). The load average is printed at start and end.
+the page has settled, ``--runs`` Simulates on the Overview tab (T_m alternated, so each gives a new run),
+each followed by ``--replay-wait`` seconds (the replay's and the K sweep's messages arrive then). Per
+Simulate: the bytes as the page receives them (viser's zstd-compressed frames) and the messages, median
+(min, max); then, for the last Simulate, where they go — per kind of viser message (each figure by its
+``layout.meta.id``), bytes as sent and decoded (:func:`ui_bench.breakdown`). Then the tabs whose figures
+wait until they are shown (:mod:`app.ui.tab_figures`) are chosen in turn, each with what it brought.
+The load average is printed at start and end.
 
 Usage: ``.venv/bin/python scripts/ui_bench_bytes.py [--runs 5] [--replay-wait 6]``
 """
@@ -26,8 +28,21 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 from ui_bench import breakdown, click_all, load_average, med, open_page, start_server  # noqa: E402
 
-from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS  # noqa: E402
+from tests.browser.conftest import CHROMIUM, LAUNCH_ARGS, click_tab  # noqa: E402
 from tests.net import free_port  # noqa: E402
+
+#: The results tabs whose figures go out when the tab is chosen, not with each Simulate.
+TABS_LATER = ("Time plots", "Energy", "Stock drive")
+
+
+def tab_bytes(page, ws, tab: str, wait_s: float) -> None:
+    """Choose the results tab ``tab`` and print the bytes and messages it brought within ``wait_s`` [s]."""
+    ws.payloads.clear()
+    b0, m0 = ws.bytes, ws.messages
+    click_tab(page, tab)
+    page.wait_for_timeout(1e3 * wait_s)
+    print(f"  then the tab {tab!r} chosen: {(ws.bytes - b0) / 1e3:.1f} kB in {ws.messages - m0} messages")
+    print(breakdown(ws.payloads, top=4))
 
 
 def main() -> int:
@@ -57,6 +72,8 @@ def main() -> int:
                   f"{med(sizes, 1e-3, '.1f')} kB in {statistics.median(msgs):.0f} messages (median)")
             print("  the last Simulate by message kind:")
             print(breakdown(ws.payloads, top=12))
+            for tab in TABS_LATER:
+                tab_bytes(page, ws, tab, args.replay_wait / 3)
             browser.close()
     finally:
         server.terminate()
