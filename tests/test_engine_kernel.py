@@ -7,7 +7,7 @@ import pytest
 
 from pmsm_commissioning.app.io.presets import load_preset
 from pmsm_commissioning.control.fdsmc.derivations import derive
-from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.engine import run_steps
 from pmsm_commissioning.sim.fdsmc.reference import run_reference
 
@@ -30,14 +30,14 @@ def test_kernel_matches_reference(controller, overrides):
     n = 1500  # 75 ms digital (through the end of the acceleration) / 7.5 ms continuous
     ref = run_reference(p, d, controller, n)
     ker = run_steps(p, controller, n, derived=d)
-    pairs = [(ref.i_d, kn.X_ID, 1e-3), (ref.i_q, kn.X_IQ, 1e-3), (ref.theta_r, kn.X_TH, 1e-6),
-             (ref.omega_r, kn.X_W, 1e-6), (ref.theta_hat, kn.X_THH, 1e-6),
-             (ref.omega_hat, kn.X_WH, 1e-6), (ref.L0, kn.X_L0, 1e-3),
-             (ref.E_friction, kn.X_EF, 1e-6), (ref.E_copper, kn.X_ECU, 1e-6),
-             (ref.E_electrical, kn.X_EEL, 1e-6)]
+    pairs = [(ref.i_d, lay.X_ID, 1e-3), (ref.i_q, lay.X_IQ, 1e-3), (ref.theta_r, lay.X_TH, 1e-6),
+             (ref.omega_r, lay.X_W, 1e-6), (ref.theta_hat, lay.X_THH, 1e-6),
+             (ref.omega_hat, lay.X_WH, 1e-6), (ref.L0, lay.X_L0, 1e-3),
+             (ref.E_friction, lay.X_EF, 1e-6), (ref.E_copper, lay.X_ECU, 1e-6),
+             (ref.E_electrical, lay.X_EEL, 1e-6)]
     for value, idx, atol in pairs:
         assert ker[idx] == pytest.approx(value, rel=1e-8, abs=atol)
-    assert abs(ker[kn.X_W]) > 1.0  # the drive actually moved
+    assert abs(ker[lay.X_W]) > 1.0  # the drive actually moved
 
 
 def test_kernel_run_is_deterministic_and_thread_safe():

@@ -93,8 +93,8 @@ def run(args: argparse.Namespace) -> int:
     tk = statistics.median(_timed(run_steps, pd, "fdsmc", n_k, derived=d) for _ in range(rep))
     tr = _timed(run_reference, pd, d, "fdsmc", n_r)
     sk, sr = n_k / tk, n_r / tr
-    print(f"kernel throughput (digital, 1 RK4 substep/sample): compiled {sk:,.0f} samples/s, "
-          f"plain-Python reference {sr:,.0f} samples/s, speed-up ×{sk / sr:,.0f}")
+    print(f"kernel throughput (digital, 1 RK4 substep/sample): compiled {sk:,.0f} samples/s "
+          f"({1e9 / sk:.1f} ns per sample), plain-Python reference {sr:,.0f} samples/s, speed-up ×{sk / sr:,.0f}")
     print(bench_figure())  # BLDC mode: 2000 rpm scenario, simulated s per wall s
     print(concurrency_figure(p, rep))
     print(cold_start_figure(args.preset, base, rep))

@@ -34,7 +34,7 @@ from pmsm_commissioning.app.io.numbers import FORMS, NumberFormatError, parse_nu
 from pmsm_commissioning.app.io.user_text import escaped
 from pmsm_commissioning.control.fdsmc.identification import Identification, identify
 from pmsm_commissioning.control.fdsmc.params import DriveParams
-from pmsm_commissioning.sim.fdsmc.kernel import CHANNELS
+from pmsm_commissioning.sim.fdsmc.trace import CHANNELS
 
 #: Largest log file accepted [bytes]; checked before reading
 MAX_BYTES = 50 * 1024 * 1024

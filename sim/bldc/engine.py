@@ -89,7 +89,7 @@ def pack_parameters(params: BldcParams, design: BldcDesign, controller: str, ant
     ``params`` keeps its ε_λ.
     """
     m, mech, g, inv, case = params.machine, params.mechanics, params.gains, params.inverter, params.case
-    prm = np.zeros(kn.N_PRM)
+    prm = kn.PRM.empty()
     prm[[kn.P_R, kn.P_L, kn.P_NPP, kn.P_PHIM, kn.P_J, kn.P_B]] = (
         m.R_s, m.L_s_minus_M_s, m.n_pp, m.Phi_m, mech.J, mech.B)
     prm[[kn.P_VDC, kn.P_TS, kn.P_KI, kn.P_KW, kn.P_TMAX, kn.P_LAM0, kn.P_EPSL]] = (
@@ -101,6 +101,7 @@ def pack_parameters(params: BldcParams, design: BldcDesign, controller: str, ant
     K_T = {"pi_sinusoidal": pi.K_T, "six_step": design.K_T_fig7}
     prm[kn.P_KTS] = K_T.get(controller, design.K_Tx)
     prm[kn.P_CTRL] = CONTROLLERS.index(controller)
+    kn.PRM.check_filled(prm)
     return prm
 
 

@@ -29,6 +29,7 @@ from pmsm_commissioning.control.bldc import pi_vector as piv
 from pmsm_commissioning.control.bldc import plain_smc as plain
 from pmsm_commissioning.control.bldc import six_step as six
 from pmsm_commissioning.control.bldc import speed_smc as spd
+from pmsm_commissioning.sim.common.layout import Layout
 
 _jit = njit(cache=True)
 _trap = _jit(dqx.trapezoid_unit)
@@ -52,10 +53,30 @@ _six_v = _jit(six.six_step_voltages)
 TWO_PI = 2.0 * math.pi
 C_SMC_INTEGRAL, C_SMC_PLAIN, C_PI_SINUSOIDAL, C_SIX_STEP = 0, 1, 2, 3
 
-# parameter vector indices
-(P_R, P_L, P_NPP, P_PHIM, P_J, P_B, P_VDC, P_TS, P_KI, P_KW, P_TMAX, P_LAM0, P_EPSL, P_WREF,
- P_W0, P_KPW, P_KIW, P_KPI, P_KII, P_KTS, P_CTRL) = range(21)
-N_PRM = 21
+# ---- the parameter vector, declared by name (indices generated: sim.common.layout) ------------
+PRM = Layout("the BLDC kernel's parameters")
+P_R = PRM.slot("P_R", "phase resistance R_s [Ω]")
+P_L = PRM.slot("P_L", "L_s − M_s [H]")
+P_NPP = PRM.slot("P_NPP", "pole pairs n_pp [-]")
+P_PHIM = PRM.slot("P_PHIM", "PM flux amplitude Φ_m [Wb]")
+P_J = PRM.slot("P_J", "inertia J [kg·m²]")
+P_B = PRM.slot("P_B", "viscous friction B [N·m·s/rad]")
+P_VDC = PRM.slot("P_VDC", "DC link V_dc [V]")
+P_TS = PRM.slot("P_TS", "sample period 1/f_s [s]")
+P_KI = PRM.slot("P_KI", "current SMC gain k_I of eq. (14) [1/A]")
+P_KW = PRM.slot("P_KW", "speed SMC gain k_ω [s/rad]")
+P_TMAX = PRM.slot("P_TMAX", "torque limit T_max [N·m]")
+P_LAM0 = PRM.slot("P_LAM0", "integral-surface gain λ₀ [1/s]")
+P_EPSL = PRM.slot("P_EPSL", "anti-windup width ε_λ [rad/s]")
+P_WREF = PRM.slot("P_WREF", "speed reference ω* [rad/s]")
+P_W0 = PRM.slot("P_W0", "initial speed ω_0 [rad/s]")
+P_KPW = PRM.slot("P_KPW", "speed PI K_p,ω (PI comparator) [N·m·s/rad]")
+P_KIW = PRM.slot("P_KIW", "speed PI K_i,ω (PI comparator) [N·m/rad]")
+P_KPI = PRM.slot("P_KPI", "current PI K_p,i (PI comparator) [V/A]")
+P_KII = PRM.slot("P_KII", "current PI K_i,i (PI comparator) [V/(A·s)]")
+P_KTS = PRM.slot("P_KTS", "torque constant the controller divides by [N·m/A]")
+P_CTRL = PRM.slot("P_CTRL", "controller code C_* [-]")
+N_PRM = PRM.size
 
 #: Recorded channels (one row per sample, at the start of the sample interval).
 CHANNELS = ("t", "omega", "T_L", "T_EL", "T_ref", "sigma", "i_a", "i_b", "i_c", "i_dx", "i_qx",

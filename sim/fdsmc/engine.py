@@ -32,8 +32,8 @@ from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.control.fdsmc.profile import infeasible_T_m
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.common.choices import check_controller
-from pmsm_commissioning.sim.fdsmc import kernel as kn
 from pmsm_commissioning.sim.fdsmc import kernel_run
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.grid import CONTINUOUS_STEP_S, MAX_POINTS, check_budget, load_steps, time_grid
 from pmsm_commissioning.sim.fdsmc.metrics import RunMetrics
 
@@ -181,13 +181,13 @@ def run_steps(
     prm = pack_parameters(params, d, controller, T_step=h if cont else h * n_sub)
     step_t, step_v = load_steps(params)
     Phi, Gam, Lo = observer_arrays(d)
-    out = np.zeros((kn.N_CH, 1))
-    info = np.zeros(kn.N_INFO)
+    out = np.zeros((lay.N_CH, 1))
+    info = np.zeros(lay.N_INFO)
     kernel_run.run_kernel(prm, step_t, step_v, Phi, Gam, Lo, cont, h, int(n_steps), 1 if cont else n_sub,
                           params.controller.delay_samples, int(n_steps) + 1, out, info,
                           np.zeros(0, dtype=np.int64), np.zeros((0, 0)), reference_rows(d, controller),
                           sensors.noise_table(params.sensors))
-    return info[kn.I_END: kn.I_END + kn.N_X].copy()
+    return info[lay.I_END: lay.I_END + lay.N_X].copy()
 
 
 def reached_target(run: RunResult) -> bool:

@@ -22,6 +22,7 @@ import numpy as np
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.common import budget
 from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.metrics import CHATTER_MAX_WINDOW_S
 
 #: Simulated horizon beyond T_m, as a fraction of T_m [-].
@@ -112,7 +113,7 @@ def run_cost(params: DriveParams, n_sub: int = 1, h_continuous: float = CONTINUO
     g = time_grid(params, int(n_sub), float(h_continuous), int(max_points))
     analysed, longest = window_samples(params, g)
     steps, samples, window = n_runs * g.n_steps * g.n_sub, n_runs * g.n_steps, n_runs * analysed
-    trace = n_runs * 8 * (kn.N_CH * g.n_out + 2 * kn.WIN_ROWS * longest)
+    trace = n_runs * 8 * (lay.N_CH * g.n_out + 2 * kn.WIN_ROWS * longest)
     return budget.Cost(steps, trace, budget.cpu_seconds(steps, samples, window, n_runs),
                        budget.memory_bytes(trace, window, n_runs, samples))
 

@@ -1,6 +1,7 @@
 """Compiled closed-loop kernel: PMSM + FDC inner loops + observer + outer loop, one sample step.
 
-Everything a run needs is packed into flat float arrays (indices below) so that one numba
+Everything a run needs is packed into flat float arrays (indices declared by name in
+:mod:`sim.fdsmc.layout`) so that one numba
 function, :func:`sim.fdsmc.kernel_run.run_kernel`, integrates the whole manoeuvre with the step
 written here (:func:`step_sample`, the plant's RK4 steps). :mod:`sim.fdsmc.reference` holds the readable plain-Python
 version of the same step, built from the laws in :mod:`control`, and the tests check that both
@@ -16,14 +17,15 @@ agree. Formulas (see [1], the FDSMC paper):
   ZOH-exact prediction form x̂[k+1] = Φ·x̂[k] + Γ·a_em[k] + L·e_o[k];
 * outer loop: eqs. (41)–(46) (FDSMC), eq. (62) sign-corrected (conventional), or tracking of a
   reference move (θ_ref, ω_ref, α_ref) by α_ref fed forward plus gains on the tracking error — the
-  minimum-energy optimum ending on the FDSMC's terminal slide (``P_CTRL`` = 3,
-  :mod:`control.fdsmc.terminal_slide`), or tracked to the very end without it (``P_CTRL`` = 2);
-* or, instead of all of the above but the plant and sensors, a stock drive's own loops (``P_CTRL`` = 4,
+  minimum-energy optimum ending on the FDSMC's terminal slide (``Law.OPTIMUM``,
+  :mod:`control.fdsmc.terminal_slide`), or tracked to the very end without it (``Law.TRACKING``);
+* or, instead of all of the above but the plant and sensors, a stock drive's own loops (``Law.DRIVE``,
   :mod:`control.stock.loops`): encoder PLL, position/speed law on a setpoint table interpolated between
   its rows, dq current PI;
 * the FDC's u_q corrected by the q-axis voltage-mismatch estimate where ``P_BDV`` > 0 (not in [1],
   :func:`control.fdsmc.fdc.voltage_mismatch`);
-* energies as extra states of the same RK4 integration, so that the balance closes.
+* **the energies** (friction, copper, electrical in, motoring, load work) as extra states ``X_EF`` …
+  ``X_ELOAD`` of the same RK4 integration (their rates in :func:`plant_rhs`), so that the balance closes.
 """
 
 from __future__ import annotations
@@ -34,48 +36,8 @@ from numba import njit
 from pmsm_commissioning.control.fdsmc import conventional, fdc, inverter, model, sliding_mode, terminal_slide
 from pmsm_commissioning.control.stock import loops
 from pmsm_commissioning.sim.common import sensors
-from pmsm_commissioning.sim.fdsmc.trace import CHANNELS as CHANNELS  # re-exported: the kernel's channel order
+from pmsm_commissioning.sim.fdsmc import layout as lay
 
-# ---- prm indices -------------------------------------------------------------------------
-(P_A, P_B, P_C, P_D, P_E, P_F, P_G, P_H, P_K, P_M, P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT,
- P_FV, P_TSI, P_TSA, P_CTRL, P_THDEM, P_OMP, P_TC, P_KB, P_AMAX, P_G1, P_G2, P_K1, P_K2, P_K3,
- P_K4, P_UMAX, P_IMAX, P_TM, P_GLE0, P_GRAMP, P_WLIM, P_ILIM) = range(39)
-# The plant's own coefficients A…G of eqs. (1)–(2) (its true R_s, L_d, L_q, Ψ_PM): P_A…P_G are the
-# controller's model of them. P_RS, P_LD, P_LQ, P_PSI, P_P, P_JR, P_JT, P_FV are the plant's.
-(P_PA, P_PB, P_PC, P_PD, P_PE, P_PF, P_PG) = range(39, 46)
-# Sensors (sim.common.sensors): encoder step [rad], current noise rms, ADC step and full scale [A];
-# the current predictor's ZOH factors over one sample (control.fdsmc.inverter.decay_factors); the
-# in-position window [rad] of the pass criteria.
-(P_ENC, P_INOISE, P_ISTEP, P_IFS, P_PHID, P_GMID, P_PHIQ, P_GMIQ, P_INPOS) = range(46, 55)
-# How far ahead the tracking law reads the reference's acceleration [s] (the inner loops' lag);
-# the filter factor β of the q-axis voltage-mismatch estimate (0 = none; control.fdsmc.fdc.voltage_mismatch).
-P_LEAD, P_BDV = 55, 56
-# The stock drive's own loops (P_CTRL = 4, :mod:`control.stock.loops`): position/speed law code, its
-# gains kp, kd, ki, integrator clamp [N·m], speed-demand clamp [rad/s], inertia feed-forward [kg·m²];
-# torque constant [N·m/A] and i_q demand clamp [A]; PLL bandwidth [rad/s] and speed snap [rad/s];
-# current PI kp [V/A], ki [V/(A·s)], voltage circle [V]; the cycle T [s] and the setpoint table's step [s].
-(P_DLAW, P_DKP, P_DKD, P_DKI, P_DILIM, P_DWLIM, P_DJFF, P_DKT, P_DIMAX, P_DWE, P_DSNAP, P_DCKP, P_DCKI,
- P_DUMAX, P_DT, P_DREFDT) = range(57, 73)
-N_PRM = 73
-#: P_CTRL of the stock drive's own loops.
-LAW_DRIVE = 4.0
-
-# ---- state indices -----------------------------------------------------------------------
-(X_ID, X_IQ, X_TH, X_W, X_EF, X_ECU, X_EEL, X_EMOT, X_ELOAD, X_THH, X_WH, X_L0, X_L1) = range(13)
-N_X = 13
-
-# ---- trace channels ----------------------------------------------------------------------
-# the fields of sim.fdsmc.trace.Trace, in order: record() writes a sample's row in it
-N_CH = len(CHANNELS)
-
-# ---- info indices ------------------------------------------------------------------------
-(I_NOUT, I_FAILED, I_TFAIL, I_TSAT, I_PW, I_PIQ, I_PU, I_PTQ, I_PID, I_TM_HIT) = range(10)
-I_SNAP = 10  # then N_X values of the state interpolated at T_m
-I_END = I_SNAP + N_X  # then N_X values of the final state
-# Peak |i_dq| [A]; time |i_dq| > i_max [s]; last sample time outside the in-position window [s]
-# (−1: never); largest overshoot beyond θ_dem [rad].
-(I_PIDQ, I_TOVER, I_TOUT, I_OVS) = range(I_END + N_X, I_END + N_X + 4)
-N_INFO = I_OVS + 1
 #: A tuple of float states or values (the plant's first X_THH states, the observer's four, the memory ``hold``).
 Floats = tuple[float, ...]
 #: What :func:`step_sample` returns: the voltages applied over the step (u_d, u_q) [V], the new observer
@@ -102,11 +64,11 @@ inlined = njit(cache=True, error_model="numpy", inline="always")
 @inlined
 def gamma_le(t: float, prm: np.ndarray, step_t: np.ndarray, step_v: np.ndarray) -> float:
     """External load torque Γ_Le(t) [N·m]: last step value (or Γ_Le0) plus the ramp."""
-    g: float = prm[P_GLE0]
+    g: float = prm[lay.P_GLE0]
     for j in range(step_t.size):
         if t >= step_t[j]:
             g = step_v[j]
-    ramp: float = prm[P_GRAMP]
+    ramp: float = prm[lay.P_GRAMP]
     return g + ramp * t
 
 
@@ -137,54 +99,59 @@ def outer_law(t: float, theta_hat: float, omega_hat: float, prm: np.ndarray,
     """Return the outer loop's demanded acceleration [rad/s²] and S [rad/s].
 
     Eqs. (44)–(46), (62), the tracked optimum's :func:`control.fdsmc.terminal_slide.slide_in_demand`
-    (``P_CTRL`` = 3) or the same reference tracked to the very end without the slide,
-    :func:`control.fdsmc.conventional.tracking_demand` (``P_CTRL`` = 2, the yardstick of what the slide
+    (``Law.OPTIMUM``) or the same reference tracked to the very end without the slide,
+    :func:`control.fdsmc.conventional.tracking_demand` (``Law.TRACKING``, the yardstick of what the slide
     removes), all of :mod:`control`.
     """
-    if prm[P_CTRL] >= 2.0:  # the acceleration fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
-        th_r, w_r, _ = reference_at(t, ref, prm[P_TM])
-        a_r = reference_at(t + prm[P_LEAD], ref, prm[P_TM])[2]
-        if prm[P_CTRL] == 2.0:
-            return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
-        return terminal_slide.slide_in_demand(th_r, w_r, a_r, ref[0, 0], theta_hat, omega_hat, prm[P_G1], prm[P_G2],
-                                              prm[P_THDEM], prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
-    if prm[P_CTRL] == 1.0:
-        return conventional.conventional_demand(prm[P_THDEM], theta_hat, omega_hat, prm[P_G1], prm[P_G2]), 0.0
-    return sliding_mode.smc_demand(theta_hat - prm[P_THDEM], omega_hat, prm[P_OMP], prm[P_TC], prm[P_KB], prm[P_AMAX])
+    law = int(prm[lay.P_CTRL])
+    g1, g2, th_dem = prm[lay.P_G1], prm[lay.P_G2], prm[lay.P_THDEM]
+    if law >= lay.Law.TRACKING:  # α_ref fed forward P_LEAD ahead, so the lagging inner loops deliver it on time
+        th_r, w_r, _ = reference_at(t, ref, prm[lay.P_TM])
+        a_r = reference_at(t + prm[lay.P_LEAD], ref, prm[lay.P_TM])[2]
+        if law == lay.Law.TRACKING:
+            return conventional.tracking_demand(th_r, w_r, a_r, theta_hat, omega_hat, g1, g2), 0.0
+        return terminal_slide.slide_in_demand(th_r, w_r, a_r, ref[0, 0], theta_hat, omega_hat, g1, g2, th_dem,
+                                              prm[lay.P_OMP], prm[lay.P_TC], prm[lay.P_KB], prm[lay.P_AMAX])
+    if law == lay.Law.CONVENTIONAL:
+        return conventional.conventional_demand(th_dem, theta_hat, omega_hat, g1, g2), 0.0
+    return sliding_mode.smc_demand(theta_hat - th_dem, omega_hat, prm[lay.P_OMP], prm[lay.P_TC], prm[lay.P_KB],
+                                   prm[lay.P_AMAX])
 
 
 @inlined
 def fdc_voltages(alpha_dem: float, i_d: float, i_q: float, omega_hat: float, L0: float,
                  L1: float, prm: np.ndarray) -> tuple[float, float, float]:
     """u_d of eq. (9), u_q of eq. (14) [V] and α of eq. (7) [rad/s²]: :func:`control.fdsmc.fdc.fdc_voltages`."""
-    return fdc.fdc_voltages(alpha_dem, i_d, i_q, omega_hat, L0, L1, prm[P_A], prm[P_B], prm[P_C], prm[P_D],
-                            prm[P_E], prm[P_F], prm[P_G], prm[P_H], prm[P_K], prm[P_M], prm[P_TSI], prm[P_TSA])
+    return fdc.fdc_voltages(alpha_dem, i_d, i_q, omega_hat, L0, L1, prm[lay.P_A], prm[lay.P_B], prm[lay.P_C],
+                            prm[lay.P_D], prm[lay.P_E], prm[lay.P_F], prm[lay.P_G], prm[lay.P_H], prm[lay.P_K],
+                            prm[lay.P_M], prm[lay.P_TSI], prm[lay.P_TSA])
 
 
 @inlined
 def predict_currents(i_d: float, i_q: float, omega_hat: float, u: tuple[float, float],
                      prm: np.ndarray) -> tuple[float, float]:
     """Currents [A] one sample on with the voltages u held: :func:`control.fdsmc.inverter.predict_currents`."""
-    return inverter.predict_currents(i_d, i_q, omega_hat, u[0], u[1], prm[P_PHID], prm[P_GMID], prm[P_PHIQ],
-                                     prm[P_GMIQ], prm[P_B], prm[P_C], prm[P_E], prm[P_F], prm[P_G])
+    return inverter.predict_currents(i_d, i_q, omega_hat, u[0], u[1], prm[lay.P_PHID], prm[lay.P_GMID],
+                                     prm[lay.P_PHIQ], prm[lay.P_GMIQ], prm[lay.P_B], prm[lay.P_C], prm[lay.P_E],
+                                     prm[lay.P_F], prm[lay.P_G])
 
 
 @inlined
 def limit_voltage(u_d: float, u_q: float, i_d: float, i_q: float, omega_hat: float,
                   prm: np.ndarray) -> tuple[float, float, bool]:
     """Apply the inverter limits of :func:`control.fdsmc.inverter.limit_voltage`; return u_d, u_q, flag."""
-    return inverter.limit_voltage(u_d, u_q, i_d, i_q, omega_hat, prm[P_IMAX], prm[P_UMAX], prm[P_PHID],
-                                  prm[P_GMID], prm[P_PHIQ], prm[P_GMIQ], prm[P_B], prm[P_C], prm[P_E],
-                                  prm[P_F], prm[P_G])
+    return inverter.limit_voltage(u_d, u_q, i_d, i_q, omega_hat, prm[lay.P_IMAX], prm[lay.P_UMAX],
+                                  prm[lay.P_PHID], prm[lay.P_GMID], prm[lay.P_PHIQ], prm[lay.P_GMIQ], prm[lay.P_B],
+                                  prm[lay.P_C], prm[lay.P_E], prm[lay.P_F], prm[lay.P_G])
 
 
 @inlined
 def measure(k: int, p: Floats, prm: np.ndarray, noise: np.ndarray) -> tuple[float, float, float]:
     """Return what the controller reads at sample k: (θ_r [rad], i_d, i_q [A]) through :mod:`sim.common.sensors`."""
     j = k % noise.shape[1]
-    return (sensors.encoder_angle(p[X_TH], prm[P_ENC]),
-            sensors.adc_current(p[X_ID], noise[0, j], prm[P_INOISE], prm[P_ISTEP], prm[P_IFS]),
-            sensors.adc_current(p[X_IQ], noise[1, j], prm[P_INOISE], prm[P_ISTEP], prm[P_IFS]))
+    return (sensors.encoder_angle(p[lay.X_TH], prm[lay.P_ENC]),
+            sensors.adc_current(p[lay.X_ID], noise[0, j], prm[lay.P_INOISE], prm[lay.P_ISTEP], prm[lay.P_IFS]),
+            sensors.adc_current(p[lay.X_IQ], noise[1, j], prm[lay.P_INOISE], prm[lay.P_ISTEP], prm[lay.P_IFS]))
 
 
 @inlined
@@ -205,23 +172,23 @@ def control_output(t: float, y: Floats, i0: Floats, o: Floats, prm: np.ndarray,
 @inlined
 def electromagnetic_torque(i_d: float, i_q: float, prm: np.ndarray) -> float:
     """Γ_em of eq. (5) [N·m] (:func:`control.fdsmc.model.electromagnetic_torque` on the packed parameters)."""
-    return model.electromagnetic_torque(prm[P_P], prm[P_PSI], prm[P_LD], prm[P_LQ], i_d, i_q)
+    return model.electromagnetic_torque(prm[lay.P_P], prm[lay.P_PSI], prm[lay.P_LD], prm[lay.P_LQ], i_d, i_q)
 
 
 @inlined
 def plant_rhs(t: float, p: Floats, u_d: float, u_q: float, prm: np.ndarray, step_t: np.ndarray,
               step_v: np.ndarray) -> Floats:
     """Return the derivatives of the plant and energy states p (eqs. 1–3, 4b, 5) [SI/s]."""
-    i_d, i_q, w = p[X_ID], p[X_IQ], p[X_W]
+    i_d, i_q, w = p[lay.X_ID], p[lay.X_IQ], p[lay.X_W]
     g_le = gamma_le(t, prm, step_t, step_v)
     T_em = electromagnetic_torque(i_d, i_q, prm)
     p_el = 1.5 * (u_d * i_d + u_q * i_q)
-    return (-prm[P_PA] * i_d + prm[P_PB] * w * i_q + prm[P_PF] * u_d,
-            -(prm[P_PC] * i_d + prm[P_PE]) * w - prm[P_PD] * i_q + prm[P_PG] * u_q,
+    return (-prm[lay.P_PA] * i_d + prm[lay.P_PB] * w * i_q + prm[lay.P_PF] * u_d,
+            -(prm[lay.P_PC] * i_d + prm[lay.P_PE]) * w - prm[lay.P_PD] * i_q + prm[lay.P_PG] * u_q,
             w,
-            (T_em - prm[P_FV] * w - g_le) / prm[P_JT],
-            prm[P_FV] * w * w,
-            1.5 * prm[P_RS] * (i_d * i_d + i_q * i_q),
+            (T_em - prm[lay.P_FV] * w - g_le) / prm[lay.P_JT],
+            prm[lay.P_FV] * w * w,
+            1.5 * prm[lay.P_RS] * (i_d * i_d + i_q * i_q),
             p_el,
             max(p_el, 0.0),
             g_le * w)
@@ -230,10 +197,10 @@ def plant_rhs(t: float, p: Floats, u_d: float, u_q: float, prm: np.ndarray, step
 @inlined
 def observer_rhs(p: Floats, o: Floats, prm: np.ndarray) -> tuple[float, float, float, float]:
     """Corrected continuous observer, eq. (15) with e_o = θ_r − θ̂_r [rad/s, rad/s², …]."""
-    e_o = p[X_TH] - o[0]
-    a_em = (prm[P_H] + prm[P_K] * p[X_ID]) * p[X_IQ]
-    return (o[1] + prm[P_K1] * e_o, a_em - prm[P_M] * o[2] + prm[P_K2] * e_o,
-            o[3] + prm[P_K3] * e_o, prm[P_K4] * e_o)
+    e_o = p[lay.X_TH] - o[0]
+    a_em = (prm[lay.P_H] + prm[lay.P_K] * p[lay.X_ID]) * p[lay.X_IQ]
+    return (o[1] + prm[lay.P_K1] * e_o, a_em - prm[lay.P_M] * o[2] + prm[lay.P_K2] * e_o,
+            o[3] + prm[lay.P_K3] * e_o, prm[lay.P_K4] * e_o)
 
 
 @inlined
@@ -276,8 +243,8 @@ def rk4_plant(t: float, h: float, p: Floats, u_d: float, u_q: float, prm: np.nda
 def full_rhs(t: float, p: Floats, o: Floats, prm: np.ndarray, step_t: np.ndarray,
              step_v: np.ndarray, ref: np.ndarray) -> tuple[Floats, Floats]:
     """Continuous mode: plant and observer derivatives with the controller inside (ideal sensors)."""
-    i = (p[X_ID], p[X_IQ])
-    u_d, u_q, _, _, _, _ = control_output(t, (p[X_TH], p[X_ID], p[X_IQ]), i, o, prm, ref, 0.0)
+    i = (p[lay.X_ID], p[lay.X_IQ])
+    u_d, u_q, _, _, _, _ = control_output(t, (p[lay.X_TH], p[lay.X_ID], p[lay.X_IQ]), i, o, prm, ref, 0.0)
     return plant_rhs(t, p, u_d, u_q, prm, step_t, step_v), observer_rhs(p, o, prm)
 
 
@@ -323,23 +290,23 @@ def step_sample(k: int, t: float, p: Floats, o: Floats, hold: Floats, continuous
     last sample's readings i_d, i_q [A], ω̂ [rad/s] and applied u_d, u_q [V]; the q-axis
     voltage-mismatch estimate [V]), HOLD0 at rest.
     """
-    if prm[P_CTRL] == LAW_DRIVE:
+    if int(prm[lay.P_CTRL]) == lay.Law.DRIVE:
         return drive_sample(k, t, p, o, hold, delay, prm, ref, noise)
     if continuous:
-        y = (p[X_TH], p[X_ID], p[X_IQ])
+        y = (p[lay.X_TH], p[lay.X_ID], p[lay.X_IQ])
         u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, (y[1], y[2]), o, prm, ref, 0.0)
         return (u_d, u_q), o, hold, (u_d, u_q, a_dem, a_hat, S), sat
     y = measure(k, p, prm, noise)
     dv = hold[7]
-    if prm[P_BDV] > 0.0:
+    if prm[lay.P_BDV] > 0.0:
         i_model = predict_currents(hold[2], hold[3], hold[4], (hold[5], hold[6]), prm)[1]
-        dv = fdc.voltage_mismatch(dv, y[2], i_model, prm[P_GMIQ] * prm[P_G], prm[P_BDV])
+        dv = fdc.voltage_mismatch(dv, y[2], i_model, prm[lay.P_GMIQ] * prm[lay.P_G], prm[lay.P_BDV])
     held = (hold[0], hold[1])
     i0 = predict_currents(y[1], y[2], o[1], held, prm) if delay == 1 else (y[1], y[2])
     u_d, u_q, a_dem, a_hat, S, sat = control_output(t, y, i0, o, prm, ref, dv)
     if delay == 1:
         held, (u_d, u_q) = (u_d, u_q), held
-    a_em = (prm[P_H] + prm[P_K] * y[1]) * y[2]
+    a_em = (prm[lay.P_H] + prm[lay.P_K] * y[1]) * y[2]
     memory = (held[0], held[1], y[1], y[2], o[1], u_d, u_q, dv)
     return (u_d, u_q), observer_update(y[0], o, a_em, Phi, Gam, Lo), memory, (u_d, u_q, a_dem, a_hat, S), sat
 
@@ -370,19 +337,20 @@ def drive_sample(k: int, t: float, p: Floats, o: Floats, hold: Floats, delay: in
     u_d, u_q [V]; the current PI's integrators v_d, v_q [V]; 0, 0, 0, 0). The recorded α_dem is the
     torque demand over J_ff (over the plant's J without feed-forward).
     """
-    T = prm[P_DT]
+    T = prm[lay.P_DT]
     y = measure(k, p, prm, noise)
-    th, w = loops.pll_update(o[0], o[1], y[0], prm[P_DWE], T, prm[P_DSNAP])
-    th_r, w_r, a_r = table_at(t, ref, prm[P_DREFDT])
-    torque, integ, lim = loops.position_torque(prm[P_DLAW], th_r, w_r, a_r, th, w, o[2], prm[P_DKP], prm[P_DKD],
-                                               prm[P_DKI], prm[P_DILIM], prm[P_DWLIM], prm[P_DJFF],
-                                               prm[P_DKT] * prm[P_DIMAX], T)
-    i_q_dem = loops.clamp(torque / prm[P_DKT], prm[P_DIMAX])
-    u_d, u_q, v_d, v_q, sat = loops.current_pi(0.0, i_q_dem, y[1], y[2], hold[2], hold[3], prm[P_DCKP],
-                                               prm[P_DCKI], prm[P_DUMAX], T)
+    th, w = loops.pll_update(o[0], o[1], y[0], prm[lay.P_DWE], T, prm[lay.P_DSNAP])
+    th_r, w_r, a_r = table_at(t, ref, prm[lay.P_DREFDT])
+    torque, integ, lim = loops.position_torque(prm[lay.P_DLAW], th_r, w_r, a_r, th, w, o[2], prm[lay.P_DKP],
+                                               prm[lay.P_DKD], prm[lay.P_DKI], prm[lay.P_DILIM], prm[lay.P_DWLIM],
+                                               prm[lay.P_DJFF],
+                                               prm[lay.P_DKT] * prm[lay.P_DIMAX], T)
+    i_q_dem = loops.clamp(torque / prm[lay.P_DKT], prm[lay.P_DIMAX])
+    u_d, u_q, v_d, v_q, sat = loops.current_pi(0.0, i_q_dem, y[1], y[2], hold[2], hold[3], prm[lay.P_DCKP],
+                                               prm[lay.P_DCKI], prm[lay.P_DUMAX], T)
     held = (hold[0], hold[1])
     if delay == 1:
         held, (u_d, u_q) = (u_d, u_q), held
-    a_dem = torque / (prm[P_DJFF] if prm[P_DJFF] > 0.0 else prm[P_JT])
+    a_dem = torque / (prm[lay.P_DJFF] if prm[lay.P_DJFF] > 0.0 else prm[lay.P_JT])
     return ((u_d, u_q), (th, w, integ, 0.0), (held[0], held[1], v_d, v_q, 0.0, 0.0, 0.0, 0.0),
             (u_d, u_q, a_dem, a_dem, 0.0), sat or lim)

@@ -18,6 +18,7 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.grid import load_steps, time_grid
 from pmsm_commissioning.sim.fdsmc.run import pack_parameters
 
@@ -58,7 +59,7 @@ class PlantInTheLoop:
         self._step_t, self._step_v = load_steps(params)
         self._h, self._n_sub = g.h, g.n_sub
         self.T_s, self.n_samples = g.h * g.n_sub, g.n_steps
-        self.x: tuple[float, ...] = (0.0,) * kn.X_THH
+        self.x: tuple[float, ...] = (0.0,) * lay.X_THH
         self.t = 0.0
 
     def step(self, u_d: float, u_q: float) -> None:

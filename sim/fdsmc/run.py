@@ -1,6 +1,6 @@
 """One run of the compiled kernel: its packed parameters, reference and observer arrays, its trace and metrics.
 
-:func:`pack_parameters` fills the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.kernel`),
+:func:`pack_parameters` fills the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.layout`),
 :func:`run_packed` runs :func:`sim.fdsmc.kernel_run.run_kernel` on a time grid and returns the frozen
 :class:`RunResult`. The controllers' runs (:mod:`sim.fdsmc.engine`) and the stock drive's route
 (:mod:`sim.stock.route`) both run through here; neither imports the other's module for it.
@@ -25,6 +25,7 @@ from pmsm_commissioning.control.fdsmc.tracking import optimum_slide, tracking_ga
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.fdsmc import kernel as kn
 from pmsm_commissioning.sim.fdsmc import kernel_run
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.criteria import pass_criteria
 from pmsm_commissioning.sim.fdsmc.grid import TimeGrid, continuous_step, load_steps
 from pmsm_commissioning.sim.fdsmc.metrics import (
@@ -35,16 +36,16 @@ from pmsm_commissioning.sim.fdsmc.metrics import (
     run_metrics,
 )
 from pmsm_commissioning.sim.fdsmc.summary import decode_info
-from pmsm_commissioning.sim.fdsmc.trace import Trace
+from pmsm_commissioning.sim.fdsmc.trace import CHANNELS, Trace
 
 #: The name each simulated outer loop goes by in messages, tables and figures.
 LABELS = {"fdsmc": "FDSMC", "conventional": "Conventional", "optimum": "Optimum", "stock": "Stock drive"}
-#: The kernel's outer law (P_CTRL) of each comparator on the FDC inner loops; the stock drive runs its own
-#: loops instead (P_CTRL = 4, :mod:`sim.stock.route`).
-KERNEL_LAW = {"fdsmc": 0.0, "conventional": 1.0, "optimum": 3.0}
+#: The kernel's outer law (``prm[P_CTRL]``) of each comparator on the FDC inner loops; the stock drive runs its
+#: own loops instead (``Law.DRIVE``, :mod:`sim.stock.route`).
+KERNEL_LAW = {"fdsmc": lay.Law.FDSMC, "conventional": lay.Law.CONVENTIONAL, "optimum": lay.Law.OPTIMUM}
 #: The kernel's law that tracks the optimum's reference to the very end, without its terminal slide:
 #: the yardstick of what the slide removes (the observer's lag carries the rotor past θ_dem).
-TRACKING_TO_THE_END = 2.0
+TRACKING_TO_THE_END = lay.Law.TRACKING
 
 
 @dataclass(frozen=True)
@@ -58,7 +59,7 @@ class RunResult:
 
 def pack_parameters(params: DriveParams, d: Derived, controller: str,
                     plant: DriveParams | None = None, T_step: float | None = None) -> np.ndarray:
-    """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.kernel`).
+    """Return the kernel's flat parameter vector (indices ``P_*`` of :mod:`sim.fdsmc.layout`).
 
     ``params``/``d`` are the controller's model; ``plant`` (default: the same) gives the true
     motor and load values the simulated drive has (R_s, L_d, L_q, Ψ_PM, p, J_r, J_L, F_v, Γ_Le).
@@ -68,52 +69,51 @@ def pack_parameters(params: DriveParams, d: Derived, controller: str,
     c, ctrl = d.coefficients, params.controller
     pl = params if plant is None else plant
     m, ld, cp = pl.motor, pl.load, c if plant is None else model_coefficients(pl.motor)
-    prm = np.zeros(kn.N_PRM)
-    for name, idx in zip("ABCDEFGHKM", (kn.P_A, kn.P_B, kn.P_C, kn.P_D, kn.P_E, kn.P_F, kn.P_G,
-                                         kn.P_H, kn.P_K, kn.P_M), strict=True):
-        prm[idx] = getattr(c, name)
-    for name, idx in zip("ABCDEFG", (kn.P_PA, kn.P_PB, kn.P_PC, kn.P_PD, kn.P_PE, kn.P_PF, kn.P_PG),
-                         strict=True):
-        prm[idx] = getattr(cp, name)
-    prm[[kn.P_RS, kn.P_LD, kn.P_LQ, kn.P_PSI, kn.P_P, kn.P_JR]] = (
+    prm = lay.PRM.empty()
+    for name in "ABCDEFGHKM":  # the controller's model, then the plant's own coefficients (P_PA … P_PG)
+        prm[getattr(lay, f"P_{name}")] = getattr(c, name)
+    for name in "ABCDEFG":
+        prm[getattr(lay, f"P_P{name}")] = getattr(cp, name)
+    prm[[lay.P_RS, lay.P_LD, lay.P_LQ, lay.P_PSI, lay.P_P, lay.P_JR]] = (
         m.R_s, m.L_d, m.L_q, m.psi_pm, m.p, m.J_r)
-    prm[[kn.P_JT, kn.P_FV, kn.P_TSI, kn.P_TSA]] = (pl.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
-    prm[kn.P_CTRL] = KERNEL_LAW[controller]
+    prm[[lay.P_JT, lay.P_FV, lay.P_TSI, lay.P_TSA]] = (pl.J_total, ld.F_v, ctrl.T_si, ctrl.T_salpha)
+    prm[lay.P_CTRL] = float(KERNEL_LAW[controller])
     pr, o = d.profile, d.observer
-    prm[[kn.P_THDEM, kn.P_OMP, kn.P_TC, kn.P_KB, kn.P_AMAX]] = (
+    prm[[lay.P_THDEM, lay.P_OMP, lay.P_TC, lay.P_KB, lay.P_AMAX]] = (
         params.manoeuvre.theta_dem, pr.omega_p, pr.T_c, ctrl.K, d.alpha.alpha_max)
     gains = d.conventional
     if controller == "optimum":  # its own K (below the chatter limit), tracking gains and terminal slide's T_c
         K, T_c = optimum_slide(d.gain, ctrl.K, d.alpha.alpha_max)
         gains = tracking_gains(d.loop, d.conventional, K)
-        prm[[kn.P_TC, kn.P_KB]] = (T_c, K)
-    prm[[kn.P_G1, kn.P_G2]] = (gains.g1, gains.g2)
+        prm[[lay.P_TC, lay.P_KB]] = (T_c, K)
+    prm[[lay.P_G1, lay.P_G2]] = (gains.g1, gains.g2)
     if controller == "optimum":  # α(t) ≈ α_dem(t − T_sα/3) (eq. (13)), one more sample with a delay
-        prm[kn.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
-    prm[[kn.P_K1, kn.P_K2, kn.P_K3, kn.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
+        prm[lay.P_LEAD] = ctrl.T_salpha / 3.0 + (0.0 if ctrl.is_continuous else ctrl.delay_samples / float(ctrl.f_s))
+    prm[[lay.P_K1, lay.P_K2, lay.P_K3, lay.P_K4]] = (o.K1, o.K2, o.K3, o.K4)
     if not ctrl.is_continuous:  # β of the q-axis voltage-mismatch estimate (0: none)
-        prm[kn.P_BDV] = mismatch_filter_factor(ctrl.T_dv, float(ctrl.f_s))
-    prm[[kn.P_UMAX, kn.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), current_limit(params))  # 0 = no limit
-    prm[[kn.P_TM, kn.P_GLE0, kn.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
+        prm[lay.P_BDV] = mismatch_filter_factor(ctrl.T_dv, float(ctrl.f_s))
+    prm[[lay.P_UMAX, lay.P_IMAX]] = (ctrl.V_dc / math.sqrt(3.0), current_limit(params))  # 0 = no limit
+    prm[[lay.P_TM, lay.P_GLE0, lay.P_GRAMP]] = (params.manoeuvre.T_m, ld.Gamma_Le, ld.Gamma_Le_ramp)
     m = params.motor
     w_scale = max(m.omega_b, pr.omega_p, abs(params.manoeuvre.theta_dem) / params.manoeuvre.T_m)
     i_scale = max(m.Gamma_max, d.alpha.torque_needed) / torque_constant(m)
-    prm[[kn.P_WLIM, kn.P_ILIM]] = (20.0 * w_scale, 100.0 * i_scale)
+    prm[[lay.P_WLIM, lay.P_ILIM]] = (20.0 * w_scale, 100.0 * i_scale)
     _pack_sensors(prm, params, d, T_step)
+    lay.PRM.check_filled(prm)
     return prm
 
 
 def _pack_sensors(prm: np.ndarray, params: DriveParams, d: Derived, T_step: float | None) -> None:
     """Sensor steps, the current predictor's factors over ``T_step`` and the in-position window."""
     se, c = params.sensors, d.coefficients
-    prm[[kn.P_ENC, kn.P_INOISE, kn.P_ISTEP, kn.P_IFS]] = (
+    prm[[lay.P_ENC, lay.P_INOISE, lay.P_ISTEP, lay.P_IFS]] = (
         se.encoder_step, se.i_noise, se.adc_step, se.i_adc_range)
     if T_step is None:
         ctrl = params.controller
         T_step = continuous_step(params) if ctrl.is_continuous else 1.0 / float(ctrl.f_s)
-    prm[[kn.P_PHID, kn.P_GMID]] = decay_factors(c.A, T_step)
-    prm[[kn.P_PHIQ, kn.P_GMIQ]] = decay_factors(c.D, T_step)
-    prm[kn.P_INPOS] = pass_criteria(params).in_position
+    prm[[lay.P_PHID, lay.P_GMID]] = decay_factors(c.A, T_step)
+    prm[[lay.P_PHIQ, lay.P_GMIQ]] = decay_factors(c.D, T_step)
+    prm[lay.P_INPOS] = pass_criteria(params).in_position
 
 
 def observer_arrays(d: Derived) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -144,8 +144,8 @@ def run_packed(params: DriveParams, d: Derived, controller: str, g: TimeGrid, pr
     """
     T_step = g.h * g.n_sub
     step_t, step_v = load_steps(params if plant is None else plant)
-    out = np.zeros((kn.N_CH, g.n_out))
-    info = np.zeros(kn.N_INFO)
+    out = np.zeros((lay.N_CH, g.n_out))
+    info = np.zeros(lay.N_INFO)
     windows = chatter_windows(params, d, controller, g.n_steps * T_step)
     steps = [chatter_window_steps(w, T_step, g.n_steps) for w in windows.values()]
     k_win = np.array([k0 for k0, _ in steps], dtype=np.int64)
@@ -167,4 +167,4 @@ def _trace(chans: np.ndarray) -> Trace:
     finite = np.all(np.isfinite(chans), axis=0)
     if not np.all(finite):
         chans = chans[:, : int(np.argmin(finite))]
-    return Trace(**{name: chans[i] for i, name in enumerate(kn.CHANNELS)})
+    return Trace(**{name: chans[i] for i, name in enumerate(CHANNELS)})

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import layout as lay
 
 
 @dataclass(frozen=True)
@@ -49,14 +49,14 @@ class KernelState:
 
 #: Field of :class:`KernelState` → index in the kernel's state vector.
 STATE_INDEX: dict[str, int] = {
-    "i_d": kn.X_ID, "i_q": kn.X_IQ, "theta_r": kn.X_TH, "omega_r": kn.X_W, "E_friction": kn.X_EF,
-    "E_copper": kn.X_ECU, "E_electrical": kn.X_EEL, "E_motoring": kn.X_EMOT, "E_load": kn.X_ELOAD,
-    "theta_hat": kn.X_THH, "omega_hat": kn.X_WH, "L0": kn.X_L0, "L1": kn.X_L1,
+    "i_d": lay.X_ID, "i_q": lay.X_IQ, "theta_r": lay.X_TH, "omega_r": lay.X_W, "E_friction": lay.X_EF,
+    "E_copper": lay.X_ECU, "E_electrical": lay.X_EEL, "E_motoring": lay.X_EMOT, "E_load": lay.X_ELOAD,
+    "theta_hat": lay.X_THH, "omega_hat": lay.X_WH, "L0": lay.X_L0, "L1": lay.X_L1,
 }
 
 
 def decode_state(x: np.ndarray) -> KernelState:
-    """Return the :class:`KernelState` of a state vector of length ``kn.N_X``."""
+    """Return the :class:`KernelState` of a state vector of length ``lay.N_X``."""
     return KernelState(**{name: x[i] for name, i in STATE_INDEX.items()})
 
 
@@ -98,13 +98,14 @@ class RunSummary:
 
 
 def decode_info(info: np.ndarray) -> RunSummary:
-    """Return the :class:`RunSummary` of the kernel's ``info`` vector (length ``kn.N_INFO``)."""
+    """Return the :class:`RunSummary` of the kernel's ``info`` vector (length ``lay.N_INFO``)."""
     return RunSummary(
-        n_out=int(info[kn.I_NOUT]), failed=bool(info[kn.I_FAILED]), t_fail=info[kn.I_TFAIL],
-        saturated_s=info[kn.I_TSAT], omega_peak=info[kn.I_PW], i_q_peak=info[kn.I_PIQ], u_peak=info[kn.I_PU],
-        torque_peak=info[kn.I_PTQ], i_d_peak=info[kn.I_PID], Tm_reached=info[kn.I_TM_HIT],
-        at_Tm=decode_state(info[kn.I_SNAP: kn.I_SNAP + kn.N_X]), end=decode_state(info[kn.I_END: kn.I_END + kn.N_X]),
-        i_dq_peak=info[kn.I_PIDQ], over_i_max_s=info[kn.I_TOVER], t_out=info[kn.I_TOUT], overshoot=info[kn.I_OVS])
+        n_out=int(info[lay.I_NOUT]), failed=bool(info[lay.I_FAILED]), t_fail=info[lay.I_TFAIL],
+        saturated_s=info[lay.I_TSAT], omega_peak=info[lay.I_PW], i_q_peak=info[lay.I_PIQ], u_peak=info[lay.I_PU],
+        torque_peak=info[lay.I_PTQ], i_d_peak=info[lay.I_PID], Tm_reached=info[lay.I_TM_HIT],
+        at_Tm=decode_state(info[lay.I_SNAP: lay.I_SNAP + lay.N_X]),
+        end=decode_state(info[lay.I_END: lay.I_END + lay.N_X]),
+        i_dq_peak=info[lay.I_PIDQ], over_i_max_s=info[lay.I_TOVER], t_out=info[lay.I_TOUT], overshoot=info[lay.I_OVS])
 
 
 __all__ = ["STATE_INDEX", "KernelState", "RunSummary", "decode_info", "decode_state"]

@@ -24,7 +24,7 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import Derived, derive
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.control.stock.loops import LAW_CASCADE, LAW_PID
-from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.grid import MAX_POINTS, check_budget, time_grid
 from pmsm_commissioning.sim.fdsmc.run import RunResult, pack_parameters, run_packed
 
@@ -99,11 +99,11 @@ def pack_loop(prm: np.ndarray, loop: StockLoop, u_max: float, encoder_step: floa
     """Write the stock drive's indices ``P_D*`` of the kernel's parameter vector (P_CTRL = 4)."""
     T = 1.0 / loop.f_loop
     snap = 0.5 * T * 0.25 * (2.0 * loop.omega_e) ** 2 * encoder_step if loop.snap else 0.0
-    prm[kn.P_CTRL] = kn.LAW_DRIVE
-    prm[[kn.P_DLAW, kn.P_DKP, kn.P_DKD, kn.P_DKI, kn.P_DILIM, kn.P_DWLIM, kn.P_DJFF]] = (
+    prm[lay.P_CTRL] = float(lay.Law.DRIVE)
+    prm[[lay.P_DLAW, lay.P_DKP, lay.P_DKD, lay.P_DKI, lay.P_DILIM, lay.P_DWLIM, lay.P_DJFF]] = (
         LAWS[loop.law], loop.kp, loop.kd, loop.ki, loop.i_lim, loop.omega_lim, loop.J_ff)
-    prm[[kn.P_DKT, kn.P_DIMAX, kn.P_DWE, kn.P_DSNAP]] = (loop.K_t, loop.current_limit, loop.omega_e, snap)
-    prm[[kn.P_DCKP, kn.P_DCKI, kn.P_DUMAX, kn.P_DT, kn.P_DREFDT]] = (
+    prm[[lay.P_DKT, lay.P_DIMAX, lay.P_DWE, lay.P_DSNAP]] = (loop.K_t, loop.current_limit, loop.omega_e, snap)
+    prm[[lay.P_DCKP, lay.P_DCKI, lay.P_DUMAX, lay.P_DT, lay.P_DREFDT]] = (
         loop.current_kp, loop.current_ki, u_max, T, loop.table_dt)
 
 

@@ -33,6 +33,7 @@ from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.common import sensors, signals
 from pmsm_commissioning.sim.fdsmc import kernel as kn
 from pmsm_commissioning.sim.fdsmc import kernel_run
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.engine import CONTROLLERS
 from pmsm_commissioning.sim.fdsmc.grid import CONTINUOUS_STEP_S, TimeGrid, load_steps, time_grid
 from pmsm_commissioning.sim.fdsmc.limit_cycle import limit_cycles
@@ -47,7 +48,7 @@ from pmsm_commissioning.sim.fdsmc.run import observer_arrays, pack_parameters, r
 
 #: Samples per compiled call [-]: bounds the trace buffers; ≥ 8 keeps two threads busy.
 BATCH = 16
-_T, _THETA, _ALPHA_DEM = kn.CHANNELS.index("t"), kn.CHANNELS.index("theta_r"), kn.CHANNELS.index("alpha_dem")
+_T, _THETA, _ALPHA_DEM = lay.CHANNELS.index("t"), lay.CHANNELS.index("theta_r"), lay.CHANNELS.index("alpha_dem")
 
 
 @njit(parallel=True, cache=True, nogil=True)
@@ -136,7 +137,7 @@ def chatter_rows(t: np.ndarray, alpha_dem: np.ndarray, window: tuple[float, floa
 
 
 def _buffers(s: Setup, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    return (np.zeros((n, kn.N_CH, s.grid.n_out)), np.zeros((n, kn.N_INFO)),
+    return (np.zeros((n, lay.N_CH, s.grid.n_out)), np.zeros((n, lay.N_INFO)),
             np.zeros((n, kn.WIN_ROWS * len(s.steps), max(k for _, k in s.steps))))
 
 
@@ -161,20 +162,20 @@ def _metrics(params: DriveParams, d: Derived, s: Setup, plants: list[DriveParams
     rows = []
     for i, plant in enumerate(plants):
         x = info[i]
-        if x[kn.I_FAILED]:
+        if x[lay.I_FAILED]:
             rows.append({**dict.fromkeys(("friction_J", "copper_J", "electrical_in_total_J", "torque_peak_Nm",
                                           "theta_error_abs_at_Tm_rad", "t_2pct_settle_s", "t_2pct_first_s")),
                          "chatter": False, "stable": False, "infeasible": True})
             continue
-        chans = out[i, :, : int(x[kn.I_NOUT])]
+        chans = out[i, :, : int(x[lay.I_NOUT])]
         finite = np.all(np.isfinite(chans), axis=0)
         k_end = chans.shape[1] if np.all(finite) else int(np.argmin(finite))
         t, theta, band = chans[_T, :k_end], chans[_THETA, :k_end], 0.02 * abs(theta_dem)
-        peak = float(x[kn.I_PTQ])
+        peak = float(x[lay.I_PTQ])
         rows.append({
-            "friction_J": float(x[kn.I_SNAP + kn.X_EF]), "copper_J": float(x[kn.I_SNAP + kn.X_ECU]),
-            "electrical_in_total_J": float(x[kn.I_END + kn.X_EEL]), "torque_peak_Nm": peak,
-            "theta_error_abs_at_Tm_rad": abs(float(x[kn.I_SNAP + kn.X_TH]) - theta_dem),
+            "friction_J": float(x[lay.I_SNAP + lay.X_EF]), "copper_J": float(x[lay.I_SNAP + lay.X_ECU]),
+            "electrical_in_total_J": float(x[lay.I_END + lay.X_EEL]), "torque_peak_Nm": peak,
+            "theta_error_abs_at_Tm_rad": abs(float(x[lay.I_SNAP + lay.X_TH]) - theta_dem),
             "t_2pct_settle_s": signals.settling_time(t, theta, theta_dem, band),
             "t_2pct_first_s": signals.first_entry_time(t, theta, theta_dem, band),
             "chatter": bool(chatter[i]), "stable": True,

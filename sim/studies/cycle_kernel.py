@@ -17,9 +17,10 @@ from numba import njit
 from pmsm_commissioning.sim.common.borrowed import borrowed
 from pmsm_commissioning.sim.fdsmc import kernel as kn
 from pmsm_commissioning.sim.fdsmc import kernel_run
+from pmsm_commissioning.sim.fdsmc import layout as lay
 
 #: Per-segment values stored in ``seg_info`` (row per segment): the state at its end.
-SEG_X = kn.N_X
+SEG_X = lay.N_X
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

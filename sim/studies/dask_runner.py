@@ -64,12 +64,13 @@ def local_hash() -> str:
 def warm() -> float:
     """Load (or compile) the batch kernel in this process; returns the seconds it took."""
     from pmsm_commissioning.sim.fdsmc import kernel as kn
+    from pmsm_commissioning.sim.fdsmc import layout as lay
     from pmsm_commissioning.sim.studies.batch import run_batch
 
     t0 = time.perf_counter()
     z1 = np.zeros(0)
-    run_batch(np.zeros((1, kn.N_PRM)), z1, z1, np.zeros((4, 4)), np.zeros(4), np.zeros(4), False, 1e-4, 1, 1,
-              0, 1, np.zeros((1, kn.N_CH, 1)), np.zeros((1, kn.N_INFO)), np.zeros(1, dtype=np.int64),
+    run_batch(np.zeros((1, lay.N_PRM)), z1, z1, np.zeros((4, 4)), np.zeros(4), np.zeros(4), False, 1e-4, 1, 1,
+              0, 1, np.zeros((1, lay.N_CH, 1)), np.zeros((1, lay.N_INFO)), np.zeros(1, dtype=np.int64),
               np.zeros((1, kn.WIN_ROWS, 1)), np.zeros((3, 2)), np.zeros((2, 1)), 0)
     return time.perf_counter() - t0
 

@@ -27,7 +27,7 @@ from pmsm_commissioning.control.fdsmc.optimum import OptimumSolverError
 from pmsm_commissioning.control.fdsmc.params import DriveParams
 from pmsm_commissioning.sim.common import sensors
 from pmsm_commissioning.sim.common.economics import J_PER_KWH, cost_per_year, kwh_per_year  # noqa: F401 - J_PER_KWH re-exported
-from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.engine import optimum_omitted
 from pmsm_commissioning.sim.fdsmc.grid import continuous_step, plant_substeps
 from pmsm_commissioning.sim.fdsmc.metrics import kinetic_energy, magnetic_energy
@@ -152,7 +152,7 @@ def _pack(cases: list[tuple[DriveParams, Derived]], moves: Sequence[Move], contr
     prm_all, refs, start = [], [], 0.0
     for (p, d), mv in zip(cases, moves, strict=True):
         prm = pack_parameters(p, d, controller)
-        prm[kn.P_THDEM] = start + mv.theta_dem
+        prm[lay.P_THDEM] = start + mv.theta_dem
         if controller == "optimum":
             tm = tracked_move(d)
             refs.append(np.vstack((start + tm.theta, tm.omega, tm.alpha)))
@@ -176,15 +176,15 @@ def cycle_run(params: DriveParams, moves: Sequence[Move], controller: str) -> Cy
     step_v = np.array([s.Gamma_Le for s in params.load.steps], dtype=float)
     total = int(steps.sum())
     decim = max(1, math.ceil(total / TRACE_POINTS))
-    out = np.zeros((kn.N_CH, total // decim + 1))
-    seg = np.zeros((len(moves), kn.N_X))
+    out = np.zeros((lay.N_CH, total // decim + 1))
+    seg = np.zeros((len(moves), lay.N_X))
     n = run_cycle(prm_all, steps, ref_all, off, step_t, step_v, Phi, Gam, Lo, continuous, h, sub,
                   params.controller.delay_samples, decim, out, seg, sensors.noise_table(params.sensors))
-    chans = {name: out[kn.CHANNELS.index(name), : abs(n) - (1 if n < 0 else 0)]
+    chans = {name: out[lay.CHANNELS.index(name), : abs(n) - (1 if n < 0 else 0)]
              for name in ("t", "theta_r", "omega_r", "E_electrical")}
     if n < 0:
         return CycleRun(None, None, None, None, None, None, None, chans, False)
-    e_el = np.concatenate(([0.0], seg[:, kn.X_EEL]))
+    e_el = np.concatenate(([0.0], seg[:, lay.X_EEL]))
     end = decode_state(seg[-1])
     stored = kinetic_energy(params, end) + magnetic_energy(params, end)
     return CycleRun(tuple(float(x) for x in np.diff(e_el)), float(end.E_electrical), float(end.E_copper),

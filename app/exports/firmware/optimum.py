@@ -34,7 +34,7 @@ from pmsm_commissioning.control.common.checks import ParameterError
 from pmsm_commissioning.control.fdsmc.derivations import Derived
 from pmsm_commissioning.control.fdsmc.optimum import tracked_move
 from pmsm_commissioning.control.fdsmc.params import DriveParams
-from pmsm_commissioning.sim.fdsmc import kernel as kn
+from pmsm_commissioning.sim.fdsmc import layout as lay
 from pmsm_commissioning.sim.fdsmc.engine import pack_parameters
 from pmsm_commissioning.sim.fdsmc.grid import time_grid
 
@@ -102,12 +102,12 @@ def optimum_constants(params: DriveParams, d: Derived, table: ReferenceTable) ->
     """(name, value, unit, reference, integer) of the optimum's ``#define`` constants, in SI units."""
     prm = pack_parameters(params, d, "optimum")
     g = time_grid(params, 1, 0.0, 1)
-    lead = float(prm[kn.P_LEAD])
+    lead = float(prm[lay.P_LEAD])
     cpr = encoder_counts_per_rev(params)
     return [
-        ("G1_TRACK", float(prm[kn.P_G1]), "1/s^2", "tracking gain a^2 (control/fdsmc/tracking.py)", False),
-        ("G2_TRACK", float(prm[kn.P_G2]), "1/s", "tracking gain 2a (control/fdsmc/tracking.py)", False),
-        ("T_C_SLIDE", float(prm[kn.P_TC]), "s",
+        ("G1_TRACK", float(prm[lay.P_G1]), "1/s^2", "tracking gain a^2 (control/fdsmc/tracking.py)", False),
+        ("G2_TRACK", float(prm[lay.P_G2]), "1/s", "tracking gain 2a (control/fdsmc/tracking.py)", False),
+        ("T_C_SLIDE", float(prm[lay.P_TC]), "s",
          "terminal slide's T_c = 3.5/(alpha_max*K), K below the chatter limit, eq. (41)", False),
         ("REF_LEAD", lead, "s", "alpha_ref read ahead: T_salpha/3 + the computation delay", False),
         ("REF_NODES", table.nodes, "-", f"nodes of the reference table ({table.float_bytes} bytes float32)", True),
