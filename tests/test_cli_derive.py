@@ -25,6 +25,12 @@ def test_derive_json_keys_and_values(capsys):
     assert out["alpha_max"] == pytest.approx(2651.16, abs=0.01)
     assert out["g1"] == pytest.approx(31.36)
     assert isinstance(out["warnings"], list) and out["warnings"]
+    # every key the README lists under ``loop``; the paper preset's exact sensors leave K to the loop's margin
+    loop = out["loop"]
+    assert set(loop) >= {"K_limit", "K_limit_cruise", "K_limit_slope", "K_recommended", "zeta_slope",
+                         "zeta_slope_recommended", "T_c_min", "K_noise", "noise_limited"}
+    assert loop["noise_limited"] is False
+    assert loop["K_recommended"] == pytest.approx(loop["K_limit"] / loop["margin"])
 
 
 def test_derive_table(capsys):

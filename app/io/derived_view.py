@@ -108,7 +108,7 @@ def derived_json(d: Derived) -> dict[str, Any]:
         "feasibility": to_json(d.feasibility),
         "warnings": list(d.warnings),
         # a K limit that does not exist (the loop is never or always unstable) becomes null
-        "loop": to_json(d.gain),
+        "loop": {**to_json(d.gain), "noise_limited": d.gain.noise_limited},
         "sample_rate": to_json(d.sample_rate),
     }
     if d.observer_discrete is not None:
