@@ -13,6 +13,8 @@ import json
 import time
 from typing import Any
 
+import pytest
+
 from pmsm_commissioning.app.ui.demo_state import DemoState, PageView, dumps_state
 from tests.browser.conftest import TIMEOUT_MS, click_tab, figure, session_of, set_number, wait_for_layout
 from tests.page_client import decode_frame
@@ -81,6 +83,11 @@ def _simulate(page: Any, session: Any, figures: Figures, T_m: float) -> int:
     return n
 
 
+def _omega_p_of(spec: dict[str, Any]) -> float:
+    """ω_p of a time-plots figure's JSON (its reference line, eq. (60)) [rad/s]."""
+    return abs(next(t for t in spec["data"] if t["name"].startswith("ω_p"))["y"][0])
+
+
 def _omega_p_drawn(page: Any) -> float | None:
     """ω_p of the time plots drawn in the page (its reference line, eq. (60)) [rad/s]; None if not drawn."""
     fig = figure(page, "time_plots")
@@ -106,6 +113,9 @@ def test_the_time_plots_go_out_when_their_tab_is_chosen_and_with_each_run_while_
         sent = figures.since(n)
         assert "phase_plane" in sent and "k_sweep" in sent  # what the Overview and the K demo show
         assert not set(WAITING) & set(sent), sent  # nothing of the tabs not shown
+        exported = json.loads(session.export.figures()["time_plots"])  # the Share tab's: this run's, unsent
+        assert _omega_p_of(exported) == pytest.approx(session.comparison.derived.profile.omega_p, rel=1e-6)
+        assert "time_plots" not in figures.since(n)
         n = len(figures.ids)
         click_tab(page, "Time plots")
         shows_the_time_plots_of(page, session)  # the run just simulated, not the start-up one
