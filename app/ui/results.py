@@ -80,6 +80,7 @@ class ResultsPanel:
             self.k_sweep = KSweepView(gui)
         with time_tab:
             self.time_plots = add_figure(gui, time_plots_json(comparison), ASPECT_TIME)
+            self.tab_figures.add("Time plots", self.time_plots, _time_plots_of, figure_json_shown(self.time_plots))
         with phase_tab:
             self.replay = Replay(gui, self.phase, scene, (comparison, targets),
                                  flush=client.flush, on_3d=on_3d)
@@ -94,7 +95,6 @@ class ResultsPanel:
         with self.panel.add_tab("Stock drive", viser.Icon.ROUTE):
             self.stock_text = gui.add_html(stock_html(comparison) if runs(comparison) else "")
             self.stock = self._tab_figure(gui, "Stock drive", _when_simulated(stock_route_spec), ASPECT_STOCK)
-        self.tab_figures.add("Time plots", self.time_plots, _time_plots_of, figure_json_shown(self.time_plots))
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
             self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
