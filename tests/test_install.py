@@ -189,6 +189,19 @@ def test_the_wheel_carries_the_licence_and_the_metadata(wheel: Path) -> None:
         f"pmsm_commissioning/presets/{p.name}" for p in (ROOT / "presets").glob("*.yaml"))
 
 
+def test_the_wheel_ships_the_c_texts_and_not_the_arm_bench_helpers(wheel: Path) -> None:
+    """The C controller's texts are package data beside their reader; the ARM cross-compile helpers
+    (scripts/c_arm.py, used by scripts/c_bench.py and the tests) are a developer's tool, not the product's.
+    """
+    with zipfile.ZipFile(wheel) as z:
+        names = z.namelist()
+    texts = ROOT / "app" / "exports" / "firmware" / "c"
+    assert sorted(n for n in names if n.endswith(".c.in")) == sorted(
+        f"pmsm_commissioning/app/exports/firmware/c/{p.name}" for p in texts.glob("*.c.in"))
+    assert len(list(texts.glob("*.c.in"))) >= 4
+    assert [n for n in names if n.rsplit("/", 1)[-1] == "c_arm.py"] == []
+
+
 def test_console_help_names_the_program_and_every_command_and_version(installed: dict[str, Path]) -> None:
     from pmsm_commissioning.app.cli.main import COMMANDS
 
