@@ -81,7 +81,7 @@ def test_sigint_stops_with_130_one_line_and_no_partial_file(tmp_path, name, argv
     out.write_bytes(OLD)
     result, _ = interrupt([a.format(out=out) for a in argv], after_s)
     assert result.returncode == 130, (name, result.returncode, result.stderr[-500:])
-    # one line of message, after any progress line the command had open (a terminal's \r overwrites it)
+    # one line of message, after the whole progress lines the command wrote (stderr is not a terminal here)
     lines = [ln for ln in re.split(r"[\r\n]+", result.stderr) if ln.strip()]
     assert "Traceback" not in result.stderr and lines[-1].startswith("interrupted"), result.stderr
     assert all(ln.strip().startswith("simulated") for ln in lines[:-1]), result.stderr

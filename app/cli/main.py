@@ -202,6 +202,7 @@ def _run_in_thread(args: argparse.Namespace) -> int:
 
 def _stop_interrupted() -> NoReturn:
     """Remove files being written, say so in one line, exit 130 at once (threads are not waited for)."""
+    from pmsm_commissioning.app.cli.progress import bar_open
     from pmsm_commissioning.app.io.atomic import discard_partial
 
     discard_partial()
@@ -210,8 +211,8 @@ def _stop_interrupted() -> NoReturn:
     _end_child_processes()  # a pool's workers (they would also end themselves, a moment later)
     try:
         sys.stdout.flush()
-        # \r: over a progress line a command may have left open (table1's "simulated 2/5"), as a terminal shows it
-        sys.stderr.write("\rinterrupted: stopped; no partial file was left\n")
+        # below a progress bar left open on the terminal (it stays as drawn last); plain progress lines are whole
+        sys.stderr.write(("\n" if bar_open() else "") + "interrupted: stopped; no partial file was left\n")
         sys.stderr.flush()
     finally:
         os._exit(INTERRUPTED)

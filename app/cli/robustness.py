@@ -22,6 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
+from pmsm_commissioning.app.cli.progress import Progress
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.numbers import integer_option, number_option
 from pmsm_commissioning.app.io.plant_overrides import load_model_and_plant
@@ -66,13 +67,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="write the same rows as Parquet, with each column's unit in the schema metadata")
 
 
-def _progress(done: int, total: int) -> None:
-    sys.stderr.write(f"\rsamples {done}/{total} ({100 * done // total} %)")
-    if done == total:
-        sys.stderr.write("\n")
-    sys.stderr.flush()
-
-
 def _print_table(summary: dict[str, Any]) -> None:
     nominal = " (one nominal run: no spread)" if summary.get("nominal_run") else ""
     print(f"{summary['samples']} samples in {summary['seconds']:.1f} s{nominal}")
@@ -113,7 +107,7 @@ def _quiet_dask() -> None:
         logging.getLogger(name).setLevel(logging.CRITICAL)
 
 
-def _compute(args: argparse.Namespace) -> RobustnessResult:
+def _compute(args: argparse.Namespace, progress: Progress) -> RobustnessResult:
     params, plant = load_model_and_plant(args.preset, args.overrides)  # plant: the nominal plant
     spreads = parse_spreads(args.spread)
     ctrl = tuple(c.strip() for c in args.controllers.split(","))
@@ -122,13 +116,13 @@ def _compute(args: argparse.Namespace) -> RobustnessResult:
 
         _quiet_dask()
         with connect(args.scheduler, args.cluster_timeout) as ex:
-            return robustness(params, spreads, args.samples, args.seed, ex, ex.workers, _progress, plant=plant,
+            return robustness(params, spreads, args.samples, args.seed, ex, ex.workers, progress, plant=plant,
                               controllers=ctrl)
     if args.workers == 1:
-        return robustness(params, spreads, args.samples, args.seed, None, 1, _progress, plant=plant,
+        return robustness(params, spreads, args.samples, args.seed, None, 1, progress, plant=plant,
                           controllers=ctrl)
     with RetryingPool(args.workers) as pool:
-        return robustness(params, spreads, args.samples, args.seed, pool, args.workers, _progress, plant=plant,
+        return robustness(params, spreads, args.samples, args.seed, pool, args.workers, progress, plant=plant,
                           controllers=ctrl)
 
 
@@ -163,9 +157,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the Monte-Carlo analysis and print the summary; 2 with one line when the executor fails."""
     _check(args)
     try:
-        res = _compute(args)
+        with Progress("samples", "sample") as progress:  # the bar's line ended before any error line
+            res = _compute(args, progress)
     except IncompleteRunError as exc:
-        sys.stderr.write("\n")
         _write(args, exc.partial)
         written = " (finished samples written, marked incomplete)" if args.csv or args.parquet else ""
         sys.stderr.write(f"error: {exc}{written}\n")

@@ -13,9 +13,9 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import sys
 
 from pmsm_commissioning.app.cli.main import add_preset_arguments
+from pmsm_commissioning.app.cli.progress import Progress
 from pmsm_commissioning.app.io.json_data import to_json
 from pmsm_commissioning.app.io.numbers import format_metric, parse_T_m_list
 from pmsm_commissioning.app.io.presets import load
@@ -49,17 +49,12 @@ def run(args: argparse.Namespace) -> int:
     """Run the sweep and print the table (or JSON)."""
     params = load(args.preset, args.overrides, mode="position")
     tms = parse_T_m_list(args.tm, "--tm")
-
-    def progress(done: int, total: int) -> None:
-        if not args.json:
-            sys.stderr.write(f"\r  simulated {done}/{total}")
-            sys.stderr.flush()
-
-    rows = table1_sweep(params, tms, progress)
     if args.json:
+        rows = table1_sweep(params, tms)
         print(json.dumps(to_json({"rows": [row_json(r) for r in rows]}), indent=2))
         return 0
-    sys.stderr.write("\n")
+    with Progress("simulated", "run") as progress:
+        rows = table1_sweep(params, tms, progress)
     print(f"Preset: {params.name}, f_s = {params.controller.f_s}, K = {params.controller.K:g} s/rad\n")
     print(f"{'T_m [s]':>8} {'W_FDSMC [J]':>12} {'W_conv [J]':>12} {'saving %':>9} {'eq.52 %':>8} "
           f"{'bound %':>8} {'paper %':>8} {'reversed %':>10}")
