@@ -134,7 +134,7 @@ def test_header_and_docs_state_the_timing_the_verification_runs(tmp_path):
 
 
 def test_the_documented_isr_sequence_keeps_the_hard_current_limit_and_the_simulators_run(tmp_path):
-    """Shadow registers loaded at k+1 with call k's u_next (c_verify.closed_loop): bit-identical to the
+    """Shadow registers loaded at k+1 with call k's u_next (firmware.verify.closed_loop): bit-identical to the
     simulator with the limits acting, |i_dq| <= I_LIMIT (0.1 %); writing the held out.u_d/u_q instead
     (two samples late) breaks the limit.
     """

@@ -1,7 +1,7 @@
 """The golden vectors kill mutants of the generated C: each mutation of the controller's source must
 make the export's host test program (fdsmc_test.c) fail, in the double and the float32 build.
 
-The vectors (app/exports/firmware/golden.py, c_targeted.py) cover the designed move and hold, the limits acting,
+The vectors (app/exports/firmware/golden.py, targeted.py) cover the designed move and hold, the limits acting,
 two injected faults, calls at rest in which the d-axis current limit or the voltage limit acts, and
 fdsmc_set_move's refusals (busy, moving), so a wrong gain on the sloped segment, a sign error in the
 q-axis or d-axis current limit, a voltage limit off by 1 %, an innovation threshold 100 times too large,
