@@ -106,18 +106,6 @@ TEMPLATE_LAYOUT: dict[str, object] = {
     "annotationdefaults": {"font": {"size": FONT_PX}},
 }
 
-#: Page CSS: no text under 14 px in the page's controls (viser draws labels, buttons, tabs and slider
-#: marks at 11–13 px): labels, inputs, buttons, tabs, slider marks (#4a4a4a on white: contrast
-#: 8.9:1) and the readouts under the live-tuning sliders at :data:`FONT_PX`.
-SLIDER_CSS = (f".mantine-Slider-markLabel{{color:#4a4a4a !important;font-size:{FONT_PX}px !important;"
-              "opacity:1 !important}"
-              f".mantine-Slider-label,.mantine-Button-label,.mantine-Tabs-tabLabel,.mantine-Tabs-tab,"
-              f".mantine-InputWrapper-label,.mantine-InputWrapper-description,.mantine-Input-input,"
-              f".mantine-Select-option,.mantine-Accordion-label,.mantine-SegmentedControl-label,"
-              f".mantine-Checkbox-label,.mantine-Tooltip-tooltip,[data-role$='-readout'],[role='tab'],"
-              f"[role='tab'] *,.mantine-Text-root,.mantine-Text-root label,.mantine-Paper-root"
-              f"{{font-size:{FONT_PX}px !important}}")
-
 #: Client-side export: the figure is laid out at a 720p slide's size [px] (so its 14 px text is 14 px
 #: on the slide), the SVG at that size, the PNG drawn at :data:`EXPORT_SCALE` (1920×1080 pixels: text
 #: 21 px in the image, 14 px again once the slide shows it at 1280×720).
@@ -126,5 +114,5 @@ EXPORT_SCALE = 1.5
 
 __all__ = ["BLDC_COLOURS", "BLDC_DASHES", "EXPORT_SCALE", "EXPORT_SIZE", "FIGURE_GROUPS", "FONT_PX", "KEY_PX",
            "OKABE_ITO",
-           "PHASE_COLOURS", "PHASE_DASHES", "POSITION_COLOURS", "POSITION_DASHES", "REFERENCE_COLOUR", "SLIDER_CSS",
+           "PHASE_COLOURS", "PHASE_DASHES", "POSITION_COLOURS", "POSITION_DASHES", "REFERENCE_COLOUR",
            "TEMPLATE_LAYOUT", "TITLE_PX", "WARNING_COLOUR", "fmt", "line", "round_to_meaning"]

@@ -17,6 +17,7 @@ from pmsm_commissioning.app.figures.bldc_panels import make_antiwindup_figure, m
 from pmsm_commissioning.app.figures.bldc_speed_smc import make_currents_figure, make_sigma_figure, make_speed_figure
 from pmsm_commissioning.app.figures.plain import placeholder_json
 from pmsm_commissioning.app.io.bldc_view import metric_table
+from pmsm_commissioning.app.ui.page_hooks import with_hooks
 from pmsm_commissioning.app.ui.viser_adapter import add_figure, figure_json_of, set_figure_json
 from pmsm_commissioning.sim.bldc.engine import LABELS, BldcComparison, BldcRunResult
 
@@ -82,23 +83,25 @@ def follow_tabs_js() -> str:
 
     "BLDC speed SMC" → "BLDC figures"; the position tab → "Overview". Installed once per page.
     """
-    return """(() => {
+    return with_hooks("""(() => {
   if (window.__appFollowTabs) return;
   window.__appFollowTabs = true;
+  const H = PAGE_HOOKS;
   document.addEventListener("click", (ev) => {
-    const tab = ev.target.closest ? ev.target.closest('[role="tab"]') : null;
-    if (!tab || !tab.closest('[data-dock-region="left"]')) return;
-    const title = tab.getAttribute("title") || tab.textContent.trim();
+    const tab = ev.target.closest ? ev.target.closest(H.TAB.sel) : null;
+    const region = tab && tab.closest(H.DOCK_REGION.sel);
+    if (!region || region.getAttribute(H.DOCK_REGION.attr) !== "left") return;
+    const title = tab.getAttribute(H.TAB.attr) || tab.textContent.trim();
     const want = title.startsWith("BLDC") ? "BLDC figures" : title.startsWith("Position") ? "Overview" : null;
     if (want === null) return;
     setTimeout(() => {
-      const target = document.querySelector(`[role="tab"][title="${want}"]`);
-      if (target && target.getAttribute("aria-selected") !== "true") {  // viser's dock tabs: Enter activates
+      const target = [...document.querySelectorAll(H.TAB.sel)].find(t => t.getAttribute(H.TAB.attr) === want);
+      if (target && target.getAttribute(H.SELECTED_TAB.attr) !== "true") {  // viser's dock tabs: Enter activates
         target.dispatchEvent(new KeyboardEvent("keydown", {key: "Enter", code: "Enter", bubbles: true}));
       }
     }, 0);
   }, true);
-})();"""
+})();""")
 
 
 __all__ = ["BldcResults", "comparison_json", "follow_tabs_js", "metrics_markdown"]

@@ -19,6 +19,7 @@ from pathlib import Path
 import viser
 
 from pmsm_commissioning.app.ui.demo_state import MODE_TABS, RESULTS_TABS, PageView, loads_view
+from pmsm_commissioning.app.ui.page_hooks import with_hooks
 from pmsm_commissioning.app.ui.viser_adapter import figure_json_shown, run_script, set_figure_json, widget_id
 
 #: Longest report read from the page [characters] (a view with every axis zoomed is ≈ 700).
@@ -26,7 +27,7 @@ MAX_REPORT = 4000
 #: Delay between selecting the mode tab and the results tab [ms]: choosing a mode tab selects its own
 #: results tab first (:func:`app.ui.bldc_results.follow_tabs_js`).
 RESULTS_TAB_DELAY_MS = 80
-_REPORT_JS = (Path(__file__).resolve().parent / "assets" / "page_view.js").read_text(encoding="utf-8")
+_REPORT_JS = with_hooks((Path(__file__).resolve().parent / "assets" / "page_view.js").read_text(encoding="utf-8"))
 
 
 def view_report_js(field_uuid: str) -> str:
@@ -40,16 +41,17 @@ def select_tabs_js(view: PageView) -> str:
 
     viser's dock tabs take Enter on the focused tab as a choice: the script sends that key to each.
     """
-    return """(([mode, results, delay]) => {
+    return with_hooks("""(([mode, results, delay]) => {
+  const H = PAGE_HOOKS;
   const press = (title) => {
-    const tab = [...document.querySelectorAll('[role="tab"]')].find(t => t.getAttribute('title') === title);
-    if (tab && tab.getAttribute('aria-selected') !== 'true') {
+    const tab = [...document.querySelectorAll(H.TAB.sel)].find(t => t.getAttribute(H.TAB.attr) === title);
+    if (tab && tab.getAttribute(H.SELECTED_TAB.attr) !== 'true') {
       tab.dispatchEvent(new KeyboardEvent('keydown', {key: 'Enter', code: 'Enter', bubbles: true}));
     }
   };
   if (mode !== null) press(mode);
   if (results !== null) setTimeout(() => press(results), delay);
-})(ARGS);""".replace("ARGS", json.dumps([view.mode_tab, view.results_tab, RESULTS_TAB_DELAY_MS]))
+})(ARGS);""").replace("ARGS", json.dumps([view.mode_tab, view.results_tab, RESULTS_TAB_DELAY_MS]))
 
 
 def zoomed_json(figure_json: str, zoom: dict[str, tuple[float, float]]) -> str:

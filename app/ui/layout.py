@@ -23,6 +23,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from pmsm_commissioning.app.figures.style import FONT_PX
+from pmsm_commissioning.app.ui import page_hooks as hk
+from pmsm_commissioning.app.ui.page_hooks import with_hooks
+
 #: Canvas width while the 3D view is folded [px]: a gutter (the results panel takes the rest).
 CANVAS_SPARE = 12.0
 #: Share of the window width given to the 3D view when it is shown [-], and its least width [px].
@@ -102,30 +106,43 @@ def page_css(show_3d: bool = False) -> str:
     """
     gutters = 2 * EDGE_GAP
     canvas = f"max({SCENE_MIN:g}px, {100 * SCENE_SHARE:g}%)" if show_3d else f"{CANVAS_SPARE:g}px"
-    root, child = "[data-dock-root]", "[data-dock-root] > div"
-    railed = "[data-app-rail-{}] [data-dock-root]"
+    root, canvas_box, tab = hk.DOCK_ROOT.selector, hk.DOCK_CANVAS.selector, hk.TAB.selector
+    railed = "[data-app-rail-{}] " + root
+    left, right = hk.DOCK_REGION.at("left"), hk.DOCK_REGION.at("right")
     return (
         "[data-app-bldc] canvas {visibility: hidden} "
         "[data-app-hidden] {display: none !important} "
-        f"[role='tab'] {{padding: 0 {TAB_PAD_EM:g}em !important}} "
-        f"[role='tab'] > div:first-child:not(:last-child) {{margin-right: {TAB_GAP_EM:g}em !important}} "
+        f"{tab} {{padding: 0 {TAB_PAD_EM:g}em !important}} "
+        f"{hk.TAB_ICON.selector} {{margin-right: {TAB_GAP_EM:g}em !important}} "
         f"{root} {{--fit-left: {CONTROL_WIDTH + gutters:g}px; --fit-canvas: {canvas}; "
         f"--fit-right: max({RESULTS_MIN + gutters:g}px, calc(100% - var(--fit-left) - var(--fit-canvas)))}} "
         f"@media (min-width: {WIDE_WINDOW + 1:g}px) {{ {root} {{--fit-left: {CONTROL_WIDTH_WIDE + gutters:g}px}} }} "
         f"{railed.format('left')} {{--fit-left: {RAIL + gutters:g}px}} "
         f"{railed.format('right')} {{--fit-right: {RAIL + gutters:g}px}} "
-        '[data-dock-region="left"], [data-app-fit="left"] {width: var(--fit-left) !important} '
-        '[data-dock-region="right"], [data-app-fit="right"] {width: var(--fit-right) !important} '
+        f'{left}, [data-app-fit="left"] {{width: var(--fit-left) !important}} '
+        f'{right}, [data-app-fit="right"] {{width: var(--fit-right) !important}} '
         "[data-app-column] {width: 100% !important} "
-        f"{child}:first-child {{left: var(--fit-left) !important; right: var(--fit-right) !important}} "
+        f"{canvas_box} {{left: var(--fit-left) !important; right: var(--fit-right) !important}} "
         f"[data-app-overview-window] {{left: auto !important; right: {EDGE_GAP:g}px !important; "
         f"top: {REGION_HANDLE:g}px !important; height: calc(100% - {REGION_HANDLE:g}px) !important; "
         f"width: calc(var(--fit-right) - {gutters:g}px) !important}}")
 
 
+#: Page CSS: no text under 14 px in the page's controls (viser draws labels, buttons, tabs and slider
+#: marks at 11–13 px): labels, inputs, buttons, tabs, slider marks (#4a4a4a on white: contrast
+#: 8.9:1) and the readouts under the live-tuning sliders (``data-role="…-readout"``) at ``FONT_PX``.
+LEGIBILITY_CSS = (
+    f"{hk.SLIDER_MARK_LABEL.selector}{{color:#4a4a4a !important;font-size:{FONT_PX}px !important;opacity:1 !important}}"
+    + ",".join((*(h.selector for h in (hk.SLIDER_VALUE_LABEL, hk.BUTTON_LABEL, hk.INPUT_LABEL, hk.INPUT,
+                                       hk.SELECT_OPTION, hk.CHECKBOX_LABEL, hk.TOOLTIP)),
+                "[data-role$='-readout']", hk.TAB.selector, f"{hk.TAB.selector} *", hk.TEXT.selector,
+                f"{hk.TEXT.selector} label", hk.PAPER.selector))
+    + f"{{font-size:{FONT_PX}px !important}}")
+
+
 #: The page script of :func:`page_marks_js`, read once per process (its fields filled in per page).
-_PAGE_MARKS_JS = (Path(__file__).resolve().parent / "assets" / "page_marks.js").read_text(
-    encoding="utf-8").replace("SCENE_MIN_PX", f"{SCENE_MIN - 1:g}")
+_PAGE_MARKS_JS = with_hooks((Path(__file__).resolve().parent / "assets" / "page_marks.js").read_text(
+    encoding="utf-8")).replace("SCENE_MIN_PX", f"{SCENE_MIN - 1:g}")
 
 
 def page_marks_js(hidden_fields: Sequence[str]) -> str:
@@ -171,14 +188,16 @@ def window_report_js(probe_uuid: str) -> str:
     it (``" ?demo=…"``, at most :data:`MAX_ADDRESS` characters; nothing when there is none), read
     before any run rewrites the address (:func:`page_address`).
     """
-    return """(() => {
+    return with_hooks("""(() => {
   const uuid = UUID;
+  const H = PAGE_HOOKS;
   const search = location.search.slice(0, MAX_ADDRESS);  // as opened: before a run rewrites it
   const setValue = Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set;
   let frame = 0;
   const report = () => {
-    const label = document.querySelector(`label[for="${uuid}"]`);
-    const input = label && label.closest('.mantine-Flex-root').querySelector('input');
+    const label = [...document.querySelectorAll(H.FIELD_LABEL.sel)]
+      .find(l => l.getAttribute(H.FIELD_LABEL.attr) === uuid);
+    const input = label && label.closest(H.FIELD_ROW.sel).querySelector('input');
     if (!input) {  // not mounted yet: look again next frame (for at most ≈ 1 min)
       if (++frame < 3600) requestAnimationFrame(report);
       return;
@@ -192,7 +211,7 @@ def window_report_js(probe_uuid: str) -> str:
   window.__reportWindow = () => { frame = 0; report(); };
   window.addEventListener('resize', window.__reportWindow);
   report();
-})();""".replace("UUID", json.dumps(probe_uuid)).replace("MAX_ADDRESS", str(MAX_ADDRESS))
+})();""").replace("UUID", json.dumps(probe_uuid)).replace("MAX_ADDRESS", str(MAX_ADDRESS))
 
 
 #: The window report: ``"<width>x<height>"`` [px], then the page address's query (if any).
@@ -257,5 +276,5 @@ class WindowFit:
             self._apply(layout)
 
 
-__all__ = ["PanelLayout", "WindowFit", "hide_field_js", "install_css_js", "layout_for_window", "page_css",
-           "page_address", "page_marks_js", "parse_window", "window_report_js"]
+__all__ = ["LEGIBILITY_CSS", "PanelLayout", "WindowFit", "hide_field_js", "install_css_js", "layout_for_window",
+           "page_css", "page_address", "page_marks_js", "parse_window", "window_report_js"]

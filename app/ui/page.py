@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 
 import viser
 
-from pmsm_commissioning.app.figures.style import SLIDER_CSS
 from pmsm_commissioning.app.threads import limit_blas_threads, release_memory
 from pmsm_commissioning.app.ui.bldc_results import follow_tabs_js
 from pmsm_commissioning.app.ui.bldc_tab import add_bldc_tab, warm_bldc
@@ -27,6 +26,7 @@ from pmsm_commissioning.app.ui.figure_export import FigureExport
 from pmsm_commissioning.app.ui.files import FilesPanel
 from pmsm_commissioning.app.ui.inputs import InputsPanel
 from pmsm_commissioning.app.ui.layout import (
+    LEGIBILITY_CSS,
     PanelLayout,
     WindowFit,
     hide_field_js,
@@ -151,7 +151,7 @@ class Session:
         self._window_probe.on_update(lambda _: self._window_reported(self._window_probe.value))
         run_script(gui, window_report_js(widget_id(self._window_probe)))
         run_script(gui, follow_tabs_js())
-        run_script(gui, install_css_js(SLIDER_CSS, "app-legibility-style"))
+        run_script(gui, install_css_js(LEGIBILITY_CSS, "app-legibility-style"))
 
     def _window_reported(self, text: str) -> None:
         """Fit the panels to the window the page reported; open the demo its address names (first report)."""

@@ -35,6 +35,7 @@ from pmsm_commissioning.app.figures.fdsmc_replay import (
 )
 from pmsm_commissioning.app.figures.plain import figure_json
 from pmsm_commissioning.app.ui.layout import ASPECT_MAX, ASPECT_MIN, CHROME_HEIGHT
+from pmsm_commissioning.app.ui.page_hooks import with_hooks
 from pmsm_commissioning.app.ui.props import assign
 from pmsm_commissioning.app.ui.scene import RotorScene
 from pmsm_commissioning.app.ui.viser_adapter import run_script, set_figure_json
@@ -136,7 +137,7 @@ SCRUB_JS = """(() => {{ const P = window.Plotly; if (!P) return;
 #: from here, where the rejection of an interrupted animation (pause, scrub, another speed) is
 #: caught. ``window.__appTrail(el, t)`` shows the trail pieces ending by ``t`` [s]: their points
 #: are kept from the figure as it arrived (a replay empties them), so a scrub sends only ``t``.
-BUTTONS_JS = (Path(__file__).resolve().parent / "assets" / "replay_buttons.js").read_text(encoding="utf-8")
+BUTTONS_JS = with_hooks((Path(__file__).resolve().parent / "assets" / "replay_buttons.js").read_text(encoding="utf-8"))
 
 
 def scrub_js(comparison: Any, targets: ScrubTargets, t: float) -> str:

@@ -8,14 +8,15 @@
 // put back with Plotly.relayout. Reads Plotly's el.layout (the ranges as drawn), a public property.
 (() => {
   const uuid = UUID, modeTabs = MODE_TABS, resultsTabs = RESULTS_TABS;
+  const H = PAGE_HOOKS;  // viser's markup this script hooks into (app/ui/page_hooks.py)
   const setValue = Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set;
   const axisKey = /^([xy]axis[2-9]?)\.(range|autorange)/;
   const overview = () => [...document.querySelectorAll('.js-plotly-plot')]
     .find(e => e.layout && e.layout.meta && e.layout.meta.id === 'phase_plane');
   const selected = (titles) => {
-    const tab = [...document.querySelectorAll('[role="tab"][aria-selected="true"]')]
-      .find(t => titles.includes(t.getAttribute('title')));
-    return tab ? tab.getAttribute('title') : null;
+    const tab = [...document.querySelectorAll(H.SELECTED_TAB.sel)]
+      .find(t => titles.includes(t.getAttribute(H.TAB.attr)));
+    return tab ? tab.getAttribute(H.TAB.attr) : null;
   };
   const restart = (el) => { el.__appZoom = Object.assign({}, (el.layout.meta || {}).zoom || {}); };
   // The figure an element shows: its title and meta (ω_p, T_c …); a new run gives a new one.
@@ -48,8 +49,9 @@
   };
   let frame = 0;
   const report = () => {
-    const label = document.querySelector(`label[for="${uuid}"]`);
-    const flex = label && label.closest('.mantine-Flex-root');
+    const label = [...document.querySelectorAll(H.FIELD_LABEL.sel)]
+      .find(l => l.getAttribute(H.FIELD_LABEL.attr) === uuid);
+    const flex = label && label.closest(H.FIELD_ROW.sel);
     const input = flex && flex.querySelector('input');
     if (!input) {  // not mounted yet: look again next frame (for at most ≈ 1 min)
       if (++frame < 3600) requestAnimationFrame(report);

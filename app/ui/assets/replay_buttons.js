@@ -2,6 +2,7 @@
 // (no public equivalent: the trail's points as drawn, and whether a replay transition still runs), and
 // draws the "Replay t" slider (app.ui.replay.Replay) at the replay's time.
 (() => { if (window.__appReplayButtons) return; window.__appReplayButtons = true;
+  const H = PAGE_HOOKS;  // viser's markup this script hooks into (app/ui/page_hooks.py)
   const stash = (el) => { if (el.__trailFor !== el.data) { el.__trailFor = el.data;
       el.__trail = (el._fullData || []).filter(d => d.meta && typeof d.meta.trail === 'number')
                    .map(d => [d.index, d.meta.trail, d.x, d.y]); }
@@ -17,15 +18,16 @@
   // value is not changed: a change would go to the server as a scrub and stop the replay)
   const follow = (frame) => { const text = frame && frame.data && frame.data[0] && frame.data[0].text;
     const t = text ? parseFloat(String(text[0]).replace('t = ', '')) : NaN;
-    const label = [...document.querySelectorAll('label')].find(l => l.textContent.trim() === 'Replay t [s]');
-    const row = label && label.closest('.mantine-Flex-root');
-    const thumb = row && row.querySelector('[role="slider"]');
+    const label = [...document.querySelectorAll(H.FIELD_LABEL.sel)].find(l => l.textContent.trim() === 'Replay t [s]');
+    const row = label && label.closest(H.FIELD_ROW.sel);
+    const thumb = row && row.querySelector(H.SLIDER_THUMB.sel);
     if (!(thumb && isFinite(t))) return;
-    const end = parseFloat(thumb.getAttribute('aria-valuemax')), p = Math.min(100, Math.max(0, 100 * t / end));
-    thumb.style.setProperty('--slider-thumb-offset', `${p}%`);
-    const bar = row.querySelector('.mantine-Slider-bar');
-    if (bar) bar.style.setProperty('--slider-bar-width', `calc(${p}% + 2 * var(--slider-size))`);
-    const box = row.querySelector('input.mantine-NumberInput-input');
+    const end = parseFloat(thumb.getAttribute(H.SLIDER_THUMB.attr)), p = Math.min(100, Math.max(0, 100 * t / end));
+    const [offset] = H.SLIDER_THUMB.vars, [width, size] = H.SLIDER_BAR.vars;
+    thumb.style.setProperty(offset, `${p}%`);
+    const bar = row.querySelector(H.SLIDER_BAR.sel);
+    if (bar) bar.style.setProperty(width, `calc(${p}% + 2 * var(${size}))`);
+    const box = row.querySelector(H.NUMBER_INPUT.sel);
     if (box && document.activeElement !== box) box.value = t.toFixed(3); };
   setInterval(() => { for (const el of document.querySelectorAll('.js-plotly-plot')) {
     if (!(el.layout && el.layout.meta && el.layout.meta.overview && el._fullData)) continue;
