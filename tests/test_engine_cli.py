@@ -66,6 +66,21 @@ def test_simulate_csv_is_the_export_format(tmp_path, capsys):
     assert float(rows[-1][2]) == pytest.approx(60.0, rel=0.02)
 
 
+def test_simulate_csv_dash_writes_the_csv_alone_to_stdout(tmp_path, capsys, monkeypatch):
+    """``--csv -`` is the usual "stdout": the same CSV as a file gets, no table around it, no file named '-'."""
+    monkeypatch.chdir(tmp_path)
+    args = ["simulate", "paper_12kw_pmsm", "--controller", "fdsmc"]
+    assert main([*args, "--csv", "-"]) == 0
+    piped = capsys.readouterr().out
+    assert not (tmp_path / "-").exists()
+    assert main([*args, "--csv", "run.csv"]) == 0
+    capsys.readouterr()
+    assert piped == (tmp_path / "run.csv").read_text()
+    assert main([*args, "--csv", "-", "--json"]) == 2  # both on stdout: refused, naming the two options
+    err = capsys.readouterr().err
+    assert "--csv -" in err and "--json" in err
+
+
 def test_table1_json_rows(capsys):
     out = _json(capsys, "table1", "paper_12kw_pmsm", "--set", "controller.K=0.3", "--tm", "1.0,2.6", "--json")
     rows = out["rows"]

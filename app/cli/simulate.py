@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from typing import Any
 
 from pmsm_commissioning.app.cli.main import add_preset_arguments, check_writable
@@ -58,7 +59,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    default="all", help="which run(s): both = FDSMC and conventional, all = both, the tracked "
                                        "minimum-energy optimum and the stock drive's trapezoid (default all)")
     p.add_argument("--json", action="store_true", help="print a machine-readable JSON object")
-    p.add_argument("--csv", metavar="FILE", help="write the time series (CSV: controller column, units in the headers)")
+    p.add_argument("--csv", metavar="FILE",
+                   help="write the time series (CSV: controller column, units in the headers); '-': to stdout instead "
+                        "of the table")
 
 
 
@@ -167,13 +170,22 @@ def print_summary(cmp: Comparison) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Simulate and print (table or JSON); optionally write the CSV."""
-    if args.csv:
+    """Simulate and print (table or JSON); optionally write the CSV (``--csv -``: the CSV alone, on stdout)."""
+    to_stdout = args.csv == "-"
+    if to_stdout and args.json:
+        raise ParameterError("--csv - writes the time series to stdout, where --json writes too: give --csv a file "
+                             "name, or leave out --json")
+    if args.csv and not to_stdout:
         check_writable(args.csv, "--csv")
     params, plant = load_model_and_plant(args.preset, args.overrides)
     ctrls = {"both": ("fdsmc", "conventional"), "all": COMPARATORS}.get(
         args.controller, (args.controller,))
     cmp = compare(params, ctrls, plant=plant)
+    if to_stdout:
+        from pmsm_commissioning.app.exports.model import trace_csv
+
+        sys.stdout.write(trace_csv(cmp))
+        return 0
     if args.csv:
         write_csv(args.csv, cmp)
     assumed = assumptions(load_raw(args.preset), params, tuple(args.overrides), params.name)
