@@ -1,7 +1,10 @@
 """The energy balance of a simulated run, shared by both modes.
 
 Each kernel integrates the electrical input and every sink (copper, friction, load work) as extra
-states; what the rotor and the windings still hold at the end closes the balance
+states of its own RK4 steps — the position drive's in :func:`sim.fdsmc.kernel.plant_rhs` (states
+``X_EF`` … ``X_ELOAD`` of :mod:`sim.fdsmc.layout`), the BLDC drive's in :mod:`sim.bldc.kernel` (its
+state's E_in, E_copper, E_friction, E_load) — and this module only reads them; what the rotor and the
+windings still hold at the end closes the balance
 
     E_in = Σ losses + Σ stored,
 
