@@ -1,7 +1,8 @@
 """Websocket bytes per Simulate, by message kind (prints; no assertions; a measurement, never a test).
 
-One ``pmsm-commission serve`` process (paper preset, no 3D view), one page in Debian's Chromium: after
-the page has settled, ``--runs`` Simulates on the Overview tab (T_m alternated, so each gives a new run),
+One ``pmsm-commission serve`` process (paper preset, no 3D view), one page in Debian's Chromium. First
+the page open: bytes received until the page is usable, then 5 s later, and where they go by message
+kind. After the page has settled, ``--runs`` Simulates on the Overview tab (T_m alternated, so each gives a new run),
 each followed by ``--replay-wait`` seconds (the replay's and the K sweep's messages arrive then). Per
 Simulate: the bytes as the page receives them (viser's zstd-compressed frames) and the messages, median
 (min, max); then, for the last Simulate, where they go — per kind of viser message (each figure by its
@@ -58,8 +59,10 @@ def main() -> int:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=LAUNCH_ARGS)
             _, opened_bytes, _, page, ws = open_page(browser, f"http://127.0.0.1:{port}", keep=True)
+            print(f"page open → usable (Simulate button and phase plane drawn): {opened_bytes / 1e3:.0f} kB")
             page.wait_for_timeout(5000)  # the page's own K sweep and figures have arrived
-            print(f"page open: {opened_bytes / 1e3:.0f} kB")
+            print(f"page open, 5 s later: {ws.bytes / 1e3:.0f} kB in {ws.messages} messages; by message kind:")
+            print(breakdown(ws.payloads, top=30))
             sizes, msgs = [], []
             for k in range(args.runs):
                 ws.payloads.clear()
@@ -71,7 +74,7 @@ def main() -> int:
             print(f"per Simulate, paper preset ({args.runs} runs, incl. {args.replay_wait:g} s after): "
                   f"{med(sizes, 1e-3, '.1f')} kB in {statistics.median(msgs):.0f} messages (median)")
             print("  the last Simulate by message kind:")
-            print(breakdown(ws.payloads, top=12))
+            print(breakdown(ws.payloads, top=30))
             for tab in TABS_LATER:
                 tab_bytes(page, ws, tab, args.replay_wait / 3)
             browser.close()

@@ -16,6 +16,9 @@ import pytest
 import viser
 import websockets
 
+from pmsm_commissioning.app.figures.fdsmc_comparison import time_plots_spec
+from pmsm_commissioning.app.figures.fdsmc_energy import energy_spec
+from pmsm_commissioning.app.figures.plain import figure_json
 from pmsm_commissioning.app.io.presets import DEFAULT_PRESET, PRESET_DIR, load_preset
 from pmsm_commissioning.app.ui.choices import checked_choice
 from pmsm_commissioning.app.ui.page import create_server
@@ -24,6 +27,7 @@ from pmsm_commissioning.app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
 from pmsm_commissioning.app.ui.worker import Cancelled, Worker
 from pmsm_commissioning.control.common.checks import ParameterError
 from tests.net import free_port, run_coroutine
+from tests.page_client import decode_frame
 
 PROTOCOL = f"viser-v{viser.__version__}"
 
@@ -326,40 +330,73 @@ def test_worker_cancel_stops_at_the_next_checkpoint():
     worker.close()
 
 
+#: The figures of the results tabs a page does not open on: sent when their tab is chosen, not with the page.
+TAB_FIGURES = {"Time plots": ("time_plots",), "Energy": ("energy_time", "energy_bars"), "Stock drive": ("stock_route",)}
+
+
 def test_page_open_sends_each_figure_once(served):
-    """A new page gets every figure once: viser's creation message of a plot widget shares its
-    properties with the handle, so a figure set before that message left used to travel twice.
+    """A new page gets each figure at most once, and only those of the tab it opens on (the Overview),
+    the K demo and the other mode's: viser's creation message of a plot widget shares its properties
+    with the handle, so a figure set before that message left used to travel twice. The figures of
+    the *Time plots*, *Energy* and *Stock drive* tabs go out when the page reports the tab chosen:
+    once, the start-up run's.
     """
     import json
 
-    import zstandard
+    from pmsm_commissioning.app.ui.viser_adapter import widget_id
 
     hostport, _, config = served
     known = set(config.sessions)
     figures: list[tuple[str, str]] = []  # (widget uuid, figure id) per figure JSON received
+    shown: dict[str, str] = {}  # figure id → the JSON last received
+    chosen: dict[str, list[str]] = {}  # results tab → the figure ids received after it was chosen
+    opened: list[str] = []  # the figure ids received with the page
+
+    async def settle(ws, until: str | None = None) -> None:
+        """Read the server's messages until 1 s without one (the page's session registered, ``until`` received)."""
+        quiet = 0
+        while quiet < 10 or not set(config.sessions) - known or (until is not None and until not in shown):
+            try:
+                frame = await asyncio.wait_for(ws.recv(), 0.1)
+            except TimeoutError:
+                quiet += 1
+                continue
+            quiet = 0
+            for m in decode_frame(frame):
+                fig = (m.get("props") or {}).get("_plotly_json_str") or (m.get("updates") or {}).get(
+                    "_plotly_json_str")
+                meta = json.loads(fig).get("layout", {}).get("meta") if fig else None
+                if meta:
+                    figures.append((m["uuid"], meta["id"]))
+                    shown[meta["id"]] = fig
+
+    async def choose(ws, tab: str) -> None:
+        """Report ``tab`` shown, as the page's view probe does, and record the figures it brought."""
+        session = config.sessions[next(iter(set(config.sessions) - known))]
+        view = json.dumps({"tab": {"mode": "Position drive (FDSMC)", "results": tab}, "zoom": {}})
+        n = len(figures)
+        await ws.send(msgspec.msgpack.encode({"type": "GuiUpdateMessage", "updates": {"value": view},
+                                              "uuid": widget_id(session.tab.demo_files.probe.field)}))
+        await settle(ws)
+        chosen.setdefault(tab, []).extend(fid for _, fid in figures[n:])
 
     async def go() -> None:
         async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}", subprotocols=[PROTOCOL],
                                       max_size=None, close_timeout=0.2) as ws:
             await ws.send(msgspec.msgpack.encode(CAMERA))
-            quiet = 0
-            while quiet < 10 or not set(config.sessions) - known:  # until 1 s without a message
-                try:
-                    frame = await asyncio.wait_for(ws.recv(), 0.1)
-                except TimeoutError:
-                    quiet += 1
-                    continue
-                quiet = 0
-                n_in, n_c = int.from_bytes(frame[:8], "little"), int.from_bytes(frame[8:16], "little")
-                raw = zstandard.ZstdDecompressor().decompress(frame[16:16 + n_c], max_output_size=n_in)
-                for m in msgspec.msgpack.decode(raw)["messages"]:
-                    fig = (m.get("props") or {}).get("_plotly_json_str") or (m.get("updates") or {}).get(
-                        "_plotly_json_str")
-                    meta = json.loads(fig).get("layout", {}).get("meta") if fig else None
-                    if meta:
-                        figures.append((m["uuid"], meta["id"]))
+            await settle(ws, "k_sweep")  # the K demo's figure: the page's worker computes it after the page
+            opened.extend(fid for _, fid in figures)
+            for tab in (*TAB_FIGURES, "Overview", *TAB_FIGURES):  # each tab twice: the second time, nothing
+                await choose(ws, tab)
 
     run_coroutine(go)
     ids = [fid for _, fid in figures]
-    assert {"phase_plane", "time_plots", "energy_time", "energy_bars", "bldc_emf"} <= set(ids)
     assert len(figures) == len(set(figures)), sorted(f for f in ids if ids.count(f) > 1)
+    waiting = [fid for tab_ids in TAB_FIGURES.values() for fid in tab_ids]
+    assert {"phase_plane", "k_sweep", "bldc_emf"} <= set(opened) and not set(waiting) & set(opened), opened
+    for tab, tab_ids in TAB_FIGURES.items():
+        assert sorted(chosen[tab]) == sorted(tab_ids), (tab, chosen[tab])  # once each, nothing else
+    assert chosen["Overview"] == []
+    initial = config.initial()  # the tabs show the start-up run, the one the page opened with
+    assert shown["time_plots"] == figure_json(time_plots_spec(initial))
+    assert shown["energy_time"] == figure_json(energy_spec(initial))

@@ -104,7 +104,7 @@ class DemoStateFiles:
         self.open(state)
 
     def open(self, state: DemoState) -> bool:
-        """Show ``state`` (inputs, slider ranges, pins, tabs), simulate it with its plant, zoom; False if busy."""
+        """Show ``state`` (inputs, slider ranges, pins), simulate it with its plant, tabs, zoom; False if busy."""
         tab = self._tab
         if tab.busy:
             return tab.submit(lambda: None)  # refused, with the "busy" note
@@ -113,14 +113,20 @@ class DemoStateFiles:
         tab.tuning.ranges = state.ranges
         tab.hold_ranges()
         tab.lecture.keep(state.pins)
-        if self.probe is not None:
-            self.probe.select_tabs(state.view)
         return tab.submit(lambda: self._run(state))
 
     def _run(self, state: DemoState) -> None:
-        """On the worker: simulate ``state`` with its plant, then draw the overview at its zoom."""
+        """On the worker: simulate ``state`` with its plant, then select its tabs and draw the overview at its zoom.
+
+        The tabs are selected after the run: a tab whose figures wait until it is shown
+        (:mod:`app.ui.tab_figures`) then gets the state's run only, not the run it replaces first.
+        """
         tab = self._tab
-        tab.run_with_plant(state.params, state.plant_J_L)
+        try:
+            tab.run_with_plant(state.params, state.plant_J_L)
+        finally:
+            if self.probe is not None:
+                self.probe.select_tabs(state.view)
         if self.probe is not None and tab.case.comparison.fdsmc is not None:
             self.probe.zoom(tab.results.phase, state.view.zoom)
 

@@ -5,8 +5,9 @@ the phase plane and a compact time plot (ω_r and Γ vs t), replayed together in
 
 Only builds widgets and pushes figures made by the pure ``make_*_figure`` functions; the
 simulations themselves run on the session's worker. The figures of the *Time plots*, *Energy* and
-*Stock drive* tabs go out only while their tab is shown (:mod:`app.ui.tab_figures`); the overview,
-its key numbers and the K sweep (the K demo) go out with every run.
+*Stock drive* tabs go out only while their tab is shown (:mod:`app.ui.tab_figures`), from the page's
+opening on: a new page gets them when such a tab is first chosen. The overview, its key numbers and
+the K sweep (the K demo) go out with the page and with every run.
 """
 
 from __future__ import annotations
@@ -52,9 +53,35 @@ def _when_simulated(spec: Callable[[Any], dict[str, Any]]) -> Build:
     return lambda comparison: figure_json(spec(comparison)) if runs(comparison) else None
 
 
-def _time_plots_of(comparison: Any) -> str:
-    """JSON of the time plots of a run (the start-up comparison's stay in :func:`time_plots_json`'s cache)."""
-    return figure_json(time_plots_spec(comparison))
+#: The JSON of the tab figures of the start-up comparison, by figure: (comparison, JSON). Every new
+#: page shows that comparison, so each of these is built once per server (when a page first
+#: chooses its tab), not once per page.
+_STARTUP: dict[str, tuple[Any, str | None]] = {}
+
+
+#: The builders of the figures that wait for their tab, by ``layout.meta.id``.
+_BUILDS: dict[str, Build] = {
+    "time_plots": lambda comparison: figure_json(time_plots_spec(comparison)),
+    "energy_time": _when_simulated(energy_spec), "energy_bars": _when_simulated(energy_bars_spec),
+    "stock_route": _when_simulated(stock_route_spec)}
+#: Where the start-up comparison's figure comes from if not from :data:`_BUILDS`: its time plots are
+#: built at server start (:func:`app.ui.replay.prebuild_figures`).
+_STARTUP_BUILDS: dict[str, Build] = {"time_plots": time_plots_json}
+
+
+def _shared_for(startup: Any, name: str) -> Build:
+    """Return the builder of the figure ``name``, taking that of the comparison ``startup`` from :data:`_STARTUP`.
+
+    No lock: two pages choosing the tab at once may both build it (the same JSON); neither waits.
+    """
+    def build(comparison: Any) -> str | None:
+        if comparison is not startup:
+            return _BUILDS[name](comparison)
+        kept = _STARTUP.get(name)
+        if kept is None or kept[0] is not comparison:
+            kept = _STARTUP[name] = (comparison, _STARTUP_BUILDS.get(name, _BUILDS[name])(comparison))
+        return kept[1]
+    return build
 
 
 class ResultsPanel:
@@ -79,8 +106,7 @@ class ResultsPanel:
         with self.panel.add_tab("K sweep", viser.Icon.CHART_DOTS):
             self.k_sweep = KSweepView(gui)
         with time_tab:
-            self.time_plots = add_figure(gui, time_plots_json(comparison), ASPECT_TIME)
-            self.tab_figures.add("Time plots", self.time_plots, _time_plots_of, figure_json_shown(self.time_plots))
+            self.time_plots = self._tab_figure(gui, "Time plots", "time_plots", ASPECT_TIME)
         with phase_tab:
             self.replay = Replay(gui, self.phase, scene, (comparison, targets),
                                  flush=client.flush, on_3d=on_3d)
@@ -89,12 +115,12 @@ class ResultsPanel:
         with time_tab:
             gui.add_html(errata_html("time_plots"))
         with self.panel.add_tab("Energy", viser.Icon.BOLT):
-            self.energy = self._tab_figure(gui, "Energy", _when_simulated(energy_spec), ASPECT_SMALL)
-            self.bars = self._tab_figure(gui, "Energy", _when_simulated(energy_bars_spec), ASPECT_SMALL)
+            self.energy = self._tab_figure(gui, "Energy", "energy_time", ASPECT_SMALL)
+            self.bars = self._tab_figure(gui, "Energy", "energy_bars", ASPECT_SMALL)
             self._build_savings(gui)
         with self.panel.add_tab("Stock drive", viser.Icon.ROUTE):
             self.stock_text = gui.add_html(stock_html(comparison) if runs(comparison) else "")
-            self.stock = self._tab_figure(gui, "Stock drive", _when_simulated(stock_route_spec), ASPECT_STOCK)
+            self.stock = self._tab_figure(gui, "Stock drive", "stock_route", ASPECT_STOCK)
         with self.panel.add_tab("Table 1 sweep", viser.Icon.TABLE):
             self.t_m_list = gui.add_text("T_m list [s]", ", ".join(map(str, TABLE1_T_M)))
             self.sweep_button = gui.add_button("Run Table-1 sweep", icon=viser.Icon.PLAYER_PLAY)
@@ -104,11 +130,10 @@ class ResultsPanel:
             gui.add_html(errata_html("table1"))
         self.sweep_button.on_click(lambda _: self._sweep_clicked(client))
 
-    def _tab_figure(self, gui: viser.GuiApi, tab: str, build: Build, aspect: float) -> viser.GuiPlotlyHandle:
-        """Add a figure of ``tab``, showing the comparison in force, sent from now on only while ``tab`` is shown."""
-        shown = build(self._comparison)
-        handle = add_figure(gui, shown, aspect)
-        self.tab_figures.add(tab, handle, build, shown)
+    def _tab_figure(self, gui: viser.GuiApi, tab: str, name: str, aspect: float) -> viser.GuiPlotlyHandle:
+        """Add the figure ``name`` of ``tab``, empty: sent (the comparison in force) only while ``tab`` is shown."""
+        handle = add_figure(gui, None, aspect)
+        self.tab_figures.add(tab, handle, _shared_for(self._comparison, name))
         return handle
 
     def _build_savings(self, gui: viser.GuiApi) -> None:
