@@ -87,3 +87,29 @@ def test_the_icons_warmed_at_server_start_are_all_the_page_shows():
     warm_icons()
     assert _icons.svg_from_icon.cache_info().currsize >= len(PAGE_ICONS)  # viser's cache holds them all
     assert all(_icons.svg_from_icon(getattr(viser.Icon, name)).lstrip().startswith("<svg") for name in PAGE_ICONS)
+
+
+def test_the_request_wrapper_sees_every_request_of_a_server_built_under_it():
+    """viser still serves through ``websockets``' ``serve``: the wrapped handler sees the page's GET."""
+    import socket
+    import urllib.request
+
+    seen: list[str] = []
+
+    def wrap(process_request):
+        def check(connection, request):
+            seen.append(request.path)
+            return process_request(connection, request) if process_request else None
+        return check
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = int(s.getsockname()[1])
+    with va.wrap_requests(wrap):
+        server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    try:
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/?probe=1", timeout=10) as response:
+            assert response.status == 200
+        assert "/?probe=1" in seen
+    finally:
+        server.stop()

@@ -22,6 +22,9 @@ The page needs four things viser's public API does not offer:
   (:func:`upload_states`), the client of a message (:func:`resolve_client`), and in front of its
   loop reading each client's websocket frames (:func:`wrap_frame_reader`: a frame that is no message
   of the protocol is refused in one line, never a traceback in the server's log);
+* **a check in front of every HTTP request and websocket handshake** (:func:`wrap_requests`: viser
+  serves both through ``websockets.asyncio.server.serve`` and offers no hook for the handshake, so its
+  ``process_request`` argument is wrapped while a server is being built);
 * **viser's icons read at server start** (:func:`warm_icons`: its cached ``svg_from_icon``).
 
 A viser upgrade is checked here and in ``tests/test_viser_adapter.py`` only.
@@ -29,12 +32,16 @@ A viser upgrade is checked here and in ``tests/test_viser_adapter.py`` only.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import threading
+from collections.abc import Callable, Iterator
 from typing import Any, Protocol
 
 import viser
 import viser._gui_api as _viser_gui
 import viser.infra._infra as _viser_infra
+import websockets.asyncio.server as ws_server
 from viser import _icons, _messages
 
 from pmsm_commissioning.app.figures.plain import blank_json
@@ -134,6 +141,30 @@ def wrap_frame_reader(wrap: Any) -> None:
     current = _viser_infra._message_consumer
     if not hasattr(current, "__wrapped__"):
         _viser_infra._message_consumer = wrap(current)
+
+
+_serve_lock = threading.Lock()
+
+
+@contextlib.contextmanager
+def wrap_requests(wrap: Callable[[Any], Any]) -> Iterator[None]:
+    """While active, every server viser starts gets ``wrap(process_request)`` in front of its requests.
+
+    ``process_request`` is viser's own handler of a request (None where it has none); ``wrap`` returns
+    the handler the server runs instead, for every HTTP request and websocket handshake.
+    """
+    with _serve_lock:
+        original = ws_server.serve
+
+        def serve(*args: Any, **kwargs: Any) -> Any:
+            kwargs["process_request"] = wrap(kwargs.get("process_request"))
+            return original(*args, **kwargs)
+
+        ws_server.serve = serve  # type: ignore[assignment]
+        try:
+            yield
+        finally:
+            ws_server.serve = original  # type: ignore[assignment]
 
 
 def input_widget(gui: Any, uuid: Any) -> Any | None:

@@ -1,8 +1,8 @@
 """Who may use the page: Origin/Host checks on every request and an access token off loopback.
 
-viser 1.1 serves its page and websocket with ``websockets.asyncio.server.serve`` and offers no
-hook for the handshake, so :func:`guarded` wraps that call while a server is being built and
-puts :meth:`Guard.check` in front of viser's own ``process_request``:
+viser offers no hook for the handshake, so :func:`guarded` puts :meth:`Guard.check` in front of
+viser's own ``process_request`` while a server is being built (through the adapter of viser's
+private API, :func:`app.ui.viser_adapter.wrap_requests`):
 
 * **Host** (every HTTP request and the websocket handshake): the host name must be one the tool
   is served as — loopback names by default, the bound address, ``--allow-origin`` hosts. This
@@ -42,14 +42,11 @@ import ipaddress
 import math
 import secrets
 import socket
-import threading
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
-
-import websockets.asyncio.server as ws_server
 
 from pmsm_commissioning.app.io.numbers import shorten
 from pmsm_commissioning.app.ui.viser_adapter import (
@@ -62,11 +59,11 @@ from pmsm_commissioning.app.ui.viser_adapter import (
     widget_state,
     wrap_frame_reader,
     wrap_gui_handler,
+    wrap_requests,
 )
 
 LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
 COOKIE = "pmsm_token"
-_patch_lock = threading.Lock()
 
 
 def new_token() -> str:
@@ -349,18 +346,8 @@ def guarded(guard: Guard) -> Iterator[None]:
     Widget updates are type-checked from then on (:func:`check_widget_updates`).
     """
     check_widget_updates()
-    with _patch_lock:
-        original = ws_server.serve
-
-        def serve(*args: Any, **kwargs: Any) -> Any:
-            kwargs["process_request"] = guard.wrap(kwargs.get("process_request"))
-            return original(*args, **kwargs)
-
-        ws_server.serve = serve  # type: ignore[assignment]
-        try:
-            yield
-        finally:
-            ws_server.serve = original  # type: ignore[assignment]
+    with wrap_requests(guard.wrap):
+        yield
 
 
 __all__ = ["COOKIE", "LOOPBACK_HOSTS", "REFUSED_UPDATES", "Guard", "check_widget_updates", "guarded", "new_token",
