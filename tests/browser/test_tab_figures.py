@@ -1,6 +1,7 @@
-"""The time plots go out only while their tab is shown: a Simulate on the Overview sends none; choosing
-*Time plots* then draws the run just simulated (sent once), a Simulate while they are shown updates them
-at once, and a demo state restoring the *Time plots* tab shows its own run there.
+"""The time plots go out only while their tab is shown: a new page gets none of them (nor the energy and
+stock-route figures) until their tab is chosen, then the start-up run's, once; a Simulate on the Overview
+sends none; choosing *Time plots* then draws the run just simulated (sent once), a Simulate while they
+are shown updates them at once, and a demo state restoring the *Time plots* tab shows its own run there.
 
 The page's websocket frames are read as they arrive (decoded like viser's client does) and each
 figure message counted by its ``layout.meta.id``.
@@ -22,8 +23,12 @@ from tests.page_client import decode_frame
 T_M_FIELD = "T_m manoeuvre time [s]"
 #: Manoeuvre times typed in turn [s]: each gives another ω_p (eq. (60)), the start-up one is 1 s.
 T_M = (0.8, 1.3, 0.7)
-#: The tabs whose figures wait for the tab (the Overview and the K sweep go out with every run).
-WAITING = ("time_plots", "energy_time", "energy_bars", "stock_route")
+#: The tabs whose figures wait for the tab, and those figures (the Overview and the K sweep go out with
+#: the page and with every run).
+TAB_IDS = {"Time plots": ("time_plots",), "Energy": ("energy_time", "energy_bars"), "Stock drive": ("stock_route",)}
+WAITING = tuple(fid for ids in TAB_IDS.values() for fid in ids)
+DRAWN = ("(id) => [...document.querySelectorAll('.js-plotly-plot')]"
+         ".some(e => e.layout && e.layout.meta && e.layout.meta.id === id)")
 PHASE_DRAWN = ("() => [...document.querySelectorAll('.js-plotly-plot')]"
                ".some(e => e.layout && e.layout.meta && e.layout.meta.id === 'phase_plane')")
 
@@ -103,6 +108,36 @@ def shows_the_time_plots_of(page: Any, session: Any) -> None:
       const ref = el && el._fullData && el._fullData.find(t => t.name.startsWith('ω_p'));
       return !!ref && Math.abs(Math.abs(ref.y[0]) - w) <= 1e-6 * w; }""", arg=omega_p)
     assert abs(_omega_p_drawn(page) - omega_p) <= 1e-6 * omega_p
+
+
+def _choose(page: Any, session: Any, tab: str) -> None:
+    """Choose the results tab ``tab`` and wait until the server holds the page's report of it."""
+    click_tab(page, tab)
+    _until(page, lambda: session.tab.demo_files.probe.view.results_tab == tab, f"the page's report of {tab!r}")
+
+
+def test_a_new_page_gets_a_tabs_figures_when_the_tab_is_chosen_once_those_of_the_start_up_run(browser, ui_server):
+    context, page, figures, session = _open(browser, ui_server)
+    try:
+        _until(page, lambda: "k_sweep" in figures.ids, "the page's own K sweep")  # the page has all it gets
+        assert session.comparison is ui_server.config.initial()
+        assert "phase_plane" in figures.ids and not set(WAITING) & set(figures.ids), figures.ids
+        for tab, ids in TAB_IDS.items():
+            n = len(figures.ids)
+            _choose(page, session, tab)
+            _until(page, lambda ids=ids, n=n: set(ids) <= set(figures.since(n)), f"the figures of {tab!r}")
+            for fid in ids:
+                page.wait_for_function(DRAWN, arg=fid)
+            if tab == "Time plots":
+                shows_the_time_plots_of(page, session)  # the start-up run's (its ω_p)
+        n = len(figures.ids)
+        for tab in ("Overview", *TAB_IDS):  # chosen again: nothing sent again
+            _choose(page, session, tab)
+        page.wait_for_timeout(500)  # a figure sent after the report would arrive by now
+        assert figures.since(n) == [], figures.since(n)
+        assert sorted(f for f in figures.ids if f in WAITING) == sorted(WAITING)  # each once in all
+    finally:
+        context.close()
 
 
 def test_the_time_plots_go_out_when_their_tab_is_chosen_and_with_each_run_while_shown(browser, ui_server):
