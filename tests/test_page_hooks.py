@@ -74,6 +74,23 @@ def test_the_page_css_selects_viser_only_by_the_declared_hooks():
     assert hk.DOCK_REGION.at("left") in css and hk.DOCK_REGION.at("right") in css
 
 
+#: Where a hook says it is used (``PageHook.used_in``) → the script's name in :func:`_scripts`.
+SCRIPT_OF = {"assets/page_marks.js": "page_marks", "assets/page_view.js": "page_view",
+             "assets/replay_buttons.js": "replay", "layout.window_report_js": "window_report",
+             "demo_view.select_tabs_js": "select_tabs", "bldc_results.follow_tabs_js": "follow_tabs"}
+
+
+def test_each_hook_says_truly_where_the_page_uses_it():
+    scripts = {name: set(hk.hooks_named(text)) for name, text in _scripts().items()}
+    css = {"layout.page_css": page_css() + page_css(show_3d=True), "layout.LEGIBILITY_CSS": LEGIBILITY_CSS}
+    claimed = {(name, place) for name, hook in hk.HOOKS.items() for place in hook.used_in}
+    used = {(name, place) for place, script in SCRIPT_OF.items() for name in scripts[script]}
+    used |= {(name, place) for place, text in css.items() for name, hook in hk.HOOKS.items()
+             if hook.selector in text or (hook.attribute and hook.selector[:-1] + "=" in text)}
+    assert claimed - used == set(), "hooks said to be used where they are not"
+    assert used - claimed == set(), "hooks used where their used_in does not say"
+
+
 def _string_literals(path: Path) -> list[tuple[int, str]]:
     """String constants of a module (f-strings' literal parts too), docstrings left out."""
     tree = ast.parse(path.read_text(encoding="utf-8"))

@@ -6,7 +6,8 @@ scripts of :mod:`app.ui.layout`, :mod:`app.ui.demo_view`, :mod:`app.ui.bldc_resu
 the selectors below, read from the client of viser :data:`READ_FROM` (its sources ship with the
 package: ``viser/client/src``, the file named in each hook's ``what``). A script names a hook as
 ``H.<NAME>`` (``.sel``: its selector, ``.attr``: the attribute whose value it reads, ``.text``: the
-text it looks for); :func:`with_hooks` puts the hooks it names into its ``PAGE_HOOKS`` placeholder.
+text it looks for, ``.vars``: Mantine's CSS variables it sets); :func:`with_hooks` puts the hooks it
+names into its ``PAGE_HOOKS`` placeholder.
 
 ``tests/browser/test_page_hooks.py`` opens the page, brings it into each hook's state
 (:attr:`PageHook.shown`) and fails naming every hook viser's markup no longer has;
