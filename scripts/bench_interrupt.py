@@ -1,6 +1,6 @@
 """Print how fast each long command stops on Ctrl-C (SIGINT to its process group) and on SIGTERM.
 
-The promise of issue 28: ≤ 1 s, exit 130, one line, no partial file. Uses the fault suite's
+The promise: ≤ 1 s, exit 130, one line, no partial file. Uses the fault suite's
 commands (``tests/test_faults_signals.py``). Run: ``.venv/bin/python scripts/bench_interrupt.py``.
 """
 

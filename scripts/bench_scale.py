@@ -1,4 +1,4 @@
-"""Scale-out figures of the robustness study (prints figures, never asserts): issue 27's targets.
+"""Scale-out figures of the robustness study (prints figures, never asserts) against their targets.
 
 1. one sample's CPU in this process: one run at a time (``sample_metrics``) vs the batch kernel;
 2. samples/s of the local pool on 1 and 2 workers (pre-started, kernels loaded), 2-vs-1 scaling;

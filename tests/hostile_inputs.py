@@ -1,4 +1,4 @@
-"""Parser attacks of issue 28 (nesting blow-ups, quote/comment tricks), shared by the regression
+"""Parser attacks (nesting blow-ups, quote/comment tricks), shared by the regression
 tests (``tests/test_faults_parsers.py``) and the timing script (``scripts/bench_hostile.py``).
 
 Each entry: name → (how it is fed: ``yaml``, ``json`` or ``set``, the text, what the refusal says).

@@ -234,7 +234,7 @@ def test_continuous_mode_is_refused_with_the_field_named():
         controller_files(params, derive(params), SCHEMA)
 
 
-# ---- C injection (issue 28) ---------------------------------------------------------------------
+# ---- C injection (user text in C) ---------------------------------------------------------------------
 
 HOSTILE = [
     "x *\\\n/\n#ifndef INJ\n#define INJ\nint fdsmc_injected(void){return 42;}\n#endif\n/* ",

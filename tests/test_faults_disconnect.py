@@ -1,4 +1,4 @@
-"""Issue 28, no orphaned work: a page that disconnects stops its running job — a robustness study
+"""No orphaned work: a page that disconnects stops its running job — a robustness study
 ends its process pool — within 2 s (the wait limits below are the promise, polled, not timed).
 """
 

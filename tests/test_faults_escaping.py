@@ -1,4 +1,4 @@
-"""Issue 28, no script in the page or the report: every user string reaching Markdown or HTML goes
+"""No script in the page or the report: every user string reaching Markdown or HTML goes
 through :func:`app.ui.text.md_text` / :func:`app.ui.text.html_text` (the browser test in
 ``tests/browser/test_hostile_page.py`` shows that no script runs in a real page).
 """

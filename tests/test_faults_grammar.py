@@ -1,4 +1,4 @@
-"""Issue 28, one number grammar: the same table of accepted and refused texts through every edge —
+"""One number grammar: the same table of accepted and refused texts through every edge —
 the parser itself (page fields), ``--set``, a YAML file or page upload, a JSON file, a drive-log CSV
 cell and the numeric CLI options. ASCII decimal or scientific notation only; nothing else is a
 number anywhere, and an accepted text means the same value everywhere.

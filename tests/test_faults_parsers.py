@@ -1,4 +1,4 @@
-"""Issue 28, parser blow-ups: every nesting attack is refused by the parser itself, with one clear
+"""Parser blow-ups: every nesting attack is refused by the parser itself, with one clear
 line, never a RecursionError; YAML (files, uploads, ``--set``) and JSON alike.
 
 Timings are printed by ``scripts/bench_hostile.py`` (not asserted here).

@@ -45,7 +45,7 @@ def test_trapezoid_refuses_a_move_shorter_than_the_triangle():
 
 @pytest.mark.parametrize("name", REAL_MOTORS)
 def test_trapezoid_friction_is_within_a_few_percent_of_the_fdsmc_profile(name):
-    """Issue 22: at α_max the trapezoid's ∫ω²dt is below the FDSMC profile's (eq. (52) with F_v = 1).
+    """At α_max the trapezoid's ∫ω²dt is below the FDSMC profile's (eq. (52) with F_v = 1).
 
     A few % on the four servo motors (T_a ≪ T_m), 14 % on the slower example_log_drive move. At the
     torque limit's α_max: the presets' min_energy α makes T_a longer, where the trapezoid's lead grows.
