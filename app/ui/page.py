@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import viser
 
+from pmsm_commissioning.app.io.presets import list_presets_of
 from pmsm_commissioning.app.threads import limit_blas_threads, release_memory
 from pmsm_commissioning.app.ui.bldc_results import follow_tabs_js
 from pmsm_commissioning.app.ui.bldc_tab import add_bldc_tab, warm_bldc
@@ -40,7 +41,7 @@ from pmsm_commissioning.app.ui.log import LogPanel
 from pmsm_commissioning.app.ui.plotly_js import use_basic_plotly
 from pmsm_commissioning.app.ui.position_tab import PositionTab
 from pmsm_commissioning.app.ui.replay import prebuild_figures
-from pmsm_commissioning.app.ui.results import ResultsPanel, empty_table1_json
+from pmsm_commissioning.app.ui.results import ResultsPanel, prebuild_results
 from pmsm_commissioning.app.ui.runs import comparison_or_derived
 from pmsm_commissioning.app.ui.scene import RotorScene, aim_camera
 from pmsm_commissioning.app.ui.studies import StudiesSection
@@ -284,7 +285,8 @@ def create_server(params: DriveParams, origin: str, host: str = "127.0.0.1", por
     config = AppConfig(params, origin, scene_3d, guard=guard)
     # the first page must not wait for the kernels' first load, the start-up run or its figures
     prebuild_figures(config.initial())
-    empty_table1_json()
+    prebuild_results(config.initial())
+    list_presets_of("position")  # the preset files read and parsed once (each page lists them: ≈ 70 ms)
     warm_icons()
     warm_bldc()
 
