@@ -7,8 +7,10 @@ Used by ``tests/test_load_pages.py`` and ``scripts/load_test.py``.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import time
+from collections.abc import AsyncIterator, Callable
 from typing import Any
 
 import msgspec
@@ -28,6 +30,40 @@ def decode_frame(frame: bytes) -> list[dict[str, Any]]:
     n_in, n_c = int.from_bytes(frame[:8], "little"), int.from_bytes(frame[8:16], "little")
     raw = zstandard.ZstdDecompressor().decompress(frame[16:16 + n_c], max_output_size=n_in)
     return list(msgspec.msgpack.decode(raw)["messages"])
+
+
+@contextlib.asynccontextmanager
+async def raw_session(hostport: str, config: Any) -> AsyncIterator[tuple[Any, Any]]:
+    """Connect as a hand-written client that never reads; yield (its socket, the page session it opened).
+
+    ``config`` is the server's :class:`app.ui.page` configuration (its ``sessions`` by client). The
+    closing handshake cannot complete for a client that never reads, so the socket closes at once.
+    """
+    known = set(config.sessions)
+    async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}", subprotocols=[PROTOCOL],
+                                  max_size=None, close_timeout=0.2) as ws:
+        await ws.send(msgspec.msgpack.encode(CAMERA))  # viser counts a client after its first camera
+        new: set[Any] = set()
+        for _ in range(600):
+            new = set(config.sessions) - known
+            if new:
+                break
+            await asyncio.sleep(0.05)
+        yield ws, config.sessions[new.pop()]
+
+
+async def wait_until(done: Callable[[], bool], tries: int = 200) -> None:
+    """Poll ``done`` every 50 ms, at most ``tries`` times (the caller asserts what it waited for)."""
+    for _ in range(tries):
+        if done():
+            return
+        await asyncio.sleep(0.05)
+
+
+def upload_start(uuid: str, name: str, size: int, parts: int) -> dict[str, Any]:
+    """The message that starts an upload of ``size`` bytes in ``parts`` parts into the widget ``uuid``."""
+    return {"type": "FileTransferStartUpload", "source_component_uuid": uuid, "transfer_uuid": name,
+            "filename": name, "mime_type": "text/csv", "part_count": parts, "size_bytes": size}
 
 
 class PageClient:

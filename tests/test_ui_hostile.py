@@ -13,7 +13,6 @@ from pathlib import Path
 
 import msgspec
 import pytest
-import viser
 import websockets
 
 from pmsm_commissioning.app.figures.fdsmc_comparison import time_plots_spec
@@ -27,11 +26,7 @@ from pmsm_commissioning.app.ui.web_guard import COOKIE, REFUSED_UPDATES, Guard
 from pmsm_commissioning.app.ui.worker import Cancelled, Worker
 from pmsm_commissioning.control.common.checks import ParameterError
 from tests.net import free_port, run_coroutine
-from tests.page_client import decode_frame
-
-PROTOCOL = f"viser-v{viser.__version__}"
-
-
+from tests.page_client import CAMERA, PROTOCOL, decode_frame, raw_session, upload_start, wait_until
 
 
 def _ws_status(hostport: str, origin: str | None, headers: dict[str, str] | None = None,
@@ -135,45 +130,26 @@ def test_token_mode_checks_host_one_token_parameter_and_any_token_text_is_403():
     finally:
         server.stop()
 
-CAMERA = {"type": "ViewerCameraMessage", "wxyz": [1.0, 0.0, 0.0, 0.0], "position": [0.0, 0.0, 1.0],
-          "fov": 1.0, "near": 0.01, "far": 100.0, "image_height": 600, "image_width": 800,
-          "look_at": [0.0, 0.0, 0.0], "up_direction": [0.0, 0.0, 1.0]}
-
 
 def _send_update(hostport: str, config: object, handle_of: str, value: str, wait_error: bool = True) -> object:
     """Connect as a hand-written client, set a GUI value by uuid (``handle_of`` a dotted attribute path of
     the session), return the session.
     """
-    known = set(config.sessions)
     done = threading.Event()
     session_box: list[object] = []
 
     async def go() -> None:
-        # this client never reads what the server sends, so the closing handshake cannot complete:
-        # close at once instead of waiting websockets' default 10 s for it
-        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
-                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
-            await ws.send(msgspec.msgpack.encode(CAMERA))  # viser counts a client after its first camera
-            for _ in range(600):
-                new = set(config.sessions) - known
-                if new:
-                    session_box.append(config.sessions[new.pop()])
-                    break
-                await asyncio.sleep(0.05)
-            handle = session_box[0]
+        async with raw_session(hostport, config) as (ws, session):
+            session_box.append(session)
+            handle = session
             for attr in handle_of.split("."):
                 handle = getattr(handle, attr)
             msg = {"type": "GuiUpdateMessage", "uuid": handle._impl.uuid, "updates": {"value": value}}
             await ws.send(msgspec.msgpack.encode(msg))
-            for _ in range(600 if wait_error else 0):
-                if session_box[0].error is not None:
-                    break
-                await asyncio.sleep(0.05)
-            if not wait_error:  # let the server apply the update before the socket closes
-                for _ in range(200):
-                    if handle.value == value:
-                        break
-                    await asyncio.sleep(0.05)
+            if wait_error:
+                await wait_until(lambda: session.error is not None, 600)
+            else:  # let the server apply the update before the socket closes
+                await wait_until(lambda: handle.value == value)
             done.set()
 
     run_coroutine(go)
@@ -189,29 +165,19 @@ HOSTILE_UPDATES = [("results.cycles", {"value": "abc"}), ("results.cycles", {"va
 
 def test_widget_values_are_type_checked_before_viser_casts_them(served):
     hostport, _, config = served
-    known, before = set(config.sessions), len(REFUSED_UPDATES)
+    before = len(REFUSED_UPDATES)
     box: list[object] = []
 
     async def go() -> None:
-        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
-                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
-            await ws.send(msgspec.msgpack.encode(CAMERA))
-            for _ in range(600):
-                if set(config.sessions) - known:
-                    box.append(config.sessions[(set(config.sessions) - known).pop()])
-                    break
-                await asyncio.sleep(0.05)
-            session = box[0]
+        async with raw_session(hostport, config) as (ws, session):
+            box.append(session)
             for path, updates in [*HOSTILE_UPDATES, ("results.cycles", {"value": 601.0})]:  # last: a valid one
                 handle = session
                 for attr in path.split("."):
                     handle = getattr(handle, attr)
                 await ws.send(msgspec.msgpack.encode({"type": "GuiUpdateMessage", "uuid": handle._impl.uuid,
                                                       "updates": updates}))
-            for _ in range(200):  # updates are handled in order: the valid one last
-                if session.results.cycles.value == 601.0:
-                    break
-                await asyncio.sleep(0.05)
+            await wait_until(lambda: session.results.cycles.value == 601.0)  # handled in order: the valid one last
 
     run_coroutine(go)
     session = box[0]
@@ -221,40 +187,25 @@ def test_widget_values_are_type_checked_before_viser_casts_them(served):
     assert all(len(r) <= 300 for r in refused) and any("allowed a finite number" in r for r in refused)
 
 
-def _start(session: object, uuid: str, name: str, size: int, parts: int) -> dict:
-    return {"type": "FileTransferStartUpload", "source_component_uuid": uuid, "transfer_uuid": name,
-            "filename": name, "mime_type": "text/csv", "part_count": parts, "size_bytes": size}
-
-
 def test_uploads_are_refused_by_declared_size_and_overrun_while_streaming(served):
     hostport, _, config = served
-    known, before = set(config.sessions), len(REFUSED_UPDATES)
+    before = len(REFUSED_UPDATES)
     box: list[object] = []
 
     async def go() -> None:
-        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
-                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
-            await ws.send(msgspec.msgpack.encode(CAMERA))
-            for _ in range(600):
-                if set(config.sessions) - known:
-                    box.append(config.sessions[(set(config.sessions) - known).pop()])
-                    break
-                await asyncio.sleep(0.05)
-            log_uuid, preset_uuid = box[0].log_panel.upload._impl.uuid, box[0].files.upload._impl.uuid
-            msgs = [_start(box[0], log_uuid, "huge.csv", 300 * 2**20, 300),  # over 50 MB: refused at once
-                    _start(box[0], preset_uuid, "big.yaml", 2 * 2**20, 2),  # over 512 KiB for a preset
-                    _start(box[0], log_uuid, "a.csv", 40 * 2**20, 40),  # accepted, held open
-                    _start(box[0], log_uuid, "b.csv", 40 * 2**20, 40),  # 80 MB unfinished: refused
-                    _start(box[0], log_uuid, "small.csv", 10, 1),
+        async with raw_session(hostport, config) as (ws, session):
+            log_uuid, preset_uuid = session.log_panel.upload._impl.uuid, session.files.upload._impl.uuid
+            msgs = [upload_start(log_uuid, "huge.csv", 300 * 2**20, 300),  # over 50 MB: refused at once
+                    upload_start(preset_uuid, "big.yaml", 2 * 2**20, 2),  # over 512 KiB for a preset
+                    upload_start(log_uuid, "a.csv", 40 * 2**20, 40),  # accepted, held open
+                    upload_start(log_uuid, "b.csv", 40 * 2**20, 40),  # 80 MB unfinished: refused
+                    upload_start(log_uuid, "small.csv", 10, 1),
                     {"type": "FileTransferPart", "source_component_uuid": log_uuid, "transfer_uuid": "small.csv",
                      "part_index": 0, "content": b"x" * 1000}]  # overruns its 10 bytes: ended
             for m in msgs:
                 await ws.send(msgspec.msgpack.encode(m))
-            for _ in range(200):
-                if len(REFUSED_UPDATES) - before >= 4:
-                    break
-                await asyncio.sleep(0.05)
-            box.append(dict(box[0].client.gui._current_file_upload_states))
+            await wait_until(lambda: len(REFUSED_UPDATES) - before >= 4)
+            box.extend([session, dict(session.client.gui._current_file_upload_states)])
 
     run_coroutine(go)
     refused = list(REFUSED_UPDATES)[before:]

@@ -14,7 +14,7 @@ import websockets
 
 from pmsm_commissioning.app.ui.web_guard import INVALID_FRAME, MAX_PART_BYTES, MIN_PART_BYTES, REFUSED_UPDATES
 from tests.net import run_coroutine
-from tests.test_ui_hostile import CAMERA, PROTOCOL
+from tests.page_client import CAMERA, PROTOCOL, raw_session, upload_start, wait_until
 
 enc = msgspec.msgpack.encode
 #: name -> a frame that is no message of viser's protocol
@@ -94,38 +94,23 @@ def test_the_server_still_serves_after_hostile_frames(served):
     assert _send(hostport, enc(CAMERA), wait_s=3.0) is None  # a good page opens and stays open
 
 
-def _start(uuid: str, name: str, size: int, parts: int) -> dict:
-    return {"type": "FileTransferStartUpload", "source_component_uuid": uuid, "transfer_uuid": name,
-            "filename": name, "mime_type": "text/csv", "part_count": parts, "size_bytes": size}
-
-
 def test_uploads_are_bounded_by_part_count_and_part_size(served):
     hostport, _, config = served
-    known, before = set(config.sessions), len(REFUSED_UPDATES)
+    before = len(REFUSED_UPDATES)
     box: list[object] = []
 
     async def go() -> None:
-        async with websockets.connect(f"ws://{hostport}", origin=f"http://{hostport}",
-                                      subprotocols=[PROTOCOL], max_size=None, close_timeout=0.2) as ws:
-            await ws.send(enc(CAMERA))
-            for _ in range(600):
-                if set(config.sessions) - known:
-                    box.append(config.sessions[(set(config.sessions) - known).pop()])
-                    break
-                await asyncio.sleep(0.05)
-            log_uuid = box[0].log_panel.upload._impl.uuid
-            size = 300_000  # the attack: 300 000 one-byte parts
-            msgs = [_start(log_uuid, "parts.csv", size, size),
-                    _start(log_uuid, "page.csv", 3 * 2**20, 6),  # as the page sends it: 512 KiB parts
+        async with raw_session(hostport, config) as (ws, session):
+            log_uuid = session.log_panel.upload._impl.uuid
+            size = 300_000  # 300 000 one-byte parts
+            msgs = [upload_start(log_uuid, "parts.csv", size, size),
+                    upload_start(log_uuid, "page.csv", 3 * 2**20, 6),  # as the page sends it: 512 KiB parts
                     {"type": "FileTransferPart", "source_component_uuid": log_uuid, "transfer_uuid": "page.csv",
                      "part_index": 0, "content": b"x" * (MAX_PART_BYTES + 1)}]  # one part over the bound
             for m in msgs:
                 await ws.send(enc(m))
-            for _ in range(200):
-                if len(REFUSED_UPDATES) - before >= 2:
-                    break
-                await asyncio.sleep(0.05)
-            box.append(dict(box[0].client.gui._current_file_upload_states))
+            await wait_until(lambda: len(REFUSED_UPDATES) - before >= 2)
+            box.extend([session, dict(session.client.gui._current_file_upload_states)])
 
     run_coroutine(go)
     refused = list(REFUSED_UPDATES)[before:]
