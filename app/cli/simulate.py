@@ -123,9 +123,15 @@ def _drawn_saving(cmp: Comparison) -> float | None:
 
 
 def write_csv(path: str, cmp: Comparison) -> None:
-    """Write the time series in the one CSV format of the exports (:func:`app.exports.model.trace_csv`)."""
+    """Write the time series in the one CSV format of the exports (:func:`app.exports.model.trace_csv`).
+
+    ``path`` ``-`` is stdout.
+    """
     from pmsm_commissioning.app.exports.model import trace_csv  # the export model's imports cost ≈ 0.25 s of cold start
 
+    if path == "-":
+        sys.stdout.write(trace_csv(cmp))
+        return
     try:
         write_atomic_text(path, trace_csv(cmp))  # a temporary file renamed when complete
     except OSError as exc:
@@ -181,13 +187,10 @@ def run(args: argparse.Namespace) -> int:
     ctrls = {"both": ("fdsmc", "conventional"), "all": COMPARATORS}.get(
         args.controller, (args.controller,))
     cmp = compare(params, ctrls, plant=plant)
-    if to_stdout:
-        from pmsm_commissioning.app.exports.model import trace_csv
-
-        sys.stdout.write(trace_csv(cmp))
-        return 0
     if args.csv:
         write_csv(args.csv, cmp)
+    if to_stdout:  # the CSV alone on stdout
+        return 0
     assumed = assumptions(load_raw(args.preset), params, tuple(args.overrides), params.name)
     if args.json:
         out = comparison_json(cmp) | {"assumptions": to_json(assumed.to_json())}
